@@ -1,0 +1,131 @@
+# gonio: build, run, test, bench.
+#   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
+#   make run | test | bench | clean | install PREFIX=/usr/local
+# Missing Debian packages are installed when run as root; otherwise the exact apt-get line
+# is printed and make stops.
+
+config ?= release
+PREFIX ?= /usr/local
+BUILD := build/$(config)
+
+CC ?= cc
+CXX ?= c++
+ifeq ($(origin CC),default)
+CC := gcc
+endif
+ifeq ($(origin CXX),default)
+CXX := g++
+endif
+
+PKGS := vulkan glfw3 OpenEXR tinygltf libpng zlib
+WARN := -Wall -Wextra -Wshadow -Werror
+CPPFLAGS += -Isrc -Iglsl -I$(BUILD)/spv -MMD -MP
+CFLAGS += -std=c11 -D_DEFAULT_SOURCE $(WARN)
+CXXFLAGS += -std=c++14 -Wall -Wextra -Werror
+
+ifeq ($(config),release)
+OPT := -O2 -g
+else ifeq ($(config),debug)
+OPT := -O0 -g
+else ifeq ($(config),sanitize)
+OPT := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
+LDFLAGS += -fsanitize=address,undefined
+else
+$(error config must be release, debug or sanitize)
+endif
+CFLAGS += $(OPT)
+CXXFLAGS += $(OPT)
+
+# pkg-config is only asked once the packages are known to be there (see deps below).
+PKG_CFLAGS = $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+PKG_LIBS = $(shell pkg-config --libs $(PKGS) 2>/dev/null)
+
+SRC_C := $(filter-out src/main.c,$(wildcard src/*.c))
+SRC_CXX := $(wildcard src/*.cpp)
+LIB_OBJ := $(SRC_C:%.c=$(BUILD)/%.o) $(SRC_CXX:%.cpp=$(BUILD)/%.o)
+MAIN_OBJ := $(BUILD)/src/main.o
+TEST_SRC := $(wildcard tests/unit/*.c)
+TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/%.o)
+SHADERS := $(wildcard glsl/*.comp)
+SPV_HDR := $(SHADERS:glsl/%.comp=$(BUILD)/spv/%.h)
+
+GONIO := $(BUILD)/gonio
+UNIT := $(BUILD)/unit_tests
+
+# ---- Debian packages -------------------------------------------------------------------
+DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
+	libopenexr-dev libtinygltf-dev libpng-dev zlib1g-dev mesa-vulkan-drivers
+DEB_TEST := vulkan-validationlayers openexr xvfb xauth imagemagick x11-apps xdotool
+DEPS_CHECK = { command -v glslangValidator && command -v spirv-val && command -v pkg-config \
+	&& pkg-config --exists $(PKGS) && ls /usr/share/vulkan/icd.d/lvp_icd*.json; } >/dev/null 2>&1
+TEST_DEPS_CHECK = { ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json \
+	&& command -v exrheader && command -v xvfb-run && command -v xauth && command -v import \
+	&& command -v xwd && command -v xdotool; } >/dev/null 2>&1
+
+.PHONY: all deps test-deps run test unit regress bench clean install shaders
+all: $(GONIO) build/gonio
+
+deps:
+	@if ! $(DEPS_CHECK); then $(call apt_install,$(DEB_BUILD)); fi
+test-deps: deps
+	@if ! $(TEST_DEPS_CHECK); then $(call apt_install,$(DEB_TEST)); fi
+
+define apt_install
+	if [ "$$(id -u)" = 0 ]; then \
+		echo "gonio: installing Debian packages: $(1)"; \
+		export DEBIAN_FRONTEND=noninteractive; \
+		{ apt-get install -y -q --no-install-recommends $(1) || \
+		  { apt-get update -q && apt-get install -y -q --no-install-recommends $(1); }; } >/dev/null \
+		|| { echo "gonio: apt-get install failed"; exit 1; }; \
+	else \
+		echo "gonio: missing packages; run as root:"; \
+		echo "  apt-get install $(1)"; exit 1; \
+	fi
+endef
+
+build/gonio: $(GONIO)
+	@ln -sf $(config)/gonio build/gonio
+
+$(GONIO): $(MAIN_OBJ) $(LIB_OBJ) | deps
+	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) -lm
+
+$(UNIT): $(TEST_OBJ) $(LIB_OBJ) | deps
+	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) -lm
+
+$(BUILD)/%.o: %.c | deps $(SPV_HDR)
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
+
+$(BUILD)/%.o: %.cpp | deps
+	@mkdir -p $(dir $@)
+	$(CXX) $(CPPFLAGS) $(PKG_CFLAGS) $(CXXFLAGS) -c -o $@ $<
+
+# Shaders: GLSL -> SPIR-V (checked by spirv-val) -> C array in a generated header.
+$(BUILD)/spv/%.h: glsl/%.comp | deps
+	@mkdir -p $(dir $@)
+	glslangValidator -V --target-env vulkan1.1 -Iglsl --depfile $(BUILD)/spv/$*.d -o $(BUILD)/spv/$*.spv $< >/dev/null || { glslangValidator -V --target-env vulkan1.1 -Iglsl -o /dev/null $<; exit 1; }
+	spirv-val --target-env vulkan1.1 $(BUILD)/spv/$*.spv
+	glslangValidator -V --target-env vulkan1.1 -Iglsl --vn spv_$(subst -,_,$*) -o $@ $< >/dev/null
+shaders: $(SPV_HDR)
+
+run: all
+	@mkdir -p out
+	$(GONIO) render scenes/cornell.gltf -o out/cornell.exr --png out/cornell.png
+
+test: all $(UNIT) test-deps
+	@GONIO=$(GONIO) UNIT=$(UNIT) CONFIG=$(config) tests/run.sh
+
+unit: $(UNIT)
+	$(UNIT) $(T)
+
+bench: all
+	@tests/bench.sh $(GONIO)
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin
+	install -m 755 $(GONIO) $(DESTDIR)$(PREFIX)/bin/gonio
+
+clean:
+	rm -rf build out
+
+-include $(LIB_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(TEST_OBJ:.o=.d) $(wildcard $(BUILD)/spv/*.d)

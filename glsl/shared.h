@@ -1,0 +1,203 @@
+/* shared.h: the one definition of every struct, constant and binding that the C host and
+ * the GLSL kernels share. C, C++ and GLSL all include this file; the C side checks sizes and
+ * offsets with static asserts (see the end of the file), so a layout change that breaks
+ * std430 fails the build instead of corrupting a buffer.
+ *
+ * Layout rule: std430, built only from vec4/uvec4, scalars, and "vec3 followed by one
+ * 4-byte scalar" pairs, which have the same offsets in C and std430. No hand padding exists
+ * in two places. */
+#ifndef GONIO_SHARED_H
+#define GONIO_SHARED_H
+
+#ifdef VULKAN /* defined by glslang when compiling GLSL for Vulkan */
+#define GN_STRUCT(name) struct name
+#define GN_END(name)
+#else
+#include <stdint.h>
+typedef struct { float x, y; } vec2;
+typedef struct { float x, y, z; } vec3;
+typedef struct { float x, y, z, w; } vec4;
+typedef struct { uint32_t x, y, z, w; } uvec4;
+typedef uint32_t uint;
+#define GN_STRUCT(name) typedef struct name
+#define GN_END(name) name
+#endif
+
+/* ---- descriptor bindings (set 0) of the render kernels -------------------------------- */
+#define GN_BIND_FRAME 0u     /* uniform GnFrame */
+#define GN_BIND_NODES 1u     /* GnBvhNode[] */
+#define GN_BIND_TRIS 2u      /* GnTri[] (BVH order) */
+#define GN_BIND_PRIMS 3u     /* GnPrim[] (BVH order) */
+#define GN_BIND_VERTICES 4u  /* GnVertex[] */
+#define GN_BIND_MATERIALS 5u /* GnMaterial[] */
+#define GN_BIND_LIGHTS 6u    /* GnLight[] */
+#define GN_BIND_TEXELS 7u    /* uint[]: RGBA8 texels of every image, packed */
+#define GN_BIND_TEXTURES 8u  /* GnTexture[] */
+#define GN_BIND_ACCUM 9u     /* vec4[] per pixel: sum of radiance samples, w = count */
+#define GN_BIND_AOV 10u      /* vec4[3 * pixels]: normal, albedo, depth sums */
+#define GN_BIND_VCOLOR 11u   /* vec4[] per vertex: Gouraud colours */
+#define GN_BIND_EMITTERS 12u /* GnEmitter[]: emissive triangles for light sampling */
+#define GN_BIND_COUNT 13u
+
+/* Work-group size of the 2D image kernels: 8x8 matches lavapipe's 8-wide SIMD rows and is a
+ * good default for GPUs (64 threads = 2 warps / 1 wavefront). */
+#define GN_TILE_X 8u
+#define GN_TILE_Y 8u
+
+/* ---- integrator modes ----------------------------------------------------------------- */
+#define GN_MODE_PATH 0u
+#define GN_MODE_PHONG 1u
+#define GN_MODE_GOURAUD 2u
+#define GN_MODE_FLAT 3u
+#define GN_MODE_NORMAL 4u
+#define GN_MODE_ALBEDO 5u
+#define GN_MODE_DEPTH 6u
+#define GN_MODE_COST 7u /* BVH nodes visited per primary ray */
+#define GN_MODE_COUNT 8u
+
+#define GN_LIGHT_POINT 0u
+#define GN_LIGHT_SPOT 1u
+#define GN_LIGHT_DIRECTIONAL 2u
+
+#define GN_INVALID 0xffffffffu
+
+/* GnMaterial.flags */
+#define GN_MAT_DOUBLE_SIDED 1u
+#define GN_MAT_UNLIT 2u
+
+/* GnFrame.flags */
+#define GN_FRAME_AOV 1u       /* write normal/albedo/depth sums */
+#define GN_FRAME_SHADOWS 2u   /* ray-traced shadows in the local modes */
+
+/* ---- BVH: both children's boxes in one 64-byte node (Aila & Laine 2009, "Understanding
+ * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only
+ * pushes the farther hit child. Node 0 holds the root's two children.
+ * For child a (and likewise b):
+ *   a_count > 0                       leaf: triangles [a_index, a_index + a_count) of GnTri[]
+ *   a_count == 0, a_index != INVALID  inner: GnBvhNode[a_index]
+ *   a_count == 0, a_index == INVALID  empty (only when the whole scene is one leaf) */
+GN_STRUCT(GnBvhNode) {
+    vec3 a_min; uint a_index;
+    vec3 a_max; uint a_count;
+    vec3 b_min; uint b_index;
+    vec3 b_max; uint b_count;
+} GN_END(GnBvhNode); /* 64 bytes */
+
+/* Triangle corners in BVH leaf order, for the watertight test (Woop, Benthin & Wald 2013).
+ * w is unused (0). Hit barycentrics (u, v): p = (1-u-v) v0 + u v1 + v v2. */
+GN_STRUCT(GnTri) {
+    vec4 v0;
+    vec4 v1;
+    vec4 v2;
+} GN_END(GnTri); /* 48 bytes */
+
+/* Shading data of a triangle, in the same (BVH) order as GnTri. */
+GN_STRUCT(GnPrim) {
+    uint i0; uint i1; uint i2; uint material;
+} GN_END(GnPrim); /* 16 bytes */
+
+GN_STRUCT(GnVertex) {
+    vec3 position; float u;
+    vec3 normal; float v;
+    vec4 tangent; /* xyz tangent, w handedness; all zero when the mesh has none */
+} GN_END(GnVertex); /* 48 bytes */
+
+/* glTF metallic-roughness material plus the classic (OpenGL 1.x) Phong parameters used by
+ * the local shading modes, and an optional BRDF-model override for the path tracer.
+ * Texture fields index GnTexture[], GN_INVALID when absent. */
+GN_STRUCT(GnMaterial) {
+    vec4 base_color;                       /* linear RGBA factor */
+    vec3 emissive; float metallic;         /* emissive factor * KHR_materials_emissive_strength */
+    vec3 specular_color; float roughness;  /* KHR_materials_specular colour factor */
+    float specular; float ior; float transmission; float normal_scale;
+    float occlusion_strength; float alpha_cutoff; uint flags; uint brdf; /* brdf: 0 = glTF model */
+    uint tex_base; uint tex_mr; uint tex_normal; uint tex_emissive;
+    uint tex_occlusion; uint pad0; uint pad1; uint pad2;
+    vec4 brdf_params;                      /* parameters of the override model */
+    vec3 phong_ambient; float phong_shininess;
+    vec3 phong_diffuse; float phong_pad0;
+    vec3 phong_specular; float phong_pad1;
+    vec3 phong_emission; float phong_pad2;
+} GN_END(GnMaterial); /* 192 bytes */
+
+/* glTF KHR_lights_punctual light in world space. color = colour * intensity (W/sr for point
+ * and spot, W/m^2 for directional: gonio reads photometric units as radiometric). direction
+ * is where the light points (the node's -Z). range <= 0 means infinite. */
+GN_STRUCT(GnLight) {
+    vec3 position; uint type;
+    vec3 direction; float range;
+    vec3 color; float inner_cos;
+    float outer_cos; float pad0; float pad1; float pad2;
+} GN_END(GnLight); /* 64 bytes */
+
+/* One emissive triangle, for light sampling in the path tracer. */
+GN_STRUCT(GnEmitter) {
+    uint prim; float area; float cdf; float pdf; /* prim: index into GnPrim[] */
+} GN_END(GnEmitter);
+
+/* An image in the packed texel buffer; RGBA8, rows top to bottom. */
+GN_STRUCT(GnTexture) {
+    uint offset;   /* first texel (uint) in the texel buffer */
+    uint width;
+    uint height;
+    uint flags;    /* bits 0-1 wrap S, 2-3 wrap T (0 repeat, 1 clamp, 2 mirror), 4 nearest */
+} GN_END(GnTexture);
+
+#define GN_WRAP_REPEAT 0u
+#define GN_WRAP_CLAMP 1u
+#define GN_WRAP_MIRROR 2u
+#define GN_TEX_NEAREST 16u
+
+/* Pinhole camera in world space. Pixel (x, y) with y going down maps to the ray
+ * forward + (2 (x+jx)/W - 1) tan_half_fovy aspect right + (1 - 2 (y+jy)/H) tan_half_fovy up. */
+GN_STRUCT(GnCamera) {
+    vec3 position; float tan_half_fovy;
+    vec3 right; float aspect;
+    vec3 up; float znear;
+    vec3 forward; float zfar;
+} GN_END(GnCamera); /* 64 bytes */
+
+/* Constant for a whole render (uniform buffer). */
+GN_STRUCT(GnFrame) {
+    GnCamera camera;
+    uint width; uint height; uint seed; uint mode;
+    uint max_depth; uint num_lights; uint num_emitters; uint flags;
+    vec3 ambient; float emitter_power;   /* ambient: global ambient light of the Phong model */
+    vec3 env_color; uint num_nodes;      /* constant environment radiance */
+    vec3 bounds_min; float depth_scale;
+    vec3 bounds_max; uint traversal_budget; /* max BVH steps per ray (see DESIGN: loop cap) */
+} GN_END(GnFrame); /* 160 bytes */
+
+/* Per-dispatch values (push constants). */
+GN_STRUCT(GnPush) {
+    uint sample_index;   /* index of the sample this pass takes in every pixel */
+    uint pass_flags;
+    uint pad0;
+    uint pad1;
+} GN_END(GnPush);
+
+#ifndef VULKAN
+#ifdef __cplusplus
+#define GN_STATIC_ASSERT static_assert
+#else
+#define GN_STATIC_ASSERT _Static_assert
+#endif
+#include <stddef.h>
+GN_STATIC_ASSERT(sizeof(GnBvhNode) == 64, "GnBvhNode layout");
+GN_STATIC_ASSERT(offsetof(GnBvhNode, b_min) == 32, "GnBvhNode layout");
+GN_STATIC_ASSERT(sizeof(GnTri) == 48, "GnTri layout");
+GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");
+GN_STATIC_ASSERT(sizeof(GnVertex) == 48, "GnVertex layout");
+GN_STATIC_ASSERT(sizeof(GnMaterial) == 192, "GnMaterial layout");
+GN_STATIC_ASSERT(offsetof(GnMaterial, brdf_params) == 112, "GnMaterial layout");
+GN_STATIC_ASSERT(offsetof(GnMaterial, phong_ambient) == 128, "GnMaterial layout");
+GN_STATIC_ASSERT(sizeof(GnLight) == 64, "GnLight layout");
+GN_STATIC_ASSERT(sizeof(GnEmitter) == 16, "GnEmitter layout");
+GN_STATIC_ASSERT(sizeof(GnTexture) == 16, "GnTexture layout");
+GN_STATIC_ASSERT(sizeof(GnCamera) == 64, "GnCamera layout");
+GN_STATIC_ASSERT(sizeof(GnFrame) == 160, "GnFrame layout");
+GN_STATIC_ASSERT(offsetof(GnFrame, ambient) == 96, "GnFrame layout");
+GN_STATIC_ASSERT(sizeof(GnPush) == 16, "GnPush layout");
+#endif
+
+#endif /* GONIO_SHARED_H */

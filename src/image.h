@@ -1,0 +1,75 @@
+/* image.h: float images (planar channels), OpenEXR read/write through OpenEXR's C API
+ * (openexr.h), sRGB PNG output, tonemapping, and the image metrics behind `gonio diff`. */
+#ifndef GONIO_IMAGE_H
+#define GONIO_IMAGE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#define IMAGE_MAX_CHANNELS 16
+
+typedef struct image {
+    int width, height;
+    int num_channels;
+    char names[IMAGE_MAX_CHANNELS][32]; /* EXR channel names, e.g. "R", "G", "B", "A", "normal.X" */
+    float *planes[IMAGE_MAX_CHANNELS];  /* width * height floats each, rows top to bottom */
+} image;
+
+typedef enum image_attr_type { IMAGE_ATTR_STRING, IMAGE_ATTR_INT, IMAGE_ATTR_DOUBLE } image_attr_type;
+
+typedef struct image_attr {
+    const char *name;   /* e.g. "gonio:spp" */
+    image_attr_type type;
+    const char *s;
+    int i;
+    double d;
+} image_attr;
+
+/* Allocates zeroed planes for the named channels. */
+void image_create(image *img, int width, int height, int num_channels, const char *const *names);
+void image_destroy(image *img); /* accepts a zeroed struct */
+/* Index of a channel by name, or -1. */
+int image_channel(const image *img, const char *name);
+
+/* Writes every channel as 32-bit float, ZIP compression, with the given header attributes.
+ * Written to a temporary file beside path and renamed, so failure leaves no partial file.
+ * False (and an error naming the file) on failure. */
+bool image_write_exr(const image *img, const char *path, const image_attr *attrs, int num_attrs);
+
+/* Reads a scanline or tiled EXR (half, float or uint channels) into float planes. False
+ * with an error naming the file on any problem (missing, not EXR, truncated). Attributes
+ * of type string/int/float/double can be fetched with image_read_exr_attrs. */
+bool image_read_exr(image *img, const char *path);
+/* Reads one attribute from an EXR header as a double (int, float or double attributes) or
+ * string; false if absent. */
+bool image_exr_attr_double(const char *path, const char *name, double *out);
+bool image_exr_attr_string(const char *path, const char *name, char *out, int cap);
+
+typedef enum image_tonemap { IMAGE_TONEMAP_CLAMP, IMAGE_TONEMAP_ACES, IMAGE_TONEMAP_REINHARD } image_tonemap;
+
+/* Linear RGB planes -> 8-bit sRGB RGBA (alpha 255): scale by 2^exposure, tonemap, sRGB
+ * transfer function, round. NaN maps to 0. */
+void image_to_srgb8(const float *r, const float *g, const float *b, int width, int height,
+                    float exposure, image_tonemap tm, uint8_t *rgba8);
+
+/* Writes 8-bit RGBA pixels as PNG (libpng), through a temporary file. */
+bool image_write_png(const char *path, const uint8_t *rgba8, int width, int height);
+/* Convenience: the R, G, B channels of img (or the first channel as grey) -> PNG. */
+bool image_write_png_from(const image *img, const char *path, float exposure, image_tonemap tm);
+/* Reads a PNG into 8-bit RGBA (tests and comparisons). */
+bool image_read_png(const char *path, uint8_t **rgba8, int *width, int *height);
+
+typedef struct image_metrics {
+    double rmse;        /* sqrt(mean((a-b)^2)) over the compared channels and pixels */
+    double psnr;        /* 20 log10(peak / rmse), peak = max(|b|) (1 when b is all zero) */
+    double mae;         /* mean |a-b| */
+    double rel_bias;    /* (mean(a) - mean(b)) / |mean(b)|; 0 when both means are 0 */
+    double max_err;     /* max |a-b| */
+    long nonfinite;     /* NaN/Inf values found in a or b */
+} image_metrics;
+
+/* Compares the channels present in both images among R, G, B (or the first channel of
+ * each when neither has RGB). False with an error when sizes differ or nothing matches. */
+bool image_compare(const image *a, const image *b, image_metrics *m);
+
+#endif

@@ -1,0 +1,54 @@
+/* util.h: error reporting, timing and small parsing helpers shared by every module.
+ *
+ * Three kinds of failure, three treatments (STYLE.md): a Vulkan/driver failure stops in
+ * VK_CHECK with the call, file, line and VkResult name; bad user input is reported with
+ * util_error (naming the file and the problem) and returned as `false` up to main, which
+ * exits 1; a programmer's mistake is an assert. */
+#ifndef GONIO_UTIL_H
+#define GONIO_UTIL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(__GNUC__)
+#define UTIL_PRINTF(a, b) __attribute__((format(printf, a, b)))
+#else
+#define UTIL_PRINTF(a, b)
+#endif
+
+/* "gonio: error: ..." on stderr. Messages about a file start with the file's path. */
+void util_error(const char *fmt, ...) UTIL_PRINTF(1, 2);
+/* "gonio: warning: ..." on stderr. */
+void util_warn(const char *fmt, ...) UTIL_PRINTF(1, 2);
+/* Informational line on stderr, silenced by util_set_quiet(true). */
+void util_info(const char *fmt, ...) UTIL_PRINTF(1, 2);
+void util_set_quiet(bool quiet);
+bool util_quiet(void);
+/* Number of warnings printed so far (tests and the CLI summary use it). */
+int util_warning_count(void);
+
+/* Monotonic seconds. */
+double util_now(void);
+
+/* malloc/calloc/realloc that stop the program with a message when memory runs out. */
+void *util_malloc(size_t size);
+void *util_calloc(size_t count, size_t size);
+void *util_realloc(void *ptr, size_t size);
+
+/* Strict number parsing: the whole string must be a number in range; false otherwise. */
+bool util_parse_int(const char *s, long min, long max, long *out);
+bool util_parse_float(const char *s, float *out);
+/* "WxH" -> width, height (each 1..16384). */
+bool util_parse_size(const char *s, int *w, int *h);
+
+/* Reads a whole file; NULL (and util_error naming the file) on failure. */
+void *util_read_file(const char *path, size_t *size);
+
+/* Writing an output file safely: util_tmp_path gives "DIR/.NAME.tmp-PID" beside the
+ * destination; util_commit_file renames it into place (or removes it when ok is false).
+ * A failed or interrupted write therefore never leaves a half-written output. */
+void util_tmp_path(char *out, size_t cap, const char *final_path);
+bool util_commit_file(const char *tmp_path, const char *final_path, bool ok);
+
+#endif

@@ -1,0 +1,1 @@
+/* Tests of the bvh module: TEST(suite, name) lines, defined in test_bvh.c. */

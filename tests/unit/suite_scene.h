@@ -1,0 +1,1 @@
+/* Tests of the scene module: TEST(suite, name) lines, defined in test_scene.c. */

@@ -1,0 +1,5 @@
+/* suites.h: every unit test, one line each: TEST(suite, name). Add yours to your suite. */
+#include "suite_bvh.h"
+#include "suite_scene.h"
+#include "suite_image.h"
+#include "suite_gpu.h"

@@ -1,0 +1,41 @@
+/* test.h: the unit-test harness. Tests are plain functions; CHECK never compiles out. */
+#ifndef GONIO_TEST_H
+#define GONIO_TEST_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+extern int test_failures;
+extern int test_checks;
+
+#define CHECK(cond)                                                                   \
+    do {                                                                              \
+        test_checks++;                                                                \
+        if (!(cond)) {                                                                \
+            test_failures++;                                                          \
+            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #cond);  \
+        }                                                                             \
+    } while (0)
+
+#define CHECKF(cond, ...)                                                             \
+    do {                                                                              \
+        test_checks++;                                                                \
+        if (!(cond)) {                                                                \
+            test_failures++;                                                          \
+            fprintf(stderr, "%s:%d: CHECK failed: %s: ", __FILE__, __LINE__, #cond);  \
+            fprintf(stderr, __VA_ARGS__);                                             \
+            fputc('\n', stderr);                                                      \
+        }                                                                             \
+    } while (0)
+
+/* Marks the running test skipped (with a reason printed once). */
+void test_skip(const char *why);
+
+/* Directory of the third-party test assets (../shared/assets relative to the repo root, or
+ * $GONIO_ASSETS); NULL when absent, in which case tests that need it call test_skip. */
+const char *test_assets_dir(void);
+
+/* Every suite file defines its tests and lists them in tests/unit/suites.h. */
+typedef void (*test_fn)(void);
+
+#endif
