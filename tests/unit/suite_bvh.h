@@ -1,1 +1,11 @@
 /* Tests of the bvh module: TEST(suite, name) lines, defined in test_bvh.c. */
+TEST(bvh, tri_intersect)
+TEST(bvh, empty)
+TEST(bvh, single_triangle)
+TEST(bvh, random_soup)
+TEST(bvh, degenerate)
+TEST(bvh, watertight)
+TEST(bvh, sphere)
+TEST(bvh, comb)
+TEST(bvh, bench_mesh)
+TEST(bvh, determinism)
