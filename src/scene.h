@@ -74,12 +74,19 @@ typedef struct scene {
     float ambient[3];           /* global ambient light of the Phong model (default 0) */
 } scene;
 
-/* Loads a .gltf or .glb file. On failure prints an error naming the file and the problem
- * and returns false with *out zeroed. Unsupported features that can be skipped safely
- * (non-triangle primitives, orthographic cameras, unknown optional extensions, alpha modes)
- * print a warning naming the file and the feature. Triangles with non-finite or absurdly
- * large (|x| > 1e15) vertices are dropped with a warning. A scene without any triangle is
- * an error. */
+/* Loads a .gltf or .glb file (GLB chosen by its magic, or by the extension). Every buffer,
+ * view, accessor and reference is validated before use; structural errors (anything that
+ * could make a read go out of bounds, unresolved references, node loops, non-finite
+ * transforms, required extensions other than KHR_lights_punctual and KHR_materials_{unlit,
+ * specular, transmission, ior, emissive_strength}) print an error naming the file and the
+ * problem and return false with *out zeroed. What can be skipped or repaired safely prints a
+ * warning naming the file and the feature: points/lines primitives (strips and fans become
+ * triangles), orthographic or invalid cameras, invalid lights, unknown optional extensions,
+ * alpha modes (rendered opaque), texCoord != 0 and missing or undecodable images (texture
+ * slot GN_INVALID; PNG and JPEG only), out-of-range material values (clamped), non-unit
+ * normals (renormalised), skins, morph targets, COLOR_0. Primitives without NORMAL get flat
+ * normals (de-indexed). Triangles with non-finite or absurdly large (|x| > 1e15) vertices
+ * are dropped with one warning. A scene without any triangle is an error ("no triangles"). */
 bool scene_load(scene *out, const char *path);
 
 /* Frees everything; accepts a zeroed struct. */
@@ -87,19 +94,34 @@ void scene_destroy(scene *s);
 
 /* A camera that frames the whole scene: looking down -Z at the centre of the bounds from
  * a distance at which the bounding sphere fits in the vertical and horizontal field of
- * view (yfov 45 degrees) for the given image aspect (width / height). */
+ * view (yfov 45 degrees) for the given image aspect (width / height, > 0); znear and zfar
+ * enclose the sphere with a factor of 2 to spare. Empty or single-point bounds still give a
+ * valid camera (a tiny sphere around the point, or the unit sphere at the origin). */
 void scene_default_camera(const scene *s, float aspect, scene_camera *out);
 
 /* Recomputes bounds_min/bounds_max from the triangles. */
 void scene_compute_bounds(scene *s);
 
+/* Removes every triangle with a corner whose position is not finite or has a coordinate
+ * beyond 1e15 in magnitude (such values overflow ray-box tests in float), compacting indices
+ * and tri_material, and zeroes those vertices (no triangle refers to them any more). Returns
+ * the number of triangles removed; prints nothing (the caller warns once). */
+uint32_t scene_drop_invalid_triangles(scene *s);
+
 /* Default material, as glTF 2.0 specifies for primitives without one (white, metallic 1,
  * roughness 1), with the Phong parameters derived as scene_phong_from_pbr does. */
 void scene_material_default(GnMaterial *m);
 
-/* Classic Phong parameters from the metallic-roughness ones (documented in docs/shading.md):
- * diffuse = base * (1 - metallic); specular = specular_color * specular * mix(0.04, base,
- * metallic) normalised so a white dielectric gives 0.04 ... see scene.c for the rule. */
+/* Classic (OpenGL 1.x) Phong parameters from the metallic-roughness ones:
+ *   diffuse   = base_color.rgb * (1 - metallic) * (1 - transmission)
+ *   specular  = mix(0.04 * specular_color * specular, base_color.rgb, metallic)
+ *               (the glTF dielectric F0 of 0.04, tinted by KHR_materials_specular; metals
+ *               reflect their base colour)
+ *   shininess = clamp(2 / alpha^2 - 2, 1, 10000), alpha = roughness^2 (the Blinn-Phong
+ *               exponent matching a Beckmann lobe of roughness alpha, Walter et al. 2007)
+ *   ambient   = diffuse (OpenGL's convention that ambient tracks the diffuse colour; the
+ *               scene's ambient light is 0 by default, so it only shows under one)
+ *   emission  = emissive */
 void scene_phong_from_pbr(GnMaterial *m);
 
 #endif

@@ -1,0 +1,143 @@
+/* scene.c: the loader-independent parts of a scene: freeing, bounds, triangle validation, a
+ * framing camera, and the glTF metallic-roughness -> OpenGL Phong mapping (Beckmann/Blinn-Phong
+ * exponent correspondence of Walter et al. 2007, "Microfacet models for refraction"). */
+#include "scene.h"
+
+#include <assert.h>
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util.h"
+
+void scene_destroy(scene *s)
+{
+    for (uint32_t i = 0; i < s->num_images; i++)
+        free(s->images[i].rgba8);
+    free(s->vertices);
+    free(s->indices);
+    free(s->tri_material);
+    free(s->materials);
+    free(s->material_extras);
+    free(s->material_names);
+    free(s->lights);
+    free(s->images);
+    free(s->textures);
+    free(s->cameras);
+    memset(s, 0, sizeof *s);
+}
+
+void scene_compute_bounds(scene *s)
+{
+    for (int k = 0; k < 3; k++) {
+        s->bounds_min[k] = FLT_MAX;
+        s->bounds_max[k] = -FLT_MAX;
+    }
+    for (uint32_t i = 0; i < 3 * s->num_triangles; i++) {
+        const vec3 *p = &s->vertices[s->indices[i]].position;
+        const float c[3] = {p->x, p->y, p->z};
+        for (int k = 0; k < 3; k++) {
+            s->bounds_min[k] = fminf(s->bounds_min[k], c[k]);
+            s->bounds_max[k] = fmaxf(s->bounds_max[k], c[k]);
+        }
+    }
+}
+
+static bool position_ok(const vec3 *p)
+{
+    return isfinite(p->x) && isfinite(p->y) && isfinite(p->z) && fabsf(p->x) <= 1e15f &&
+           fabsf(p->y) <= 1e15f && fabsf(p->z) <= 1e15f;
+}
+
+uint32_t scene_drop_invalid_triangles(scene *s)
+{
+    uint32_t kept = 0;
+    for (uint32_t t = 0; t < s->num_triangles; t++) {
+        const uint32_t *tri = &s->indices[3 * t];
+        if (!position_ok(&s->vertices[tri[0]].position) ||
+            !position_ok(&s->vertices[tri[1]].position) ||
+            !position_ok(&s->vertices[tri[2]].position))
+            continue;
+        memmove(&s->indices[3 * kept], tri, 3 * sizeof *tri);
+        s->tri_material[kept++] = s->tri_material[t];
+    }
+    for (uint32_t v = 0; v < s->num_vertices; v++)
+        if (!position_ok(&s->vertices[v].position))
+            memset(&s->vertices[v], 0, sizeof s->vertices[v]);
+    uint32_t dropped = s->num_triangles - kept;
+    s->num_triangles = kept;
+    return dropped;
+}
+
+void scene_default_camera(const scene *s, float aspect, scene_camera *out)
+{
+    assert(aspect > 0 && isfinite(aspect));
+    const float half_v = 0.5f * (float)(M_PI / 4);
+    const float half_h = atanf(tanf(half_v) * aspect);
+    const float fit = fminf(half_v, half_h);
+    float c[3] = {0, 0, 0}, r = 1;
+    if (s->bounds_min[0] <= s->bounds_max[0]) {
+        float d2 = 0, cmax = 0;
+        for (int k = 0; k < 3; k++) {
+            float e = s->bounds_max[k] - s->bounds_min[k];
+            c[k] = 0.5f * (s->bounds_min[k] + s->bounds_max[k]);
+            d2 += e * e;
+            cmax = fmaxf(cmax, fabsf(c[k]));
+        }
+        /* A point (or a box below float resolution at its position) still needs a sphere
+         * the camera can stand outside of. */
+        float floor = 1e-5f * fmaxf(1.0f, cmax);
+        r = fmaxf(0.5f * sqrtf(d2), floor);
+    }
+    float dist = r / sinf(fit);
+    memset(out, 0, sizeof *out);
+    strcpy(out->name, "default");
+    out->position[0] = c[0];
+    out->position[1] = c[1];
+    out->position[2] = c[2] + dist;
+    out->right[0] = 1;
+    out->up[1] = 1;
+    out->forward[2] = -1;
+    out->yfov = (float)(M_PI / 4);
+    out->aspect = aspect;
+    out->znear = 0.5f * (dist - r);
+    out->zfar = 2.0f * (dist + r);
+}
+
+void scene_material_default(GnMaterial *m)
+{
+    memset(m, 0, sizeof *m);
+    m->base_color = (vec4){1, 1, 1, 1};
+    m->metallic = 1;
+    m->roughness = 1;
+    m->specular_color = (vec3){1, 1, 1};
+    m->specular = 1;
+    m->ior = 1.5f;
+    m->normal_scale = 1;
+    m->occlusion_strength = 1;
+    m->alpha_cutoff = 0.5f;
+    m->tex_base = m->tex_mr = m->tex_normal = m->tex_emissive = m->tex_occlusion = GN_INVALID;
+    scene_phong_from_pbr(m);
+}
+
+static float mixf(float a, float b, float t) { return a + (b - a) * t; }
+
+void scene_phong_from_pbr(GnMaterial *m)
+{
+    const float base[3] = {m->base_color.x, m->base_color.y, m->base_color.z};
+    const float tint[3] = {m->specular_color.x, m->specular_color.y, m->specular_color.z};
+    float diffuse[3], specular[3];
+    for (int k = 0; k < 3; k++) {
+        diffuse[k] = base[k] * (1 - m->metallic) * (1 - m->transmission);
+        specular[k] = mixf(0.04f * tint[k] * m->specular, base[k], m->metallic);
+    }
+    m->phong_diffuse = (vec3){diffuse[0], diffuse[1], diffuse[2]};
+    m->phong_ambient = m->phong_diffuse;
+    m->phong_specular = (vec3){specular[0], specular[1], specular[2]};
+    m->phong_emission = m->emissive;
+    float alpha = m->roughness * m->roughness;
+    float a2 = alpha * alpha;
+    float n = a2 > 0 ? 2 / a2 - 2 : 10000;
+    m->phong_shininess = fminf(fmaxf(n, 1), 10000);
+}

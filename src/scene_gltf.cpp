@@ -1,0 +1,1584 @@
+/* scene_gltf.cpp: scene_load, the glTF 2.0 loader. tinygltf parses the JSON/GLB and fetches
+ * buffers and images; everything it returns is checked here against the glTF 2.0 specification
+ * (references, accessor ranges and formats, values) before one byte is read, in cgltf's order:
+ * parse, load buffers, validate, read. Geometry is baked into world space, normals with the
+ * cofactor matrix (the inverse transpose up to det, Lengyel, "Mathematics for 3D Game
+ * Programming and Computer Graphics", 3rd ed., 4.5). No C++ exception escapes into C. */
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <string>
+#include <strings.h>
+#include <vector>
+
+extern "C" {
+#include "scene.h"
+#include "util.h"
+}
+
+namespace {
+
+/* Loader limits: keep a hostile file from asking for more memory than any real scene needs
+ * (util_malloc would stop the program) and from recursing deeply inside tinygltf. */
+const size_t MAX_ELEMENTS = size_t(1) << 28; /* per accessor backed by a buffer view */
+const size_t MAX_ZERO_ELEMENTS = size_t(1) << 22; /* per accessor without one (all zeros) */
+const size_t MAX_SCENE = size_t(1) << 26;    /* vertices or triangles after instancing (3 GiB) */
+const size_t MAX_PIXELS = size_t(1) << 28;   /* per image */
+const int MAX_JSON_DEPTH = 64;               /* tinygltf copies extras/extensions recursively */
+
+const char *const SUPPORTED_EXTENSIONS[] = {
+    "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_materials_specular",
+    "KHR_materials_transmission", "KHR_materials_ior",               "KHR_materials_unlit"};
+
+typedef std::array<double, 16> Mat; /* column-major, as glTF stores matrices */
+
+struct Prim {                 /* one triangle primitive of a glTF mesh, in the mesh's space */
+    std::vector<float> pos;   /* 3 per vertex */
+    std::vector<float> nrm;   /* 3 per vertex */
+    std::vector<float> uv;    /* 2 per vertex, empty without TEXCOORD_0 */
+    std::vector<float> tan;   /* 4 per vertex, empty without TANGENT */
+    std::vector<uint32_t> idx; /* 3 per triangle */
+    uint32_t material;        /* glTF material, or GN_INVALID for the default one */
+};
+
+struct Instance {
+    int node, mesh;
+    Mat world;
+};
+
+struct Ctx {
+    const char *path;
+    tinygltf::Model m;
+    bool failed = false;
+    std::map<int, std::string> image_errors; /* decode failures reported by the image callback */
+    std::vector<Mat> local;                  /* per node */
+    std::vector<bool> camera_ok, light_ok;   /* per glTF camera / light: values usable */
+    std::vector<std::vector<Prim>> meshes;   /* per glTF mesh */
+    std::vector<uint32_t> image_map, texture_map; /* glTF index -> scene index or GN_INVALID */
+    bool warned_skin = false, warned_targets = false, warned_color = false;
+};
+
+void vreport(const Ctx &c, bool error, const char *fmt, va_list ap)
+{
+    char msg[1024];
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    if (error)
+        util_error("%s: %s", c.path, msg);
+    else
+        util_warn("%s: %s", c.path, msg);
+}
+
+/* Bad input: always returns false so checks read `if (bad) return fail(...)`. */
+bool fail(Ctx &c, const char *fmt, ...) UTIL_PRINTF(2, 3);
+bool fail(Ctx &c, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vreport(c, true, fmt, ap);
+    va_end(ap);
+    c.failed = true;
+    return false;
+}
+
+void warn(Ctx &c, const char *fmt, ...) UTIL_PRINTF(2, 3);
+void warn(Ctx &c, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vreport(c, false, fmt, ap);
+    va_end(ap);
+}
+
+/* "mesh 3 'Body'": how messages name a glTF object. */
+std::string label(const char *kind, int i, const std::string &name)
+{
+    std::string s = std::string(kind) + " " + std::to_string(i);
+    if (!name.empty())
+        s += " '" + name.substr(0, 64) + "'";
+    return s;
+}
+
+bool in_range(int i, size_t n) { return i >= 0 && size_t(i) < n; }
+
+void report_lines(Ctx &c, const std::string &text, bool error)
+{
+    size_t start = 0;
+    while (start < text.size()) {
+        size_t end = text.find('\n', start);
+        if (end == std::string::npos)
+            end = text.size();
+        if (end > start) {
+            std::string line = text.substr(start, end - start);
+            if (error)
+                fail(c, "%s", line.c_str());
+            else
+                warn(c, "%s", line.c_str());
+        }
+        start = end + 1;
+    }
+}
+
+/* ---- container and JSON checks, before tinygltf sees the bytes --------------------------- */
+
+uint32_t rd32(const uint8_t *p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+
+/* GLB layout (glTF 2.0, "Binary glTF Layout"): a 12-byte header, a JSON chunk, an optional
+ * BIN chunk that must come second, then chunks of unknown types to ignore. On success the
+ * header's length is rewritten to end after JSON/BIN, which is the form tinygltf accepts,
+ * and the JSON chunk is returned for the checks below. Returns the new length, 0 on error. */
+uint32_t check_glb(Ctx &c, uint8_t *d, size_t size, const uint8_t **json, size_t *json_len)
+{
+    const uint32_t JSON = 0x4E4F534A, BIN = 0x004E4942;
+    if (size < 12)
+        return fail(c, "truncated GLB header (%zu bytes)", size);
+    if (memcmp(d, "glTF", 4) != 0)
+        return fail(c, "not a GLB file (bad magic)");
+    if (rd32(d + 4) != 2)
+        return fail(c, "unsupported GLB version %u", rd32(d + 4));
+    uint32_t length = rd32(d + 8);
+    if (length < 20)
+        return fail(c, "declared GLB length %u is too small", length);
+    if (length > size)
+        return fail(c, "declared GLB length %u exceeds the file size %zu (truncated file?)", length, size);
+    if (length < size)
+        warn(c, "%zu bytes of extra data after the end of the GLB (ignored)", size - length);
+    uint32_t pos = 12, end = 0;
+    bool have_bin = false;
+    for (int n = 0; pos < length; n++) {
+        if (length - pos < 8)
+            return fail(c, "truncated GLB chunk header at byte %u", pos);
+        uint32_t len = rd32(d + pos), type = rd32(d + pos + 4);
+        if (len > length - pos - 8)
+            return fail(c, "GLB chunk at byte %u (length %u) runs past the end of the GLB", pos, len);
+        if (len % 4)
+            return fail(c, "GLB chunk at byte %u: length %u is not a multiple of 4", pos, len);
+        if (len == 0)
+            return fail(c, "GLB chunk at byte %u is empty", pos);
+        if (n == 0 && type != JSON)
+            return fail(c, "the first GLB chunk must be JSON (found type 0x%08x)", type);
+        if (n == 0) {
+            *json = d + 20;
+            *json_len = len;
+            end = 20 + len;
+        } else if (type == JSON) {
+            return fail(c, "GLB has a second JSON chunk at byte %u", pos);
+        } else if (type == BIN) {
+            if (have_bin || n != 1)
+                return fail(c, "misplaced BIN chunk at byte %u (it must be the second and only one)", pos);
+            have_bin = true;
+            end = pos + 8 + len;
+        } else {
+            warn(c, "unknown GLB chunk type 0x%08x at byte %u (ignored)", type, pos);
+        }
+        pos += 8 + len;
+    }
+    d[8] = uint8_t(end);
+    d[9] = uint8_t(end >> 8);
+    d[10] = uint8_t(end >> 16);
+    d[11] = uint8_t(end >> 24);
+    return end;
+}
+
+bool check_json_text(Ctx &c, const uint8_t *s, size_t n)
+{
+    if (n >= 3 && s[0] == 0xEF && s[1] == 0xBB && s[2] == 0xBF)
+        warn(c, "JSON starts with a UTF-8 byte order mark, which glTF forbids (ignored)");
+    int depth = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < n; i++) {
+        uint8_t ch = s[i];
+        if (in_string) {
+            if (ch == '\\')
+                i++;
+            else if (ch == '"')
+                in_string = false;
+        } else if (ch == '"') {
+            in_string = true;
+        } else if (ch == '{' || ch == '[') {
+            if (++depth > MAX_JSON_DEPTH)
+                return fail(c, "JSON nested deeper than %d levels", MAX_JSON_DEPTH);
+        } else if (ch == '}' || ch == ']') {
+            depth--;
+        }
+    }
+    return true;
+}
+
+/* Decodes PNG or JPEG, the formats glTF 2.0 allows. Anything else is refused before stb_image
+ * sees it: its other decoders are not needed, and the 16-bit PNM path of the stb bundled with
+ * tinygltf 2.7 overflows its buffer. On failure returns the reason. */
+std::string decode_image(tinygltf::Image *img, int idx, const unsigned char *bytes, size_t size)
+{
+    static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    bool is_png = size >= 8 && memcmp(bytes, png, 8) == 0;
+    bool is_jpeg = size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
+    if (!is_png && !is_jpeg)
+        return "not a PNG or JPEG image";
+    if (size > size_t(INT32_MAX))
+        return "image data too large";
+    std::string err, warn_text;
+    if (!tinygltf::LoadImageData(img, idx, &err, &warn_text, 0, 0, bytes, int(size), nullptr))
+        return err.empty() ? "cannot decode" : err;
+    return "";
+}
+
+/* tinygltf image callback. Images in buffer views arrive before any buffer view is checked, so
+ * they are decoded later (decode_view_images); a file that fails to decode is recorded rather
+ * than failing the whole load, and its textures are dropped with a warning. */
+bool image_callback(tinygltf::Image *img, const int idx, std::string *, std::string *, int, int,
+                    const unsigned char *bytes, int size, void *user)
+{
+    Ctx &c = *static_cast<Ctx *>(user);
+    if (img->bufferView >= 0)
+        return true;
+    std::string why = decode_image(img, idx, bytes, size_t(size));
+    if (!why.empty())
+        c.image_errors[idx] = why;
+    return true;
+}
+
+/* ---- structural validation ---------------------------------------------------------------- */
+
+size_t comp_size(int ct)
+{
+    switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
+    }
+}
+
+size_t num_comps(const tinygltf::Accessor &a) { return size_t(tinygltf::GetNumComponentsInType(uint32_t(a.type))); }
+
+size_t elem_size(const tinygltf::Accessor &a)
+{
+    size_t cs = comp_size(a.componentType);
+    /* Matrix columns start on 4-byte boundaries (glTF 2.0, "Data Alignment"). */
+    if (a.type == TINYGLTF_TYPE_MAT2 && cs == 1)
+        return 8;
+    if (a.type == TINYGLTF_TYPE_MAT3 && cs == 1)
+        return 12;
+    if (a.type == TINYGLTF_TYPE_MAT3 && cs == 2)
+        return 24;
+    return cs * num_comps(a);
+}
+
+/* Whether `count` elements of `size` bytes, `stride` apart, starting at `off` fit in `len`
+ * bytes; written so no product can overflow. */
+bool fits(size_t off, size_t stride, size_t count, size_t size, size_t len)
+{
+    return off <= len && size <= len - off && count - 1 <= (len - off - size) / stride;
+}
+
+bool check_buffers_and_views(Ctx &c)
+{
+    const auto &m = c.m;
+    for (size_t i = 0; i < m.buffers.size(); i++)
+        if (m.buffers[i].data.empty())
+            fail(c, "buffer %zu is empty (byteLength must be at least 1)", i);
+    for (size_t i = 0; i < m.bufferViews.size(); i++) {
+        const auto &v = m.bufferViews[i];
+        if (!in_range(v.buffer, m.buffers.size())) {
+            fail(c, "buffer view %zu refers to buffer %d, which does not exist", i, v.buffer);
+            continue;
+        }
+        size_t blen = m.buffers[size_t(v.buffer)].data.size();
+        if (v.byteLength < 1)
+            fail(c, "buffer view %zu has byteLength 0", i);
+        else if (v.byteOffset > blen || v.byteLength > blen - v.byteOffset)
+            fail(c, "buffer view %zu (offset %zu, length %zu) does not fit in buffer %d (%zu bytes)", i,
+                 v.byteOffset, v.byteLength, v.buffer, blen);
+        if (v.byteStride && (v.byteStride < 4 || v.byteStride > v.byteLength))
+            fail(c, "buffer view %zu: byteStride %zu is out of range (4..min(252, byteLength %zu))", i,
+                 v.byteStride, v.byteLength);
+    }
+    return !c.failed;
+}
+
+const uint8_t *view_data(const Ctx &c, int view, size_t offset)
+{
+    const auto &v = c.m.bufferViews[size_t(view)];
+    return c.m.buffers[size_t(v.buffer)].data.data() + v.byteOffset + offset;
+}
+
+double read_comp(const uint8_t *p, int ct, bool norm)
+{
+    switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+        int8_t v;
+        memcpy(&v, p, 1);
+        return norm ? std::fmax(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return norm ? p[0] / 255.0 : p[0];
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+        int16_t v;
+        memcpy(&v, p, 2);
+        return norm ? std::fmax(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        uint16_t v;
+        memcpy(&v, p, 2);
+        return norm ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        uint32_t v;
+        memcpy(&v, p, 4);
+        return v;
+    }
+    default: {
+        float v;
+        memcpy(&v, p, 4);
+        return v;
+    }
+    }
+}
+
+bool check_sparse(Ctx &c, int i, const tinygltf::Accessor &a)
+{
+    const auto &s = a.sparse;
+    const auto &views = c.m.bufferViews;
+    std::string what = label("accessor", i, a.name);
+    if (s.count < 1 || size_t(s.count) > a.count)
+        return fail(c, "%s: sparse count %d is out of range (1..%zu)", what.c_str(), s.count, a.count);
+    size_t is = comp_size(s.indices.componentType), es = elem_size(a);
+    if (s.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
+        s.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
+        s.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || !is)
+        return fail(c, "%s: invalid sparse indices componentType %d", what.c_str(), s.indices.componentType);
+    const int vi[2] = {s.indices.bufferView, s.values.bufferView};
+    const int off[2] = {s.indices.byteOffset, s.values.byteOffset};
+    const size_t sz[2] = {is, es};
+    for (int k = 0; k < 2; k++) {
+        const char *part = k ? "values" : "indices";
+        if (!in_range(vi[k], views.size()))
+            return fail(c, "%s: sparse %s refer to buffer view %d, which does not exist", what.c_str(), part, vi[k]);
+        const auto &v = views[size_t(vi[k])];
+        if (v.byteStride)
+            return fail(c, "%s: buffer view %d of the sparse %s must not have a byteStride", what.c_str(), vi[k], part);
+        if (off[k] < 0 || (v.byteOffset + size_t(off[k])) % comp_size(k ? a.componentType : s.indices.componentType))
+            return fail(c, "%s: sparse %s byteOffset %d is negative or misaligned", what.c_str(), part, off[k]);
+        if (!fits(size_t(off[k]), sz[k], size_t(s.count), sz[k], v.byteLength))
+            return fail(c, "%s: sparse %s do not fit in buffer view %d", what.c_str(), part, vi[k]);
+    }
+    const uint8_t *p = view_data(c, vi[0], size_t(off[0]));
+    double prev = -1;
+    for (int j = 0; j < s.count; j++) {
+        double idx = read_comp(p + size_t(j) * is, s.indices.componentType, false);
+        if (idx <= prev || idx >= double(a.count))
+            return fail(c, "%s: sparse index %.0f at %d is out of range or not increasing", what.c_str(), idx, j);
+        prev = idx;
+    }
+    return true;
+}
+
+bool check_accessor(Ctx &c, int i)
+{
+    const auto &a = c.m.accessors[size_t(i)];
+    std::string what = label("accessor", i, a.name);
+    size_t cs = comp_size(a.componentType);
+    if (!cs)
+        return fail(c, "%s: invalid componentType %d", what.c_str(), a.componentType);
+    size_t max = a.bufferView == -1 ? MAX_ZERO_ELEMENTS : MAX_ELEMENTS;
+    if (a.count < 1 || a.count > max)
+        return fail(c, "%s: count %zu is out of range (1..%zu)", what.c_str(), a.count, max);
+    if (a.normalized && (a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+                         a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+        return fail(c, "%s: only (unsigned) byte and short accessors can be normalized", what.c_str());
+    size_t nc = num_comps(a);
+    if ((!a.minValues.empty() && a.minValues.size() != nc) || (!a.maxValues.empty() && a.maxValues.size() != nc))
+        return fail(c, "%s: min and max must have %zu values", what.c_str(), nc);
+    if (a.bufferView == -1) {
+        if (a.byteOffset)
+            return fail(c, "%s: byteOffset without a bufferView", what.c_str());
+    } else {
+        if (!in_range(a.bufferView, c.m.bufferViews.size()))
+            return fail(c, "%s refers to buffer view %d, which does not exist", what.c_str(), a.bufferView);
+        const auto &v = c.m.bufferViews[size_t(a.bufferView)];
+        size_t es = elem_size(a), stride = v.byteStride ? v.byteStride : es;
+        if (a.byteOffset % cs || (v.byteOffset + a.byteOffset) % cs)
+            return fail(c, "%s: byteOffset %zu (in buffer view %d at %zu) is not a multiple of the component size %zu",
+                        what.c_str(), a.byteOffset, a.bufferView, v.byteOffset, cs);
+        if (v.byteStride && v.byteStride < es)
+            return fail(c, "%s: buffer view %d's byteStride %zu is smaller than the element size %zu", what.c_str(),
+                        a.bufferView, v.byteStride, es);
+        if (!fits(a.byteOffset, stride, a.count, es, v.byteLength))
+            return fail(c, "%s (offset %zu, %zu elements of %zu bytes, stride %zu) does not fit in buffer view %d (%zu bytes)",
+                        what.c_str(), a.byteOffset, a.count, es, stride, a.bufferView, v.byteLength);
+    }
+    return !a.sparse.isSparse || check_sparse(c, i, a);
+}
+
+/* Accessor data as doubles, count * components, sparse substitution applied, integer types
+ * normalised when the accessor says so. Only for validated, non-matrix accessors. */
+std::vector<double> read_accessor(const Ctx &c, int i)
+{
+    const auto &a = c.m.accessors[size_t(i)];
+    size_t nc = num_comps(a), cs = comp_size(a.componentType), es = elem_size(a);
+    std::vector<double> out(a.count * nc, 0.0);
+    if (a.bufferView >= 0) {
+        size_t stride = c.m.bufferViews[size_t(a.bufferView)].byteStride;
+        stride = stride ? stride : es;
+        const uint8_t *p = view_data(c, a.bufferView, a.byteOffset);
+        for (size_t j = 0; j < a.count; j++)
+            for (size_t k = 0; k < nc; k++)
+                out[j * nc + k] = read_comp(p + j * stride + k * cs, a.componentType, a.normalized);
+    }
+    if (a.sparse.isSparse) {
+        const auto &s = a.sparse;
+        const uint8_t *ip = view_data(c, s.indices.bufferView, size_t(s.indices.byteOffset));
+        const uint8_t *vp = view_data(c, s.values.bufferView, size_t(s.values.byteOffset));
+        size_t is = comp_size(s.indices.componentType);
+        for (size_t j = 0; j < size_t(s.count); j++) {
+            size_t row = size_t(read_comp(ip + j * is, s.indices.componentType, false));
+            for (size_t k = 0; k < nc; k++)
+                out[row * nc + k] = read_comp(vp + j * es + k * cs, a.componentType, a.normalized);
+        }
+    }
+    return out;
+}
+
+/* Data-level problems the validator reports as errors but that cannot make reading unsafe:
+ * warn, and let the geometry code deal with what it uses. */
+void check_accessor_data(Ctx &c, int i)
+{
+    const auto &a = c.m.accessors[size_t(i)];
+    size_t nc = num_comps(a);
+    if (nc > 4 || (a.bufferView < 0 && !a.sparse.isSparse))
+        return;
+    std::vector<double> d = read_accessor(c, i);
+    std::string what = label("accessor", i, a.name);
+    for (size_t j = 0; j < d.size(); j++) {
+        double v = d[j];
+        if (!std::isfinite(v)) {
+            warn(c, "%s: element %zu is not finite", what.c_str(), j / nc);
+            return;
+        }
+        /* Declared bounds are decimal JSON numbers, the data float: allow the rounding. */
+        double lo = a.minValues.empty() ? v : a.minValues[j % nc];
+        double hi = a.maxValues.empty() ? v : a.maxValues[j % nc];
+        double tol = 1e-6 * std::fmax(1.0, std::fmax(std::fabs(lo), std::fabs(hi)));
+        if (v < lo - tol || v > hi + tol) {
+            warn(c, "%s: element %zu (%g) lies outside its declared min/max [%g, %g]", what.c_str(), j / nc, v, lo, hi);
+            return;
+        }
+    }
+}
+
+struct Format {
+    const char *semantic; /* name, or prefix when it ends in '_' */
+    int type, alt_type;   /* allowed accessor types */
+    bool f, u8n, u16n, u8, u16; /* allowed component types */
+};
+/* glTF 2.0, "Meshes": accessor formats allowed per attribute semantic. */
+const Format FORMATS[] = {
+    {"POSITION", TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC3, true, false, false, false, false},
+    {"NORMAL", TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC3, true, false, false, false, false},
+    {"TANGENT", TINYGLTF_TYPE_VEC4, TINYGLTF_TYPE_VEC4, true, false, false, false, false},
+    {"TEXCOORD_", TINYGLTF_TYPE_VEC2, TINYGLTF_TYPE_VEC2, true, true, true, false, false},
+    {"COLOR_", TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4, true, true, true, false, false},
+    {"JOINTS_", TINYGLTF_TYPE_VEC4, TINYGLTF_TYPE_VEC4, false, false, false, true, true},
+    {"WEIGHTS_", TINYGLTF_TYPE_VEC4, TINYGLTF_TYPE_VEC4, true, true, true, false, false},
+};
+
+bool format_ok(const Format &f, const tinygltf::Accessor &a)
+{
+    if (a.type != f.type && a.type != f.alt_type)
+        return false;
+    switch (a.componentType) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return f.f;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return a.normalized ? f.u8n : f.u8;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return a.normalized ? f.u16n : f.u16;
+    default: return false;
+    }
+}
+
+bool check_primitive(Ctx &c, int mi, int pi)
+{
+    const auto &m = c.m;
+    const auto &p = m.meshes[size_t(mi)].primitives[size_t(pi)];
+    std::string what = label("mesh", mi, m.meshes[size_t(mi)].name) + " primitive " + std::to_string(pi);
+    if (p.mode < 0 || p.mode > TINYGLTF_MODE_TRIANGLE_FAN)
+        return fail(c, "%s: invalid mode %d", what.c_str(), p.mode);
+    if (p.material != -1 && !in_range(p.material, m.materials.size()))
+        return fail(c, "%s refers to material %d, which does not exist", what.c_str(), p.material);
+    if (p.indices != -1) {
+        if (!in_range(p.indices, m.accessors.size()))
+            return fail(c, "%s: indices refer to accessor %d, which does not exist", what.c_str(), p.indices);
+        const auto &a = m.accessors[size_t(p.indices)];
+        if (a.type != TINYGLTF_TYPE_SCALAR || a.normalized || a.bufferView < 0 ||
+            (a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+             a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+             a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+            return fail(c, "%s: indices accessor %d must be unsigned byte/short/int scalars in a buffer view",
+                        what.c_str(), p.indices);
+    }
+    size_t count = 0;
+    for (const auto &attr : p.attributes) {
+        const char *name = attr.first.c_str();
+        if (!in_range(attr.second, m.accessors.size()))
+            return fail(c, "%s: attribute %s refers to accessor %d, which does not exist", what.c_str(), name, attr.second);
+        const auto &a = m.accessors[size_t(attr.second)];
+        if (count && a.count != count)
+            return fail(c, "%s: attribute %s has %zu elements, others %zu (all must have the same count)",
+                        what.c_str(), name, a.count, count);
+        count = a.count;
+        for (const Format &f : FORMATS) {
+            size_t n = strlen(f.semantic);
+            bool prefix = f.semantic[n - 1] == '_';
+            if ((prefix ? strncmp(name, f.semantic, n) : strcmp(name, f.semantic)) == 0 && !format_ok(f, a))
+                return fail(c, "%s: accessor %d has a format not allowed for attribute %s", what.c_str(), attr.second, name);
+        }
+    }
+    return true;
+}
+
+bool check_number_array(Ctx &c, const std::vector<double> &v, size_t n, const std::string &what, const char *name)
+{
+    if (v.empty())
+        return true;
+    if (v.size() != n)
+        return fail(c, "%s: %s must have %zu numbers (has %zu)", what.c_str(), name, n, v.size());
+    for (double x : v)
+        if (!std::isfinite(x))
+            return fail(c, "%s: %s is not finite", what.c_str(), name);
+    return true;
+}
+
+Mat mat_mul(const Mat &a, const Mat &b)
+{
+    Mat r;
+    for (int col = 0; col < 4; col++)
+        for (int row = 0; row < 4; row++) {
+            double s = 0;
+            for (int k = 0; k < 4; k++)
+                s += a[size_t(k * 4 + row)] * b[size_t(col * 4 + k)];
+            r[size_t(col * 4 + row)] = s;
+        }
+    return r;
+}
+
+bool mat_finite(const Mat &m)
+{
+    for (double x : m)
+        if (!std::isfinite(x))
+            return false;
+    return true;
+}
+
+bool node_local(Ctx &c, int i, Mat &out)
+{
+    const auto &n = c.m.nodes[size_t(i)];
+    std::string what = label("node", i, n.name);
+    if (!check_number_array(c, n.matrix, 16, what, "matrix") || !check_number_array(c, n.translation, 3, what, "translation") ||
+        !check_number_array(c, n.rotation, 4, what, "rotation") || !check_number_array(c, n.scale, 3, what, "scale"))
+        return false;
+    if (!n.matrix.empty()) {
+        std::copy(n.matrix.begin(), n.matrix.end(), out.begin());
+        return true;
+    }
+    double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+    std::copy(n.translation.begin(), n.translation.end(), t);
+    std::copy(n.rotation.begin(), n.rotation.end(), q);
+    std::copy(n.scale.begin(), n.scale.end(), s);
+    double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (!(len > 1e-6) || !std::isfinite(len))
+        return fail(c, "%s: rotation is not a unit quaternion (length %g)", what.c_str(), len);
+    if (std::fabs(len - 1) > 1e-3)
+        warn(c, "%s: rotation is not a unit quaternion (length %g, normalised)", what.c_str(), len);
+    double x = q[0] / len, y = q[1] / len, z = q[2] / len, w = q[3] / len;
+    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w),
+                         2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
+                         2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)};
+    out = Mat{};
+    for (int col = 0; col < 3; col++)
+        for (int row = 0; row < 3; row++)
+            out[size_t(col * 4 + row)] = r[col * 3 + row] * s[col];
+    out[12] = t[0];
+    out[13] = t[1];
+    out[14] = t[2];
+    out[15] = 1;
+    return true;
+}
+
+int node_light(const tinygltf::Node &n)
+{
+    auto it = n.extensions.find("KHR_lights_punctual");
+    if (it == n.extensions.end() || !it->second.IsObject() || !it->second.Has("light"))
+        return -1;
+    const tinygltf::Value &v = it->second.Get("light");
+    return v.IsInt() ? v.Get<int>() : -2;
+}
+
+bool check_nodes_and_scenes(Ctx &c)
+{
+    const auto &m = c.m;
+    size_t nn = m.nodes.size();
+    std::vector<int> parent(nn, -1);
+    c.local.assign(nn, Mat{});
+    for (size_t i = 0; i < nn; i++) {
+        const auto &n = m.nodes[i];
+        std::string what = label("node", int(i), n.name);
+        node_local(c, int(i), c.local[i]);
+        if (n.mesh != -1 && !in_range(n.mesh, m.meshes.size()))
+            fail(c, "%s refers to mesh %d, which does not exist", what.c_str(), n.mesh);
+        if (n.camera != -1 && !in_range(n.camera, m.cameras.size()))
+            fail(c, "%s refers to camera %d, which does not exist", what.c_str(), n.camera);
+        if (n.skin != -1 && !in_range(n.skin, m.skins.size()))
+            fail(c, "%s refers to skin %d, which does not exist", what.c_str(), n.skin);
+        int light = node_light(n);
+        if (light != -1 && !in_range(light, m.lights.size()))
+            fail(c, "%s refers to KHR_lights_punctual light %d, which does not exist", what.c_str(), light);
+        for (int ch : n.children) {
+            if (!in_range(ch, nn))
+                fail(c, "%s has child %d, which does not exist", what.c_str(), ch);
+            else if (parent[size_t(ch)] != -1)
+                fail(c, "node %d has more than one parent (nodes %d and %zu)", ch, parent[size_t(ch)], i);
+            else
+                parent[size_t(ch)] = int(i);
+        }
+    }
+    if (c.failed)
+        return false;
+    /* With one parent each, the nodes not reachable from a parentless node are exactly those
+     * in loops or below one; walking up from such a node for nn steps lands inside the loop. */
+    std::vector<bool> reached(nn, false);
+    std::vector<int> stack;
+    for (size_t i = 0; i < nn; i++)
+        if (parent[i] == -1)
+            stack.push_back(int(i));
+    while (!stack.empty()) {
+        int i = stack.back();
+        stack.pop_back();
+        reached[size_t(i)] = true;
+        for (int ch : m.nodes[size_t(i)].children)
+            stack.push_back(ch);
+    }
+    for (size_t i = 0; i < nn; i++)
+        if (!reached[i]) {
+            int k = int(i);
+            for (size_t step = 0; step < nn; step++)
+                k = parent[size_t(k)];
+            return fail(c, "node %d is part of a node loop", k);
+        }
+    if (m.defaultScene != -1 && !in_range(m.defaultScene, m.scenes.size()))
+        return fail(c, "default scene %d does not exist", m.defaultScene);
+    for (size_t s = 0; s < m.scenes.size(); s++)
+        for (int r : m.scenes[s].nodes)
+            if (!in_range(r, nn))
+                fail(c, "scene %zu refers to node %d, which does not exist", s, r);
+    return !c.failed;
+}
+
+bool check_texture_ref(Ctx &c, const tinygltf::Material &mat, int mi, int index, const char *slot)
+{
+    if (index == -1 || in_range(index, c.m.textures.size()))
+        return true;
+    return fail(c, "%s: %s refers to texture %d, which does not exist", label("material", mi, mat.name).c_str(), slot, index);
+}
+
+bool check_textures_and_materials(Ctx &c)
+{
+    const auto &m = c.m;
+    for (size_t i = 0; i < m.textures.size(); i++) {
+        const auto &t = m.textures[i];
+        if (t.source != -1 && !in_range(t.source, m.images.size()))
+            fail(c, "texture %zu refers to image %d, which does not exist", i, t.source);
+        if (t.sampler != -1 && !in_range(t.sampler, m.samplers.size()))
+            fail(c, "texture %zu refers to sampler %d, which does not exist", i, t.sampler);
+    }
+    for (size_t i = 0; i < m.materials.size(); i++) {
+        const auto &mat = m.materials[i];
+        const auto &pbr = mat.pbrMetallicRoughness;
+        check_texture_ref(c, mat, int(i), pbr.baseColorTexture.index, "baseColorTexture");
+        check_texture_ref(c, mat, int(i), pbr.metallicRoughnessTexture.index, "metallicRoughnessTexture");
+        check_texture_ref(c, mat, int(i), mat.normalTexture.index, "normalTexture");
+        check_texture_ref(c, mat, int(i), mat.occlusionTexture.index, "occlusionTexture");
+        check_texture_ref(c, mat, int(i), mat.emissiveTexture.index, "emissiveTexture");
+    }
+    return !c.failed;
+}
+
+/* Cameras and lights with bad values are skipped with a warning: the rest of the scene is fine. */
+void check_cameras(Ctx &c)
+{
+    c.camera_ok.assign(c.m.cameras.size(), false);
+    for (size_t i = 0; i < c.m.cameras.size(); i++) {
+        const auto &cam = c.m.cameras[i];
+        std::string what = label("camera", int(i), cam.name);
+        if (cam.type != "perspective") {
+            warn(c, "orthographic camera %zu not supported, skipped", i);
+            continue;
+        }
+        const auto &p = cam.perspective;
+        if (!(p.yfov > 0 && p.yfov < M_PI))
+            warn(c, "%s: yfov %g is out of range (0, pi); skipped", what.c_str(), p.yfov);
+        else if (!(p.znear > 0))
+            warn(c, "%s: znear %g must be positive; skipped", what.c_str(), p.znear);
+        else if (p.zfar != 0 && !(p.zfar > p.znear))
+            warn(c, "%s: zfar %g must be greater than znear %g; skipped", what.c_str(), p.zfar, p.znear);
+        else if (p.aspectRatio < 0)
+            warn(c, "%s: aspectRatio %g must be positive; skipped", what.c_str(), p.aspectRatio);
+        else
+            c.camera_ok[i] = true;
+    }
+}
+
+void check_lights(Ctx &c)
+{
+    c.light_ok.assign(c.m.lights.size(), false);
+    for (size_t i = 0; i < c.m.lights.size(); i++) {
+        const auto &l = c.m.lights[i];
+        std::string what = label("KHR_lights_punctual light", int(i), l.name);
+        bool neg_color = l.color.size() == 3 && (l.color[0] < 0 || l.color[1] < 0 || l.color[2] < 0);
+        if (l.type != "point" && l.type != "spot" && l.type != "directional")
+            warn(c, "%s: unknown type '%s'; skipped", what.c_str(), l.type.c_str());
+        else if (!l.color.empty() && (l.color.size() != 3 || neg_color))
+            warn(c, "%s: color must be 3 non-negative numbers; skipped", what.c_str());
+        else if (!(l.intensity >= 0))
+            warn(c, "%s: intensity %g must not be negative; skipped", what.c_str(), l.intensity);
+        else if (l.type == "spot" && !(l.spot.innerConeAngle >= 0 && l.spot.innerConeAngle < l.spot.outerConeAngle &&
+                                       l.spot.outerConeAngle <= M_PI / 2))
+            warn(c, "%s: cone angles inner %g, outer %g must satisfy 0 <= inner < outer <= pi/2; skipped",
+                 what.c_str(), l.spot.innerConeAngle, l.spot.outerConeAngle);
+        else
+            c.light_ok[i] = true;
+        if (l.range < 0)
+            warn(c, "%s: negative range %g ignored (infinite)", what.c_str(), l.range);
+    }
+}
+
+bool check_asset(Ctx &c)
+{
+    const auto &m = c.m;
+    const std::string &v = m.asset.version;
+    if (v.compare(0, 2, "2.") != 0)
+        return fail(c, "unsupported glTF version '%s' (gonio reads 2.x)", v.c_str());
+    if (v != "2.0")
+        warn(c, "glTF version %s is newer than 2.0; read as 2.0", v.c_str());
+    if (!m.asset.minVersion.empty() && m.asset.minVersion != "2.0")
+        return fail(c, "requires glTF %s (gonio reads 2.0)", m.asset.minVersion.c_str());
+    auto supported = [](const std::string &e) {
+        for (const char *s : SUPPORTED_EXTENSIONS)
+            if (e == s)
+                return true;
+        return false;
+    };
+    for (const auto &e : m.extensionsRequired)
+        if (!supported(e))
+            fail(c, "requires unsupported extension %s", e.c_str());
+    for (const auto &e : m.extensionsUsed)
+        if (!supported(e))
+            warn(c, "uses unsupported extension %s (ignored)", e.c_str());
+    return !c.failed;
+}
+
+/* ---- geometry ------------------------------------------------------------------------------- */
+
+std::vector<float> to_float(const std::vector<double> &d)
+{
+    return std::vector<float>(d.begin(), d.end());
+}
+
+bool all_finite(const std::vector<double> &d)
+{
+    for (double x : d)
+        if (!std::isfinite(x))
+            return false;
+    return true;
+}
+
+void read_normals(Ctx &c, const std::string &what, int acc, Prim &out)
+{
+    std::vector<double> d = read_accessor(c, acc);
+    bool off_unit = false;
+    for (size_t j = 0; j < d.size(); j += 3) {
+        double len = std::sqrt(d[j] * d[j] + d[j + 1] * d[j + 1] + d[j + 2] * d[j + 2]);
+        if (!(len > 1e-20) || !std::isfinite(len)) {
+            warn(c, "%s: normal %zu is zero or not finite; using flat normals", what.c_str(), j / 3);
+            return;
+        }
+        off_unit |= std::fabs(len - 1) > 1e-2;
+        for (int k = 0; k < 3; k++)
+            d[j + size_t(k)] /= len;
+    }
+    if (off_unit)
+        warn(c, "%s: normals are not unit length (renormalised)", what.c_str());
+    out.nrm = to_float(d);
+}
+
+void read_tangents(Ctx &c, const std::string &what, int acc, Prim &out)
+{
+    std::vector<double> d = read_accessor(c, acc);
+    bool bad_w = false;
+    for (size_t j = 0; j < d.size(); j += 4) {
+        double len = std::sqrt(d[j] * d[j] + d[j + 1] * d[j + 1] + d[j + 2] * d[j + 2]);
+        if (!(len > 1e-20) || !std::isfinite(len) || !std::isfinite(d[j + 3])) {
+            warn(c, "%s: tangent %zu is zero or not finite; tangents ignored", what.c_str(), j / 4);
+            return;
+        }
+        for (int k = 0; k < 3; k++)
+            d[j + size_t(k)] /= len;
+        bad_w |= std::fabs(d[j + 3]) != 1;
+        d[j + 3] = d[j + 3] < 0 ? -1 : 1;
+    }
+    if (bad_w)
+        warn(c, "%s: tangent w must be 1 or -1 (replaced by its sign)", what.c_str());
+    out.tan = to_float(d);
+}
+
+/* glTF 2.0, "Meshes": without NORMAL, flat normals are used, so every triangle gets its own
+ * three vertices. */
+void make_flat(Prim &p)
+{
+    Prim f;
+    f.material = p.material;
+    size_t nt = p.idx.size() / 3;
+    f.pos.resize(nt * 9);
+    f.nrm.resize(nt * 9);
+    if (!p.uv.empty())
+        f.uv.resize(nt * 6);
+    f.idx.resize(nt * 3);
+    for (size_t t = 0; t < nt; t++) {
+        for (size_t k = 0; k < 3; k++) {
+            size_t v = p.idx[t * 3 + k], o = t * 3 + k;
+            std::copy(&p.pos[v * 3], &p.pos[v * 3] + 3, &f.pos[o * 3]);
+            if (!p.uv.empty())
+                std::copy(&p.uv[v * 2], &p.uv[v * 2] + 2, &f.uv[o * 2]);
+            f.idx[o] = uint32_t(o);
+        }
+        const float *a = &f.pos[t * 9], *b = a + 3, *cc = a + 6;
+        double e1[3], e2[3];
+        for (int k = 0; k < 3; k++) {
+            e1[k] = double(b[k]) - a[k];
+            e2[k] = double(cc[k]) - a[k];
+        }
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (!(len > 0) || !std::isfinite(len)) { /* degenerate: never hit, any unit normal */
+            n[0] = n[1] = 0;
+            n[2] = len = 1;
+        }
+        for (size_t k = 0; k < 3; k++)
+            for (size_t j = 0; j < 3; j++)
+                f.nrm[t * 9 + k * 3 + j] = float(n[j] / len);
+    }
+    p = std::move(f);
+}
+
+const char *mode_name(int mode)
+{
+    static const char *const names[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+    return names[mode];
+}
+
+/* Reads one primitive into `out`; false when it is skipped (with a warning) or bad (error). */
+bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
+{
+    const auto &p = c.m.meshes[size_t(mi)].primitives[size_t(pi)];
+    std::string what = label("mesh", mi, c.m.meshes[size_t(mi)].name) + " primitive " + std::to_string(pi);
+    if (p.mode < TINYGLTF_MODE_TRIANGLES) {
+        warn(c, "%s: mode %s is not supported (skipped)", what.c_str(), mode_name(p.mode));
+        return false;
+    }
+    auto attr = [&](const char *name) {
+        auto it = p.attributes.find(name);
+        return it == p.attributes.end() ? -1 : it->second;
+    };
+    int pos = attr("POSITION"), nrm = attr("NORMAL"), tan = attr("TANGENT"), uv = attr("TEXCOORD_0");
+    if (pos < 0) {
+        warn(c, "%s has no POSITION (skipped)", what.c_str());
+        return false;
+    }
+    if (!p.targets.empty() && !c.warned_targets) {
+        warn(c, "morph targets are not supported (meshes drawn with their base shapes)");
+        c.warned_targets = true;
+    }
+    if (attr("COLOR_0") >= 0 && !c.warned_color) {
+        warn(c, "vertex colours (COLOR_0) are ignored");
+        c.warned_color = true;
+    }
+    size_t nv = c.m.accessors[size_t(pos)].count;
+    std::vector<uint32_t> seq;
+    if (p.indices >= 0) {
+        const auto &a = c.m.accessors[size_t(p.indices)];
+        double restart = a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? 255.0
+                         : a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? 65535.0
+                                                                                      : 4294967295.0;
+        std::vector<double> d = read_accessor(c, p.indices);
+        seq.resize(d.size());
+        for (size_t j = 0; j < d.size(); j++) {
+            if (d[j] == restart)
+                return fail(c, "%s: index %zu is the primitive restart value %.0f, which glTF forbids", what.c_str(), j, restart);
+            if (d[j] >= double(nv))
+                return fail(c, "%s: index %zu is %.0f but there are only %zu vertices", what.c_str(), j, d[j], nv);
+            seq[j] = uint32_t(d[j]);
+        }
+    } else {
+        seq.resize(nv);
+        for (size_t j = 0; j < nv; j++)
+            seq[j] = uint32_t(j);
+    }
+    size_t n = seq.size();
+    if (p.mode == TINYGLTF_MODE_TRIANGLES) {
+        if (n % 3)
+            warn(c, "%s: %zu indices is not a multiple of 3 (last %zu ignored)", what.c_str(), n, n % 3);
+        out.idx.assign(seq.begin(), seq.begin() + long(n - n % 3));
+    } else {
+        /* Strips and fans as the glTF 2.0 spec lists their triangles ("Meshes"). */
+        for (size_t i = 0; i + 2 < n; i++) {
+            uint32_t t[3];
+            if (p.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+                t[0] = seq[i];
+                t[1] = seq[i + 1 + i % 2];
+                t[2] = seq[i + 2 - i % 2];
+            } else {
+                t[0] = seq[i + 1];
+                t[1] = seq[i + 2];
+                t[2] = seq[0];
+            }
+            out.idx.insert(out.idx.end(), t, t + 3);
+        }
+    }
+    out.pos = to_float(read_accessor(c, pos));
+    out.material = p.material >= 0 ? uint32_t(p.material) : GN_INVALID;
+    if (nrm >= 0)
+        read_normals(c, what, nrm, out);
+    if (tan >= 0 && nrm < 0)
+        warn(c, "%s: TANGENT without NORMAL is ignored", what.c_str());
+    else if (tan >= 0 && !out.nrm.empty())
+        read_tangents(c, what, tan, out);
+    if (uv >= 0) {
+        std::vector<double> d = read_accessor(c, uv);
+        if (all_finite(d))
+            out.uv = to_float(d);
+        else
+            warn(c, "%s: TEXCOORD_0 has non-finite values (ignored)", what.c_str());
+    }
+    if (out.nrm.empty())
+        make_flat(out);
+    return true;
+}
+
+bool load_meshes(Ctx &c)
+{
+    c.meshes.resize(c.m.meshes.size());
+    for (size_t mi = 0; mi < c.m.meshes.size(); mi++)
+        for (size_t pi = 0; pi < c.m.meshes[mi].primitives.size(); pi++) {
+            Prim p;
+            if (load_primitive(c, int(mi), int(pi), p))
+                c.meshes[mi].push_back(std::move(p));
+        }
+    return !c.failed;
+}
+
+/* Walks the default scene (scene 0 without one; every parentless node without scenes). */
+bool collect_instances(Ctx &c, std::vector<Instance> &inst, std::vector<Instance> &cams, std::vector<Instance> &lights)
+{
+    const auto &m = c.m;
+    std::vector<int> roots;
+    if (!m.scenes.empty()) {
+        roots = m.scenes[size_t(m.defaultScene >= 0 ? m.defaultScene : 0)].nodes;
+    } else {
+        std::vector<bool> child(m.nodes.size(), false);
+        for (const auto &n : m.nodes)
+            for (int ch : n.children)
+                child[size_t(ch)] = true;
+        for (size_t i = 0; i < m.nodes.size(); i++)
+            if (!child[i])
+                roots.push_back(int(i));
+    }
+    std::vector<bool> visited(m.nodes.size(), false);
+    for (int r : roots) {
+        std::vector<Instance> stack;
+        Mat id{};
+        id[0] = id[5] = id[10] = id[15] = 1;
+        stack.push_back({r, -1, id});
+        while (!stack.empty()) {
+            Instance it = stack.back();
+            stack.pop_back();
+            const auto &n = m.nodes[size_t(it.node)];
+            if (visited[size_t(it.node)]) {
+                warn(c, "%s is reached more than once from the scene's roots (drawn once)", label("node", it.node, n.name).c_str());
+                continue;
+            }
+            visited[size_t(it.node)] = true;
+            it.world = mat_mul(it.world, c.local[size_t(it.node)]);
+            if (!mat_finite(it.world))
+                return fail(c, "%s: world transform is not finite", label("node", it.node, n.name).c_str());
+            if (n.skin >= 0 && !c.warned_skin) {
+                warn(c, "skins are not supported (skinned meshes drawn in their bind pose)");
+                c.warned_skin = true;
+            }
+            if (n.mesh >= 0)
+                inst.push_back({it.node, n.mesh, it.world});
+            if (n.camera >= 0 && c.camera_ok[size_t(n.camera)])
+                cams.push_back(it);
+            int light = node_light(n);
+            if (light >= 0 && c.light_ok[size_t(light)])
+                lights.push_back(it);
+            for (auto ch = n.children.rbegin(); ch != n.children.rend(); ++ch)
+                stack.push_back({*ch, -1, it.world});
+        }
+    }
+    return true; /* pre-order, children in file order (pushed reversed) */
+}
+
+void xform_dir(const Mat &m, const double v[3], double out[3])
+{
+    for (int r = 0; r < 3; r++)
+        out[r] = m[size_t(r)] * v[0] + m[size_t(4 + r)] * v[1] + m[size_t(8 + r)] * v[2];
+}
+
+bool normalize3(double v[3])
+{
+    double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (!(len > 1e-30) || !std::isfinite(len))
+        return false;
+    v[0] /= len;
+    v[1] /= len;
+    v[2] /= len;
+    return true;
+}
+
+bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
+{
+    uint64_t nv = 0, nt = 0, np = 0;
+    for (const auto &in : inst)
+        for (const Prim &p : c.meshes[size_t(in.mesh)]) {
+            nv += p.pos.size() / 3;
+            nt += p.idx.size() / 3;
+            np++;
+            if (nv > MAX_SCENE || nt > MAX_SCENE)
+                return fail(c, "scene too large (over %zu vertices or triangles after instancing)", MAX_SCENE);
+        }
+    out->num_vertices = uint32_t(nv);
+    out->num_triangles = uint32_t(nt);
+    out->num_meshes = uint32_t(np);
+    out->vertices = static_cast<GnVertex *>(util_calloc(nv, sizeof(GnVertex)));
+    out->indices = static_cast<uint32_t *>(util_calloc(nt * 3, sizeof(uint32_t)));
+    out->tri_material = static_cast<uint32_t *>(util_calloc(nt, sizeof(uint32_t)));
+    uint32_t vbase = 0, tbase = 0, default_material = uint32_t(c.m.materials.size());
+    for (const auto &in : inst) {
+        const Mat &w = in.world;
+        /* Normals go through the cofactor matrix, det * inverse transpose: defined even for a
+         * singular matrix; multiplied by sign(det) so mirroring keeps them pointing out. */
+        double a[3][3];
+        for (int r = 0; r < 3; r++)
+            for (int k = 0; k < 3; k++)
+                a[r][k] = w[size_t(k * 4 + r)];
+        double cof[3][3];
+        for (int r = 0; r < 3; r++)
+            for (int k = 0; k < 3; k++) {
+                int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+                cof[r][k] = a[r1][k1] * a[r2][k2] - a[r1][k2] * a[r2][k1];
+            }
+        double det = a[0][0] * cof[0][0] + a[0][1] * cof[0][1] + a[0][2] * cof[0][2];
+        double sgn = det < 0 ? -1 : 1;
+        for (const Prim &p : c.meshes[size_t(in.mesh)]) {
+            size_t pv = p.pos.size() / 3;
+            for (size_t v = 0; v < pv; v++) {
+                GnVertex &o = out->vertices[vbase + v];
+                const float *q = &p.pos[v * 3];
+                double x[3];
+                for (int r = 0; r < 3; r++)
+                    x[r] = a[r][0] * q[0] + a[r][1] * q[1] + a[r][2] * q[2] + w[size_t(12 + r)];
+                o.position = vec3{float(x[0]), float(x[1]), float(x[2])};
+                const float *nn = &p.nrm[v * 3];
+                double n[3];
+                for (int r = 0; r < 3; r++)
+                    n[r] = sgn * (cof[r][0] * nn[0] + cof[r][1] * nn[1] + cof[r][2] * nn[2]);
+                if (!normalize3(n)) { /* a scale that flattens the mesh to a line: never hit */
+                    n[0] = n[1] = 0;
+                    n[2] = 1;
+                }
+                o.normal = vec3{float(n[0]), float(n[1]), float(n[2])};
+                if (!p.uv.empty()) {
+                    o.u = p.uv[v * 2];
+                    o.v = p.uv[v * 2 + 1];
+                }
+                if (!p.tan.empty()) {
+                    const double t0[3] = {p.tan[v * 4], p.tan[v * 4 + 1], p.tan[v * 4 + 2]};
+                    double t[3];
+                    xform_dir(w, t0, t);
+                    if (normalize3(t))
+                        o.tangent = vec4{float(t[0]), float(t[1]), float(t[2]), float(p.tan[v * 4 + 3] * sgn)};
+                }
+            }
+            size_t pt = p.idx.size() / 3;
+            for (size_t t = 0; t < pt; t++) {
+                uint32_t *dst = &out->indices[(tbase + t) * 3];
+                dst[0] = vbase + p.idx[t * 3];
+                dst[1] = vbase + p.idx[t * 3 + (det < 0 ? 2 : 1)]; /* mirrored: keep front faces */
+                dst[2] = vbase + p.idx[t * 3 + (det < 0 ? 1 : 2)];
+                out->tri_material[tbase + t] = p.material == GN_INVALID ? default_material : p.material;
+            }
+            vbase += uint32_t(pv);
+            tbase += uint32_t(pt);
+        }
+    }
+    return true;
+}
+
+void bake_cameras(Ctx &c, const std::vector<Instance> &cams, scene *out)
+{
+    out->cameras = static_cast<scene_camera *>(util_calloc(cams.size(), sizeof(scene_camera)));
+    for (const auto &in : cams) {
+        const auto &n = c.m.nodes[size_t(in.node)];
+        const auto &cam = c.m.cameras[size_t(n.camera)];
+        const double fz[3] = {0, 0, -1}, uy[3] = {0, 1, 0};
+        double f[3], u[3];
+        xform_dir(in.world, fz, f);
+        xform_dir(in.world, uy, u);
+        bool ok = normalize3(f);
+        double d = f[0] * u[0] + f[1] * u[1] + f[2] * u[2];
+        for (int k = 0; k < 3; k++)
+            u[k] -= d * f[k];
+        if (!ok || !normalize3(u)) {
+            warn(c, "camera on %s has a degenerate transform; skipped", label("node", in.node, n.name).c_str());
+            continue;
+        }
+        scene_camera &o = out->cameras[out->num_cameras++];
+        snprintf(o.name, sizeof o.name, "%s", cam.name.empty() ? ("camera " + std::to_string(n.camera)).c_str() : cam.name.c_str());
+        const double r[3] = {f[1] * u[2] - f[2] * u[1], f[2] * u[0] - f[0] * u[2], f[0] * u[1] - f[1] * u[0]};
+        for (int k = 0; k < 3; k++) {
+            o.position[k] = float(in.world[size_t(12 + k)]);
+            o.forward[k] = float(f[k]);
+            o.up[k] = float(u[k]);
+            o.right[k] = float(r[k]);
+        }
+        o.yfov = float(cam.perspective.yfov);
+        o.aspect = float(cam.perspective.aspectRatio);
+        o.znear = float(cam.perspective.znear);
+        o.zfar = float(cam.perspective.zfar);
+    }
+}
+
+void bake_lights(Ctx &c, const std::vector<Instance> &lights, scene *out)
+{
+    out->lights = static_cast<GnLight *>(util_calloc(lights.size(), sizeof(GnLight)));
+    for (const auto &in : lights) {
+        const auto &n = c.m.nodes[size_t(in.node)];
+        const auto &l = c.m.lights[size_t(node_light(n))];
+        const double fz[3] = {0, 0, -1};
+        double d[3];
+        xform_dir(in.world, fz, d);
+        if (!normalize3(d) && l.type != "point") {
+            warn(c, "light on %s has a degenerate transform; skipped", label("node", in.node, n.name).c_str());
+            continue;
+        }
+        if (!std::isfinite(d[0])) { /* a point light's direction is unused */
+            d[0] = d[1] = 0;
+            d[2] = -1;
+        }
+        GnLight &o = out->lights[out->num_lights++];
+        o.type = l.type == "point" ? GN_LIGHT_POINT : l.type == "spot" ? GN_LIGHT_SPOT : GN_LIGHT_DIRECTIONAL;
+        o.position = vec3{float(in.world[12]), float(in.world[13]), float(in.world[14])};
+        o.direction = vec3{float(d[0]), float(d[1]), float(d[2])};
+        double col[3] = {1, 1, 1};
+        if (l.color.size() == 3)
+            std::copy(l.color.begin(), l.color.end(), col);
+        o.color = vec3{float(col[0] * l.intensity), float(col[1] * l.intensity), float(col[2] * l.intensity)};
+        o.range = o.type == GN_LIGHT_DIRECTIONAL || l.range < 0 ? 0.0f : float(l.range);
+        o.inner_cos = o.outer_cos = -1; /* no cone */
+        if (o.type == GN_LIGHT_SPOT) {
+            o.inner_cos = float(std::cos(l.spot.innerConeAngle));
+            o.outer_cos = float(std::cos(l.spot.outerConeAngle));
+        }
+    }
+}
+
+/* ---- images, textures, materials ----------------------------------------------------------- */
+
+void decode_view_images(Ctx &c)
+{
+    for (size_t i = 0; i < c.m.images.size(); i++) {
+        tinygltf::Image &img = c.m.images[i];
+        if (img.bufferView < 0) /* tinygltf checked that the view exists, check_buffers_and_views that it fits */
+            continue;
+        const auto &v = c.m.bufferViews[size_t(img.bufferView)];
+        std::string why = decode_image(&img, int(i), view_data(c, img.bufferView, 0), v.byteLength);
+        if (!why.empty())
+            c.image_errors[int(i)] = why;
+    }
+}
+
+/* Decoded image -> RGBA8: grey, grey+alpha and RGB expand as glTF samples them; 16-bit
+ * channels round to 8 bits (v * 255 / 65535 = v / 257). */
+bool convert_image(const tinygltf::Image &img, scene_image &out)
+{
+    int comps = img.component, bytes = img.bits / 8;
+    if (img.width < 1 || img.height < 1 || comps < 1 || comps > 4 || (img.bits != 8 && img.bits != 16) ||
+        size_t(img.width) * size_t(img.height) > MAX_PIXELS ||
+        img.image.size() != size_t(img.width) * size_t(img.height) * size_t(comps * bytes))
+        return false;
+    size_t n = size_t(img.width) * size_t(img.height);
+    out.width = uint32_t(img.width);
+    out.height = uint32_t(img.height);
+    out.rgba8 = static_cast<uint8_t *>(util_malloc(n * 4));
+    const uint8_t *src = img.image.data();
+    if (comps == 4 && bytes == 1) { /* what tinygltf's decoder delivers */
+        memcpy(out.rgba8, src, n * 4);
+        return true;
+    }
+    for (size_t p = 0; p < n; p++) {
+        uint8_t ch[4] = {0, 0, 0, 255};
+        for (int k = 0; k < comps; k++) {
+            const uint8_t *s = src + (p * size_t(comps) + size_t(k)) * size_t(bytes);
+            if (bytes == 1) {
+                ch[k] = s[0];
+            } else {
+                uint16_t v;
+                memcpy(&v, s, 2);
+                ch[k] = uint8_t((v + 128) / 257);
+            }
+        }
+        if (comps <= 2) { /* luminance (+ alpha) */
+            ch[3] = comps == 2 ? ch[1] : 255;
+            ch[1] = ch[2] = ch[0];
+        }
+        memcpy(out.rgba8 + p * 4, ch, 4);
+    }
+    return true;
+}
+
+uint32_t wrap_mode(Ctx &c, size_t sampler, int mode)
+{
+    switch (mode) {
+    case TINYGLTF_TEXTURE_WRAP_REPEAT: return GN_WRAP_REPEAT;
+    case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return GN_WRAP_CLAMP;
+    case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return GN_WRAP_MIRROR;
+    default: warn(c, "sampler %zu: invalid wrap mode %d (using REPEAT)", sampler, mode); return GN_WRAP_REPEAT;
+    }
+}
+
+void load_images_and_textures(Ctx &c, scene *out)
+{
+    const auto &m = c.m;
+    decode_view_images(c);
+    out->images = static_cast<scene_image *>(util_calloc(m.images.size(), sizeof(scene_image)));
+    c.image_map.assign(m.images.size(), GN_INVALID);
+    for (size_t i = 0; i < m.images.size(); i++) {
+        const auto &img = m.images[i];
+        if (c.image_errors.count(int(i)) || !convert_image(img, out->images[out->num_images])) {
+            std::string why = c.image_errors.count(int(i)) ? c.image_errors[int(i)] : "file missing or unreadable";
+            while (!why.empty() && why.back() == '\n')
+                why.pop_back();
+            warn(c, "%s%s%s: %s; textures using it are ignored", label("image", int(i), img.name).c_str(),
+                 img.uri.empty() ? "" : " ", img.uri.substr(0, 200).c_str(), why.c_str());
+            continue;
+        }
+        c.image_map[i] = out->num_images++;
+        std::vector<unsigned char>().swap(c.m.images[i].image); /* keep one copy at a time */
+    }
+    out->textures = static_cast<scene_texture *>(util_calloc(m.textures.size(), sizeof(scene_texture)));
+    c.texture_map.assign(m.textures.size(), GN_INVALID);
+    for (size_t i = 0; i < m.textures.size(); i++) {
+        const auto &t = m.textures[i];
+        if (t.source < 0) {
+            warn(c, "texture %zu has no image source (ignored)", i);
+            continue;
+        }
+        if (c.image_map[size_t(t.source)] == GN_INVALID)
+            continue;
+        uint32_t flags = 0;
+        if (t.sampler >= 0) {
+            const auto &s = m.samplers[size_t(t.sampler)];
+            flags = wrap_mode(c, size_t(t.sampler), s.wrapS) | wrap_mode(c, size_t(t.sampler), s.wrapT) << 2;
+            if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST)
+                flags |= GN_TEX_NEAREST;
+        }
+        out->textures[out->num_textures] = scene_texture{c.image_map[size_t(t.source)], flags};
+        c.texture_map[i] = out->num_textures++;
+    }
+}
+
+/* A number in [lo, hi]; outside -> warning and clamped. */
+float ranged(Ctx &c, double v, double lo, double hi, const std::string &what, const char *name)
+{
+    if (v >= lo && v <= hi)
+        return float(v);
+    warn(c, "%s: %s %g is out of range [%g, %g] (clamped)", what.c_str(), name, v, lo, hi);
+    return float(v < lo ? lo : hi);
+}
+
+/* Member `key` of an extension object, `def` when absent. */
+double ext_number(Ctx &c, const tinygltf::Value &ext, const char *key, double def, const std::string &what)
+{
+    if (!ext.IsObject() || !ext.Has(key))
+        return def;
+    const tinygltf::Value &v = ext.Get(key);
+    if (v.IsNumber())
+        return v.GetNumberAsDouble();
+    warn(c, "%s: %s is not a number (ignored)", what.c_str(), key);
+    return def;
+}
+
+const tinygltf::Value *extension(const tinygltf::Material &mat, const char *name)
+{
+    auto it = mat.extensions.find(name);
+    return it == mat.extensions.end() ? nullptr : &it->second;
+}
+
+uint32_t texture_slot(Ctx &c, int index, int tex_coord, const std::string &what, const char *slot)
+{
+    if (index < 0)
+        return GN_INVALID;
+    if (tex_coord != 0) {
+        warn(c, "%s: %s uses TEXCOORD_%d, only TEXCOORD_0 is supported (texture ignored)", what.c_str(), slot, tex_coord);
+        return GN_INVALID;
+    }
+    return c.texture_map[size_t(index)];
+}
+
+bool number_triple(const tinygltf::Value &v, float out[3])
+{
+    if (!v.IsArray() || v.ArrayLen() != 3)
+        return false;
+    for (int k = 0; k < 3; k++) {
+        if (!v.Get(k).IsNumber())
+            return false;
+        out[k] = float(v.Get(k).GetNumberAsDouble());
+    }
+    return true;
+}
+
+/* extras: {"gonio": {"brdf": NAME, PARAM: number, ..., "phong": {...}}} */
+void read_gonio_extras(Ctx &c, const tinygltf::Value &extras, const std::string &what, GnMaterial &g, scene_material_extras &x)
+{
+    if (!extras.IsObject() || !extras.Has("gonio"))
+        return;
+    const tinygltf::Value &go = extras.Get("gonio");
+    if (!go.IsObject()) {
+        warn(c, "%s: extras.gonio is not an object (ignored)", what.c_str());
+        return;
+    }
+    for (const std::string &key : go.Keys()) {
+        const tinygltf::Value &v = go.Get(key);
+        if (key == "brdf") {
+            if (!v.IsString() || v.Get<std::string>().size() >= sizeof x.brdf)
+                warn(c, "%s: extras.gonio.brdf must be a name of at most %zu characters (ignored)", what.c_str(), sizeof x.brdf - 1);
+            else
+                snprintf(x.brdf, sizeof x.brdf, "%s", v.Get<std::string>().c_str());
+        } else if (key == "phong") {
+            if (!v.IsObject()) {
+                warn(c, "%s: extras.gonio.phong is not an object (ignored)", what.c_str());
+                continue;
+            }
+            x.has_phong = true;
+            struct { const char *name; vec3 *dst; } cols[] = {{"ambient", &g.phong_ambient}, {"diffuse", &g.phong_diffuse},
+                                                              {"specular", &g.phong_specular}, {"emission", &g.phong_emission}};
+            for (auto &col : cols) {
+                float t[3];
+                if (!v.Has(col.name))
+                    continue;
+                if (number_triple(v.Get(col.name), t) && t[0] >= 0 && t[1] >= 0 && t[2] >= 0)
+                    *col.dst = vec3{t[0], t[1], t[2]};
+                else
+                    warn(c, "%s: extras.gonio.phong.%s must be 3 non-negative numbers (ignored)", what.c_str(), col.name);
+            }
+            if (v.Has("shininess")) {
+                const tinygltf::Value &s = v.Get("shininess");
+                if (s.IsNumber() && s.GetNumberAsDouble() >= 0)
+                    g.phong_shininess = float(s.GetNumberAsDouble());
+                else
+                    warn(c, "%s: extras.gonio.phong.shininess must be a non-negative number (ignored)", what.c_str());
+            }
+        } else if (!v.IsNumber() || x.num_params == 8 || key.size() >= sizeof x.param_names[0]) {
+            warn(c, "%s: extras.gonio.%s ignored (parameters are up to 8 numbers with names of at most %zu characters)",
+                 what.c_str(), key.substr(0, 64).c_str(), sizeof x.param_names[0] - 1);
+        } else {
+            snprintf(x.param_names[x.num_params], sizeof x.param_names[0], "%s", key.c_str());
+            x.param_values[x.num_params++] = float(v.GetNumberAsDouble());
+        }
+    }
+}
+
+void convert_material(Ctx &c, int mi, GnMaterial &g, scene_material_extras &x, char name[64])
+{
+    const auto &mat = c.m.materials[size_t(mi)];
+    const auto &pbr = mat.pbrMetallicRoughness;
+    std::string what = label("material", mi, mat.name);
+    snprintf(name, 64, "%s", mat.name.empty() ? ("material " + std::to_string(mi)).c_str() : mat.name.c_str());
+    scene_material_default(&g);
+    if (pbr.baseColorFactor.size() == 4)
+        g.base_color = vec4{ranged(c, pbr.baseColorFactor[0], 0, 1, what, "baseColorFactor"),
+                            ranged(c, pbr.baseColorFactor[1], 0, 1, what, "baseColorFactor"),
+                            ranged(c, pbr.baseColorFactor[2], 0, 1, what, "baseColorFactor"),
+                            ranged(c, pbr.baseColorFactor[3], 0, 1, what, "baseColorFactor")};
+    g.metallic = ranged(c, pbr.metallicFactor, 0, 1, what, "metallicFactor");
+    g.roughness = ranged(c, pbr.roughnessFactor, 0, 1, what, "roughnessFactor");
+    float strength = 1;
+    if (const tinygltf::Value *e = extension(mat, "KHR_materials_emissive_strength"))
+        strength = ranged(c, ext_number(c, *e, "emissiveStrength", 1, what), 0, INFINITY, what, "emissiveStrength");
+    if (mat.emissiveFactor.size() == 3)
+        g.emissive = vec3{ranged(c, mat.emissiveFactor[0], 0, 1, what, "emissiveFactor") * strength,
+                          ranged(c, mat.emissiveFactor[1], 0, 1, what, "emissiveFactor") * strength,
+                          ranged(c, mat.emissiveFactor[2], 0, 1, what, "emissiveFactor") * strength};
+    if (const tinygltf::Value *e = extension(mat, "KHR_materials_specular")) {
+        g.specular = ranged(c, ext_number(c, *e, "specularFactor", 1, what), 0, 1, what, "specularFactor");
+        float t[3];
+        if (e->IsObject() && e->Has("specularColorFactor")) {
+            if (number_triple(e->Get("specularColorFactor"), t) && t[0] >= 0 && t[1] >= 0 && t[2] >= 0)
+                g.specular_color = vec3{t[0], t[1], t[2]};
+            else
+                warn(c, "%s: specularColorFactor must be 3 non-negative numbers (ignored)", what.c_str());
+        }
+    }
+    if (const tinygltf::Value *e = extension(mat, "KHR_materials_transmission"))
+        g.transmission = ranged(c, ext_number(c, *e, "transmissionFactor", 0, what), 0, 1, what, "transmissionFactor");
+    if (const tinygltf::Value *e = extension(mat, "KHR_materials_ior")) {
+        /* KHR_materials_ior allows 0 besides [1, inf): F0 = ((ior-1)/(ior+1))^2 = 1, a mirror. */
+        double ior = ext_number(c, *e, "ior", 1.5, what);
+        g.ior = ior == 0 ? 0.0f : ranged(c, ior, 1, INFINITY, what, "ior");
+    }
+    if (extension(mat, "KHR_materials_unlit"))
+        g.flags |= GN_MAT_UNLIT;
+    if (mat.doubleSided)
+        g.flags |= GN_MAT_DOUBLE_SIDED;
+    g.normal_scale = float(mat.normalTexture.scale);
+    g.occlusion_strength = ranged(c, mat.occlusionTexture.strength, 0, 1, what, "occlusionTexture.strength");
+    g.alpha_cutoff = ranged(c, mat.alphaCutoff, 0, INFINITY, what, "alphaCutoff");
+    if (mat.alphaMode == "MASK" || mat.alphaMode == "BLEND")
+        warn(c, "%s: alphaMode %s is rendered opaque", what.c_str(), mat.alphaMode.c_str());
+    else if (mat.alphaMode != "OPAQUE")
+        warn(c, "%s: unknown alphaMode '%s' (rendered opaque)", what.c_str(), mat.alphaMode.substr(0, 64).c_str());
+    g.tex_base = texture_slot(c, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, what, "baseColorTexture");
+    g.tex_mr = texture_slot(c, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, what,
+                            "metallicRoughnessTexture");
+    g.tex_normal = texture_slot(c, mat.normalTexture.index, mat.normalTexture.texCoord, what, "normalTexture");
+    g.tex_emissive = texture_slot(c, mat.emissiveTexture.index, mat.emissiveTexture.texCoord, what, "emissiveTexture");
+    g.tex_occlusion = texture_slot(c, mat.occlusionTexture.index, mat.occlusionTexture.texCoord, what, "occlusionTexture");
+    scene_phong_from_pbr(&g);
+    read_gonio_extras(c, mat.extras, what, g, x);
+}
+
+void load_materials(Ctx &c, scene *out)
+{
+    size_t n = c.m.materials.size();
+    bool need_default = false;
+    for (uint32_t t = 0; t < out->num_triangles; t++)
+        need_default |= out->tri_material[t] == n;
+    out->num_materials = uint32_t(n + (need_default ? 1 : 0));
+    out->materials = static_cast<GnMaterial *>(util_calloc(out->num_materials, sizeof(GnMaterial)));
+    out->material_extras = static_cast<scene_material_extras *>(util_calloc(out->num_materials, sizeof(scene_material_extras)));
+    out->material_names = static_cast<char(*)[64]>(util_calloc(out->num_materials, 64));
+    for (size_t i = 0; i < n; i++)
+        convert_material(c, int(i), out->materials[i], out->material_extras[i], out->material_names[i]);
+    if (need_default) {
+        scene_material_default(&out->materials[n]);
+        snprintf(out->material_names[n], 64, "default");
+    }
+}
+
+/* ---- scene_load ------------------------------------------------------------------------------- */
+
+bool parse(Ctx &c, uint8_t *data, size_t size)
+{
+    const char *ext = strrchr(c.path, '.');
+    bool glb = (size >= 4 && memcmp(data, "glTF", 4) == 0) || (ext && strcasecmp(ext, ".glb") == 0);
+    const uint8_t *json = data;
+    size_t json_len = size, len = size;
+    if (size > UINT32_MAX)
+        return fail(c, "file too large (%zu bytes)", size);
+    if (glb && !(len = check_glb(c, data, size, &json, &json_len)))
+        return false;
+    if (!glb && size == 0)
+        return fail(c, "empty file");
+    if (!check_json_text(c, json, json_len))
+        return false;
+    /* tinygltf calls any JSON under 4 bytes "too short"; padded, it says what is wrong. */
+    std::string small = size < 4 ? std::string(reinterpret_cast<const char *>(data), size) + "   " : "";
+    const char *text = small.empty() ? reinterpret_cast<const char *>(data) : small.c_str();
+    unsigned text_len = small.empty() ? unsigned(len) : unsigned(small.size());
+    std::string base_dir(c.path, strrchr(c.path, '/') ? size_t(strrchr(c.path, '/') - c.path) : 0);
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(image_callback, &c);
+    std::string err, warnings;
+    bool ok = glb ? loader.LoadBinaryFromMemory(&c.m, &err, &warnings, data, unsigned(len), base_dir)
+                  : loader.LoadASCIIFromString(&c.m, &err, &warnings, text, text_len, base_dir);
+    /* tinygltf 2.7 only warns about external images it cannot read, which get their own
+     * warning in load_images_and_textures: `warnings` is not repeated. */
+    if (!ok && err.empty())
+        return fail(c, "cannot parse glTF");
+    report_lines(c, err, !ok);
+    return ok;
+}
+
+bool load(scene *out, const char *path)
+{
+    Ctx c;
+    c.path = path;
+    snprintf(out->path, sizeof out->path, "%s", path);
+    size_t size = 0;
+    std::unique_ptr<uint8_t, decltype(&free)> data(static_cast<uint8_t *>(util_read_file(path, &size)), &free);
+    if (!data || !parse(c, data.get(), size))
+        return false;
+    data.reset();
+    if (!check_asset(c) || !check_buffers_and_views(c))
+        return false;
+    for (size_t i = 0; i < c.m.accessors.size(); i++)
+        check_accessor(c, int(i));
+    if (c.failed)
+        return false;
+    for (size_t mi = 0; mi < c.m.meshes.size(); mi++) {
+        if (c.m.meshes[mi].primitives.empty())
+            fail(c, "%s has no primitives", label("mesh", int(mi), c.m.meshes[mi].name).c_str());
+        for (size_t pi = 0; pi < c.m.meshes[mi].primitives.size(); pi++)
+            check_primitive(c, int(mi), int(pi));
+    }
+    if (c.failed || !check_textures_and_materials(c) || !check_nodes_and_scenes(c))
+        return false;
+    check_cameras(c);
+    check_lights(c);
+    for (size_t i = 0; i < c.m.accessors.size(); i++)
+        check_accessor_data(c, int(i));
+    if (!load_meshes(c))
+        return false;
+    std::vector<Instance> inst, cams, lights;
+    if (!collect_instances(c, inst, cams, lights) || !bake_geometry(c, inst, out))
+        return false;
+    load_images_and_textures(c, out);
+    load_materials(c, out);
+    bake_cameras(c, cams, out);
+    bake_lights(c, lights, out);
+    out->num_gltf_meshes = uint32_t(c.m.meshes.size());
+    out->num_nodes = uint32_t(c.m.nodes.size());
+    uint32_t dropped = scene_drop_invalid_triangles(out);
+    if (dropped)
+        warn(c, "dropped %u triangle(s) with non-finite or huge (|x| > 1e15) vertex positions", dropped);
+    if (out->num_triangles == 0)
+        return fail(c, "no triangles");
+    scene_compute_bounds(out);
+    return true;
+}
+
+} // namespace
+
+bool scene_load(scene *out, const char *path)
+{
+    bool ok = false;
+    memset(out, 0, sizeof *out);
+    try {
+        ok = load(out, path);
+    } catch (const std::bad_alloc &) {
+        util_error("%s: out of memory", path);
+    } catch (const std::exception &e) {
+        util_error("%s: %s", path, e.what());
+    } catch (...) {
+        util_error("%s: unexpected error in the glTF loader", path);
+    }
+    if (!ok)
+        scene_destroy(out);
+    return ok;
+}
