@@ -38,7 +38,7 @@ bool image_write_exr(const image *img, const char *path, const image_attr *attrs
 
 /* Reads a scanline or tiled EXR (half, float or uint channels) into float planes. False
  * with an error naming the file on any problem (missing, not EXR, truncated). Attributes
- * of type string/int/float/double can be fetched with image_read_exr_attrs. */
+ * of type string/int/float/double can be fetched with image_exr_attr_double/string. */
 bool image_read_exr(image *img, const char *path);
 /* Reads one attribute from an EXR header as a double (int, float or double attributes) or
  * string; false if absent. */
@@ -69,7 +69,10 @@ typedef struct image_metrics {
 } image_metrics;
 
 /* Compares the channels present in both images among R, G, B (or the first channel of
- * each when neither has RGB). False with an error when sizes differ or nothing matches. */
+ * each when neither has RGB). False with an error when sizes differ or nothing matches.
+ * NaN/Inf values are counted in nonfinite and their pixel pairs left out of the other metrics. */
 bool image_compare(const image *a, const image *b, image_metrics *m);
+/* The same over the n named channels, each of which must exist in both images. */
+bool image_compare_channels(const image *a, const image *b, const char *const *names, int n, image_metrics *m);
 
 #endif

@@ -1,1 +1,13 @@
 /* Tests of the image module: TEST(suite, name) lines, defined in test_image.c. */
+TEST(image, exr_roundtrip)
+TEST(image, exr_half)
+TEST(image, exr_tiled)
+TEST(image, exr_bad_files)
+TEST(image, exr_write_fails)
+TEST(image, srgb)
+TEST(image, png)
+TEST(image, metrics)
+TEST(image, diff_cli)
+TEST(image, draw_text)
+TEST(image, draw_shapes)
+TEST(image, draw_colormap)
