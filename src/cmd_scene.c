@@ -1,0 +1,294 @@
+/* cmd_scene.c: `gonio scene cornell|teapot` and `gonio teapot`: the project's own scenes as
+ * glTF. The Cornell box follows the Cornell Program of Computer Graphics' published
+ * measurements (graphics.cornell.edu/online/box/data.html); the teapot scene is the
+ * lecture's OpenGL 1.x example (red diffuse, white specular, shininess 128, light from
+ * (1,1,1)). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+#include "gltf_write.h"
+#include "teapot.h"
+#include "util.h"
+
+#define SCENE_TEAPOT_LEVEL 8
+#define SCENE_TEAPOT_MAX_LEVEL 256 /* 4.2 M triangles: far past any use */
+
+static const char scene_usage[] =
+    "usage: gonio scene cornell -o FILE.gltf\n"
+    "       gonio scene teapot [--level N] -o FILE.gltf\n"
+    "       gonio teapot [--level N] -o FILE.gltf\n"
+    "\n"
+    "Writes one of gonio's own scenes as a self-contained glTF 2.0 file.\n"
+    "  cornell             the Cornell box (published measurements, metres, one area light)\n"
+    "  teapot              the Utah teapot as in the lecture's OpenGL 1.x example\n"
+    "  -o, --output FILE   the .gltf to write\n"
+    "  --level N           teapot: N x N grid cells per Bezier patch, 1..256 (default 8);\n"
+    "                      64 N^2 - 8 N triangles\n";
+
+/* Rotation of a node whose -Z (view or light direction) is turned to the direction
+ * (-cos(pitch) sin(yaw), -sin(pitch), -cos(pitch) cos(yaw)): q = q_y(yaw) q_x(-pitch). */
+static void yaw_pitch_quat(double yaw, double pitch, float q[4])
+{
+    double sy = sin(yaw / 2), cy = cos(yaw / 2), sx = sin(-pitch / 2), cx = cos(-pitch / 2);
+    q[0] = (float)(cy * sx);
+    q[1] = (float)(cx * sy);
+    q[2] = (float)(-sy * sx);
+    q[3] = (float)(cy * cx);
+}
+
+/* ---- Cornell box -------------------------------------------------------------------------
+ * Quads in the published frame (millimetres, right-handed, Y up, the camera at
+ * (278, 273, -800) looking along +z, so +x is on its LEFT). A rotation by 180 degrees about
+ * Y (x -> 278 - x, z -> -z, then metres) turns the camera to look down glTF's -Z from
+ * (0, 0.273, 0.8) with the red wall (x ~ 556) on its left at x' = -0.278, as in the
+ * photographs. A rotation keeps the scene's handedness; a mirror of z alone would swap the
+ * walls. */
+typedef float cornell_quad[4][3];
+
+static const cornell_quad cornell_floor[] = {
+    {{552.8f, 0, 0}, {0, 0, 0}, {0, 0, 559.2f}, {549.6f, 0, 559.2f}}};
+static const cornell_quad cornell_ceiling[] = {
+    {{556, 548.8f, 0}, {556, 548.8f, 559.2f}, {0, 548.8f, 559.2f}, {0, 548.8f, 0}}};
+static const cornell_quad cornell_back[] = {
+    {{549.6f, 0, 559.2f}, {0, 0, 559.2f}, {0, 548.8f, 559.2f}, {556, 548.8f, 559.2f}}};
+static const cornell_quad cornell_red[] = {
+    {{552.8f, 0, 0}, {549.6f, 0, 559.2f}, {556, 548.8f, 559.2f}, {556, 548.8f, 0}}};
+static const cornell_quad cornell_green[] = {
+    {{0, 0, 559.2f}, {0, 0, 0}, {0, 548.8f, 0}, {0, 548.8f, 559.2f}}};
+/* The published light is at the ceiling's height (548.8); 0.1 mm lower keeps the two
+ * surfaces apart, as pbrt's and Mitsuba's versions do. */
+static const cornell_quad cornell_light[] = {
+    {{343, 548.7f, 227}, {343, 548.7f, 332}, {213, 548.7f, 332}, {213, 548.7f, 227}}};
+static const cornell_quad cornell_short[] = {
+    {{130, 165, 65}, {82, 165, 225}, {240, 165, 272}, {290, 165, 114}},
+    {{290, 0, 114}, {290, 165, 114}, {240, 165, 272}, {240, 0, 272}},
+    {{130, 0, 65}, {130, 165, 65}, {290, 165, 114}, {290, 0, 114}},
+    {{82, 0, 225}, {82, 165, 225}, {130, 165, 65}, {130, 0, 65}},
+    {{240, 0, 272}, {240, 165, 272}, {82, 165, 225}, {82, 0, 225}}};
+static const cornell_quad cornell_tall[] = {
+    {{423, 330, 247}, {265, 330, 296}, {314, 330, 456}, {472, 330, 406}},
+    {{423, 0, 247}, {423, 330, 247}, {472, 330, 406}, {472, 0, 406}},
+    {{472, 0, 406}, {472, 330, 406}, {314, 330, 456}, {314, 0, 456}},
+    {{314, 0, 456}, {314, 330, 456}, {265, 330, 296}, {265, 0, 296}},
+    {{265, 0, 296}, {265, 330, 296}, {423, 330, 247}, {423, 0, 247}}};
+
+enum { CORNELL_WHITE, CORNELL_RED, CORNELL_GREEN, CORNELL_LIGHT, CORNELL_MATERIALS };
+#define CORNELL_MAX_QUADS 5
+
+typedef struct cornell_part {
+    const char *name;
+    const cornell_quad *quads;
+    int num_quads;
+    uint32_t material;
+    bool outward; /* block faces face out of the block; walls and light into the box */
+} cornell_part;
+
+typedef struct cornell_mesh {
+    float positions[CORNELL_MAX_QUADS * 4 * 3], normals[CORNELL_MAX_QUADS * 4 * 3];
+    uint32_t indices[CORNELL_MAX_QUADS * 6];
+} cornell_mesh;
+
+static void cornell_to_gltf(const float p[3], float out[3])
+{
+    out[0] = (278.0f - p[0]) * 0.001f;
+    out[1] = p[1] * 0.001f;
+    out[2] = 0.0f - p[2] * 0.001f; /* 0 - x: no "-0" in the file */
+}
+
+static void sub3(const float a[3], const float b[3], float out[3])
+{
+    for (int k = 0; k < 3; k++)
+        out[k] = a[k] - b[k];
+}
+
+static void cross3(const float a[3], const float b[3], float out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Flat-shaded quads, two triangles each, wound counter-clockwise about the side they face:
+ * into the box (towards its centre) or out of a block (away from the block's centre). */
+static void cornell_build(const cornell_part *part, cornell_mesh *m)
+{
+    static const float box_centre[3] = {278, 274.4f, 279.6f};
+    static const uint32_t corners[6] = {0, 1, 2, 0, 2, 3};
+    float centre[3] = {0, 0, 0};
+    const float *ref = box_centre;
+    if (part->outward) { /* the top quad is first: its middle, at half the block's height */
+        for (int c = 0; c < 4; c++)
+            for (int k = 0; k < 3; k++)
+                centre[k] += part->quads[0][c][k] / 4;
+        centre[1] /= 2;
+        ref = centre;
+    }
+    for (int q = 0; q < part->num_quads; q++) {
+        float p[4][3], d0[3], d1[3], n[3], to_ref[3], ref_g[3], len;
+        bool flip;
+        for (int c = 0; c < 4; c++)
+            cornell_to_gltf(part->quads[q][c], p[c]);
+        cornell_to_gltf(ref, ref_g);
+        sub3(p[2], p[0], d0);
+        sub3(p[3], p[1], d1);
+        cross3(d0, d1, n); /* the quad's normal for its vertex order (diagonals' cross) */
+        sub3(ref_g, p[0], to_ref);
+        flip = (n[0] * to_ref[0] + n[1] * to_ref[1] + n[2] * to_ref[2] > 0) == part->outward;
+        len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * (flip ? -1.0f : 1.0f);
+        for (int c = 0; c < 4; c++) {
+            int src = flip ? (4 - c) % 4 : c;
+            for (int k = 0; k < 3; k++) {
+                m->positions[(4 * q + c) * 3 + k] = p[src][k];
+                m->normals[(4 * q + c) * 3 + k] = n[k] / len;
+            }
+        }
+        for (int t = 0; t < 6; t++)
+            m->indices[6 * q + t] = 4 * (uint32_t)q + corners[t];
+    }
+}
+
+static bool write_cornell(const char *path)
+{
+    static const cornell_part parts[] = {
+        {"floor", cornell_floor, 1, CORNELL_WHITE, false},
+        {"ceiling", cornell_ceiling, 1, CORNELL_WHITE, false},
+        {"back_wall", cornell_back, 1, CORNELL_WHITE, false},
+        {"left_wall_red", cornell_red, 1, CORNELL_RED, false},
+        {"right_wall_green", cornell_green, 1, CORNELL_GREEN, false},
+        {"short_block", cornell_short, 5, CORNELL_WHITE, true},
+        {"tall_block", cornell_tall, 5, CORNELL_WHITE, true},
+        {"light", cornell_light, 1, CORNELL_LIGHT, false},
+    };
+    enum { NUM_PARTS = sizeof parts / sizeof *parts };
+    /* Reflectances and the light's radiance (17, 12, 4): RGB fits of the measured spectra
+     * as in Benedikt Bitterli's Rendering Resources (Mitsuba/pbrt/Tungsten "cornell-box"),
+     * all Lambertian: specularFactor 0 removes the glTF dielectric's specular layer. The
+     * emissive factor must lie in [0, 1], so the strength carries the 17. */
+#define CORNELL_LAMBERT(nm, r, g, b) \
+    {.name = nm, .base_color = {r, g, b, 1}, .roughness = 1, .has_specular = true, \
+     .specular_color = {1, 1, 1}}
+    gltf_write_material materials[CORNELL_MATERIALS] = {
+        [CORNELL_WHITE] = CORNELL_LAMBERT("white", 0.725f, 0.71f, 0.68f),
+        [CORNELL_RED] = CORNELL_LAMBERT("red", 0.63f, 0.065f, 0.05f),
+        [CORNELL_GREEN] = CORNELL_LAMBERT("green", 0.14f, 0.45f, 0.091f),
+        [CORNELL_LIGHT] = CORNELL_LAMBERT("light", 0.78f, 0.78f, 0.78f),
+    };
+#undef CORNELL_LAMBERT
+    cornell_mesh built[NUM_PARTS];
+    gltf_write_mesh meshes[NUM_PARTS];
+    gltf_write_node nodes[NUM_PARTS + 1];
+    /* The published camera: 35 mm focal length, 25 x 25 mm film. */
+    gltf_write_camera camera = {
+        .name = "camera", .yfov = (float)(2 * atan(12.5 / 35.0)), .aspect = 1, .znear = 0.01f};
+    gltf_write_desc desc = {.meshes = meshes, .num_meshes = NUM_PARTS,
+                            .materials = materials, .num_materials = CORNELL_MATERIALS,
+                            .cameras = &camera, .num_cameras = 1,
+                            .nodes = nodes, .num_nodes = NUM_PARTS + 1};
+    materials[CORNELL_LIGHT].emissive[0] = 1;
+    materials[CORNELL_LIGHT].emissive[1] = 12.0f / 17.0f;
+    materials[CORNELL_LIGHT].emissive[2] = 4.0f / 17.0f;
+    materials[CORNELL_LIGHT].emissive_strength = 17;
+    for (int i = 0; i < NUM_PARTS; i++) {
+        cornell_build(&parts[i], &built[i]);
+        meshes[i] = (gltf_write_mesh){.name = parts[i].name,
+                                      .num_vertices = 4 * (uint32_t)parts[i].num_quads,
+                                      .positions = built[i].positions,
+                                      .normals = built[i].normals,
+                                      .num_indices = 6 * (uint32_t)parts[i].num_quads,
+                                      .indices = built[i].indices,
+                                      .material = parts[i].material};
+        nodes[i] = (gltf_write_node){.name = parts[i].name, .index = (uint32_t)i};
+    }
+    nodes[NUM_PARTS] = (gltf_write_node){.name = "camera", .kind = GLTF_WRITE_NODE_CAMERA,
+                                         .translation = {0, 0.273f, 0.8f}};
+    return gltf_write_file(path, &desc);
+}
+
+/* ---- the lecture's teapot ----------------------------------------------------------------
+ * glMaterial: diffuse (1,0,0), specular (1,1,1), shininess 128 (and OpenGL's default ambient
+ * 0.2), kept verbatim in extras for the Phong modes. For the path tracer, the roughness
+ * whose Phong-equivalent exponent 2/alpha^2 - 2 (Walter et al. 2007) is 128, alpha =
+ * roughness^2. The light: glLightfv(GL_POSITION, {1,1,1,0}), a directional light from
+ * (1,1,1), i.e. shining along -(1,1,1)/sqrt(3): yaw 45 degrees, pitch asin(1/sqrt(3)). */
+static bool write_teapot(const char *path, int level)
+{
+    teapot_mesh t;
+    bool ok;
+    gltf_write_mesh mesh;
+    gltf_write_material material = {
+        .name = "red_plastic", .base_color = {1, 0, 0, 1}, .metallic = 0,
+        .roughness = powf(2.0f / 130.0f, 0.25f),
+        .extras = "{\"gonio\":{\"phong\":{\"diffuse\":[1,0,0],\"specular\":[1,1,1],"
+                  "\"shininess\":128,\"ambient\":[0.2,0.2,0.2]}}}"};
+    gltf_write_light light = {.name = "sun", .type = GLTF_WRITE_DIRECTIONAL, .intensity = 1};
+    /* Front-right and a little above; the target centres the teapot in the frame. */
+    const double yaw = 30 * M_PI / 180, pitch = 20 * M_PI / 180, dist = 3.4;
+    const float target[3] = {0.19f, 0.45f, -0.07f};
+    gltf_write_camera camera = {.name = "camera", .yfov = (float)(30 * M_PI / 180),
+                                .aspect = 4.0f / 3.0f, .znear = 0.05f};
+    gltf_write_node nodes[3] = {
+        {.name = "teapot", .kind = GLTF_WRITE_NODE_MESH},
+        {.name = "sun", .kind = GLTF_WRITE_NODE_LIGHT},
+        {.name = "camera", .kind = GLTF_WRITE_NODE_CAMERA,
+         .translation = {target[0] + (float)(dist * cos(pitch) * sin(yaw)),
+                         target[1] + (float)(dist * sin(pitch)),
+                         target[2] + (float)(dist * cos(pitch) * cos(yaw))}}};
+    gltf_write_desc desc = {.meshes = &mesh, .num_meshes = 1, .materials = &material,
+                            .num_materials = 1, .cameras = &camera, .num_cameras = 1,
+                            .lights = &light, .num_lights = 1, .nodes = nodes, .num_nodes = 3};
+    yaw_pitch_quat(M_PI / 4, asin(1 / sqrt(3.0)), nodes[1].rotation);
+    yaw_pitch_quat(yaw, pitch, nodes[2].rotation);
+    teapot_tessellate(&t, level);
+    mesh = (gltf_write_mesh){.name = "teapot", .num_vertices = t.num_vertices,
+                             .positions = t.positions, .normals = t.normals,
+                             .num_indices = 3 * t.num_triangles, .indices = t.indices};
+    ok = gltf_write_file(path, &desc);
+    teapot_destroy(&t);
+    return ok;
+}
+
+/* Options shared by both commands; name is the scene (NULL for `gonio teapot`). */
+static int run(int argc, char **argv, int first, const char *name)
+{
+    const char *out = NULL;
+    long level = SCENE_TEAPOT_LEVEL;
+    bool teapot = !name || !strcmp(name, "teapot");
+    for (int i = first; i < argc; i++) {
+        const char *a = argv[i], *val;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            fputs(scene_usage, stdout);
+            return 0;
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            if (!(out = cli_value(argc, argv, &i)))
+                return 2;
+        } else if (!strcmp(a, "--level") && teapot) {
+            if (!(val = cli_value(argc, argv, &i)))
+                return 2;
+            if (!util_parse_int(val, 1, SCENE_TEAPOT_MAX_LEVEL, &level))
+                return cli_usage_error(argv[0], "--level '%s': expected an integer 1..%d", val,
+                                       SCENE_TEAPOT_MAX_LEVEL);
+        } else {
+            return cli_usage_error(argv[0], "unknown option '%s'", a);
+        }
+    }
+    if (name && !teapot && strcmp(name, "cornell"))
+        return cli_usage_error(argv[0], "unknown scene '%s' (cornell or teapot)", name);
+    if (!out)
+        return cli_usage_error(argv[0], "missing -o FILE.gltf");
+    return (teapot ? write_teapot(out, (int)level) : write_cornell(out)) ? 0 : 1;
+}
+
+int cmd_scene(int argc, char **argv)
+{
+    if (argc >= 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
+        fputs(scene_usage, stdout);
+        return 0;
+    }
+    if (argc < 2 || argv[1][0] == '-')
+        return cli_usage_error(argv[0], "which scene? (cornell or teapot)");
+    return run(argc, argv, 2, argv[1]);
+}
+
+int cmd_teapot(int argc, char **argv) { return run(argc, argv, 1, NULL); }

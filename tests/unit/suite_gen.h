@@ -1,0 +1,12 @@
+/* Tests of the scene generators (gltf_write, teapot, cmd_scene): TEST lines, in test_gen.c. */
+TEST(gen, gltf_roundtrip)
+TEST(gen, gltf_base64_padding)
+TEST(gen, gltf_unwritable)
+TEST(gen, teapot_counts)
+TEST(gen, teapot_topology)
+TEST(gen, teapot_normals)
+TEST(gen, teapot_convergence)
+TEST(gen, teapot_bounds)
+TEST(gen, cornell)
+TEST(gen, teapot_scene)
+TEST(gen, scene_usage)
