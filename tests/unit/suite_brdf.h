@@ -1,0 +1,10 @@
+/* Tests of the BRDF library (glsl/brdf.glsl through brdf_test.comp), defined in test_brdf.c. */
+TEST(brdf, model_table)
+TEST(brdf, fresnel)
+TEST(brdf, delta_lobes)
+TEST(brdf, finite_and_positive)
+TEST(brdf, reciprocity)
+TEST(brdf, lambert_albedo)
+TEST(brdf, sampling_matches_pdf)
+TEST(brdf, energy)
+TEST(brdf, broken_variants_fail)

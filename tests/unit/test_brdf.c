@@ -1,0 +1,835 @@
+/* test_brdf.c: the BRDF library (glsl/brdf.glsl) proven physical on the GPU through
+ * glsl/brdf_test.comp: finiteness and positivity everywhere, Helmholtz reciprocity, energy
+ * conservation (white-furnace albedo <= 1, = albedo for Lambert), sampling against the pdf
+ * by a chi-square test (as pbrt-v4 and Mitsuba 3 do), pdf normalisation, weight = f cos/pdf,
+ * the Fresnel equations against analytic values and a complex-arithmetic reference, the
+ * Dirac lobes; a self-test shows the checks reject a pdf scaled by 1.1 and a missing 1/pi.
+ * References are analytic or brute-force quadrature of eval, never sample() itself. */
+#include <complex.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "brdf.h"
+#include "test.h"
+#include "util.h"
+
+#define PI 3.14159265358979323846
+
+/* A spread of physically valid settings (max(diffuse) + specular <= 1): wide and narrow
+ * lobes, sums, Dirac lobes, both sides of dielectrics. */
+typedef struct config {
+    const char *model;
+    const char *params; /* "name=value ..." */
+} config;
+
+static const config configs[] = {
+    {"lambert", "diffuse=0.8,0.5,0.2"},
+    {"lambert", "diffuse=1"},
+    {"mirror", "reflectance=0.9,0.6,0.3"},
+    {"phong", "exponent=1"},
+    {"phong", "diffuse=0.5 specular=0.5 exponent=20"},
+    {"phong", "exponent=200"},
+    {"blinn-phong", "exponent=0"},
+    {"blinn-phong", "diffuse=0.3 specular=0.7 exponent=50"},
+    {"torrance-sparrow", "exponent=20"},
+    {"torrance-sparrow", "diffuse=0.5 specular=0.5 exponent=300 ior=1.8"},
+    {"beckmann", "alpha=0.5"},
+    {"beckmann", "diffuse=0.5 specular=0.5 alpha=0.1 ior=2"},
+    {"ggx", "alpha=0.7"},
+    {"ggx", "diffuse=0.6 specular=0.4 alpha=0.15"},
+    {"ggx", "diffuse=0.5 specular=0.5 alpha=0"},
+    {"conductor", ""},
+    {"conductor", "eta=1.5 k=0 alpha=0.5"},
+    {"conductor", "alpha=0"},
+    {"dielectric", ""},
+    {"dielectric", "alpha=0.3"},
+    {"dielectric", "alpha=0.1 ior=1.33 tint=0.8,0.9,1"},
+    {"gltf", ""},
+    {"gltf", "metallic=1 roughness=0.3 base-color=0.9,0.6,0.2"},
+    {"gltf", "metallic=0.3 roughness=0.2 specular-color=1,0.5,0.5 ior=1.7"},
+    {"gltf", "transmission=1 roughness=0.4"},
+    {"gltf", "roughness=0"},
+    {"gltf", "transmission=0.5 metallic=0.2 roughness=0"},
+};
+#define NUM_CONFIGS ((int)(sizeof configs / sizeof *configs))
+
+static bool make_setting(const config *c, brdf_setting *s)
+{
+    char buf[256], *save = NULL;
+    const brdf_model *m = brdf_model_find(c->model);
+    if (!m)
+        return false;
+    brdf_setting_init(s, m);
+    snprintf(buf, sizeof buf, "%s", c->params);
+    for (char *tok = strtok_r(buf, " ", &save); tok; tok = strtok_r(NULL, " ", &save)) {
+        char *eq = strchr(tok, '=');
+        if (!eq)
+            return false;
+        *eq = 0;
+        if (!brdf_setting_set(s, tok, eq + 1))
+            return false;
+    }
+    return true;
+}
+
+static const char *describe(const config *c)
+{
+    static char buf[300];
+    snprintf(buf, sizeof buf, "%s %s", c->model, c->params);
+    return buf;
+}
+
+/* ---- host helpers ------------------------------------------------------------------- */
+
+static uint64_t rng_state;
+static double rnd(void) /* splitmix64 -> [0, 1) */
+{
+    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return (double)((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+}
+
+static vec3 v3(double x, double y, double z) { return (vec3){(float)x, (float)y, (float)z}; }
+static vec3 polar(double theta, double phi) { return v3(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta)); }
+static vec3 rnd_u(void) { return v3(rnd() * 0.99999994, rnd() * 0.99999994, rnd() * 0.99999994); }
+static double rad(double deg) { return deg * PI / 180.0; }
+static bool finite3(vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
+static double sum3(vec3 v) { return (double)v.x + v.y + v.z; }
+
+static BrdfQuery query(const brdf_setting *s, uint32_t op, vec3 wo, vec3 wi, vec3 u)
+{
+    BrdfQuery q;
+    memset(&q, 0, sizeof q);
+    brdf_setting_to_query(s, &q);
+    q.op = op;
+    q.wo = wo;
+    q.wi = wi;
+    q.u = u;
+    return q;
+}
+
+static gpu test_gpu;
+static brdf_runner runner;
+#define CHUNK 65536 /* queries per batch: small buffers keep page faults (and ASan) cheap */
+static BrdfQuery *qbuf; /* CHUNK queries and results, reused by every batch */
+static BrdfResult *rbuf;
+
+static void grid_init(void);
+
+static bool open_runner(void)
+{
+    gpu_desc d = {.device_index = -1};
+    const char *env = getenv("GONIO_VALIDATE");
+    d.validate = env && !strcmp(env, "1");
+    if (!gpu_create(&test_gpu, &d)) {
+        CHECKF(false, "no Vulkan device");
+        return false;
+    }
+    brdf_runner_create(&runner, &test_gpu, CHUNK);
+    grid_init();
+    return true;
+}
+
+static void close_runner(void)
+{
+    brdf_runner_destroy(&runner);
+    CHECK(gpu_validation_message_count() == 0);
+    gpu_destroy(&test_gpu);
+    free(qbuf);
+    free(rbuf);
+    qbuf = NULL;
+    rbuf = NULL;
+}
+
+/* ---- statistics --------------------------------------------------------------------- */
+
+/* Regularised upper incomplete gamma Q(a, x) (series below a + 1, continued fraction above,
+ * as in Numerical Recipes 6.2): the chi-square tail is Q(dof / 2, chi2 / 2). */
+static double gamma_q(double a, double x)
+{
+    double lg = lgamma(a);
+    if (x <= 0)
+        return 1;
+    if (x < a + 1) {
+        double ap = a, sum = 1 / a, del = sum;
+        for (int n = 0; n < 1000 && fabs(del) > fabs(sum) * 1e-15; n++)
+            sum += del *= x / ++ap;
+        return 1 - sum * exp(-x + a * log(x) - lg);
+    }
+    double b = x + 1 - a, c = 1e300, d = 1 / b, h = d;
+    for (int i = 1; i < 1000; i++) {
+        double an = -i * (i - a), del;
+        b += 2;
+        d = an * d + b;
+        c = b + an / c;
+        d = 1 / (fabs(d) < 1e-300 ? 1e-300 : d);
+        del = d * c;
+        h *= del;
+        if (fabs(del - 1) < 1e-15)
+            break;
+    }
+    return exp(-x + a * log(x) - lg) * h;
+}
+
+static int cmp_by_expected(const void *a, const void *b)
+{
+    const double *x = a, *y = b;
+    return (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+/* Pearson chi-square p-value of observed against expected counts; cells expected below 5
+ * are pooled into one (Mitsuba 3's chi2 test does the same). */
+static double chi2_pvalue(const double *obs, const double *expct, int n)
+{
+    double (*cell)[2] = util_malloc(sizeof *cell * (size_t)n);
+    double pool_o = 0, pool_e = 0, chi2 = 0;
+    int cells = 0, i = 0;
+    for (int k = 0; k < n; k++)
+        cell[k][0] = obs[k], cell[k][1] = expct[k];
+    qsort(cell, (size_t)n, sizeof *cell, cmp_by_expected);
+    for (; i < n && (cell[i][1] < 5 || pool_e < 5); i++)
+        pool_o += cell[i][0], pool_e += cell[i][1];
+    if (pool_e > 0 || pool_o > 0) {
+        if (pool_e <= 0) {
+            free(cell);
+            return 0; /* samples where the pdf says none can be */
+        }
+        chi2 += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
+        cells++;
+    }
+    for (; i < n; i++, cells++)
+        chi2 += (cell[i][0] - cell[i][1]) * (cell[i][0] - cell[i][1]) / cell[i][1];
+    free(cell);
+    return cells < 2 ? 1 : gamma_q(0.5 * (cells - 1), 0.5 * chi2);
+}
+
+/* Sidak: per-test level so the whole family rejects a correct sampler with probability 0.01. */
+static double sidak(int tests) { return 1 - pow(1 - 0.01, 1.0 / tests); }
+
+/* ---- measuring one (setting, wo) --------------------------------------------------------- */
+
+/* The sphere in 10 x 20 equal-area bins (cos theta, phi), as pbrt-v4's chi2 test. Each bin
+ * is integrated by cells uniform in theta (so lobes at the poles stay resolved; the two
+ * polar bins get 4x more, for the narrow refracted lobes of glass seen head-on) and phi,
+ * with 2 x 2 Gauss-Legendre nodes per cell (exact for cubics). Half-vector lobes seen at
+ * grazing angles are slivers narrower than any grid (2 alpha cos(theta_o) wide in phi), so
+ * the quadrature checks stop at 75 degrees; sampled albedos cover the rest. */
+#define BT 10
+#define BP 20
+#define GT 24
+#define GP 12
+#define NBINS (BT * BP)
+#define NTH (2 * GT * (BT + 6)) /* theta nodes */
+#define NPH (BP * GP * 2)       /* phi nodes */
+#define NGRID (NTH * NPH)
+#define NSAMPLES 100000
+
+typedef struct measure {
+    double expected[NBINS + 1];  /* N * integral of pdf per bin; [NBINS]: the rest */
+    double observed[NBINS + 1];  /* sample counts; [NBINS]: failed or Dirac samples */
+    double pdf_integral;         /* integral of pdf over the sphere */
+    double albedo_quad[3];       /* integral of f |cos| (non-Dirac parts), by quadrature */
+    double albedo_mc[3];         /* mean sample weight, all parts */
+    double albedo_mc_smooth[3];  /* mean weight of the non-Dirac samples (times 1 or 0) */
+    double sigma_mc[3];          /* standard errors of albedo_mc */
+    double sigma_smooth[3];
+    double valid_smooth;         /* fraction of samples that are non-Dirac directions */
+    int bad_samples;             /* samples whose weight != f cos / pdf or pdf != pdf(wi) */
+    int nonfinite;
+} measure;
+
+static int bin_of(vec3 w)
+{
+    double phi = atan2(w.y, w.x);
+    int t = (int)floor((w.z + 1.0) / 2.0 * BT), p;
+    if (phi < 0)
+        phi += 2 * PI;
+    p = (int)floor(phi / (2 * PI) * BP);
+    t = t < 0 ? 0 : t >= BT ? BT - 1 : t;
+    p = p < 0 ? 0 : p >= BP ? BP - 1 : p;
+    return t * BP + p;
+}
+
+static vec3 grid_dir[NGRID];
+static double grid_weight[NGRID]; /* solid angle of each node */
+static int grid_bin[NGRID];
+
+static void grid_init(void)
+{
+    const double g = 0.5 / sqrt(3.0);
+    int n = 0, k = 0;
+    qbuf = util_malloc(sizeof *qbuf * CHUNK);
+    rbuf = util_malloc(sizeof *rbuf * CHUNK);
+    for (int bin = 0; bin < BT; bin++) {
+        int cells = bin == 0 || bin == BT - 1 ? 4 * GT : GT;
+        double th_lo = acos(-1 + 2.0 * (bin + 1) / BT), th_hi = acos(-1 + 2.0 * bin / BT);
+        double dth = (th_hi - th_lo) / cells;
+        for (int c = 0; c < 2 * cells; c++, n++) {
+            double th = th_lo + (c / 2 + 0.5 + (c % 2 ? g : -g)) * dth;
+            for (int p = 0; p < NPH; p++, k++) {
+                grid_dir[k] = polar(th, (p / 2 + 0.5 + (p % 2 ? g : -g)) * 2 * PI / (BP * GP));
+                grid_weight[k] = 0.5 * dth * sin(th) * PI / (BP * GP);
+                grid_bin[k] = bin * BP + p / (2 * GP);
+            }
+        }
+    }
+}
+
+/* Quadrature over the grid (when `grid`) and NSAMPLES samples of one (setting, wo).
+ * pdf_scale and f_scale break the measurement on purpose (the self-test). */
+static void measure_case(const brdf_setting *s, vec3 wo, bool grid, double pdf_scale, double f_scale, measure *m)
+{
+    BrdfQuery *q = qbuf;
+    BrdfResult *r = rbuf;
+    memset(m, 0, sizeof *m);
+    for (int k0 = 0; grid && k0 < NGRID; k0 += CHUNK) {
+        int n = NGRID - k0 < CHUNK ? NGRID - k0 : CHUNK;
+        BrdfQuery q0 = query(s, BRDF_OP_EVAL, wo, v3(0, 0, 1), v3(0, 0, 0));
+        for (int i = 0; i < n; i++) {
+            q[i] = q0;
+            q[i].wi = grid_dir[k0 + i];
+        }
+        brdf_runner_run(&runner, q, r, (size_t)n);
+        for (int i = 0; i < n; i++) {
+            double w = grid_weight[k0 + i], pdf = r[i].pdf * pdf_scale, cosw = fabs(q[i].wi.z) * w * f_scale;
+            m->nonfinite += !finite3(r[i].f) || !isfinite(r[i].pdf);
+            m->expected[grid_bin[k0 + i]] += pdf * w * NSAMPLES;
+            m->pdf_integral += pdf * w;
+            m->albedo_quad[0] += r[i].f.x * cosw;
+            m->albedo_quad[1] += r[i].f.y * cosw;
+            m->albedo_quad[2] += r[i].f.z * cosw;
+        }
+    }
+    m->expected[NBINS] = fmax(0, NSAMPLES * (1 - m->pdf_integral));
+    double sq[3] = {0}, sq_smooth[3] = {0};
+    for (int i0 = 0; i0 < NSAMPLES; i0 += CHUNK) {
+        int n = NSAMPLES - i0 < CHUNK ? NSAMPLES - i0 : CHUNK;
+        for (int i = 0; i < n; i++)
+            q[i] = query(s, BRDF_OP_SAMPLE, wo, v3(0, 0, 1), rnd_u());
+        brdf_runner_run(&runner, q, r, (size_t)n);
+        for (int i = 0; i < n; i++) {
+            const BrdfResult *x = &r[i];
+            double w[3] = {x->s_weight.x, x->s_weight.y, x->s_weight.z};
+            bool delta = (x->s_flags & BRDF_FLAG_DELTA) != 0, smooth = x->s_flags && !delta;
+            if (!finite3(x->s_weight) || !finite3(x->s_wi) || !isfinite(x->s_pdf)) {
+                m->nonfinite++;
+                continue;
+            }
+            if (smooth) {
+                double cosw = fabs(x->s_wi.z) / x->s_pdf_eval;
+                double fw[3] = {x->s_f.x * cosw, x->s_f.y * cosw, x->s_f.z * cosw};
+                for (int c = 0; c < 3; c++)
+                    if (fabs(w[c] - fw[c]) > 1e-4 * fabs(fw[c]) + 1e-6)
+                        m->bad_samples++;
+                if (fabs(x->s_pdf - x->s_pdf_eval) > 1e-4 * x->s_pdf_eval)
+                    m->bad_samples++;
+                m->observed[bin_of(x->s_wi)]++;
+                m->valid_smooth += 1.0 / NSAMPLES;
+            } else {
+                m->observed[NBINS]++;
+            }
+            for (int c = 0; c < 3; c++) {
+                w[c] *= f_scale;
+                m->albedo_mc[c] += w[c] / NSAMPLES;
+                sq[c] += w[c] * w[c] / NSAMPLES;
+                if (smooth) {
+                    m->albedo_mc_smooth[c] += w[c] / NSAMPLES;
+                    sq_smooth[c] += w[c] * w[c] / NSAMPLES;
+                }
+            }
+        }
+    }
+    for (int c = 0; c < 3; c++) {
+        m->sigma_mc[c] = sqrt(fmax(0, sq[c] - m->albedo_mc[c] * m->albedo_mc[c]) / NSAMPLES);
+        m->sigma_smooth[c] = sqrt(fmax(0, sq_smooth[c] - m->albedo_mc_smooth[c] * m->albedo_mc_smooth[c]) / NSAMPLES);
+    }
+}
+
+/* Does the setting have any non-Dirac part to test against its pdf? */
+static bool has_smooth_part(const measure *m) { return m->pdf_integral > 1e-3; }
+
+/* The chi-square verdict and the pdf-normalisation checks for one case; false with the
+ * reason in why. */
+static bool check_sampling(const measure *m, double alpha, char *why, size_t cap)
+{
+    double p = chi2_pvalue(m->observed, m->expected, NBINS + 1);
+    double tol = 5 * sqrt(fmax(m->valid_smooth * (1 - m->valid_smooth), 1e-4) / NSAMPLES) + 2e-3;
+    if (p < alpha) {
+        int worst = 0;
+        for (int i = 1; i <= NBINS; i++)
+            if (fabs(m->observed[i] - m->expected[i]) / sqrt(m->expected[i] + 1) >
+                fabs(m->observed[worst] - m->expected[worst]) / sqrt(m->expected[worst] + 1))
+                worst = i;
+        if (worst == NBINS)
+            return snprintf(why, cap, "chi2 p-value %.3g < %.3g; worst cell: failed/Dirac samples %g, expected %.1f",
+                            p, alpha, m->observed[worst], m->expected[worst]), false;
+        return snprintf(why, cap, "chi2 p-value %.3g < %.3g; worst cell: cos theta bin %d, phi bin %d: observed %g, "
+                        "expected %.1f", p, alpha, worst / BP, worst % BP, m->observed[worst], m->expected[worst]), false;
+    }
+    /* The pdf integrates to the probability that sample() returns a non-Dirac direction:
+     * 1 where it never fails or picks a Dirac lobe. */
+    if (m->pdf_integral > 1 + 2e-3)
+        return snprintf(why, cap, "pdf integrates to %.4f > 1", m->pdf_integral), false;
+    if (fabs(m->pdf_integral - m->valid_smooth) > tol)
+        return snprintf(why, cap, "pdf integrates to %.4f but %.4f of samples are non-Dirac directions",
+                        m->pdf_integral, m->valid_smooth), false;
+    return true;
+}
+
+/* Energy: albedo <= 1 by quadrature of eval (plus the Dirac parts' mean weight) and by the
+ * sample mean; and sample() agrees with eval/pdf: the mean weight of its non-Dirac samples
+ * equals the quadrature of f cos. False with the reason in why. */
+static bool check_energy(const measure *m, bool quadrature, char *why, size_t cap)
+{
+    for (int c = 0; c < 3 && !quadrature; c++)
+        if (m->albedo_mc[c] > 1 + 1e-3 + 5 * m->sigma_mc[c])
+            return snprintf(why, cap, "channel %d: albedo %.4f +- %.4f > 1 (sampled)", c, m->albedo_mc[c],
+                            m->sigma_mc[c]), false;
+    for (int c = 0; c < 3 && quadrature; c++) {
+        double delta = m->albedo_mc[c] - m->albedo_mc_smooth[c];
+        double total = m->albedo_quad[c] + delta;
+        double diff = m->albedo_mc_smooth[c] - m->albedo_quad[c];
+        if (total > 1 + 5e-3 + 5 * m->sigma_mc[c])
+            return snprintf(why, cap, "channel %d: albedo %.4f > 1 (quadrature)", c, total), false;
+        if (m->albedo_mc[c] > 1 + 1e-3 + 5 * m->sigma_mc[c])
+            return snprintf(why, cap, "channel %d: albedo %.4f +- %.4f > 1 (sampled)", c, m->albedo_mc[c],
+                            m->sigma_mc[c]), false;
+        if (fabs(diff) > 5 * m->sigma_smooth[c] + 5e-3 * m->albedo_quad[c] + 1e-3)
+            return snprintf(why, cap, "channel %d: mean sample weight %.4f +- %.4f != integral of f cos %.4f", c,
+                            m->albedo_mc_smooth[c], m->sigma_smooth[c], m->albedo_quad[c]), false;
+    }
+    return true;
+}
+
+/* ---- the tests -------------------------------------------------------------------------- */
+
+/* Model table and parameter parsing: clear errors for bad names and values. */
+void test_brdf_model_table(void)
+{
+    brdf_setting s;
+    for (int i = 0; i < brdf_num_models; i++)
+        CHECK(brdf_model_find(brdf_models[i].name) == &brdf_models[i]);
+    CHECK(brdf_model_find("blinn") == NULL);
+    CHECK(brdf_model_find("") == NULL);
+    brdf_setting_init(&s, brdf_model_find("phong"));
+    CHECK(s.v[BRDF_SLOT_PARAMS + BRDF_P_SHAPE] == 32);
+    CHECK(brdf_setting_set(&s, "exponent", "64") && s.v[BRDF_SLOT_PARAMS + BRDF_P_SHAPE] == 64);
+    CHECK(brdf_setting_set(&s, "diffuse", "0.5") && s.v[0] == 0.5f && s.v[1] == 0.5f && s.v[2] == 0.5f);
+    CHECK(brdf_setting_set(&s, "diffuse", "0.1,0.2,0.3") && s.v[0] == 0.1f && s.v[2] == 0.3f);
+    CHECK(!brdf_setting_set(&s, "alpha", "0.1"));        /* not a Phong parameter */
+    CHECK(!brdf_setting_set(&s, "exponent", "abc"));
+    CHECK(!brdf_setting_set(&s, "exponent", "-1"));      /* out of range */
+    CHECK(!brdf_setting_set(&s, "exponent", "1,2,3"));   /* scalar */
+    CHECK(!brdf_setting_set(&s, "diffuse", "0.1,0.2"));  /* two components */
+    CHECK(!brdf_setting_set(&s, "diffuse", "0.1,0.2,0.3,0.4"));
+    CHECK(!brdf_setting_set(&s, "diffuse", "0.1,,0.3"));
+    CHECK(!brdf_setting_set(&s, "diffuse", "nan"));
+    CHECK(!brdf_setting_set(&s, "diffuse", "1.5"));
+    CHECK(s.v[0] == 0.1f && s.v[BRDF_SLOT_PARAMS + BRDF_P_SHAPE] == 64); /* failures change nothing */
+    brdf_setting_init(&s, brdf_model_find("gltf"));
+    CHECK(brdf_setting_set(&s, "transmission", "0.5") && s.v[BRDF_SLOT_EXTRA + 3] == 0.5f);
+    CHECK(brdf_setting_set(&s, "specular-color", "1,0.5,0.25") && s.v[BRDF_SLOT_EXTRA + 2] == 0.25f);
+    for (int i = 0; i < NUM_CONFIGS; i++)
+        CHECKF(make_setting(&configs[i], &s), "config %s", describe(&configs[i]));
+}
+
+/* No NaN or Inf anywhere, f >= 0, pdf >= 0, weight >= 0, sampled directions unit length,
+ * and nothing from an opaque model below its surface: over random, grazing (|z| down to
+ * 1e-8 and 0), normal, back-facing and degenerate (wi = +-wo) directions and edge randoms. */
+void test_brdf_finite_and_positive(void)
+{
+    enum { N = 8192 };
+    if (!open_runner())
+        return;
+    BrdfQuery *q = qbuf;
+    BrdfResult *r = rbuf;
+    rng_state = 1;
+    for (int ci = 0; ci < NUM_CONFIGS; ci++) {
+        brdf_setting s;
+        int bad = 0, below = 0;
+        make_setting(&configs[ci], &s);
+        for (int i = 0; i < N; i++) {
+            vec3 wo = polar(acos(1 - 2 * rnd()), 2 * PI * rnd()), wi = polar(acos(1 - 2 * rnd()), 2 * PI * rnd());
+            vec3 u = rnd_u();
+            double g = pow(10.0, -2.0 - 6.0 * rnd()) * (rnd() < 0.5 ? -1 : 1);
+            switch (i % 8) {
+            case 1: wo = polar(acos(g), 2 * PI * rnd()); break;     /* grazing wo */
+            case 2: wi = polar(acos(g), 2 * PI * rnd()); break;     /* grazing wi */
+            case 3: wo = polar(PI / 2, 2 * PI * rnd()); wo.z = 0; wi = v3(-wo.x, -wo.y, 0); break; /* z = 0 */
+            case 4: wi = wo; break;
+            case 5: wi = v3(-wo.x, -wo.y, -wo.z); break;
+            case 6: wo = v3(0, 0, i & 8 ? 1 : -1); wi = v3(-wi.x, -wi.y, wi.z); break;
+            case 7: u = v3(i & 8 ? 0 : 0.99999994, i & 16 ? 0 : 0.99999994, i & 32 ? 0 : 0.99999994); break;
+            }
+            q[i] = query(&s, BRDF_OP_EVAL | BRDF_OP_SAMPLE, wo, wi, u);
+        }
+        brdf_runner_run(&runner, q, r, N);
+        for (int i = 0; i < N; i++) {
+            const BrdfResult *x = &r[i];
+            bool ok = finite3(x->f) && isfinite(x->pdf) && finite3(x->s_wi) && finite3(x->s_weight) &&
+                      isfinite(x->s_pdf) && finite3(x->s_f) && isfinite(x->s_pdf_eval);
+            ok = ok && x->f.x >= 0 && x->f.y >= 0 && x->f.z >= 0 && x->pdf >= 0 && x->s_pdf >= 0;
+            ok = ok && x->s_weight.x >= 0 && x->s_weight.y >= 0 && x->s_weight.z >= 0;
+            if (x->s_flags) {
+                double len = sqrt(sum3((vec3){x->s_wi.x * x->s_wi.x, x->s_wi.y * x->s_wi.y, x->s_wi.z * x->s_wi.z}));
+                ok = ok && fabs(len - 1) < 1e-4 && x->s_pdf > 0;
+            } else {
+                ok = ok && sum3(x->s_weight) == 0;
+            }
+            if (!ok && bad++ < 3)
+                fprintf(stderr, "  %s: wo (%g %g %g) wi (%g %g %g) u (%g %g %g): f %g pdf %g s_wi (%g %g %g) "
+                        "w %g pdf %g flags %u\n", describe(&configs[ci]), q[i].wo.x, q[i].wo.y, q[i].wo.z,
+                        q[i].wi.x, q[i].wi.y, q[i].wi.z, q[i].u.x, q[i].u.y, q[i].u.z, x->f.x, x->pdf,
+                        x->s_wi.x, x->s_wi.y, x->s_wi.z, x->s_weight.x, x->s_pdf, x->s_flags);
+            if (!brdf_setting_two_sided(&s) && (q[i].wo.z <= 0 || q[i].wi.z <= 0) && (sum3(x->f) != 0 || x->pdf != 0))
+                below++;
+            if (!brdf_setting_two_sided(&s) && x->s_flags && (q[i].wo.z <= 0 || x->s_wi.z <= 0))
+                below++;
+        }
+        CHECKF(bad == 0, "%s: %d queries with NaN/Inf or negative values", describe(&configs[ci]), bad);
+        CHECKF(below == 0, "%s: %d queries reflect light below an opaque surface", describe(&configs[ci]), below);
+    }
+    close_runner();
+}
+
+/* Helmholtz reciprocity f(wo, wi) = f(wi, wo) for every reflection; refraction instead obeys
+ * f(wo, wi) / eta(wi)^2 = f(wi, wo) / eta(wo)^2 (eta of the side each direction is on),
+ * because the transmitted solid angle is compressed by (eta_t / eta_i)^2. */
+void test_brdf_reciprocity(void)
+{
+    enum { N = 4096 };
+    if (!open_runner())
+        return;
+    BrdfQuery *q = qbuf;
+    BrdfResult *r = rbuf;
+    rng_state = 2;
+    for (int ci = 0; ci < NUM_CONFIGS; ci++) {
+        brdf_setting s;
+        int bad = 0, nonzero = 0;
+        make_setting(&configs[ci], &s);
+        bool sides = brdf_setting_two_sided(&s);
+        double ior = s.model->id == BRDF_DIELECTRIC ? s.v[BRDF_SLOT_PARAMS + BRDF_P_DIELECTRIC_IOR]
+                                                     : s.v[BRDF_SLOT_PARAMS + 3];
+        for (int i = 0; i < N; i++) {
+            double zo = rnd(), zi = rnd();
+            if (sides && i % 4 == 1)
+                zi = -zi; /* refraction */
+            if (sides && i % 4 == 2)
+                zo = -zo, zi = -zi; /* reflection inside */
+            if (sides && i % 4 == 3)
+                zo = -zo;
+            vec3 wo = polar(acos(zo), 2 * PI * rnd()), wi = polar(acos(zi), 2 * PI * rnd());
+            q[2 * i] = query(&s, BRDF_OP_EVAL, wo, wi, v3(0, 0, 0));
+            q[2 * i + 1] = query(&s, BRDF_OP_EVAL, wi, wo, v3(0, 0, 0));
+        }
+        brdf_runner_run(&runner, q, r, 2 * N);
+        for (int i = 0; i < N; i++) {
+            double scale = 1; /* f(wo, wi) / f(wi, wo) predicted */
+            vec3 o = q[2 * i].wo, w = q[2 * i].wi;
+            if (o.z * w.z < 0) {
+                /* Within ~3 degrees of grazing on the microfacet (its refracted side at the
+                 * critical angle) 1 - F has an infinite slope and float directions cannot
+                 * fix it to better than 10%: skip those pairs. */
+                double e = w.z < 0 ? ior : 1 / ior, h[3] = {e * w.x + o.x, e * w.y + o.y, e * w.z + o.z};
+                double len = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+                if (fabs(h[0] * o.x + h[1] * o.y + h[2] * o.z) < 0.05 * len ||
+                    fabs(h[0] * w.x + h[1] * w.y + h[2] * w.z) < 0.05 * len)
+                    continue;
+                scale = w.z < 0 ? ior * ior : 1 / (ior * ior);
+            }
+            const float *a = &r[2 * i].f.x, *b = &r[2 * i + 1].f.x;
+            for (int c = 0; c < 3; c++) {
+                double x = a[c], y = b[c] * scale;
+                nonzero += x > 0;
+                if (fabs(x - y) > 2e-4 * fmax(x, y) + 1e-7 && bad++ < 3)
+                    fprintf(stderr, "  %s: f(wo,wi) = %g, f(wi,wo) * %g = %g (wo %.9g %.9g %.9g wi %.9g %.9g %.9g)\n",
+                            describe(&configs[ci]), x, scale, y, q[2 * i].wo.x, q[2 * i].wo.y, q[2 * i].wo.z, q[2 * i].wi.x, q[2 * i].wi.y, q[2 * i].wi.z);
+            }
+        }
+        CHECKF(bad == 0, "%s: %d pairs break reciprocity", describe(&configs[ci]), bad);
+        /* Dirac-only models have nothing to compare; the rest must have been exercised. */
+        bool dirac = !strcmp(s.model->name, "mirror") ||
+                     (s.model->id == BRDF_CONDUCTOR && s.v[BRDF_SLOT_PARAMS + BRDF_P_ALPHA] == 0) ||
+                     (s.model->id == BRDF_DIELECTRIC && s.v[BRDF_SLOT_PARAMS + BRDF_P_DIELECTRIC_ALPHA] == 0);
+        CHECKF(dirac || nonzero > N / 4, "%s: only %d non-zero values", describe(&configs[ci]), nonzero);
+    }
+    close_runner();
+}
+
+/* Lambert: the directional albedo equals the albedo at every angle, by quadrature of eval
+ * and by uniform-sphere Monte Carlo (independent of sample()); and cosine sampling makes
+ * every weight exactly the albedo. */
+void test_brdf_lambert_albedo(void)
+{
+    const double theta[] = {0, 30, 60, 85, 89.9};
+    enum { N = CHUNK };
+    brdf_setting s;
+    const double kd[3] = {0.8, 0.5, 0.2};
+    if (!open_runner())
+        return;
+    BrdfQuery *q = qbuf;
+    BrdfResult *r = rbuf;
+    make_setting(&configs[0], &s);
+    rng_state = 3;
+    for (int t = 0; t < 5; t++) {
+        vec3 wo = polar(rad(theta[t]), 0.3);
+        double mean[3] = {0}, sq[3] = {0};
+        measure m;
+        measure_case(&s, wo, true, 1, 1, &m);
+        for (int i = 0; i < N; i++)
+            q[i] = query(&s, BRDF_OP_EVAL | BRDF_OP_SAMPLE, wo, polar(acos(1 - 2 * rnd()), 2 * PI * rnd()), rnd_u());
+        brdf_runner_run(&runner, q, r, N);
+        int bad_weight = 0;
+        for (int i = 0; i < N; i++) {
+            const float *f = &r[i].f.x, *w = &r[i].s_weight.x;
+            for (int c = 0; c < 3; c++) {
+                double e = f[c] * fabs(q[i].wi.z) * 4 * PI;
+                mean[c] += e / N;
+                sq[c] += e * e / N;
+                bad_weight += fabs(w[c] - kd[c]) > 1e-5;
+            }
+        }
+        for (int c = 0; c < 3; c++) {
+            double sigma = sqrt((sq[c] - mean[c] * mean[c]) / N);
+            CHECKF(fabs(mean[c] - kd[c]) < 4 * sigma, "theta %g: uniform MC albedo %.5f +- %.5f != %.2f", theta[t],
+                   mean[c], sigma, kd[c]);
+            CHECKF(fabs(m.albedo_quad[c] - kd[c]) < 1e-3, "theta %g: quadrature albedo %.5f != %.2f", theta[t],
+                   m.albedo_quad[c], kd[c]);
+        }
+        CHECKF(bad_weight == 0, "theta %g: %d weights differ from the albedo", theta[t], bad_weight);
+        CHECKF(fabs(m.pdf_integral - 1) < 1e-3, "theta %g: pdf integrates to %.5f", theta[t], m.pdf_integral);
+    }
+    close_runner();
+}
+
+/* The directions bsdf_sample draws follow bsdf_pdf (chi-square, Sidak-corrected 1% level
+ * over all cases); pdf integrates to the fraction of non-Dirac samples (1 where sampling
+ * never fails); each sample's weight and pdf equal f cos / pdf and pdf at its wi; the mean
+ * weight equals the quadrature of f cos; and that albedo is <= 1 (energy conservation). */
+void test_brdf_sampling_matches_pdf(void)
+{
+    const double theta[] = {0, 40, 75, 110, 160};
+    int tests = 0;
+    if (!open_runner())
+        return;
+    for (int ci = 0; ci < NUM_CONFIGS; ci++) {
+        brdf_setting s;
+        make_setting(&configs[ci], &s);
+        tests += brdf_setting_two_sided(&s) ? 5 : 3;
+    }
+    rng_state = 4;
+    for (int ci = 0; ci < NUM_CONFIGS; ci++) {
+        brdf_setting s;
+        make_setting(&configs[ci], &s);
+        for (int t = 0; t < (brdf_setting_two_sided(&s) ? 5 : 3); t++) {
+            const char *what = describe(&configs[ci]);
+            char why[200];
+            measure m;
+            measure_case(&s, polar(rad(theta[t]), 1.0), true, 1, 1, &m);
+            CHECKF(m.nonfinite == 0, "%s wo %.0f: %d NaN/Inf", what, theta[t], m.nonfinite);
+            CHECKF(m.bad_samples == 0, "%s wo %.0f: %d samples whose weight or pdf disagree with eval/pdf", what,
+                   theta[t], m.bad_samples);
+            if (has_smooth_part(&m) || m.valid_smooth > 0)
+                CHECKF(check_sampling(&m, sidak(tests), why, sizeof why), "%s wo %.0f deg: %s", what, theta[t], why);
+            CHECKF(check_energy(&m, true, why, sizeof why), "%s wo %.0f deg: %s", what, theta[t], why);
+        }
+    }
+    close_runner();
+}
+
+/* Energy conservation from normal to grazing incidence (and from inside glass): the sampled
+ * white-furnace albedo is <= 1 within its error. */
+void test_brdf_energy(void)
+{
+    const double theta[] = {0, 30, 60, 80, 85, 89, 89.9, 100, 135, 179};
+    if (!open_runner())
+        return;
+    rng_state = 5;
+    for (int ci = 0; ci < NUM_CONFIGS; ci++) {
+        brdf_setting s;
+        make_setting(&configs[ci], &s);
+        for (int t = 0; t < (brdf_setting_two_sided(&s) ? 10 : 7); t++) {
+            measure m;
+            char why[200];
+            measure_case(&s, polar(rad(theta[t]), 2.0), false, 1, 1, &m);
+            CHECKF(m.nonfinite == 0, "%s wo %.1f: %d NaN/Inf", describe(&configs[ci]), theta[t], m.nonfinite);
+            CHECKF(check_energy(&m, false, why, sizeof why), "%s wo %.1f deg: %s", describe(&configs[ci]), theta[t],
+                   why);
+        }
+    }
+    close_runner();
+}
+
+/* The checks have teeth: a pdf scaled by 1.1 fails the chi-square and the normalisation, and
+ * a Lambert without its 1/pi (f scaled by pi) fails energy conservation and the agreement of
+ * sample weights with eval. */
+void test_brdf_broken_variants_fail(void)
+{
+    brdf_setting s;
+    measure m;
+    if (!open_runner())
+        return;
+    rng_state = 6;
+    make_setting(&configs[1], &s); /* white Lambert */
+    char why[200] = "";
+    measure_case(&s, polar(rad(30), 1.0), true, 1, 1, &m);
+    CHECKF(check_sampling(&m, sidak(100), why, sizeof why), "the correct Lambert fails: %s", why);
+    CHECKF(check_energy(&m, true, why, sizeof why), "the correct Lambert fails: %s", why);
+    measure_case(&s, polar(rad(30), 1.0), true, 1.1, 1, &m);
+    CHECKF(!check_sampling(&m, sidak(100), why, sizeof why), "a pdf scaled by 1.1 passed the sampling checks");
+    printf("    pdf * 1.1 rejected: %s\n", why);
+    measure_case(&s, polar(rad(30), 1.0), true, 1, PI, &m);
+    CHECKF(!check_energy(&m, true, why, sizeof why), "a Lambert without 1/pi passed the energy checks");
+    printf("    Lambert without 1/pi rejected: %s\n", why);
+    close_runner();
+}
+
+/* ---- Fresnel -------------------------------------------------------------------------------- */
+
+/* The lecture's r_par, r_perp with complex cos_t: an independent conductor reference. */
+static double fresnel_complex(double cos_i, double complex n)
+{
+    double sin2 = 1 - cos_i * cos_i;
+    double complex cos_t = csqrt(1 - sin2 / (n * n));
+    double complex rpar = (n * cos_i - cos_t) / (n * cos_i + cos_t);
+    double complex rperp = (cos_i - n * cos_t) / (cos_i + n * cos_t);
+    return 0.5 * (creal(rpar * conj(rpar)) + creal(rperp * conj(rperp)));
+}
+
+/* Dielectric Fresnel against analytic values: ((n-1)/(n+1))^2 at normal incidence, r_par = 0
+ * at Brewster's angle, 1 at grazing and beyond the critical angle (total internal
+ * reflection), equal transmission both ways through the interface (Stokes); conductors
+ * against complex arithmetic and ((n-1)^2+k^2)/((n+1)^2+k^2); Schlick at its end points. */
+void test_brdf_fresnel(void)
+{
+    enum { N = 64 };
+    BrdfQuery q[N];
+    BrdfResult r[N];
+    const double eta = 1.5, cn[3] = {0.143, 0.374, 1.442}, ck[3] = {3.983, 2.385, 1.603};
+    double brewster = atan(eta), crit = asin(1 / eta);
+    if (!open_runner())
+        return;
+    memset(q, 0, sizeof q);
+    for (int i = 0; i < N; i++) {
+        double c = i < 40 ? cos(rad(90.0 * i / 39)) : 0;
+        q[i].op = BRDF_OP_FRESNEL;
+        q[i].params = (vec4){(float)eta, 0.04f, 1, 0};
+        q[i].color = v3(cn[0], cn[1], cn[2]);
+        q[i].extra = (vec4){(float)ck[0], (float)ck[1], (float)ck[2], 0};
+        q[i].wo.z = (float)c;
+    }
+    q[40].wo.z = (float)cos(brewster);
+    q[41].wo.z = (float)-cos(crit + 0.01); /* inside, just past the critical angle */
+    q[42].wo.z = (float)-cos(crit - 0.01);
+    q[43].wo.z = (float)cos(rad(40));
+    q[44].wo.z = (float)-sqrt(1 - sin(rad(40)) * sin(rad(40)) / (eta * eta)); /* the refracted ray of 43 */
+    q[45].wo.z = 0.5f;
+    q[45].color = v3(1.5, 0.3, 2); /* k = 0: a dielectric */
+    q[45].extra = (vec4){0, 0, 0, 0};
+    brdf_runner_run(&runner, q, r, N);
+    double f0 = pow((eta - 1) / (eta + 1), 2);
+    CHECKF(fabs(r[0].f.x - f0) < 1e-6, "F(normal) %g != %g", r[0].f.x, f0);
+    CHECKF(r[39].f.x > 0.999f, "F(grazing) %g", r[39].f.x);
+    {
+        double ci = cos(brewster), ct = cos(PI / 2 - brewster);
+        double rperp = (ci - eta * ct) / (ci + eta * ct);
+        CHECKF(fabs(r[40].f.x - 0.5 * rperp * rperp) < 1e-5, "Brewster: F %g != r_perp^2/2 %g", r[40].f.x,
+               0.5 * rperp * rperp);
+    }
+    CHECKF(r[41].f.x == 1.0f, "past the critical angle F = %g, not 1 (TIR)", r[41].f.x);
+    CHECKF(r[42].f.x < 1.0f, "before the critical angle F = %g", r[42].f.x);
+    CHECKF(fabs(r[43].f.x - r[44].f.x) < 1e-5, "Stokes: F out %g != F in %g", r[43].f.x, r[44].f.x);
+    for (int i = 0; i < 40; i++) {
+        double c = q[i].wo.z, m5 = pow(1 - c, 5);
+        CHECKF(fabs(r[i].f.y - (0.04 + 0.96 * m5)) < 1e-6, "Schlick at cos %g: %g", c, r[i].f.y);
+        for (int ch = 0; ch < 3; ch++) {
+            double ref = fresnel_complex(c, cn[ch] + ck[ch] * I);
+            CHECKF(fabs((&r[i].s_f.x)[ch] - ref) < 2e-5, "conductor ch %d cos %g: %g != %g", ch, c,
+                   (&r[i].s_f.x)[ch], ref);
+            if (i == 0) {
+                double n = cn[ch], k = ck[ch], normal = ((n - 1) * (n - 1) + k * k) / ((n + 1) * (n + 1) + k * k);
+                CHECKF(fabs((&r[i].s_f.x)[ch] - normal) < 1e-5, "conductor at normal incidence");
+            }
+        }
+        /* The dielectric against the same complex formula with k = 0. */
+        CHECKF(fabs(r[i].f.x - fresnel_complex(c, eta)) < 1e-5, "dielectric cos %g: %g", c, r[i].f.x);
+    }
+    CHECKF(fabs(r[45].s_f.y - fresnel_complex(0.5, 0.3)) < 1e-5, "conductor with k = 0, n < 1 (TIR side)");
+    CHECKF(fabs(r[45].s_f.x - fresnel_complex(0.5, 1.5)) < 1e-5, "conductor with k = 0");
+    close_runner();
+}
+
+/* Dirac lobes: the mirror returns r(wo) with weight R (the lecture's Lo = Li(r(wo))); the
+ * smooth dielectric reflects with probability F and refracts by Snell's law otherwise (always
+ * reflecting past the critical angle); polished conductors and glTF weight by their Fresnel. */
+void test_brdf_delta_lobes(void)
+{
+    enum { N = 2000 };
+    const double thetas[] = {0, 25, 50, 70, 85, 130, 150, 170};
+    brdf_setting mirror, glass, gold, metal;
+    if (!open_runner())
+        return;
+    BrdfQuery *q = qbuf;
+    BrdfResult *r = rbuf;
+    make_setting(&configs[2], &mirror);
+    make_setting(&configs[18], &glass);
+    make_setting(&configs[17], &gold);
+    make_setting(&(config){"gltf", "metallic=1 roughness=0 base-color=0.9,0.6,0.2"}, &metal);
+    for (int t = 0; t < 8; t++) {
+        double th = rad(thetas[t]), ct = cos(th), eta = ct > 0 ? 1.5 : 1 / 1.5;
+        vec3 wo = polar(th, 0.7), refl = v3(-wo.x, -wo.y, wo.z);
+        double fr = fresnel_complex(fabs(ct), eta);
+        double sin_t = sin(th) / eta;
+        int nrefl = 0, bad = 0;
+        if (sin_t >= 1)
+            fr = 1;
+        for (int i = 0; i < N; i++)
+            q[i] = query(&glass, BRDF_OP_EVAL | BRDF_OP_SAMPLE, wo, refl, v3((i + 0.5) / N, 0.5, 0.5));
+        brdf_runner_run(&runner, q, r, N);
+        for (int i = 0; i < N; i++) {
+            const BrdfResult *x = &r[i];
+            bad += x->f.x != 0 || x->pdf != 0; /* eval/pdf exclude the Dirac lobes */
+            if (x->s_flags == (BRDF_FLAG_REFLECTION | BRDF_FLAG_DELTA)) {
+                nrefl++;
+                bad += fabs(x->s_wi.x - refl.x) + fabs(x->s_wi.y - refl.y) + fabs(x->s_wi.z - refl.z) > 1e-6;
+                bad += fabs(x->s_weight.x - 1) > 1e-5;
+            } else if (x->s_flags == (BRDF_FLAG_TRANSMISSION | BRDF_FLAG_DELTA)) {
+                /* Snell: sin_t = sin_i / eta, the other side, in the plane of incidence */
+                double st = sqrt(x->s_wi.x * x->s_wi.x + x->s_wi.y * x->s_wi.y);
+                bad += fabs(st - sin_t) > 1e-5 || x->s_wi.z * wo.z >= 0;
+                bad += fabs(x->s_wi.x * wo.y - x->s_wi.y * wo.x) > 1e-5 || x->s_wi.x * wo.x > 0;
+                bad += fabs(x->s_weight.x - 1) > 1e-5;
+            } else {
+                bad++;
+            }
+        }
+        CHECKF(bad == 0, "glass at %g deg: %d wrong samples", thetas[t], bad);
+        CHECKF(fabs((double)nrefl / N - fr) <= 1.0 / N, "glass at %g deg: reflected %d/%d, F = %g", thetas[t], nrefl,
+               N, fr);
+        if (ct <= 0)
+            continue;
+        const brdf_setting *opaque[] = {&mirror, &gold, &metal};
+        for (int k = 0; k < 3; k++)
+            q[k] = query(opaque[k], BRDF_OP_EVAL | BRDF_OP_SAMPLE, wo, refl, v3(0.3, 0.6, 0.9));
+        brdf_runner_run(&runner, q, r, 3);
+        double m5 = pow(1 - ct, 5);
+        const double want[3][3] = {
+            {0.9, 0.6, 0.3},
+            {fresnel_complex(ct, 0.143 + 3.983 * I), fresnel_complex(ct, 0.374 + 2.385 * I),
+             fresnel_complex(ct, 1.442 + 1.603 * I)},
+            {0.9 + 0.1 * m5, 0.6 + 0.4 * m5, 0.2 + 0.8 * m5}};
+        for (int k = 0; k < 3; k++) {
+            CHECKF(r[k].s_flags == (BRDF_FLAG_REFLECTION | BRDF_FLAG_DELTA), "model %d flags %u", k, r[k].s_flags);
+            CHECKF(fabs(r[k].s_wi.x - refl.x) + fabs(r[k].s_wi.y - refl.y) + fabs(r[k].s_wi.z - refl.z) < 1e-6,
+                   "model %d: not the mirror direction", k);
+            CHECKF(r[k].f.x == 0 && r[k].pdf == 0, "model %d: eval/pdf of a Dirac lobe not 0", k);
+            for (int c = 0; c < 3; c++)
+                CHECKF(fabs((&r[k].s_weight.x)[c] - want[k][c]) < 2e-5, "model %d at %g deg ch %d: weight %g != %g",
+                       k, thetas[t], c, (&r[k].s_weight.x)[c], want[k][c]);
+        }
+    }
+    close_runner();
+}
