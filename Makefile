@@ -20,8 +20,9 @@ endif
 PKGS := vulkan glfw3 OpenEXR tinygltf libpng zlib
 WARN := -Wall -Wextra -Wshadow -Werror
 CPPFLAGS += -Isrc -Iglsl -I$(BUILD)/spv -MMD -MP
-CFLAGS += -std=c11 -D_DEFAULT_SOURCE $(WARN)
-CXXFLAGS += -std=c++14 -Wall -Wextra -Werror
+CFLAGS += -std=c11 -D_DEFAULT_SOURCE -pthread $(WARN)
+CXXFLAGS += -std=c++14 -pthread -Wall -Wextra -Werror
+LDFLAGS += -pthread
 
 ifeq ($(config),release)
 OPT := -O2 -g
@@ -46,11 +47,13 @@ LIB_OBJ := $(SRC_C:%.c=$(BUILD)/%.o) $(SRC_CXX:%.cpp=$(BUILD)/%.o)
 MAIN_OBJ := $(BUILD)/src/main.o
 TEST_SRC := $(wildcard tests/unit/*.c)
 TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/%.o)
+TOOL_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(wildcard tests/tool/*.c))
 SHADERS := $(wildcard glsl/*.comp)
 SPV_HDR := $(SHADERS:glsl/%.comp=$(BUILD)/spv/%.h)
 
 GONIO := $(BUILD)/gonio
 UNIT := $(BUILD)/unit_tests
+TESTTOOL := $(BUILD)/testtool
 
 # ---- Debian packages -------------------------------------------------------------------
 DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
@@ -92,6 +95,9 @@ $(GONIO): $(MAIN_OBJ) $(LIB_OBJ) | deps
 $(UNIT): $(TEST_OBJ) $(LIB_OBJ) | deps
 	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) -lm
 
+$(TESTTOOL): $(TOOL_OBJ) $(LIB_OBJ) | deps
+	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) -lm
+
 $(BUILD)/%.o: %.c | deps $(SPV_HDR)
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
@@ -106,14 +112,15 @@ $(BUILD)/spv/%.h: glsl/%.comp | deps
 	glslangValidator -V --target-env vulkan1.1 -Iglsl --depfile $(BUILD)/spv/$*.d -o $(BUILD)/spv/$*.spv $< >/dev/null || { glslangValidator -V --target-env vulkan1.1 -Iglsl -o /dev/null $<; exit 1; }
 	spirv-val --target-env vulkan1.1 $(BUILD)/spv/$*.spv
 	glslangValidator -V --target-env vulkan1.1 -Iglsl --vn spv_$(subst -,_,$*) -o $@ $< >/dev/null
+	@sed -i 's|\.spv:|.h:|' $(BUILD)/spv/$*.d
 shaders: $(SPV_HDR)
 
 run: all
 	@mkdir -p out
 	$(GONIO) render scenes/cornell.gltf -o out/cornell.exr --png out/cornell.png
 
-test: all $(UNIT) test-deps
-	@GONIO=$(GONIO) UNIT=$(UNIT) CONFIG=$(config) tests/run.sh
+test: all $(UNIT) $(TESTTOOL) test-deps
+	@GONIO=$(GONIO) UNIT=$(UNIT) TESTTOOL=$(TESTTOOL) CONFIG=$(config) tests/run.sh
 
 unit: $(UNIT)
 	$(UNIT) $(T)
@@ -128,4 +135,4 @@ install: all
 clean:
 	rm -rf build out
 
--include $(LIB_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(TEST_OBJ:.o=.d) $(wildcard $(BUILD)/spv/*.d)
+-include $(LIB_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(TEST_OBJ:.o=.d) $(TOOL_OBJ:.o=.d) $(wildcard $(BUILD)/spv/*.d)

@@ -37,7 +37,8 @@ typedef uint32_t uint;
 #define GN_BIND_AOV 10u      /* vec4[3 * pixels]: normal, albedo, depth sums */
 #define GN_BIND_VCOLOR 11u   /* vec4[] per vertex: Gouraud colours */
 #define GN_BIND_EMITTERS 12u /* GnEmitter[]: emissive triangles for light sampling */
-#define GN_BIND_COUNT 13u
+#define GN_BIND_STATUS 13u   /* uint[4]: [0] rays whose walk hit the traversal budget */
+#define GN_BIND_COUNT 14u
 
 /* Work-group size of the 2D image kernels: 8x8 matches lavapipe's 8-wide SIMD rows and is a
  * good default for GPUs (64 threads = 2 warps / 1 wavefront). */
@@ -58,6 +59,9 @@ typedef uint32_t uint;
 #define GN_LIGHT_POINT 0u
 #define GN_LIGHT_SPOT 1u
 #define GN_LIGHT_DIRECTIONAL 2u
+/* A small Lambertian emitter seen as a point: I(theta) = color * max(cos theta, 0) around
+ * direction. Stands in for emissive geometry in the local modes (src/render.c). */
+#define GN_LIGHT_COSINE 3u
 
 #define GN_INVALID 0xffffffffu
 

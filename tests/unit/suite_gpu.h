@@ -1,1 +1,5 @@
-/* Tests of the gpu module: TEST(suite, name) lines, defined in test_gpu.c. */
+/* Tests of the GLSL traversal and the renderer on the Vulkan device (test_gpu.c). */
+TEST(gpu, traversal_random)
+TEST(gpu, traversal_sphere)
+TEST(gpu, traversal_edges)
+TEST(gpu, traversal_deep)

@@ -3,3 +3,5 @@
 #include "suite_scene.h"
 #include "suite_image.h"
 #include "suite_gpu.h"
+#include "suite_gen.h"
+#include "suite_brdf.h"

@@ -1,0 +1,189 @@
+// bvh.glsl: closest-hit and any-hit BVH traversal over GnBvhNode (both children's boxes in
+// one node, Aila & Laine 2009) with the watertight ray-triangle test of Woop, Benthin &
+// Wald (JCGT 2013). The C traversal in src/bvh.c is the same algorithm and the reference in
+// the tests; keep the two in step (including what counts as a step).
+//
+// llvmpipe ends an invocation's loops silently after 65,535 iterations in total (DESIGN.md).
+// A walk is bounded by frame.traversal_budget node visits: a ray that needs more reports
+// `truncated` instead of a silently wrong answer, and the host counts those.
+#ifndef GONIO_BVH_GLSL
+#define GONIO_BVH_GLSL
+
+#include "scene.glsl"
+
+#define BVH_STACK 64
+
+struct Hit {
+    float t, u, v;
+    uint tri;       // BVH-order triangle, GN_INVALID on a miss
+    uint steps;     // GnBvhNode visits
+    bool truncated; // the budget ran out: the result may be wrong
+};
+
+// Per-ray constants of the watertight test. The paper permutes the axes (kx, ky, kz) and
+// shears; here the permutation and shear are folded into three row vectors, so that the
+// triangle loop has no per-lane dynamic component indexing (costly on SIMD CPUs such as
+// lavapipe): Ax = A[kx] - Sx A[kz] = dot(sx, A), and likewise for y and z. Every vertex is
+// transformed by the same arithmetic, so shared edges stay watertight.
+struct RayPre {
+    vec3 o;
+    vec3 inv;       // 1 / d, with zero components replaced by a huge finite value
+    vec3 sx, sy, sz;
+};
+
+RayPre ray_pre(vec3 o, vec3 d)
+{
+    RayPre r;
+    r.o = o;
+    vec3 ad = abs(d);
+    int kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
+    int kx = kz == 2 ? 0 : kz + 1;
+    int ky = kx == 2 ? 0 : kx + 1;
+    if (d[kz] < 0.0) { int tmp = kx; kx = ky; ky = tmp; } // keep the winding
+    vec3 ex = vec3(0.0), ey = vec3(0.0), ez = vec3(0.0);
+    ex[kx] = 1.0; ey[ky] = 1.0; ez[kz] = 1.0;
+    float Sx = d[kx] / d[kz], Sy = d[ky] / d[kz], Sz = 1.0 / d[kz];
+    r.sx = ex - Sx * ez;
+    r.sy = ey - Sy * ez;
+    r.sz = Sz * ez;
+    r.inv = vec3(1.0) / mix(d, sign(d) * 1e-30 + vec3(equal(d, vec3(0.0))) * 1e-30,
+                            lessThan(ad, vec3(1e-30)));
+    return r;
+}
+
+// a * b - c * d with one rounding error at most 1.5 ulp (Kahan; see Jeannerod et al. 2013).
+float diff_of_products(float a, float b, float c, float d)
+{
+    precise float cd = c * d;
+    precise float err = fma(-c, d, cd);
+    precise float dop = fma(a, b, -cd);
+    return dop + err;
+}
+
+// Watertight test: vertices relative to the origin, sheared so the ray is +z; the edge
+// functions decide inside-ness exactly consistently on shared edges.
+bool tri_intersect(RayPre r, vec3 p0, vec3 p1, vec3 p2, float tmin, float tmax,
+                   out float t, out float u, out float v)
+{
+    vec3 A = p0 - r.o, B = p1 - r.o, C = p2 - r.o;
+    float Ax = dot(r.sx, A), Ay = dot(r.sy, A);
+    float Bx = dot(r.sx, B), By = dot(r.sy, B);
+    float Cx = dot(r.sx, C), Cy = dot(r.sy, C);
+    float U = Cx * By - Cy * Bx;
+    float V = Ax * Cy - Ay * Cx;
+    float W = Bx * Ay - By * Ax;
+    // On an edge (a zero), Woop et al. recompute in double precision; many GPUs have no
+    // fp64, and Kahan's FMA form is within 1.5 ulp of exact, so its sign (and zero) is the
+    // exact one.
+    if (U == 0.0 || V == 0.0 || W == 0.0) {
+        U = diff_of_products(Cx, By, Cy, Bx);
+        V = diff_of_products(Ax, Cy, Ay, Cx);
+        W = diff_of_products(Bx, Ay, By, Ax);
+    }
+    if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0))
+        return false;
+    float det = U + V + W;
+    if (det == 0.0)
+        return false;
+    float Az = dot(r.sz, A), Bz = dot(r.sz, B), Cz = dot(r.sz, C);
+    float T = U * Az + V * Bz + W * Cz;
+    float rcp = 1.0 / det;
+    t = T * rcp;
+    if (!(t > tmin && t < tmax))
+        return false;
+    u = V * rcp;
+    v = W * rcp;
+    return true;
+}
+
+// Slab test of one child box: entry distance, or +inf on a miss. The far distance is
+// scaled by 1 + 2 gamma(3) (Ize 2013) so rounding never loses a box the triangle test hits.
+float box_enter(RayPre r, vec3 bmin, vec3 bmax, float tmin, float tmax)
+{
+    vec3 t0 = (bmin - r.o) * r.inv, t1 = (bmax - r.o) * r.inv;
+    vec3 lo = min(t0, t1), hi = max(t0, t1);
+    float enter = max(max(lo.x, lo.y), max(lo.z, tmin));
+    float leave = min(min(hi.x, hi.y), min(hi.z, tmax)) * 1.0000004;
+    return enter <= leave ? enter : 1e38;
+}
+
+// The state of a walk, so one that runs out of budget can be resumed later (the unit tests
+// resume walks across dispatches to get exact answers on meshes beyond llvmpipe's loop cap).
+struct Walk {
+    Hit hit;
+    uint node;      // next node to visit, GN_INVALID when the walk is over
+    int sp;
+    uint stack[BVH_STACK];
+};
+
+Walk walk_start(float tmax)
+{
+    Walk w;
+    w.hit.t = tmax; w.hit.u = 0.0; w.hit.v = 0.0; w.hit.tri = GN_INVALID;
+    w.hit.steps = 0u; w.hit.truncated = false;
+    w.node = 0u;
+    w.sp = 0;
+    return w;
+}
+
+// Continues w for at most `budget` more node visits. Closest hit (any_hit false) or the
+// first hit found (any_hit true) with t in (tmin, w.hit.t). On return either w.node is
+// GN_INVALID (done) or w.hit.truncated is set (budget spent; call again to go on).
+void bvh_walk(inout Walk w, RayPre r, float tmin, bool any_hit, uint budget)
+{
+    uint end = w.hit.steps + budget;
+    w.hit.truncated = false;
+    while (w.node != GN_INVALID) {
+        if (w.hit.steps >= end) { w.hit.truncated = true; return; }
+        w.hit.steps++;
+        GnBvhNode n = nodes[w.node];
+        float ea = n.a_index == GN_INVALID ? 1e38 : box_enter(r, n.a_min, n.a_max, tmin, w.hit.t);
+        float eb = n.b_index == GN_INVALID ? 1e38 : box_enter(r, n.b_min, n.b_max, tmin, w.hit.t);
+        // Leaves are intersected right away; only inner children go on.
+        if (ea < 1e38 && n.a_count > 0u) {
+            for (uint i = n.a_index; i < n.a_index + n.a_count; i++) {
+                float t, u, v;
+                if (tri_intersect(r, tris[i].v0.xyz, tris[i].v1.xyz, tris[i].v2.xyz, tmin, w.hit.t, t, u, v)) {
+                    w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = i;
+                }
+            }
+            ea = 1e38;
+            if (any_hit && w.hit.tri != GN_INVALID) { w.node = GN_INVALID; return; }
+        }
+        if (eb < 1e38 && eb > w.hit.t) eb = 1e38;
+        if (eb < 1e38 && n.b_count > 0u) {
+            for (uint i = n.b_index; i < n.b_index + n.b_count; i++) {
+                float t, u, v;
+                if (tri_intersect(r, tris[i].v0.xyz, tris[i].v1.xyz, tris[i].v2.xyz, tmin, w.hit.t, t, u, v)) {
+                    w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = i;
+                }
+            }
+            eb = 1e38;
+            if (any_hit && w.hit.tri != GN_INVALID) { w.node = GN_INVALID; return; }
+        }
+        if (ea < 1e38 && ea > w.hit.t) ea = 1e38;
+        if (ea < 1e38 && eb < 1e38) {
+            // Both inner children: descend into the nearer, keep the farther.
+            bool a_first = ea <= eb;
+            if (w.sp == BVH_STACK) { w.hit.truncated = true; w.node = GN_INVALID; return; }
+            w.stack[w.sp++] = a_first ? n.b_index : n.a_index;
+            w.node = a_first ? n.a_index : n.b_index;
+        } else if (ea < 1e38) {
+            w.node = n.a_index;
+        } else if (eb < 1e38) {
+            w.node = n.b_index;
+        } else {
+            w.node = w.sp == 0 ? GN_INVALID : w.stack[--w.sp];
+        }
+    }
+}
+
+// Closest hit (any_hit false) or any hit (true) in (tmin, tmax) within frame's budget.
+Hit bvh_trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
+{
+    Walk w = walk_start(tmax);
+    bvh_walk(w, ray_pre(o, d), tmin, any_hit, frame.traversal_budget);
+    return w.hit;
+}
+
+#endif

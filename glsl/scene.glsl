@@ -1,0 +1,189 @@
+// scene.glsl: the scene buffers of the render kernels, camera rays, the per-sample random
+// numbers and the shading data at a hit (interpolated normal, uv, textured material).
+// Include after "#version 450" and the extensions; bvh.glsl builds on it.
+#ifndef GONIO_SCENE_GLSL
+#define GONIO_SCENE_GLSL
+
+#include "shared.h"
+
+layout(std140, binding = GN_BIND_FRAME) uniform FrameBlock { GnFrame frame; };
+layout(std430, binding = GN_BIND_NODES) readonly buffer NodeBlock { GnBvhNode nodes[]; };
+layout(std430, binding = GN_BIND_TRIS) readonly buffer TriBlock { GnTri tris[]; };
+layout(std430, binding = GN_BIND_PRIMS) readonly buffer PrimBlock { GnPrim prims[]; };
+layout(std430, binding = GN_BIND_VERTICES) readonly buffer VertexBlock { GnVertex vertices[]; };
+layout(std430, binding = GN_BIND_MATERIALS) readonly buffer MaterialBlock { GnMaterial materials[]; };
+layout(std430, binding = GN_BIND_LIGHTS) readonly buffer LightBlock { GnLight lights[]; };
+layout(std430, binding = GN_BIND_TEXELS) readonly buffer TexelBlock { uint texels[]; };
+layout(std430, binding = GN_BIND_TEXTURES) readonly buffer TextureBlock { GnTexture textures[]; };
+
+const float PI = 3.14159265358979323846;
+
+// ---- random numbers that depend only on (pixel, sample, dimension, seed) ---------------
+// pcg4d of Jarzynski & Olano, "Hash Functions for GPU Rendering" (JCGT 2020): a hash, not a
+// sequence, so any sample of any pixel is computed independently (reproducible, splittable
+// across processes by seed).
+uvec4 pcg4d(uvec4 v)
+{
+    v = v * 1664525u + 1013904223u;
+    v.x += v.y * v.w; v.y += v.z * v.x; v.z += v.x * v.y; v.w += v.y * v.z;
+    v ^= v >> 16u;
+    v.x += v.y * v.w; v.y += v.z * v.x; v.z += v.x * v.y; v.w += v.y * v.z;
+    return v;
+}
+
+// Two independent uniforms in [0, 1) for dimensions (2 dim2, 2 dim2 + 1).
+vec2 rand2(uint pixel, uint sample_index, uint dim2)
+{
+    uvec4 h = pcg4d(uvec4(pixel, sample_index, dim2, frame.seed));
+    return vec2(h.xy >> 8u) * (1.0 / 16777216.0);
+}
+
+// ---- camera ------------------------------------------------------------------------------
+// Ray through image position (px, py) in pixels (y down), see GnCamera.
+vec3 camera_dir(vec2 p)
+{
+    GnCamera c = frame.camera;
+    vec2 ndc = vec2(2.0 * p.x / float(frame.width) - 1.0, 1.0 - 2.0 * p.y / float(frame.height));
+    return normalize(c.forward + ndc.x * c.tan_half_fovy * c.aspect * c.right +
+                     ndc.y * c.tan_half_fovy * c.up);
+}
+
+// ---- textures: RGBA8 texels packed in one buffer (lavapipe has no descriptor indexing,
+// so an arbitrary number of textures cannot be bound as samplers), filtered here ----------
+vec4 texel_fetch(GnTexture t, ivec2 p)
+{
+    uint c = texels[t.offset + uint(p.y) * t.width + uint(p.x)];
+    return vec4(c & 255u, (c >> 8u) & 255u, (c >> 16u) & 255u, c >> 24u) * (1.0 / 255.0);
+}
+
+int tex_wrap(int i, int n, uint mode)
+{
+    if (mode == GN_WRAP_CLAMP)
+        return clamp(i, 0, n - 1);
+    if (mode == GN_WRAP_MIRROR) {
+        int period = 2 * n;
+        int m = ((i % period) + period) % period;
+        return m < n ? m : period - 1 - m;
+    }
+    return ((i % n) + n) % n;
+}
+
+vec4 srgb_to_linear(vec4 c)
+{
+    vec3 lo = c.rgb / 12.92, hi = pow((c.rgb + 0.055) / 1.055, vec3(2.4));
+    return vec4(mix(hi, lo, lessThanEqual(c.rgb, vec3(0.04045))), c.a);
+}
+
+// Bilinear (or nearest) lookup; srgb decodes before filtering, as GPUs do.
+vec4 texture_sample(uint index, vec2 uv, bool srgb)
+{
+    GnTexture t = textures[index];
+    int w = int(t.width), h = int(t.height);
+    uint ws = t.flags & 3u, wt = (t.flags >> 2u) & 3u;
+    vec2 p = uv * vec2(w, h) - 0.5;
+    if ((t.flags & GN_TEX_NEAREST) != 0u) {
+        ivec2 q = ivec2(floor(p + 0.5));
+        vec4 c = texel_fetch(t, ivec2(tex_wrap(q.x, w, ws), tex_wrap(q.y, h, wt)));
+        return srgb ? srgb_to_linear(c) : c;
+    }
+    ivec2 q = ivec2(floor(p));
+    vec2 f = p - vec2(q);
+    int x0 = tex_wrap(q.x, w, ws), x1 = tex_wrap(q.x + 1, w, ws);
+    int y0 = tex_wrap(q.y, h, wt), y1 = tex_wrap(q.y + 1, h, wt);
+    vec4 c00 = texel_fetch(t, ivec2(x0, y0)), c10 = texel_fetch(t, ivec2(x1, y0));
+    vec4 c01 = texel_fetch(t, ivec2(x0, y1)), c11 = texel_fetch(t, ivec2(x1, y1));
+    if (srgb) {
+        c00 = srgb_to_linear(c00); c10 = srgb_to_linear(c10);
+        c01 = srgb_to_linear(c01); c11 = srgb_to_linear(c11);
+    }
+    return mix(mix(c00, c10, f.x), mix(c01, c11, f.x), f.y);
+}
+
+// ---- surface data at a hit ---------------------------------------------------------------
+struct Surface {
+    vec3 p;           // world position
+    vec3 ng;          // geometric normal, facing the incoming ray
+    vec3 n;           // shading normal (interpolated, normal-mapped), same side as ng
+    vec2 uv;
+    vec3 base;        // linear base colour (factor * texture)
+    float alpha;
+    float metallic;
+    float roughness;
+    vec3 emission;
+    float occlusion;
+    uint material;
+    bool front;       // the ray hit the side the triangle's winding calls front
+};
+
+// tri: BVH-order triangle index; (u, v): barycentrics of v1 and v2; d: ray direction.
+Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
+{
+    Surface s;
+    GnPrim pr = prims[tri];
+    GnVertex a = vertices[pr.i0], b = vertices[pr.i1], c = vertices[pr.i2];
+    float w = 1.0 - u - v;
+    s.p = o + t * d;
+    vec3 e1 = b.position - a.position, e2 = c.position - a.position;
+    vec3 ng = normalize(cross(e1, e2));
+    s.front = dot(ng, d) < 0.0;
+    vec3 n = w * a.normal + u * b.normal + v * c.normal;
+    n = dot(n, n) > 1e-20 ? normalize(n) : ng;
+    // Shade the side the ray sees: the geometric normal faces the viewer, and the shading
+    // normal is kept on its side (meshes whose winding disagrees with their normals exist).
+    if (!s.front) ng = -ng;
+    if (dot(n, ng) < 0.0) n = -n;
+    s.ng = ng;
+    s.uv = w * vec2(a.u, a.v) + u * vec2(b.u, b.v) + v * vec2(c.u, c.v);
+
+    GnMaterial m = materials[pr.material];
+    s.material = pr.material;
+    vec4 base = m.base_color;
+    if (m.tex_base != GN_INVALID)
+        base *= texture_sample(m.tex_base, s.uv, true);
+    s.base = base.rgb;
+    s.alpha = base.a;
+    s.metallic = m.metallic;
+    s.roughness = m.roughness;
+    if (m.tex_mr != GN_INVALID) {
+        vec4 mr = texture_sample(m.tex_mr, s.uv, false);
+        s.roughness *= mr.g;
+        s.metallic *= mr.b;
+    }
+    s.emission = m.emissive;
+    if (m.tex_emissive != GN_INVALID)
+        s.emission *= texture_sample(m.tex_emissive, s.uv, true).rgb;
+    s.occlusion = 1.0;
+    if (m.tex_occlusion != GN_INVALID)
+        s.occlusion = 1.0 + m.occlusion_strength * (texture_sample(m.tex_occlusion, s.uv, false).r - 1.0);
+    if (m.tex_normal != GN_INVALID) {
+        // Tangent frame: the vertex tangents when the mesh has them, else the triangle's
+        // uv gradient (glTF asks for MikkTSpace; per-triangle is its flat approximation).
+        vec4 tg = w * a.tangent + u * b.tangent + v * c.tangent;
+        vec3 tangent;
+        float sign = 1.0;
+        if (dot(tg.xyz, tg.xyz) > 1e-12) {
+            tangent = tg.xyz;
+            sign = tg.w < 0.0 ? -1.0 : 1.0;
+        } else {
+            vec2 d1 = vec2(b.u - a.u, b.v - a.v), d2 = vec2(c.u - a.u, c.v - a.v);
+            float det = d1.x * d2.y - d1.y * d2.x;
+            tangent = abs(det) > 1e-20 ? (e1 * d2.y - e2 * d1.y) / det : vec3(0.0);
+            if (det < 0.0) sign = -1.0;
+        }
+        if (!s.front) tangent = -tangent;
+        tangent = tangent - n * dot(n, tangent);
+        if (dot(tangent, tangent) > 1e-20) {
+            tangent = normalize(tangent);
+            vec3 bitangent = sign * cross(n, tangent);
+            vec3 tn = texture_sample(m.tex_normal, s.uv, false).xyz * 2.0 - 1.0;
+            tn.xy *= m.normal_scale;
+            vec3 nm = tn.x * tangent + tn.y * bitangent + tn.z * n;
+            if (dot(nm, nm) > 1e-20)
+                n = normalize(nm);
+        }
+    }
+    s.n = n;
+    return s;
+}
+
+#endif

@@ -1,0 +1,35 @@
+/* cli.h: the subcommands of the gonio program; each takes argv with argv[0] = its name and
+ * returns the process exit code: 0 ok, 1 bad input or failed work, 2 bad usage. */
+#ifndef GONIO_CLI_H
+#define GONIO_CLI_H
+
+#include <stdbool.h>
+
+#include "gpu.h"
+
+#define GONIO_VERSION "0.1.0"
+
+int cmd_render(int argc, char **argv);
+int cmd_info(int argc, char **argv);
+int cmd_devices(int argc, char **argv);
+int cmd_bench(int argc, char **argv);
+int cmd_diff(int argc, char **argv);
+int cmd_scene(int argc, char **argv);
+int cmd_brdf(int argc, char **argv);
+int cmd_teapot(int argc, char **argv);
+
+/* Shared option handling. cli_value returns argv[i + 1] (advancing *i) or reports a usage
+ * error naming the option; cli_usage_error prints "gonio CMD: MESSAGE" and the hint to use
+ * --help. */
+const char *cli_value(int argc, char **argv, int *i);
+int cli_usage_error(const char *cmd, const char *fmt, ...);
+/* The Vulkan device for a command: --device, --validate (or GONIO_VALIDATE=1 in the
+ * environment). */
+bool cli_gpu_create(gpu *g, int device_index, bool validate);
+/* After work under validation: false (with an error) if any validation message was seen. */
+bool cli_gpu_finish(gpu *g);
+/* The command line, space-joined, for output headers. */
+void cli_set_command_line(int argc, char **argv);
+const char *cli_command_line(void);
+
+#endif

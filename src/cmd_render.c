@@ -1,0 +1,302 @@
+/* cmd_render.c: `gonio render`, `gonio info` and `gonio devices`. */
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "image.h"
+#include "render.h"
+#include "scene.h"
+#include "util.h"
+
+static const char render_usage[] =
+    "usage: gonio render SCENE.gltf|.glb -o OUT.exr [options]\n"
+    "\n"
+    "  -o, --output FILE   linear float RGBA OpenEXR (written atomically)\n"
+    "  --png FILE          also write a tonemapped sRGB PNG (alone: PNG only)\n"
+    "  --mode M            phong (default), normal, albedo, depth, cost\n"
+    "                      (path, gouraud, flat: see gonio --help as they arrive)\n"
+    "  --spp N             samples per pixel (default 16)\n"
+    "  --time SECONDS      render for this long instead of --spp\n"
+    "  --size WxH          image size (default 512x512, or the camera's aspect)\n"
+    "  --camera N          the scene's N-th perspective camera (default: frame the scene)\n"
+    "  --seed S            random seed (default 0); renders with different seeds merge\n"
+    "  --aov LIST          extra EXR channels: normal,albedo,depth\n"
+    "  --env R,G,B | V     constant background radiance (default 0)\n"
+    "  --no-shadows        local modes: no shadow rays\n"
+    "  --exposure E        PNG only: scale by 2^E before tonemapping (default 0)\n"
+    "  --tonemap T         PNG only: clamp (default), reinhard, aces\n"
+    "  --device N          Vulkan device index (see gonio devices)\n"
+    "  --validate          enable the Vulkan validation layer; any message fails the render\n"
+    "  --quiet             no progress bar and no summary line\n";
+
+static volatile sig_atomic_t stop_requested;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    stop_requested = 1;
+}
+
+/* A value, or "R,G,B". */
+static bool parse_rgb(const char *s, float out[3])
+{
+    char buf[128];
+    char *a, *b;
+    if (strlen(s) >= sizeof buf)
+        return false;
+    strcpy(buf, s);
+    a = strchr(buf, ',');
+    if (!a)
+        return util_parse_float(buf, &out[0]) && (out[1] = out[2] = out[0], true);
+    *a++ = 0;
+    b = strchr(a, ',');
+    if (!b)
+        return false;
+    *b++ = 0;
+    return util_parse_float(buf, &out[0]) && util_parse_float(a, &out[1]) &&
+           util_parse_float(b, &out[2]);
+}
+
+/* Fails early when the directory of an output file cannot be written, rather than after a
+ * long render. */
+static bool check_writable(const char *path)
+{
+    char dir[4096];
+    const char *slash = strrchr(path, '/');
+    if (strlen(path) >= sizeof dir)
+        return false;
+    if (slash)
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    else
+        strcpy(dir, ".");
+    if (!*dir)
+        strcpy(dir, "/");
+    if (access(dir, W_OK) != 0) {
+        util_error("%s: cannot write into '%s': %s", path, dir, strerror(errno));
+        return false;
+    }
+    return true;
+}
+
+int cmd_render(int argc, char **argv)
+{
+    const char *scene_path = NULL, *out_path = NULL, *png_path = NULL;
+    render_settings s = {.mode = GN_MODE_PHONG, .spp = 16, .camera = -1, .shadows = true,
+                         .progress = true, .stop = &stop_requested};
+    bool size_given = false, quiet = false, validate = false;
+    int device = -1;
+    float exposure = 0;
+    image_tonemap tm = IMAGE_TONEMAP_CLAMP;
+    long v;
+    scene sc = {0};
+    gpu g = {0};
+    renderer r = {0};
+    image img = {0};
+    render_stats st;
+    int rc = 1;
+
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *val;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            fputs(render_usage, stdout);
+            return 0;
+        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
+            quiet = true;
+        } else if (!strcmp(a, "--validate")) {
+            validate = true;
+        } else if (!strcmp(a, "--no-shadows")) {
+            s.shadows = false;
+        } else if (a[0] == '-' && a[1]) {
+            if (!(val = cli_value(argc, argv, &i)))
+                return 2;
+            if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+                out_path = val;
+            } else if (!strcmp(a, "--png")) {
+                png_path = val;
+            } else if (!strcmp(a, "--mode")) {
+                int m = render_mode_from_name(val);
+                if (m < 0)
+                    return cli_usage_error("render", "--mode '%s': expected one of %s", val,
+                                           render_mode_list());
+                s.mode = (uint32_t)m;
+            } else if (!strcmp(a, "--spp")) {
+                if (!util_parse_int(val, 1, 1 << 24, &v))
+                    return cli_usage_error("render", "--spp '%s': expected an integer 1..16777216", val);
+                s.spp = (int)v;
+            } else if (!strcmp(a, "--time")) {
+                float t;
+                if (!util_parse_float(val, &t) || t <= 0)
+                    return cli_usage_error("render", "--time '%s': expected seconds > 0", val);
+                s.time_limit = t;
+            } else if (!strcmp(a, "--size")) {
+                if (!util_parse_size(val, &s.width, &s.height))
+                    return cli_usage_error("render", "--size '%s': expected WxH, e.g. 640x480 (1..16384)", val);
+                size_given = true;
+            } else if (!strcmp(a, "--camera")) {
+                if (!util_parse_int(val, 0, 1 << 20, &v))
+                    return cli_usage_error("render", "--camera '%s': expected an index >= 0", val);
+                s.camera = (int)v;
+            } else if (!strcmp(a, "--seed")) {
+                if (!util_parse_int(val, 0, 0xffffffffL, &v))
+                    return cli_usage_error("render", "--seed '%s': expected an integer 0..4294967295", val);
+                s.seed = (uint32_t)v;
+            } else if (!strcmp(a, "--aov")) {
+                char buf[256], *tok, *save;
+                snprintf(buf, sizeof buf, "%s", val);
+                for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save))
+                    if (strcmp(tok, "normal") && strcmp(tok, "albedo") && strcmp(tok, "depth"))
+                        return cli_usage_error("render", "--aov '%s': expected a list of normal, albedo, depth", tok);
+                s.aov = true;
+            } else if (!strcmp(a, "--env")) {
+                if (!parse_rgb(val, s.env) || s.env[0] < 0 || s.env[1] < 0 || s.env[2] < 0)
+                    return cli_usage_error("render", "--env '%s': expected R,G,B or one value >= 0", val);
+            } else if (!strcmp(a, "--exposure")) {
+                if (!util_parse_float(val, &exposure))
+                    return cli_usage_error("render", "--exposure '%s': expected a number", val);
+            } else if (!strcmp(a, "--tonemap")) {
+                if (!strcmp(val, "clamp")) tm = IMAGE_TONEMAP_CLAMP;
+                else if (!strcmp(val, "reinhard")) tm = IMAGE_TONEMAP_REINHARD;
+                else if (!strcmp(val, "aces")) tm = IMAGE_TONEMAP_ACES;
+                else return cli_usage_error("render", "--tonemap '%s': expected clamp, reinhard or aces", val);
+            } else if (!strcmp(a, "--device")) {
+                if (!util_parse_int(val, 0, 64, &v))
+                    return cli_usage_error("render", "--device '%s': expected an index (see gonio devices)", val);
+                device = (int)v;
+            } else {
+                return cli_usage_error("render", "unknown option '%s'", a);
+            }
+        } else if (!scene_path) {
+            scene_path = a;
+        } else {
+            return cli_usage_error("render", "unexpected argument '%s'", a);
+        }
+    }
+    if (!scene_path)
+        return cli_usage_error("render", "no scene given");
+    if (!out_path && !png_path)
+        return cli_usage_error("render", "no output given (-o OUT.exr and/or --png OUT.png)");
+    util_set_quiet(quiet);
+    s.progress = !quiet;
+    if ((out_path && !check_writable(out_path)) || (png_path && !check_writable(png_path)))
+        return 1;
+
+    if (!scene_load(&sc, scene_path))
+        return 1;
+    if (!size_given) {
+        float aspect = 1.0f;
+        if (s.camera >= 0 && (uint32_t)s.camera < sc.num_cameras && sc.cameras[s.camera].aspect > 0)
+            aspect = sc.cameras[s.camera].aspect;
+        s.width = 512;
+        s.height = (int)(512.0f / aspect + 0.5f);
+        if (s.height < 1)
+            s.height = 1;
+    }
+    if (s.camera >= 0 && (uint32_t)s.camera >= sc.num_cameras) {
+        util_error("%s: --camera %d: the scene has %u perspective camera(s)", scene_path,
+                   s.camera, sc.num_cameras);
+        scene_destroy(&sc);
+        return 1;
+    }
+    if (!cli_gpu_create(&g, device, validate)) {
+        scene_destroy(&sc);
+        return 1;
+    }
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    renderer_create(&r, &g, &sc);
+    if (renderer_render(&r, &s, &img, &st)) {
+        char seconds[32];
+        image_attr attrs[] = {
+            {"gonio:spp", IMAGE_ATTR_INT, NULL, st.spp, 0},
+            {"gonio:seed", IMAGE_ATTR_INT, NULL, (int)s.seed, 0},
+            {"gonio:mode", IMAGE_ATTR_STRING, render_mode_name(s.mode), 0, 0},
+            {"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, st.seconds},
+            {"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0},
+            {"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0},
+        };
+        bool ok = true;
+        if (stop_requested && !quiet)
+            util_warn("interrupted: writing the %d spp rendered so far", st.spp);
+        if (out_path)
+            ok = image_write_exr(&img, out_path, attrs, sizeof attrs / sizeof *attrs);
+        if (ok && png_path)
+            ok = image_write_png_from(&img, png_path, exposure, tm);
+        snprintf(seconds, sizeof seconds, "%.2f", st.seconds);
+        if (ok && !quiet)
+            fprintf(stderr, "gonio: %s %dx%d, %s, %d spp in %s s (%.2f Mrays/s primary), setup %.2f s\n",
+                    out_path ? out_path : png_path, s.width, s.height, render_mode_name(s.mode),
+                    st.spp, seconds, st.seconds > 0 ? (double)st.rays / st.seconds * 1e-6 : 0.0,
+                    st.setup_seconds);
+        rc = ok ? 0 : 1;
+    }
+    image_destroy(&img);
+    renderer_destroy(&r);
+    if (!cli_gpu_finish(&g))
+        rc = 1;
+    scene_destroy(&sc);
+    return rc;
+}
+
+static const char info_usage[] = "usage: gonio info SCENE.gltf|.glb\n\n"
+                                 "Prints the scene's contents and its BVH statistics.\n";
+
+int cmd_info(int argc, char **argv)
+{
+    const char *path = NULL;
+    scene sc = {0};
+    bvh b = {0};
+    for (int i = 1; i < argc; i++) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            fputs(info_usage, stdout);
+            return 0;
+        } else if (argv[i][0] == '-' && argv[i][1]) {
+            return cli_usage_error("info", "unknown option '%s'", argv[i]);
+        } else if (path) {
+            return cli_usage_error("info", "unexpected argument '%s'", argv[i]);
+        }
+        path = argv[i];
+    }
+    if (!path)
+        return cli_usage_error("info", "no scene given");
+    if (!scene_load(&sc, path))
+        return 1;
+    bvh_build(&b, &sc.vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc.indices,
+              sc.num_triangles);
+    printf("scene          %s\n", path);
+    printf("triangles      %u\n", sc.num_triangles);
+    printf("vertices       %u\n", sc.num_vertices);
+    printf("meshes         %u (primitive instances; %u glTF meshes, %u nodes)\n", sc.num_meshes,
+           sc.num_gltf_meshes, sc.num_nodes);
+    printf("materials      %u\n", sc.num_materials);
+    printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
+    printf("lights         %u\n", sc.num_lights);
+    printf("cameras        %u\n", sc.num_cameras);
+    printf("bounds         (%g, %g, %g) - (%g, %g, %g)\n", sc.bounds_min[0], sc.bounds_min[1],
+           sc.bounds_min[2], sc.bounds_max[0], sc.bounds_max[1], sc.bounds_max[2]);
+    printf("bvh nodes      %u (%zu bytes each)\n", b.num_nodes, sizeof(GnBvhNode));
+    printf("bvh depth      %u\n", b.depth);
+    printf("bvh max leaf   %u triangles\n", b.max_leaf_size);
+    printf("bvh sah cost   %.2f\n", b.sah_cost);
+    printf("bvh build      %.2f ms (%.2f M triangles/s)\n", b.build_seconds * 1e3,
+           b.build_seconds > 0 ? sc.num_triangles / b.build_seconds * 1e-6 : 0.0);
+    bvh_destroy(&b);
+    scene_destroy(&sc);
+    return 0;
+}
+
+int cmd_devices(int argc, char **argv)
+{
+    if (argc > 1 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
+        puts("usage: gonio devices\n\nLists the Vulkan devices: index (for --device), name, "
+             "type, driver, API version.\nWithout --device, gonio picks a discrete GPU, then "
+             "an integrated one, then the CPU (lavapipe).");
+        return 0;
+    }
+    if (argc > 1)
+        return cli_usage_error("devices", "unexpected argument '%s'", argv[1]);
+    return gpu_print_devices() ? 0 : 1;
+}

@@ -1,0 +1,55 @@
+/* main.c: the gonio command-line program: dispatches to the subcommands of cli.h. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "util.h"
+
+static const struct {
+    const char *name;
+    int (*fn)(int, char **);
+    const char *summary;
+} commands[] = {
+    {"render", cmd_render, "render a glTF scene to EXR (and PNG)"},
+    {"info", cmd_info, "print a scene's contents and BVH statistics"},
+    {"devices", cmd_devices, "list the Vulkan devices"},
+    {"diff", cmd_diff, "compare two EXR images (RMSE, PSNR, bias); exit 1 above thresholds"},
+    {"bench", cmd_bench, "measure BVH build and ray throughput"},
+    {"brdf", cmd_brdf, "virtual goniophotometer: BRDF lobe plots, albedo, material balls"},
+    {"scene", cmd_scene, "write a built-in scene (cornell, teapot) as glTF"},
+    {"teapot", cmd_teapot, "write the Utah teapot at a tessellation level as glTF"},
+};
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: gonio COMMAND [OPTIONS]   (gonio COMMAND --help for details)\n\n"
+               "A physically based renderer: GLSL compute shaders on Vulkan ray-trace\n"
+               "triangle BVHs and shade with the BRDFs of the lecture.\n\ncommands:\n");
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
+        fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].summary);
+    fprintf(f, "\n  --version   print the version\n");
+}
+
+int main(int argc, char **argv)
+{
+    cli_set_command_line(argc, argv);
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) {
+        usage(stdout);
+        return 0;
+    }
+    if (!strcmp(argv[1], "--version")) {
+        printf("gonio %s\n", GONIO_VERSION);
+        return 0;
+    }
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
+        if (!strcmp(argv[1], commands[i].name))
+            return commands[i].fn(argc - 1, argv + 1);
+    fprintf(stderr, "gonio: unknown command '%s'\n\n", argv[1]);
+    usage(stderr);
+    return 2;
+}

@@ -1,0 +1,78 @@
+/* render.h: a scene on the GPU and the progressive sample passes that render it.
+ *
+ * Work is submitted as short dispatches of one sample per pixel each (DESIGN.md: keeps a
+ * window responsive, GPU watchdogs quiet, llvmpipe's loop cap away, and lets an interrupted
+ * render write what it has). Samples depend only on (pixel, sample, dimension, seed). */
+#ifndef GONIO_RENDER_H
+#define GONIO_RENDER_H
+
+#include <signal.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "bvh.h"
+#include "gpu.h"
+#include "image.h"
+#include "scene.h"
+
+typedef struct render_settings {
+    uint32_t mode;          /* GN_MODE_* */
+    int width, height;
+    int spp;                /* samples per pixel */
+    double time_limit;      /* > 0: stop after this many seconds (at least one pass) */
+    uint32_t seed;
+    int camera;             /* glTF camera index, -1 = frame the scene */
+    bool aov;               /* add normal, albedo, depth channels */
+    bool shadows;           /* ray-traced shadows in the local modes (default on) */
+    int max_depth;          /* path tracer: 0 = unbounded (roulette only) */
+    float env[3];           /* constant environment radiance */
+    bool progress;          /* progress bar on stderr */
+    volatile sig_atomic_t *stop; /* set asynchronously to end after the current pass */
+} render_settings;
+
+typedef struct render_stats {
+    int spp;                /* samples per pixel actually taken */
+    double seconds;         /* rendering time (passes only) */
+    double first_pass_seconds;
+    double setup_seconds;   /* BVH build and upload */
+    uint64_t rays;          /* camera rays traced (pixels * spp) */
+    uint32_t truncated;     /* rays whose BVH walk hit the traversal budget */
+} render_stats;
+
+typedef struct renderer {
+    gpu *g;
+    const scene *sc;
+    bvh tree;
+    uint32_t num_lights, num_emitters;
+    gpu_buffer frame, nodes, tris, prims, vertices, materials, lights, texels, textures,
+        emitters, vcolor, status;
+    gpu_buffer accum, aov;  /* sized for the current image */
+    int width, height;
+    double setup_seconds;
+} renderer;
+
+/* Builds the BVH and uploads the scene. */
+void renderer_create(renderer *r, gpu *g, const scene *sc);
+void renderer_destroy(renderer *r); /* accepts a zeroed struct */
+
+/* The camera for settings->camera (or the framing one) as the GPU wants it. Returns false
+ * (with an error) if the index is out of range. */
+bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out);
+
+/* Fills and uploads the frame constants for s; (re)allocates and clears the accumulation,
+ * AOV and status buffers for s's image size. */
+bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame);
+/* The descriptor bindings of every render kernel (up to GN_BIND_COUNT entries). */
+uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
+
+/* Renders and fills `out` with R, G, B, A (A = coverage) and, with s->aov, the channels
+ * normal.X/Y/Z, albedo.R/G/B and depth.Z (depth along the camera axis, 0 on a miss). */
+bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats);
+
+/* Name <-> GN_MODE_* ("path", "phong", ...); -1 when unknown. */
+int render_mode_from_name(const char *name);
+const char *render_mode_name(uint32_t mode);
+/* Comma-separated list of every mode name, for messages. */
+const char *render_mode_list(void);
+
+#endif

@@ -1,0 +1,182 @@
+/* testtool.c: scenes with analytic answers, and those answers as EXR images, for the shell
+ * regression tests. The references are computed here from the geometry's equations (ray
+ * and plane, ray and sphere) with a camera model written out independently of the
+ * renderer's, so a render that matches them is right for reasons of its own.
+ *
+ *   testtool scene NAME OUT.gltf       NAME: plane, inside-sphere
+ *   testtool ref NAME AOV W H OUT.exr [SHIFT]  AOV: depth, normal; SHIFT: pixels, in x
+ *                                      (a deliberately wrong reference, to show a test fails)
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gltf_write.h"
+#include "image.h"
+#include "meshgen.h"
+
+/* The camera of both scenes: at `eye`, looking along -Z of a rotation about Y by `yaw`
+ * then about X by `pitch`; yfov 50 degrees; square images. */
+typedef struct view {
+    double eye[3], yaw, pitch, yfov;
+} view;
+
+static const view plane_view = {{0.2, 0.5, 3.0}, 0.3, -0.25, 50.0 * M_PI / 180.0};
+static const view sphere_view = {{0.3, -0.2, 0.25}, 1.1, 0.35, 60.0 * M_PI / 180.0};
+
+/* The plane: through (0, 0, -1) with normal n (unit), a 40 x 40 quad. */
+static const double plane_n[3] = {0.26726124191, 0.53452248382, 0.80178372573}; /* (1,2,3)/sqrt14 */
+
+static void basis(const view *v, double right[3], double up[3], double fwd[3])
+{
+    double cy = cos(v->yaw), sy = sin(v->yaw), cp = cos(v->pitch), sp = sin(v->pitch);
+    /* R = Ry(yaw) Rx(pitch): columns are the camera's x, y, z axes in the world */
+    right[0] = cy, right[1] = 0, right[2] = -sy;
+    up[0] = sy * sp, up[1] = cp, up[2] = cy * sp;
+    fwd[0] = -(sy * cp), fwd[1] = sp, fwd[2] = -(cy * cp); /* -z column */
+}
+
+static void quat(const view *v, float q[4])
+{
+    /* q = qy(yaw) * qx(pitch) */
+    double hy = 0.5 * v->yaw, hp = 0.5 * v->pitch;
+    double ay[4] = {0, sin(hy), 0, cos(hy)}, ax[4] = {sin(hp), 0, 0, cos(hp)};
+    q[0] = (float)(ay[3] * ax[0] + ay[0] * ax[3] + ay[1] * ax[2] - ay[2] * ax[1]);
+    q[1] = (float)(ay[3] * ax[1] - ay[0] * ax[2] + ay[1] * ax[3] + ay[2] * ax[0]);
+    q[2] = (float)(ay[3] * ax[2] + ay[0] * ax[1] - ay[1] * ax[0] + ay[2] * ax[3]);
+    q[3] = (float)(ay[3] * ax[3] - ay[0] * ax[0] - ay[1] * ax[1] - ay[2] * ax[2]);
+}
+
+static int write_scene(const char *name, const char *out)
+{
+    gltf_write_camera cam = {.name = "camera", .aspect = 1.0f, .znear = 0.001f};
+    gltf_write_material mat = {.name = "grey", .base_color = {0.5f, 0.5f, 0.5f, 1}, .roughness = 1};
+    gltf_write_node nodes[2] = {{.name = "mesh", .kind = GLTF_WRITE_NODE_MESH},
+                                {.name = "camera", .kind = GLTF_WRITE_NODE_CAMERA}};
+    gltf_write_mesh mesh = {.name = name};
+    gltf_write_desc d = {&mesh, 1, &mat, 1, &cam, 1, NULL, 0, nodes, 2};
+    const view *v;
+    float pos[12], nrm[12];
+    uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    meshgen_mesh m = {0};
+    bool ok;
+
+    if (!strcmp(name, "plane")) {
+        /* a 40 x 40 square in the plane, corners c +- 20 t1 +- 20 t2 */
+        double t1[3] = {0.89442719, -0.44721360, 0}, t2[3], c[3] = {0, 0, -1};
+        t2[0] = plane_n[1] * t1[2] - plane_n[2] * t1[1];
+        t2[1] = plane_n[2] * t1[0] - plane_n[0] * t1[2];
+        t2[2] = plane_n[0] * t1[1] - plane_n[1] * t1[0];
+        for (int i = 0; i < 4; i++) {
+            double a = (i == 1 || i == 2) ? 20 : -20, b = (i >= 2) ? 20 : -20;
+            for (int k = 0; k < 3; k++) {
+                pos[3 * i + k] = (float)(c[k] + a * t1[k] + b * t2[k]);
+                nrm[3 * i + k] = (float)plane_n[k];
+            }
+        }
+        mesh.num_vertices = 4;
+        mesh.positions = pos;
+        mesh.normals = nrm;
+        mesh.num_indices = 6;
+        mesh.indices = idx;
+        v = &plane_view;
+    } else if (!strcmp(name, "inside-sphere")) {
+        const float center[3] = {0, 0, 0};
+        m = meshgen_uv_sphere(center, 1.0f, 512, 256);
+        mesh.num_vertices = m.num_vertices;
+        mesh.positions = m.positions;
+        mesh.normals = m.normals;
+        mesh.num_indices = 3 * m.num_triangles;
+        mesh.indices = m.indices;
+        v = &sphere_view;
+    } else {
+        fprintf(stderr, "testtool: unknown scene '%s'\n", name);
+        return 2;
+    }
+    cam.yfov = (float)v->yfov;
+    for (int k = 0; k < 3; k++)
+        nodes[1].translation[k] = (float)v->eye[k];
+    quat(v, nodes[1].rotation);
+    ok = gltf_write_file(out, &d);
+    meshgen_destroy(&m);
+    return ok ? 0 : 1;
+}
+
+/* Analytic hit along the ray through the centre of pixel (x, y): distance t and the
+ * normal seen by the ray (facing it). False on a miss. */
+static int trace(const char *name, const double o[3], const double d[3], double *t, double n[3])
+{
+    if (!strcmp(name, "plane")) {
+        double c[3] = {0, 0, -1}, dn = 0, cn = 0;
+        for (int k = 0; k < 3; k++) {
+            dn += d[k] * plane_n[k];
+            cn += (c[k] - o[k]) * plane_n[k];
+        }
+        if (dn == 0 || cn / dn <= 0)
+            return 0;
+        *t = cn / dn;
+        for (int k = 0; k < 3; k++)
+            n[k] = dn < 0 ? plane_n[k] : -plane_n[k];
+        return 1;
+    }
+    /* unit sphere at the origin, seen from inside: t = -b + sqrt(b^2 - c) */
+    double b = o[0] * d[0] + o[1] * d[1] + o[2] * d[2];
+    double c = o[0] * o[0] + o[1] * o[1] + o[2] * o[2] - 1.0;
+    *t = -b + sqrt(b * b - c);
+    for (int k = 0; k < 3; k++)
+        n[k] = -(o[k] + *t * d[k]); /* inward: the side the camera sees */
+    return 1;
+}
+
+static int write_ref(const char *name, const char *aov, int w, int h, const char *out, double shift)
+{
+    static const char *const names[] = {"R", "G", "B", "A"};
+    const view *v = !strcmp(name, "plane") ? &plane_view : &sphere_view;
+    double right[3], up[3], fwd[3], th = tan(0.5 * v->yfov), aspect = (double)w / h;
+    image img;
+    bool depth = !strcmp(aov, "depth");
+    if (strcmp(name, "plane") && strcmp(name, "inside-sphere")) {
+        fprintf(stderr, "testtool: unknown scene '%s'\n", name);
+        return 2;
+    }
+    basis(v, right, up, fwd);
+    image_create(&img, w, h, 4, names);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double sx = (2.0 * (x + 0.5 + shift) / w - 1.0) * th * aspect, sy = (1.0 - 2.0 * (y + 0.5) / h) * th;
+            double d[3], len = 0, t, n[3], val[3];
+            for (int k = 0; k < 3; k++) {
+                d[k] = fwd[k] + sx * right[k] + sy * up[k];
+                len += d[k] * d[k];
+            }
+            for (int k = 0; k < 3; k++)
+                d[k] /= sqrt(len);
+            if (trace(name, v->eye, d, &t, n)) {
+                double dz = d[0] * fwd[0] + d[1] * fwd[1] + d[2] * fwd[2];
+                for (int k = 0; k < 3; k++)
+                    val[k] = depth ? t * dz : n[k];
+                img.planes[3][y * w + x] = 1;
+            } else {
+                val[0] = val[1] = val[2] = 0;
+            }
+            for (int k = 0; k < 3; k++)
+                img.planes[k][y * w + x] = (float)val[k];
+        }
+    {
+        bool ok = image_write_exr(&img, out, NULL, 0);
+        image_destroy(&img);
+        return ok ? 0 : 1;
+    }
+}
+
+int main(int argc, char **argv)
+{
+    if (argc == 4 && !strcmp(argv[1], "scene"))
+        return write_scene(argv[2], argv[3]);
+    if ((argc == 7 || argc == 8) && !strcmp(argv[1], "ref"))
+        return write_ref(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]), argv[6],
+                         argc == 8 ? atof(argv[7]) : 0.0);
+    fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n");
+    return 2;
+}
