@@ -152,9 +152,12 @@ void renderer_destroy(renderer *r)
     gpu_buffer *bufs[] = {&r->frame, &r->nodes, &r->tris, &r->prims, &r->vertices,
                           &r->materials, &r->lights, &r->texels, &r->textures, &r->emitters,
                           &r->vcolor, &r->status, &r->accum, &r->aov};
-    if (r->g)
+    if (r->g) {
         for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
             gpu_buffer_destroy(r->g, bufs[i]);
+        for (uint32_t i = 0; i < GN_MODE_COUNT; i++)
+            gpu_pipeline_destroy(r->g, &r->pipelines[i]);
+    }
     bvh_destroy(&r->tree);
     memset(r, 0, sizeof *r);
 }
@@ -267,25 +270,10 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     return true;
 }
 
-bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats)
+gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
 {
-    gpu *g = r->g;
-    GnFrame frame;
-    const VkDeviceSize pixels = (VkDeviceSize)s->width * s->height;
-    gpu_pipeline pipe = {0};
-    uint32_t mode = s->mode;
-    double t0, last_progress = 0;
-    int done = 0, batch = 1;
-    bool show_progress = s->progress && isatty(2);
-
-    memset(stats, 0, sizeof *stats);
-    if (mode == GN_MODE_PATH || mode == GN_MODE_GOURAUD || mode == GN_MODE_FLAT) {
-        util_error("--mode %s is not available yet", render_mode_name(mode));
-        return false;
-    }
-    if (!renderer_begin(r, s, &frame))
-        return false;
-    {
+    gpu_pipeline *p = &r->pipelines[mode];
+    if (!p->pipeline) {
         gpu_binding b[GN_BIND_COUNT];
         VkSpecializationMapEntry entry = {0, 0, sizeof(uint32_t)};
         VkSpecializationInfo spec = {1, &entry, sizeof mode, &mode};
@@ -293,8 +281,61 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
             .name = "local", .code = spv_local, .code_size = sizeof spv_local,
             .local_size = {GN_TILE_X, GN_TILE_Y, 1}, .push_size = sizeof(GnPush),
             .bindings = b, .num_bindings = renderer_bindings(r, b), .specialization = &spec};
-        gpu_pipeline_create(g, &pipe, &pd);
+        gpu_pipeline_create(r->g, p, &pd);
     }
+    return p;
+}
+
+bool renderer_mode_available(uint32_t mode)
+{
+    return mode != GN_MODE_PATH && mode != GN_MODE_GOURAUD && mode != GN_MODE_FLAT;
+}
+
+void renderer_record_pass(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t sample_index)
+{
+    GnPush push = {sample_index, 0, 0, 0};
+    gpu_dispatch(cmd, renderer_pipeline(r, mode), &push, (uint32_t)r->width, (uint32_t)r->height, 1);
+    gpu_barrier(cmd);
+}
+
+void renderer_resolve(renderer *r, int spp, bool aov, image *out)
+{
+    static const char *const names[] = {"R", "G", "B", "A", "normal.X", "normal.Y",
+                                        "normal.Z", "albedo.R", "albedo.G", "albedo.B",
+                                        "depth.Z"};
+    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
+    const float *acc = r->accum.mapped, *aovs = r->aov.mapped;
+    float inv = 1.0f / (float)spp;
+    image_create(out, r->width, r->height, aov ? 11 : 4, names);
+    for (VkDeviceSize p = 0; p < pixels; p++) {
+        for (int c = 0; c < 4; c++)
+            out->planes[c][p] = acc[4 * p + c] * inv;
+        if (aov) {
+            for (int c = 0; c < 3; c++) {
+                out->planes[4 + c][p] = aovs[12 * p + c] * inv;
+                out->planes[7 + c][p] = aovs[12 * p + 4 + c] * inv;
+            }
+            out->planes[10][p] = aovs[12 * p + 8] * inv;
+        }
+    }
+}
+
+bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats)
+{
+    gpu *g = r->g;
+    GnFrame frame;
+    const VkDeviceSize pixels = (VkDeviceSize)s->width * s->height;
+    double t0, last_progress = 0;
+    int done = 0, batch = 1;
+    bool show_progress = s->progress && isatty(2);
+
+    memset(stats, 0, sizeof *stats);
+    if (!renderer_mode_available(s->mode)) {
+        util_error("--mode %s is not available yet", render_mode_name(s->mode));
+        return false;
+    }
+    if (!renderer_begin(r, s, &frame))
+        return false;
 
     /* Passes are submitted in batches sized to take about 0.1 s each: short enough for a
      * responsive progress bar and an early stop, long enough to hide submission costs. */
@@ -305,11 +346,8 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
         int n = batch;
         if (s->time_limit <= 0 && n > s->spp - done)
             n = s->spp - done;
-        for (int i = 0; i < n; i++) {
-            GnPush push = {(uint32_t)(done + i), 0, 0, 0};
-            gpu_dispatch(cmd, &pipe, &push, frame.width, frame.height, 1);
-            gpu_barrier(cmd);
-        }
+        for (int i = 0; i < n; i++)
+            renderer_record_pass(r, cmd, s->mode, (uint32_t)(done + i));
         gpu_submit_wait(g, cmd);
         done += n;
         if (done == n)
@@ -333,7 +371,6 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
         progress_bar(done, done, stats->seconds);
         fputc('\n', stderr);
     }
-    gpu_pipeline_destroy(g, &pipe);
     stats->spp = done;
     stats->rays = (uint64_t)pixels * (uint64_t)done;
     stats->setup_seconds = r->setup_seconds;
@@ -341,26 +378,6 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
     if (stats->truncated)
         util_warn("%s: %u ray(s) needed more BVH steps than the per-ray budget (%u) and may be "
                   "wrong", r->sc->path, stats->truncated, frame.traversal_budget);
-
-    {
-        static const char *const names[] = {"R", "G", "B", "A", "normal.X", "normal.Y",
-                                            "normal.Z", "albedo.R", "albedo.G", "albedo.B",
-                                            "depth.Z"};
-        const float *acc = r->accum.mapped, *aov = r->aov.mapped;
-        float inv = 1.0f / (float)done;
-        image_create(out, s->width, s->height, s->aov ? 11 : 4, names);
-        for (VkDeviceSize p = 0; p < pixels; p++) {
-            for (int c = 0; c < 3; c++)
-                out->planes[c][p] = acc[4 * p + c] * inv;
-            out->planes[3][p] = acc[4 * p + 3] * inv;
-            if (s->aov) {
-                for (int c = 0; c < 3; c++) {
-                    out->planes[4 + c][p] = aov[12 * p + c] * inv;
-                    out->planes[7 + c][p] = aov[12 * p + 4 + c] * inv;
-                }
-                out->planes[10][p] = aov[12 * p + 8] * inv;
-            }
-        }
-    }
+    renderer_resolve(r, done, s->aov, out);
     return true;
 }

@@ -47,6 +47,7 @@ typedef struct renderer {
     gpu_buffer frame, nodes, tris, prims, vertices, materials, lights, texels, textures,
         emitters, vcolor, status;
     gpu_buffer accum, aov;  /* sized for the current image */
+    gpu_pipeline pipelines[GN_MODE_COUNT]; /* created on first use */
     int width, height;
     double setup_seconds;
 } renderer;
@@ -64,6 +65,15 @@ bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out)
 bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame);
 /* The descriptor bindings of every render kernel (up to GN_BIND_COUNT entries). */
 uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
+
+/* The kernel of a mode (created on first use, kept until renderer_destroy). */
+gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode);
+bool renderer_mode_available(uint32_t mode);
+/* Records one sample pass (sample `sample_index` in every pixel) and a barrier. Call
+ * renderer_begin first. */
+void renderer_record_pass(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t sample_index);
+/* The accumulated image divided by spp: R, G, B, A and, with aov, the AOV channels. */
+void renderer_resolve(renderer *r, int spp, bool aov, image *out);
 
 /* Renders and fills `out` with R, G, B, A (A = coverage) and, with s->aov, the channels
  * normal.X/Y/Z, albedo.R/G/B and depth.Z (depth along the camera axis, 0 on a miss). */
