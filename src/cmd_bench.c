@@ -1,5 +1,6 @@
 /* cmd_bench.c: `gonio bench`: BVH build rate, primary and diffuse-bounce ray throughput
  * of the GLSL traversal, and the time from start to the first finished pixel. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,6 +38,37 @@ static bool build_scene(scene *sc, const char *path, long generate)
     scene_from_mesh(sc, "generated", m.num_vertices, m.positions, m.normals, m.num_triangles,
                     m.indices);
     meshgen_destroy(&m);
+    /* A three-quarter view from above, so nearly every camera ray meets the spheres or the
+     * ground, as in a real image (the framing camera sees the ground edge-on). */
+    {
+        scene_camera *c = sc->cameras = util_calloc(1, sizeof *sc->cameras);
+        float ctr[3], ext = 0, f[3], len = 0, r[3], u[3];
+        for (int k = 0; k < 3; k++) {
+            ctr[k] = 0.5f * (sc->bounds_min[k] + sc->bounds_max[k]);
+            ext = fmaxf(ext, sc->bounds_max[k] - sc->bounds_min[k]);
+        }
+        c->position[0] = ctr[0];
+        c->position[1] = ctr[1] + 0.45f * ext;
+        c->position[2] = ctr[2] + 0.45f * ext;
+        for (int k = 0; k < 3; k++) {
+            f[k] = ctr[k] - c->position[k];
+            len += f[k] * f[k];
+        }
+        for (int k = 0; k < 3; k++)
+            c->forward[k] = f[k] / sqrtf(len);
+        r[0] = -c->forward[2], r[1] = 0, r[2] = c->forward[0]; /* forward x (0,1,0) */
+        len = sqrtf(r[0] * r[0] + r[2] * r[2]);
+        for (int k = 0; k < 3; k++)
+            c->right[k] = r[k] / len;
+        u[0] = c->right[1] * c->forward[2] - c->right[2] * c->forward[1];
+        u[1] = c->right[2] * c->forward[0] - c->right[0] * c->forward[2];
+        u[2] = c->right[0] * c->forward[1] - c->right[1] * c->forward[0];
+        memcpy(c->up, u, sizeof u);
+        c->yfov = 0.8f;
+        c->znear = 1e-3f * ext;
+        snprintf(c->name, sizeof c->name, "bench");
+        sc->num_cameras = 1;
+    }
     return true;
 }
 
