@@ -30,7 +30,7 @@ void main()
             rays[2u * pixel + 1u] = vec4(0.0, 0.0, 1.0, -1.0);
             return;
         }
-        GnTri t = tris[h.tri];
+        GnTri t = bvh_tri(h.tri);
         vec3 n = normalize(cross(t.v1.xyz - t.v0.xyz, t.v2.xyz - t.v0.xyz));
         if (dot(n, d) > 0.0) n = -n;
         vec2 u = rand2(pixel, push.sample_index, 1u);

@@ -13,6 +13,21 @@
 
 #define BVH_STACK 64
 
+GnBvhNode bvh_node(uint i)
+{
+    int k = int(4u * i);
+    vec4 t0 = texelFetch(node_texels, k), t1 = texelFetch(node_texels, k + 1);
+    vec4 t2 = texelFetch(node_texels, k + 2), t3 = texelFetch(node_texels, k + 3);
+    return GnBvhNode(t0.xyz, floatBitsToUint(t0.w), t1.xyz, floatBitsToUint(t1.w),
+                     t2.xyz, floatBitsToUint(t2.w), t3.xyz, floatBitsToUint(t3.w));
+}
+
+GnTri bvh_tri(uint i)
+{
+    int k = int(3u * i);
+    return GnTri(texelFetch(tri_texels, k), texelFetch(tri_texels, k + 1), texelFetch(tri_texels, k + 2));
+}
+
 struct Hit {
     float t, u, v;
     uint tri;       // BVH-order triangle, GN_INVALID on a miss
@@ -116,34 +131,37 @@ struct Walk {
     uint stack[BVH_STACK];
 };
 
-Walk walk_start(float tmax)
+// The walk of this invocation: a private global that bvh_walk works on in place (as a
+// function parameter its 64-entry stack would be copied in and out on every trace).
+Walk walk;
+
+void walk_start(float tmax)
 {
-    Walk w;
-    w.hit.t = tmax; w.hit.u = 0.0; w.hit.v = 0.0; w.hit.tri = GN_INVALID;
-    w.hit.steps = 0u; w.hit.truncated = false;
-    w.node = 0u;
-    w.sp = 0;
-    return w;
+    walk.hit.t = tmax; walk.hit.u = 0.0; walk.hit.v = 0.0; walk.hit.tri = GN_INVALID;
+    walk.hit.steps = 0u; walk.hit.truncated = false;
+    walk.node = 0u;
+    walk.sp = 0;
 }
 
-// Continues w for at most `budget` more node visits. Closest hit (any_hit false) or the
-// first hit found (any_hit true) with t in (tmin, w.hit.t). On return either w.node is
-// GN_INVALID (done) or w.hit.truncated is set (budget spent; call again to go on).
-void bvh_walk(inout Walk w, RayPre r, float tmin, bool any_hit, uint budget)
+// Continues `walk` for at most `budget` more node visits. Closest hit (any_hit false) or
+// the first hit found (any_hit true) with t in (tmin, walk.hit.t). On return either
+// walk.node is GN_INVALID (done) or walk.hit.truncated is set (budget spent; call again).
+void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
 {
+#define w walk
     uint end = w.hit.steps + budget;
     w.hit.truncated = false;
     while (w.node != GN_INVALID) {
         if (w.hit.steps >= end) { w.hit.truncated = true; return; }
         w.hit.steps++;
-        GnBvhNode n = nodes[w.node];
+        GnBvhNode n = bvh_node(w.node);
         float ea = n.a_index == GN_INVALID ? 1e38 : box_enter(r, n.a_min, n.a_max, tmin, w.hit.t);
         float eb = n.b_index == GN_INVALID ? 1e38 : box_enter(r, n.b_min, n.b_max, tmin, w.hit.t);
         // Leaves are intersected right away; only inner children go on.
         if (ea < 1e38 && n.a_count > 0u) {
             for (uint i = n.a_index; i < n.a_index + n.a_count; i++) {
                 float t, u, v;
-                if (tri_intersect(r, tris[i].v0.xyz, tris[i].v1.xyz, tris[i].v2.xyz, tmin, w.hit.t, t, u, v)) {
+                if (tri_intersect(r, texelFetch(tri_texels, int(3u * i)).xyz, texelFetch(tri_texels, int(3u * i) + 1).xyz, texelFetch(tri_texels, int(3u * i) + 2).xyz, tmin, w.hit.t, t, u, v)) {
                     w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = i;
                 }
             }
@@ -154,7 +172,7 @@ void bvh_walk(inout Walk w, RayPre r, float tmin, bool any_hit, uint budget)
         if (eb < 1e38 && n.b_count > 0u) {
             for (uint i = n.b_index; i < n.b_index + n.b_count; i++) {
                 float t, u, v;
-                if (tri_intersect(r, tris[i].v0.xyz, tris[i].v1.xyz, tris[i].v2.xyz, tmin, w.hit.t, t, u, v)) {
+                if (tri_intersect(r, texelFetch(tri_texels, int(3u * i)).xyz, texelFetch(tri_texels, int(3u * i) + 1).xyz, texelFetch(tri_texels, int(3u * i) + 2).xyz, tmin, w.hit.t, t, u, v)) {
                     w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = i;
                 }
             }
@@ -176,14 +194,15 @@ void bvh_walk(inout Walk w, RayPre r, float tmin, bool any_hit, uint budget)
             w.node = w.sp == 0 ? GN_INVALID : w.stack[--w.sp];
         }
     }
+#undef w
 }
 
 // Closest hit (any_hit false) or any hit (true) in (tmin, tmax) within frame's budget.
 Hit bvh_trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
 {
-    Walk w = walk_start(tmax);
-    bvh_walk(w, ray_pre(o, d), tmin, any_hit, frame.traversal_budget);
-    return w.hit;
+    walk_start(tmax);
+    bvh_walk(ray_pre(o, d), tmin, any_hit, frame.traversal_budget);
+    return walk.hit;
 }
 
 #endif

@@ -7,8 +7,12 @@
 #include "shared.h"
 
 layout(std140, binding = GN_BIND_FRAME) uniform FrameBlock { GnFrame frame; };
-layout(std430, binding = GN_BIND_NODES) readonly buffer NodeBlock { GnBvhNode nodes[]; };
-layout(std430, binding = GN_BIND_TRIS) readonly buffer TriBlock { GnTri tris[]; };
+// The BVH nodes (GnBvhNode = 4 texels) and triangle corners (GnTri = 3 texels) are read as
+// RGBA32F texel buffers, not storage buffers: llvmpipe fetches a storage buffer with
+// per-lane offsets one lane and one component at a time, a texel buffer with vector
+// gathers, which makes the walk several times faster there; GPUs read both at full speed.
+layout(binding = GN_BIND_NODES) uniform samplerBuffer node_texels;
+layout(binding = GN_BIND_TRIS) uniform samplerBuffer tri_texels;
 layout(std430, binding = GN_BIND_PRIMS) readonly buffer PrimBlock { GnPrim prims[]; };
 layout(std430, binding = GN_BIND_VERTICES) readonly buffer VertexBlock { GnVertex vertices[]; };
 layout(std430, binding = GN_BIND_MATERIALS) readonly buffer MaterialBlock { GnMaterial materials[]; };

@@ -24,15 +24,15 @@ void main()
     if (i >= push.sample_index)
         return;
     vec4 a = rays[2u * i], b = rays[2u * i + 1u];
-    Walk w;
     if (push.pass_flags == 0u) {
-        w = walk_start(b.w);
+        walk_start(b.w);
     } else {
         if (hits[2u * i + 1u].y == 0.0)
             return; // finished earlier
-        w = walks[i];
+        walk = walks[i];
     }
-    bvh_walk(w, ray_pre(a.xyz, b.xyz), a.w, push.pad0 != 0u, frame.traversal_budget);
+    bvh_walk(ray_pre(a.xyz, b.xyz), a.w, push.pad0 != 0u, frame.traversal_budget);
+    Walk w = walk;
     hits[2u * i] = vec4(w.hit.t, w.hit.u, w.hit.v, uintBitsToFloat(w.hit.tri));
     hits[2u * i + 1u] = vec4(float(w.hit.steps), w.hit.truncated ? 1.0 : 0.0, 0.0, 0.0);
     if (w.hit.truncated) {

@@ -140,12 +140,12 @@ int cmd_bench(int argc, char **argv)
     }
     for (uint32_t mode = 0; mode < 2; mode++) {
         gpu_binding b[GN_BIND_COUNT];
-        VkSpecializationMapEntry entry = {0, 0, sizeof(uint32_t)};
-        VkSpecializationInfo spec = {1, &entry, sizeof mode, &mode};
+        renderer_spec spec;
         gpu_pipeline_desc pd = {.name = "bench", .code = spv_bench, .code_size = sizeof spv_bench,
                                 .local_size = {GN_TILE_X, GN_TILE_Y, 1},
                                 .push_size = sizeof(GnPush), .bindings = b,
-                                .num_bindings = renderer_bindings(&r, b), .specialization = &spec};
+                                .num_bindings = renderer_bindings(&r, b),
+                                .specialization = renderer_specialize(&r, mode, &spec)};
         gpu_pipeline_create(&g, &pipes[mode], &pd);
     }
 

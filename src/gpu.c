@@ -358,8 +358,24 @@ void gpu_buffer_create(gpu *g, gpu_buffer *b, VkDeviceSize size, VkBufferUsageFl
         GPU_CHECK(vkMapMemory(g->device, b->memory, 0, VK_WHOLE_SIZE, 0, &b->mapped));
 }
 
+void gpu_buffer_create_texels(gpu *g, gpu_buffer *b, const void *data, VkDeviceSize size)
+{
+    VkBufferViewCreateInfo vci = {.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+    gpu_buffer_create(g, b, size, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, GPU_MEMORY_DEVICE);
+    if (data)
+        gpu_buffer_upload(g, b, data, size, 0);
+    else
+        gpu_buffer_fill_zero(g, b);
+    vci.buffer = b->buffer;
+    vci.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    vci.range = b->size;
+    GPU_CHECK(vkCreateBufferView(g->device, &vci, NULL, &b->view));
+}
+
 void gpu_buffer_destroy(gpu *g, gpu_buffer *b)
 {
+    if (b->view)
+        vkDestroyBufferView(g->device, b->view, NULL);
     if (b->buffer)
         vkDestroyBuffer(g->device, b->buffer, NULL);
     if (b->memory)
@@ -439,8 +455,9 @@ void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc)
     VkPipelineLayoutCreateInfo plci = {.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
     VkShaderModuleCreateInfo smci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
     VkComputePipelineCreateInfo cpci = {.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 0},
-                                     {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 0}};
+    VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 0},
+                                     {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 0},
+                                     {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 0}};
     VkDescriptorPoolCreateInfo dpci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     VkDescriptorSetAllocateInfo dsai = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
     VkDescriptorBufferInfo infos[32];
@@ -458,7 +475,8 @@ void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc)
     for (uint32_t i = 0; i < desc->num_bindings; i++) {
         lb[i] = (VkDescriptorSetLayoutBinding){desc->bindings[i].binding, desc->bindings[i].type,
                                                1, VK_SHADER_STAGE_COMPUTE_BIT, NULL};
-        sizes[desc->bindings[i].type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER].descriptorCount++;
+        for (int k = 0; k < 3; k++)
+            sizes[k].descriptorCount += sizes[k].type == desc->bindings[i].type;
     }
     dlci.bindingCount = desc->num_bindings;
     dlci.pBindings = lb;
@@ -484,8 +502,8 @@ void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc)
     dpci.maxSets = 1;
     dpci.poolSizeCount = 0;
     {
-        VkDescriptorPoolSize used[2];
-        for (int i = 0; i < 2; i++)
+        VkDescriptorPoolSize used[3];
+        for (int i = 0; i < 3; i++)
             if (sizes[i].descriptorCount)
                 used[dpci.poolSizeCount++] = sizes[i];
         dpci.pPoolSizes = used;
@@ -497,9 +515,12 @@ void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc)
     GPU_CHECK(vkAllocateDescriptorSets(g->device, &dsai, &p->set));
     for (uint32_t i = 0; i < desc->num_bindings; i++) {
         infos[i] = (VkDescriptorBufferInfo){desc->bindings[i].buffer->buffer, 0, VK_WHOLE_SIZE};
+        bool texel = desc->bindings[i].type == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
         writes[i] = (VkWriteDescriptorSet){VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, NULL, p->set,
                                            desc->bindings[i].binding, 0, 1,
-                                           desc->bindings[i].type, NULL, &infos[i], NULL};
+                                           desc->bindings[i].type, NULL,
+                                           texel ? NULL : &infos[i],
+                                           texel ? &desc->bindings[i].buffer->view : NULL};
     }
     vkUpdateDescriptorSets(g->device, desc->num_bindings, writes, 0, NULL);
 }

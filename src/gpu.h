@@ -61,6 +61,7 @@ typedef struct gpu_buffer {
     VkDeviceMemory memory;
     VkDeviceSize size;
     void *mapped;        /* non-NULL when host-visible */
+    VkBufferView view;   /* texel buffers only */
 } gpu_buffer;
 
 /* size 0 is allowed and becomes a small dummy buffer (so empty scene arrays can be bound). */
@@ -76,9 +77,13 @@ void gpu_buffer_fill_zero(gpu *g, gpu_buffer *b);
 /* Creates a storage buffer holding `data` (size bytes; NULL data = zeroed). */
 void gpu_buffer_create_storage(gpu *g, gpu_buffer *b, const void *data, VkDeviceSize size);
 
+/* A uniform texel buffer of RGBA32F texels (size: bytes, a multiple of 16) holding data:
+ * read in GLSL through a samplerBuffer with texelFetch. */
+void gpu_buffer_create_texels(gpu *g, gpu_buffer *b, const void *data, VkDeviceSize size);
+
 typedef struct gpu_binding {
     uint32_t binding;
-    VkDescriptorType type;   /* STORAGE_BUFFER or UNIFORM_BUFFER */
+    VkDescriptorType type;   /* STORAGE_BUFFER, UNIFORM_BUFFER or UNIFORM_TEXEL_BUFFER */
     const gpu_buffer *buffer;
 } gpu_binding;
 

@@ -50,8 +50,8 @@ static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any
     f.traversal_budget = budget;
     gpu_buffer_create(g, &frame, sizeof f, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, GPU_MEMORY_HOST);
     gpu_buffer_upload(g, &frame, &f, sizeof f, 0);
-    gpu_buffer_create_storage(g, &nodes, b->nodes, sizeof(GnBvhNode) * b->num_nodes);
-    gpu_buffer_create_storage(g, &tris, b->tris, sizeof(GnTri) * b->num_tris);
+    gpu_buffer_create_texels(g, &nodes, b->nodes, sizeof(GnBvhNode) * b->num_nodes);
+    gpu_buffer_create_texels(g, &tris, b->tris, sizeof(GnTri) * b->num_tris);
     gpu_buffer_create_storage(g, &rbuf, rays, sizeof(ray) * n);
     gpu_buffer_create(g, &hbuf, sizeof(gpu_hit) * n, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
     gpu_buffer_create_storage(g, &wbuf, NULL, (VkDeviceSize)WALK_BYTES * n);
@@ -59,8 +59,8 @@ static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any
     {
         const gpu_binding bind[] = {
             {GN_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, &frame},
-            {GN_BIND_NODES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &nodes},
-            {GN_BIND_TRIS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &tris},
+            {GN_BIND_NODES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &nodes},
+            {GN_BIND_TRIS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &tris},
             {GN_BIND_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &rbuf},
             {GN_BIND_AOV, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &hbuf},
             {GN_BIND_VCOLOR, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &wbuf},
