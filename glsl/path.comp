@@ -1,0 +1,355 @@
+#version 450
+// path.comp: Monte Carlo path tracing of the lecture's rendering equation
+// L_o = L_e + integral f L_i cos, one path sample per pixel per dispatch. At every vertex:
+// next-event estimation (one light from the power-proportional table, area sampling on
+// triangles, the lat-long environment map by its luminance) and a BSDF sample from
+// brdf.glsl, combined by multiple importance sampling with the power heuristic (Veach &
+// Guibas 1995, "Optimally combining sampling techniques"); Dirac lobes and punctual lights
+// take their one strategy exactly; Russian roulette after ROULETTE_DEPTH bounces.
+// docs/path-tracing.md derives the estimator and names the tests that check it.
+#extension GL_GOOGLE_include_directive : require
+
+#include "bvh.glsl"
+#include "brdf.glsl"
+
+layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
+
+layout(std430, binding = GN_BIND_ACCUM) buffer AccumBlock { vec4 accum[]; };
+layout(std430, binding = GN_BIND_AOV) buffer AovBlock { vec4 aov[]; };
+layout(std430, binding = GN_BIND_EMITTERS) readonly buffer EmitterBlock { GnEmitter emitters[]; };
+layout(std430, binding = GN_BIND_STATUS) buffer StatusBlock { uint status[]; };
+layout(std430, binding = GN_BIND_SQUARES) buffer SquaresBlock { vec4 squares[]; };
+// Lat-long map: 2 words (RGB as half floats) per texel, rows top (+Y) to bottom, then the
+// marginal CDF of the rows (env_height floats), then each row's conditional CDF.
+layout(std430, binding = GN_BIND_ENV) readonly buffer EnvBlock { uint envdata[]; };
+layout(push_constant) uniform PushBlock { GnPush push; };
+
+#define ROULETTE_DEPTH 3u
+#define MAX_BOUNCES 4096u // never reached: roulette and the step budget end paths first
+// A ray's own loop iterations besides its walk (light selection, map searches), in node
+// visits (a visit costs up to 17 iterations): charged so the whole path stays under
+// llvmpipe's loop cap with frame.traversal_budget node visits per invocation.
+#define TRACE_OVERHEAD 4u
+
+uint budget;    // node visits left to this invocation
+bool truncated; // a walk ran out of budget: the path was cut short
+
+vec4 rng(uint pixel, uint dim)
+{
+    return vec4(pcg4d(uvec4(pixel, push.sample_index, dim, frame.seed)) >> 8u) * (1.0 / 16777216.0);
+}
+
+float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+
+float power_heuristic(float a, float b) { return a * a / (a * a + b * b); }
+
+Hit trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
+{
+    walk_start(tmax);
+    bvh_walk(ray_pre(o, d), tmin, any_hit, budget);
+    budget -= min(walk.hit.steps + TRACE_OVERHEAD, budget);
+    truncated = truncated || walk.hit.truncated;
+    return walk.hit;
+}
+
+// ---- the environment -------------------------------------------------------------------
+// Lat-long mapping: u = atan(d.z, d.x) / 2pi + 1/2, v = acos(d.y) / pi (+Y up, v = 0 at the
+// top row), so dOmega = 2 pi^2 sin(theta) du dv.
+ivec2 env_texel(vec3 d, out float sin_theta)
+{
+    float v = acos(clamp(d.y, -1.0, 1.0)) / PI, u = atan(d.z, d.x) / (2.0 * PI) + 0.5;
+    sin_theta = sqrt(max(0.0, 1.0 - d.y * d.y));
+    return ivec2(min(uint(u * float(frame.env_width)), frame.env_width - 1u),
+                 min(uint(v * float(frame.env_height)), frame.env_height - 1u));
+}
+
+float env_cdf(uint i) { return uintBitsToFloat(envdata[i]); }
+
+// Density (over the unit square) of the map's sampler in texel xy: exactly the mass the
+// CDFs give the texel, times the texel count.
+float env_pdf_uv(ivec2 xy)
+{
+    uint m = 2u * frame.env_width * frame.env_height, c = m + frame.env_height + uint(xy.y) * frame.env_width;
+    float pm = env_cdf(m + uint(xy.y)) - (xy.y > 0 ? env_cdf(m + uint(xy.y) - 1u) : 0.0);
+    float pc = env_cdf(c + uint(xy.x)) - (xy.x > 0 ? env_cdf(c + uint(xy.x) - 1u) : 0.0);
+    return pm * pc * float(frame.env_width * frame.env_height);
+}
+
+vec3 env_radiance(vec3 d)
+{
+    if ((frame.flags & GN_FRAME_ENV_MAP) == 0u)
+        return frame.env_color;
+    float st;
+    ivec2 xy = env_texel(d, st);
+    uint i = 2u * (uint(xy.y) * frame.env_width + uint(xy.x));
+    return vec3(unpackHalf2x16(envdata[i]), unpackHalf2x16(envdata[i + 1u]).x);
+}
+
+// Solid-angle density with which light sampling picks direction d toward the environment.
+float env_pdf(vec3 d)
+{
+    if ((frame.flags & GN_FRAME_ENV_MAP) == 0u)
+        return frame.env_select / (4.0 * PI);
+    float st;
+    ivec2 xy = env_texel(d, st);
+    return st > 0.0 ? frame.env_select * env_pdf_uv(xy) / (2.0 * PI * PI * st) : 0.0;
+}
+
+// First index in [first, first + n) whose CDF value exceeds u (the last when none does).
+uint cdf_search(uint first, uint n, float u)
+{
+    uint lo = 0u, hi = n - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi) / 2u;
+        if (env_cdf(first + mid) > u) hi = mid; else lo = mid + 1u;
+    }
+    return lo;
+}
+
+// A direction from the map's piecewise-constant density; pdf excludes env_select.
+vec3 env_sample(vec2 u, out float pdf)
+{
+    uint w = frame.env_width, h = frame.env_height, m = 2u * w * h;
+    uint y = cdf_search(m, h, u.x);
+    float y0 = y > 0u ? env_cdf(m + y - 1u) : 0.0, y1 = env_cdf(m + y);
+    uint c = m + h + y * w;
+    uint x = cdf_search(c, w, u.y);
+    float x0 = x > 0u ? env_cdf(c + x - 1u) : 0.0, x1 = env_cdf(c + x);
+    float fu = (float(x) + clamp((u.y - x0) / max(x1 - x0, 1e-30), 0.0, 1.0)) / float(w);
+    float fv = (float(y) + clamp((u.x - y0) / max(y1 - y0, 1e-30), 0.0, 1.0)) / float(h);
+    float theta = fv * PI, phi = (fu - 0.5) * 2.0 * PI, st = sin(theta);
+    pdf = st > 0.0 ? (y1 - y0) * (x1 - x0) * float(w * h) / (2.0 * PI * PI * st) : 0.0;
+    return vec3(st * cos(phi), cos(theta), st * sin(phi));
+}
+
+// ---- lights ---------------------------------------------------------------------------------
+struct LightSample {
+    vec3 wi;     // toward the light
+    float dist;  // to the light point (1e30: at infinity)
+    vec3 L;      // incident radiance; for a punctual light its irradiance at normal incidence
+    float pdf;   // solid-angle density, selection included; punctual: the selection probability
+    bool delta;  // punctual: no other strategy can find it
+};
+
+float area_sides(GnMaterial m) { return (m.flags & GN_MAT_DOUBLE_SIDED) != 0u ? 2.0 : 1.0; }
+
+// Emitted radiance of triangle `prim` at barycentrics (u, v) toward -d, 0 from the back of a
+// single-sided material (glTF: back faces are culled).
+vec3 tri_emission(uint prim, float u, float v, vec3 d, vec3 ng)
+{
+    GnPrim pr = prims[prim];
+    GnMaterial m = materials[pr.material];
+    if (dot(ng, d) >= 0.0 && (m.flags & GN_MAT_DOUBLE_SIDED) == 0u)
+        return vec3(0.0);
+    vec3 e = m.emissive;
+    if (m.tex_emissive != GN_INVALID) {
+        GnVertex a = vertices[pr.i0], b = vertices[pr.i1], c = vertices[pr.i2];
+        vec2 uv = (1.0 - u - v) * vec2(a.u, a.v) + u * vec2(b.u, b.v) + v * vec2(c.u, c.v);
+        e *= texture_sample(m.tex_emissive, uv, true).rgb;
+    }
+    return e;
+}
+
+// KHR_lights_punctual: irradiance at p from light l (range window and spot cone as the
+// extension recommends), direction and distance.
+vec3 punctual_incident(GnLight l, vec3 p, out vec3 wi, out float dist)
+{
+    if (l.type == GN_LIGHT_DIRECTIONAL) {
+        wi = -l.direction;
+        dist = 1e30;
+        return l.color;
+    }
+    vec3 to = l.position - p;
+    float d2 = max(dot(to, to), 1e-12);
+    dist = sqrt(d2);
+    wi = to / dist;
+    float atten = 1.0 / d2;
+    if (l.range > 0.0) {
+        float x = dist / l.range, win = clamp(1.0 - x * x * x * x, 0.0, 1.0);
+        atten *= win * win;
+    }
+    if (l.type == GN_LIGHT_SPOT)
+        atten *= smoothstep(l.outer_cos, l.inner_cos, dot(l.direction, -wi));
+    return l.color * atten;
+}
+
+LightSample light_sample(vec3 p, vec3 u)
+{
+    LightSample s;
+    s.pdf = 0.0;
+    s.delta = false;
+    s.L = vec3(0.0);
+    uint lo = 0u, hi = frame.num_emitters - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi) / 2u;
+        if (emitters[mid].cdf > u.x) hi = mid; else lo = mid + 1u;
+    }
+    GnEmitter e = emitters[lo];
+    if (e.prim == GN_INVALID) {
+        float pdf = 1.0 / (4.0 * PI);
+        s.wi = (frame.flags & GN_FRAME_ENV_MAP) != 0u ? env_sample(u.yz, pdf) : sampling_uniform_sphere(u.yz);
+        s.dist = 1e30;
+        s.L = env_radiance(s.wi);
+        s.pdf = e.pdf * pdf;
+    } else if ((e.prim & GN_EMITTER_LIGHT) != 0u) {
+        s.L = punctual_incident(lights[e.prim & ~GN_EMITTER_LIGHT], p, s.wi, s.dist);
+        s.pdf = e.pdf;
+        s.delta = true;
+    } else {
+        GnTri t = bvh_tri(e.prim);
+        float su = sqrt(u.y), b1 = 1.0 - su, b2 = u.z * su;
+        vec3 q = (1.0 - b1 - b2) * t.v0.xyz + b1 * t.v1.xyz + b2 * t.v2.xyz;
+        vec3 ng = normalize(cross(t.v1.xyz - t.v0.xyz, t.v2.xyz - t.v0.xyz));
+        vec3 to = q - p;
+        float d2 = dot(to, to);
+        s.dist = sqrt(d2);
+        s.wi = to / s.dist;
+        float c = abs(dot(ng, s.wi));
+        if (c > 0.0 && d2 > 0.0) {
+            s.L = tri_emission(e.prim, b1, b2, s.wi, ng);
+            s.pdf = e.pdf / e.area * d2 / c;
+        }
+    }
+    return s;
+}
+
+// ---- materials ------------------------------------------------------------------------------
+Bsdf material_bsdf(Surface s, GnMaterial m)
+{
+    if (m.brdf != BRDF_GLTF) // the colour of a conductor is its index, never a texture's
+        return bsdf_from_model(m.brdf, m.brdf == BRDF_CONDUCTOR ? m.base_color.rgb : s.base, m.brdf_params);
+    return bsdf_gltf(s.base, s.metallic, s.roughness, m.specular, m.specular_color, m.ior, m.transmission);
+}
+
+// Does b have a part that light sampling can reach (anything but Dirac lobes)?
+bool bsdf_has_smooth(Bsdf b)
+{
+    return any(greaterThan(b.diffuse, vec3(0.0))) ||
+           (b.lobe != BRDF_LOBE_NONE && b.lobe != BRDF_LOBE_MIRROR) ||
+           (b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN);
+}
+
+// Offset of a ray origin off the surface, to the side of w (scaled to the coordinates'
+// magnitude so float rounding of the hit point cannot put it behind the surface).
+vec3 offset_origin(vec3 p, vec3 ng, vec3 w)
+{
+    float eps = 1e-4 * max(1.0, max(abs(p.x), max(abs(p.y), abs(p.z))));
+    return p + ng * (dot(ng, w) >= 0.0 ? eps : -eps);
+}
+
+void main()
+{
+    uvec2 px = gl_GlobalInvocationID.xy;
+    if (px.x >= frame.width || px.y >= frame.height)
+        return;
+    uint pixel = px.y * frame.width + px.x;
+    bool light_only = (frame.flags & GN_FRAME_LIGHT_ONLY) != 0u;
+    bool bsdf_only = (frame.flags & GN_FRAME_BSDF_ONLY) != 0u;
+    budget = frame.traversal_budget;
+    truncated = false;
+
+    vec3 o = frame.camera.position;
+    vec3 d = camera_dir(vec2(px) + rng(pixel, 0u).xy);
+    float tmin = frame.camera.znear / dot(d, frame.camera.forward);
+    vec3 radiance = vec3(0.0), beta = vec3(1.0);
+    float prev_pdf = 0.0;
+    bool prev_delta = true; // the camera ray: what it sees has one strategy only
+    bool covered = false;
+    vec3 normal = vec3(0.0), albedo = vec3(0.0);
+    float depth_aov = 0.0;
+
+    for (uint depth = 0u; depth < MAX_BOUNCES; depth++) {
+        Hit h = trace(o, d, tmin, 1e30, false);
+        tmin = 0.0;
+        if (h.truncated)
+            break;
+        if (h.tri == GN_INVALID) {
+            vec3 le = env_radiance(d);
+            float w = 1.0;
+            if (!prev_delta && frame.env_select > 0.0)
+                w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, env_pdf(d));
+            radiance += beta * le * w;
+            break;
+        }
+        Surface s = surface_at(h.tri, h.t, h.u, h.v, o, d);
+        GnMaterial m = materials[s.material];
+        if (depth == 0u) {
+            covered = true;
+            normal = s.n;
+            albedo = s.base;
+            depth_aov = h.t * dot(d, frame.camera.forward);
+        }
+        if ((m.flags & GN_MAT_UNLIT) != 0u) { // KHR_materials_unlit: the colour is the radiance
+            radiance += beta * s.base;
+            break;
+        }
+        if ((s.front || (m.flags & GN_MAT_DOUBLE_SIDED) != 0u) && luminance(m.emissive) > 0.0) {
+            float w = 1.0;
+            if (!prev_delta) {
+                float pl = luminance(m.emissive) * area_sides(m) / frame.emitter_power * h.t * h.t /
+                           abs(dot(s.ng, d));
+                w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, pl);
+            }
+            radiance += beta * s.emission * w;
+        }
+        if (frame.max_depth != 0u && depth >= frame.max_depth)
+            break;
+
+        Bsdf b = material_bsdf(s, m);
+        // A transmitting surface needs the side: brdf.glsl's normal points outside.
+        bool flip = b.dielectric > 0.0 && !s.front;
+        vec3 n = flip ? -s.n : s.n, ng = flip ? -s.ng : s.ng, tx, ty;
+        sampling_basis(n, tx, ty);
+        vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
+        vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
+
+        if (frame.num_emitters > 0u && bsdf_has_smooth(b)) {
+            LightSample ls = light_sample(s.p, ul.xyz);
+            vec3 wi = vec3(dot(ls.wi, tx), dot(ls.wi, ty), dot(ls.wi, n));
+            // The shading and geometric normals must agree on the side of wi (no light leaks).
+            if (ls.pdf > 0.0 && !(bsdf_only && !ls.delta) && dot(ng, ls.wi) * wi.z > 0.0 &&
+                luminance(ls.L) > 0.0) {
+                vec3 f;
+                float pb;
+                bsdf_eval_pdf(b, wo, wi, f, pb);
+                float w = ls.delta || light_only ? 1.0 : power_heuristic(ls.pdf, pb);
+                vec3 c = beta * f * abs(wi.z) * ls.L * (w / ls.pdf);
+                if (luminance(c) > 0.0) {
+                    Hit sh = trace(offset_origin(s.p, ng, ls.wi), ls.wi, 0.0, ls.dist * (1.0 - 1e-3), true);
+                    if (sh.tri == GN_INVALID && !sh.truncated)
+                        radiance += c;
+                }
+            }
+        }
+
+        BsdfSample bs = bsdf_sample(b, wo, ub.xyz);
+        if (bs.flags == 0u)
+            break;
+        vec3 wi = bs.wi.x * tx + bs.wi.y * ty + bs.wi.z * n;
+        if (dot(ng, wi) * bs.wi.z <= 0.0)
+            break;
+        beta *= bs.weight;
+        prev_delta = (bs.flags & BRDF_FLAG_DELTA) != 0u;
+        prev_pdf = bs.pdf;
+        o = offset_origin(s.p, ng, wi);
+        d = wi;
+        if (depth + 1u >= ROULETTE_DEPTH) {
+            float q = min(max(beta.r, max(beta.g, beta.b)), 0.95);
+            if (ul.w >= q)
+                break;
+            beta /= q;
+        }
+    }
+    if (truncated)
+        atomicAdd(status[0], 1u);
+    // A NaN or infinity from a degenerate configuration would poison the pixel for good.
+    if (any(isnan(radiance)) || any(isinf(radiance)))
+        radiance = vec3(0.0);
+    accum[pixel] += vec4(radiance, covered ? 1.0 : 0.0);
+    squares[pixel] += vec4(radiance * radiance, 0.0);
+    if ((frame.flags & GN_FRAME_AOV) != 0u) {
+        aov[3u * pixel + 0u] += vec4(normal, 0.0);
+        aov[3u * pixel + 1u] += vec4(albedo, 0.0);
+        aov[3u * pixel + 2u] += vec4(depth_aov, 0.0, 0.0, 0.0);
+    }
+}

@@ -1,0 +1,523 @@
+/* test_path.c: the path tracer (glsl/path.comp) against answers it does not compute itself:
+ * furnaces (a closed convex object of albedo a under a constant environment of radiance 1
+ * shows a), the three estimators (MIS, light only, BSDF only) against each other, the error
+ * falling as 1/sqrt(spp), the Cornell box against a brute-force CPU path tracer written
+ * here (BSDF sampling only, no MIS, double precision), bit-identical reruns and exact
+ * merging. Comparisons are z-tests with the renders' own variance channels. */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "gltf_write.h"
+#include "gpu.h"
+#include "image.h"
+#include "meshgen.h"
+#include "render.h"
+#include "scene.h"
+#include "test.h"
+
+#define Z_MAX 5.0 /* |z| above this fails: 1 in 1.7 million for a true Gaussian statistic */
+
+static bool open_gpu(gpu *g)
+{
+    const char *env = getenv("GONIO_VALIDATE");
+    gpu_desc d = {.device_index = -1, .validate = env && !strcmp(env, "1")};
+    bool ok = gpu_create(g, &d);
+    CHECKF(ok, "no Vulkan device");
+    return ok;
+}
+
+/* Renders a scene file with the path tracer; brdf as for render_material_overrides. */
+static bool render_file(gpu *g, const char *path, const char *brdf, render_settings s, image *out)
+{
+    scene sc = {0};
+    renderer r = {0};
+    render_stats st;
+    bool ok = scene_load(&sc, path) && render_material_overrides(&sc, brdf);
+    s.mode = GN_MODE_PATH;
+    s.variance = true;
+    if (ok) {
+        renderer_create(&r, g, &sc);
+        ok = renderer_render(&r, &s, out, &st);
+        CHECKF(st.truncated == 0, "%u paths ran out of BVH budget", st.truncated);
+        renderer_destroy(&r);
+    }
+    scene_destroy(&sc);
+    CHECKF(ok, "rendering %s failed", path);
+    return ok;
+}
+
+/* A flat-shaded (no NORMAL: shading = geometric normal, so the furnace is exact) unit sphere
+ * at the origin seen by a camera at z = 3, with one material. */
+static void write_sphere(const char *path, const gltf_write_material *mat)
+{
+    const float c[3] = {0, 0, 0};
+    meshgen_mesh m = meshgen_uv_sphere(c, 1, 24, 12);
+    gltf_write_mesh mesh = {.num_vertices = m.num_vertices, .positions = m.positions,
+                            .num_indices = 3 * m.num_triangles, .indices = m.indices};
+    gltf_write_camera cam = {.yfov = 0.8f, .aspect = 1};
+    gltf_write_node nodes[] = {{.kind = GLTF_WRITE_NODE_MESH},
+                               {.kind = GLTF_WRITE_NODE_CAMERA, .translation = {0, 0, 3}}};
+    gltf_write_desc d = {.meshes = &mesh, .num_meshes = 1, .materials = mat, .num_materials = 1,
+                         .cameras = &cam, .num_cameras = 1, .nodes = nodes, .num_nodes = 2};
+    CHECK(gltf_write_file(path, &d));
+    meshgen_destroy(&m);
+}
+
+/* Mean of channel c over the pixels every sample of which hit the object (A = 1), and the
+ * standard error of that mean from the variance channel. */
+static double covered_mean(const image *img, int c, double *se, int *count)
+{
+    int a = image_channel(img, "A"), v = image_channel(img, "variance.R") + c;
+    double sum = 0, var = 0;
+    int n = 0;
+    for (int p = 0; p < img->width * img->height; p++)
+        if (img->planes[a][p] == 1.0f) {
+            sum += img->planes[c][p];
+            var += img->planes[v][p];
+            n++;
+        }
+    *count = n;
+    *se = n ? sqrt(var) / n : 0;
+    return n ? sum / n : 0;
+}
+
+static void tmp_file(char *out, size_t cap, const char *name)
+{
+    snprintf(out, cap, "/tmp/gonio-test-path-%d-%s", (int)getpid(), name);
+}
+
+void test_path_furnace(void)
+{
+    static const struct {
+        const char *extras; /* NULL: glTF Lambertian (specular 0) of albedo 0.5 */
+        double expect;      /* < 0: lossy, at most 1 */
+    } cases[] = {
+        {NULL, 0.5},
+        {"{\"gonio\":{\"brdf\":\"lambert\",\"diffuse\":1}}", 1},
+        {"{\"gonio\":{\"brdf\":\"mirror\",\"reflectance\":1}}", 1},
+        {"{\"gonio\":{\"brdf\":\"dielectric\",\"tint\":1,\"ior\":1.5}}", 1},
+        {"{\"gonio\":{\"brdf\":\"dielectric\",\"tint\":1,\"ior\":1.5,\"alpha\":0.3}}", -1}, /* single scattering */
+        {"{\"gonio\":{\"brdf\":\"conductor\",\"alpha\":0.3}}", -1},
+        {"{\"gonio\":{\"brdf\":\"ggx\",\"diffuse\":0.5,\"specular\":0.5,\"alpha\":0.5}}", -1},
+        {"{\"gonio\":{\"brdf\":\"torrance-sparrow\",\"diffuse\":0.5,\"specular\":0.5}}", -1},
+        {"{\"gonio\":{\"brdf\":\"phong\",\"diffuse\":0.5,\"specular\":0.5}}", -1},
+    };
+    char path[256];
+    gpu g = {0};
+    if (!open_gpu(&g))
+        return;
+    tmp_file(path, sizeof path, "furnace.gltf");
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        gltf_write_material mat = {.base_color = {0.5f, 0.5f, 0.5f, 1}, .roughness = 1,
+                                   .has_specular = true, .specular_color = {1, 1, 1},
+                                   .extras = cases[i].extras};
+        render_settings s = {.width = 32, .height = 32, .spp = 64, .camera = 0,
+                             .env = {1, 1, 1}, .seed = 1};
+        image img = {0};
+        write_sphere(path, &mat);
+        if (!render_file(&g, path, NULL, s, &img))
+            continue;
+        for (int c = 0; c < 3; c++) {
+            int n;
+            double se, mean = covered_mean(&img, c, &se, &n);
+            CHECKF(n > 300, "case %zu: only %d covered pixels", i, n);
+            if (cases[i].expect > 0)
+                CHECKF(fabs(mean - cases[i].expect) <= Z_MAX * se + 1e-4,
+                       "case %zu (%s): furnace gives %.5f +- %.5f, expected %.3f", i,
+                       cases[i].extras ? cases[i].extras : "gltf", mean, se, cases[i].expect);
+            else
+                CHECKF(mean <= 1 + Z_MAX * se + 1e-4 && mean > 0.1,
+                       "case %zu (%s): lossy furnace gives %.5f +- %.5f, expected (0.1, 1]", i,
+                       cases[i].extras, mean, se);
+        }
+        image_destroy(&img);
+    }
+    unlink(path);
+    gpu_destroy(&g);
+}
+
+/* A lat-long map under which the sphere is lit: constant 1 (the furnace again, through map
+ * sampling), and a bright band, where MIS and BSDF sampling only must agree. */
+void test_path_env_map(void)
+{
+    char scene_path[256], map_path[256];
+    const char *names[] = {"R", "G", "B"};
+    gpu g = {0};
+    image map = {0}, a = {0}, b = {0};
+    gltf_write_material mat = {.base_color = {0.5f, 0.5f, 0.5f, 1}, .roughness = 1,
+                               .has_specular = true, .specular_color = {1, 1, 1}};
+    render_settings s = {.width = 32, .height = 32, .spp = 64, .camera = 0, .seed = 3};
+    int n;
+    double se, mean;
+    if (!open_gpu(&g))
+        return;
+    tmp_file(scene_path, sizeof scene_path, "env.gltf");
+    tmp_file(map_path, sizeof map_path, "env.exr");
+    write_sphere(scene_path, &mat);
+    image_create(&map, 32, 16, 3, names);
+    for (int p = 0; p < 32 * 16; p++)
+        map.planes[0][p] = map.planes[1][p] = map.planes[2][p] = 1;
+    s.env_map = &map;
+    if (render_file(&g, scene_path, NULL, s, &a)) {
+        mean = covered_mean(&a, 0, &se, &n);
+        CHECKF(fabs(mean - 0.5) <= Z_MAX * se + 1e-3, "constant map: %.5f +- %.5f, expected 0.5", mean, se);
+    }
+    image_destroy(&a);
+    /* A band 10x brighter, above and to one side (rows 3-5, columns 20-27), plus a dim rest. */
+    for (int y = 0; y < 16; y++)
+        for (int x = 0; x < 32; x++)
+            map.planes[0][y * 32 + x] = map.planes[1][y * 32 + x] = map.planes[2][y * 32 + x] =
+                y >= 3 && y <= 5 && x >= 20 && x <= 27 ? 20.0f : 0.2f;
+    s.spp = 128;
+    if (render_file(&g, scene_path, NULL, s, &a)) {
+        s.strategy = GN_FRAME_BSDF_ONLY;
+        s.seed = 4;
+        if (render_file(&g, scene_path, NULL, s, &b)) {
+            double ma, mb, sa, sb;
+            ma = covered_mean(&a, 1, &sa, &n);
+            mb = covered_mean(&b, 1, &sb, &n);
+            CHECKF(fabs(ma - mb) <= Z_MAX * sqrt(sa * sa + sb * sb),
+                   "map: MIS %.5f +- %.5f vs BSDF only %.5f +- %.5f", ma, sa, mb, sb);
+            CHECKF(sa < sb, "map importance sampling should reduce noise: %.5f vs %.5f", sa, sb);
+        }
+    }
+    image_destroy(&a);
+    image_destroy(&b);
+    image_destroy(&map);
+    unlink(scene_path);
+    gpu_destroy(&g);
+}
+
+/* z statistics of a - b in blocks of bs x bs pixels over R, G, B: the largest |z| of any
+ * block and channel. */
+static double max_block_z(const image *a, const image *b, int bs)
+{
+    double zmax = 0;
+    for (int c = 0; c < 3; c++) {
+        int va = image_channel(a, "variance.R") + c, vb = image_channel(b, "variance.R") + c;
+        for (int by = 0; by < a->height / bs; by++)
+            for (int bx = 0; bx < a->width / bs; bx++) {
+                double d = 0, v = 0;
+                for (int y = by * bs; y < (by + 1) * bs; y++)
+                    for (int x = bx * bs; x < (bx + 1) * bs; x++) {
+                        int p = y * a->width + x;
+                        d += (double)a->planes[c][p] - b->planes[c][p];
+                        v += (double)a->planes[va][p] + b->planes[vb][p];
+                    }
+                if (v > 0 && fabs(d) / sqrt(v) > zmax)
+                    zmax = fabs(d) / sqrt(v);
+                else if (v == 0 && fabs(d) > 1e-5)
+                    zmax = 1e9;
+            }
+    }
+    return zmax;
+}
+
+/* The Cornell box with glossy (GGX) walls: MIS, light sampling only and BSDF sampling only
+ * converge to the same image; and the test notices a missing bounce. 256 spp: BSDF sampling
+ * finds the small light rarely, and below that its variance estimates run low (at 128 spp
+ * the z of a correct render reaches 9). */
+void test_path_estimators(void)
+{
+    static const uint32_t strategies[] = {0, GN_FRAME_LIGHT_ONLY, GN_FRAME_BSDF_ONLY};
+    const char *brdf = "ggx:alpha=0.25:specular=0.3";
+    gpu g = {0};
+    image img[3] = {{0}}, direct = {0};
+    render_settings s = {.width = 32, .height = 32, .spp = 256, .camera = 0};
+    if (!open_gpu(&g))
+        return;
+    for (int i = 0; i < 3; i++) {
+        s.strategy = strategies[i];
+        s.seed = 10 + (uint32_t)i;
+        render_file(&g, "scenes/cornell.gltf", brdf, s, &img[i]);
+    }
+    s.strategy = 0;
+    s.max_depth = 1;
+    render_file(&g, "scenes/cornell.gltf", brdf, s, &direct);
+    if (img[0].planes[0] && img[1].planes[0] && img[2].planes[0] && direct.planes[0]) {
+        double z01 = max_block_z(&img[0], &img[1], 4), z02 = max_block_z(&img[0], &img[2], 4);
+        double z12 = max_block_z(&img[1], &img[2], 4), zd = max_block_z(&img[0], &direct, 4);
+        CHECKF(z01 < Z_MAX, "MIS vs light sampling: max block |z| = %.2f", z01);
+        CHECKF(z02 < Z_MAX, "MIS vs BSDF sampling: max block |z| = %.2f", z02);
+        CHECKF(z12 < Z_MAX, "light vs BSDF sampling: max block |z| = %.2f", z12);
+        CHECKF(zd > 2 * Z_MAX, "the test cannot tell direct light only from MIS: |z| = %.2f", zd);
+    }
+    for (int i = 0; i < 3; i++)
+        image_destroy(&img[i]);
+    image_destroy(&direct);
+    gpu_destroy(&g);
+}
+
+static double rmse_rgb(const image *a, const image *b)
+{
+    double s = 0;
+    int n = a->width * a->height;
+    for (int c = 0; c < 3; c++)
+        for (int p = 0; p < n; p++) {
+            double d = (double)a->planes[c][p] - b->planes[c][p];
+            s += d * d;
+        }
+    return sqrt(s / (3.0 * n));
+}
+
+/* RMSE against a 512 spp render falls as 1/sqrt(spp): the fitted log-log slope over
+ * 4..64 spp is -1/2, once the reference's own noise (its variance channel) is taken out. */
+void test_path_convergence(void)
+{
+    gpu g = {0};
+    image ref = {0};
+    render_settings s = {.width = 32, .height = 32, .spp = 512, .camera = 0, .seed = 100};
+    double ref_var = 0, x[3], y[3], sx = 0, sy = 0, sxx = 0, sxy = 0, slope;
+    if (!open_gpu(&g))
+        return;
+    if (!render_file(&g, "scenes/cornell.gltf", NULL, s, &ref)) {
+        gpu_destroy(&g);
+        return;
+    }
+    for (int c = 0; c < 3; c++)
+        for (int p = 0; p < 32 * 32; p++)
+            ref_var += ref.planes[image_channel(&ref, "variance.R") + c][p] / (3.0 * 32 * 32);
+    for (int i = 0; i < 3; i++) {
+        image img = {0};
+        s.spp = 4 << (2 * i);
+        s.seed = 200 + (uint32_t)i;
+        if (!render_file(&g, "scenes/cornell.gltf", NULL, s, &img))
+            break;
+        x[i] = log(s.spp);
+        y[i] = 0.5 * log(fmax(pow(rmse_rgb(&img, &ref), 2) - ref_var, 1e-30));
+        image_destroy(&img);
+        sx += x[i], sy += y[i], sxx += x[i] * x[i], sxy += x[i] * y[i];
+    }
+    slope = (3 * sxy - sx * sy) / (3 * sxx - sx * sx);
+    CHECKF(fabs(slope + 0.5) < 0.1, "RMSE ~ spp^%.3f, expected spp^-0.5", slope);
+    image_destroy(&ref);
+    gpu_destroy(&g);
+}
+
+/* ---- an independent reference: brute-force CPU path tracing of the Cornell box --------- */
+
+static double rnd(uint64_t *s) /* splitmix64 -> [0, 1) */
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return (double)((z ^ (z >> 31)) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static void sub3(double *o, const float *a, const float *b)
+{
+    for (int k = 0; k < 3; k++)
+        o[k] = (double)a[k] - b[k];
+}
+static void cross3(double *o, const double *a, const double *b)
+{
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* Closest triangle hit by Moller-Trumbore over every triangle; -1 on a miss. */
+static int ref_hit(const scene *sc, const double *o, const double *d, double *tbest)
+{
+    int best = -1;
+    *tbest = 1e300;
+    for (uint32_t t = 0; t < sc->num_triangles; t++) {
+        const float *p0 = &sc->vertices[sc->indices[3 * t]].position.x;
+        double e1[3], e2[3], pv[3], tv[3], qv[3], det, u, v, dist, o0[3];
+        sub3(e1, &sc->vertices[sc->indices[3 * t + 1]].position.x, p0);
+        sub3(e2, &sc->vertices[sc->indices[3 * t + 2]].position.x, p0);
+        cross3(pv, d, e2);
+        det = dot3(e1, pv);
+        if (fabs(det) < 1e-14)
+            continue;
+        for (int k = 0; k < 3; k++)
+            o0[k] = p0[k];
+        for (int k = 0; k < 3; k++)
+            tv[k] = o[k] - o0[k];
+        u = dot3(tv, pv) / det;
+        if (u < 0 || u > 1)
+            continue;
+        cross3(qv, tv, e1);
+        v = dot3(d, qv) / det;
+        if (v < 0 || u + v > 1)
+            continue;
+        dist = dot3(e2, qv) / det;
+        if (dist > 1e-9 && dist < *tbest) {
+            *tbest = dist;
+            best = (int)t;
+        }
+    }
+    return best;
+}
+
+/* Radiance along one camera ray: Lambertian BRDFs sampled by the cosine, emission added
+ * where a path happens to hit a lit front face, roulette after three bounces. */
+static void ref_radiance(const scene *sc, double *o, double *d, uint64_t *rng, double L[3])
+{
+    double beta[3] = {1, 1, 1};
+    L[0] = L[1] = L[2] = 0;
+    for (int depth = 0; depth < 1000; depth++) {
+        double t, e1[3], e2[3], n[3], len, tx[3], ty[3], r, phi, z, q;
+        int tri = ref_hit(sc, o, d, &t);
+        const GnMaterial *m;
+        if (tri < 0)
+            return;
+        m = &sc->materials[sc->tri_material[tri]];
+        sub3(e1, &sc->vertices[sc->indices[3 * tri + 1]].position.x, &sc->vertices[sc->indices[3 * tri]].position.x);
+        sub3(e2, &sc->vertices[sc->indices[3 * tri + 2]].position.x, &sc->vertices[sc->indices[3 * tri]].position.x);
+        cross3(n, e1, e2);
+        len = sqrt(dot3(n, n));
+        for (int k = 0; k < 3; k++)
+            n[k] /= len;
+        if (dot3(n, d) < 0 || (m->flags & GN_MAT_DOUBLE_SIDED))
+            for (int k = 0; k < 3; k++)
+                L[k] += beta[k] * (&m->emissive.x)[k];
+        if (dot3(n, d) > 0)
+            for (int k = 0; k < 3; k++)
+                n[k] = -n[k];
+        for (int k = 0; k < 3; k++) {
+            o[k] += t * d[k] + 1e-6 * n[k];
+            beta[k] *= (&m->base_color.x)[k];
+        }
+        /* a cosine-distributed direction about n */
+        tx[0] = fabs(n[0]) > 0.5 ? 0 : 1;
+        tx[1] = fabs(n[0]) > 0.5 ? 1 : 0;
+        tx[2] = 0;
+        cross3(ty, n, tx);
+        len = sqrt(dot3(ty, ty));
+        for (int k = 0; k < 3; k++)
+            ty[k] /= len;
+        cross3(tx, ty, n);
+        r = sqrt(rnd(rng));
+        phi = 2 * M_PI * rnd(rng);
+        z = sqrt(fmax(0, 1 - r * r));
+        for (int k = 0; k < 3; k++)
+            d[k] = r * cos(phi) * tx[k] + r * sin(phi) * ty[k] + z * n[k];
+        if (depth >= 2) {
+            q = fmin(fmax(beta[0], fmax(beta[1], beta[2])), 0.95);
+            if (rnd(rng) >= q)
+                return;
+            for (int k = 0; k < 3; k++)
+                beta[k] /= q;
+        }
+    }
+}
+
+void test_path_cornell_reference(void)
+{
+    enum { W = 32, H = 32, SPP = 256 };
+    const char *names[] = {"R", "G", "B", "variance.R", "variance.G", "variance.B"};
+    gpu g = {0};
+    scene sc = {0};
+    image gpu_img = {0}, ref = {0};
+    render_settings s = {.width = W, .height = H, .spp = SPP, .camera = 0, .seed = 5};
+    uint64_t rng = 12345;
+    if (!scene_load(&sc, "scenes/cornell.gltf")) {
+        CHECK(!"scenes/cornell.gltf loads");
+        return;
+    }
+    image_create(&ref, W, H, 6, names);
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            const scene_camera *c = &sc.cameras[0];
+            double sum[3] = {0}, sq[3] = {0}, th = tan(0.5 * c->yfov);
+            for (int i = 0; i < SPP; i++) {
+                double nx = 2 * (x + rnd(&rng)) / W - 1, ny = 1 - 2 * (y + rnd(&rng)) / H;
+                double o[3], d[3], len = 0, L[3];
+                for (int k = 0; k < 3; k++) {
+                    o[k] = c->position[k];
+                    d[k] = c->forward[k] + nx * th * c->right[k] + ny * th * c->up[k];
+                    len += d[k] * d[k];
+                }
+                for (int k = 0; k < 3; k++)
+                    d[k] /= sqrt(len);
+                ref_radiance(&sc, o, d, &rng, L);
+                for (int k = 0; k < 3; k++) {
+                    sum[k] += L[k];
+                    sq[k] += L[k] * L[k];
+                }
+            }
+            for (int k = 0; k < 3; k++) {
+                double m = sum[k] / SPP;
+                ref.planes[k][y * W + x] = (float)m;
+                ref.planes[3 + k][y * W + x] = (float)fmax(0, (sq[k] / SPP - m * m) / (SPP - 1));
+            }
+        }
+    scene_destroy(&sc);
+    if (open_gpu(&g) && render_file(&g, "scenes/cornell.gltf", NULL, s, &gpu_img)) {
+        double z = max_block_z(&gpu_img, &ref, 4), mg = 0, mr = 0;
+        for (int p = 0; p < W * H; p++)
+            mg += gpu_img.planes[1][p], mr += ref.planes[1][p];
+        CHECKF(z < Z_MAX, "Cornell box vs the CPU reference: max block |z| = %.2f (mean G %.4f vs %.4f)",
+               z, mg / (W * H), mr / (W * H));
+    }
+    image_destroy(&gpu_img);
+    image_destroy(&ref);
+    gpu_destroy(&g);
+}
+
+/* The same settings twice give the same bits. */
+void test_path_determinism(void)
+{
+    gpu g = {0};
+    image a = {0}, b = {0};
+    render_settings s = {.width = 24, .height = 24, .spp = 8, .camera = 0, .seed = 9, .aov = true};
+    if (!open_gpu(&g))
+        return;
+    if (render_file(&g, "scenes/cornell.gltf", NULL, s, &a) &&
+        render_file(&g, "scenes/cornell.gltf", NULL, s, &b)) {
+        bool same = a.num_channels == b.num_channels;
+        for (int c = 0; same && c < a.num_channels; c++)
+            same = !memcmp(a.planes[c], b.planes[c], sizeof(float) * 24 * 24);
+        CHECKF(same, "two renders with the same settings differ");
+    }
+    image_destroy(&a);
+    image_destroy(&b);
+    gpu_destroy(&g);
+}
+
+/* gonio merge on hand-made files: means weight by spp, variances by the sums of squares
+ * they imply (computed here by hand for two pixels of two samples each). */
+void test_path_merge(void)
+{
+    const char *names[] = {"R", "variance.R"};
+    char a_path[256], b_path[256], o_path[256];
+    image a = {0}, b = {0}, o = {0};
+    image_attr attr_a[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 1, 0}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 1, 0}};
+    image_attr attr_b[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 3, 0}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 2, 0}};
+    tmp_file(a_path, sizeof a_path, "a.exr");
+    tmp_file(b_path, sizeof b_path, "b.exr");
+    tmp_file(o_path, sizeof o_path, "o.exr");
+    image_create(&a, 1, 1, 2, names);
+    image_create(&b, 1, 1, 2, names);
+    /* a: one sample, 2. b: three samples 1, 2, 6: mean 3, variance of the mean
+     * (sum (x - 3)^2 / 2) / 3 = (4 + 1 + 9) / 6 = 7/3. All four: 2, 1, 2, 6: mean 11/4,
+     * sample variance (sum x^2 - 4 m^2) / 3 = (45 - 30.25) / 3, of the mean / 4. */
+    a.planes[0][0] = 2;
+    b.planes[0][0] = 3;
+    b.planes[1][0] = 7.0f / 3;
+    CHECK(image_write_exr(&a, a_path, attr_a, 2) && image_write_exr(&b, b_path, attr_b, 2));
+    {
+        char *argv[] = {"merge", a_path, b_path, "-o", o_path, NULL};
+        CHECK(cmd_merge(5, argv) == 0);
+    }
+    if (image_read_exr(&o, o_path)) {
+        double spp = 0;
+        CHECKF(fabs(o.planes[0][0] - 2.75) < 1e-6, "merged mean %g, expected 2.75", o.planes[0][0]);
+        CHECKF(fabs(o.planes[1][0] - (45 - 30.25) / 3 / 4) < 1e-5, "merged variance %g, expected %g",
+               o.planes[1][0], (45 - 30.25) / 3 / 4);
+        CHECK(image_exr_attr_double(o_path, "gonio:spp", &spp) && spp == 4);
+    }
+    image_destroy(&a);
+    image_destroy(&b);
+    image_destroy(&o);
+    unlink(a_path);
+    unlink(b_path);
+    unlink(o_path);
+}
