@@ -1,12 +1,12 @@
 #version 450
 // local.comp: one sample per pixel per dispatch of the non-path-traced modes: the Phong
-// reflection model of the lecture (L_o = ambient + emission + diffuse + specular, summed
-// over the punctual lights, with ray-traced shadows), and the debug images normal, albedo,
-// depth and BVH cost. The mode is a specialization constant, so each mode compiles to its
-// own lean kernel.
+// reflection model of the lecture (glsl/phong.glsl) evaluated once per triangle (flat),
+// per vertex and interpolated (Gouraud) or per pixel (Phong shading), and the debug images
+// normal, albedo, depth and BVH cost. The mode is a specialization constant, so each mode
+// compiles to its own lean kernel.
 #extension GL_GOOGLE_include_directive : require
 
-#include "bvh.glsl"
+#include "phong.glsl"
 
 layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
 layout(constant_id = 0) const uint MODE = GN_MODE_PHONG;
@@ -17,73 +17,32 @@ layout(std430, binding = GN_BIND_VCOLOR) readonly buffer VColorBlock { vec4 vcol
 layout(std430, binding = GN_BIND_STATUS) buffer StatusBlock { uint status[]; };
 layout(push_constant) uniform PushBlock { GnPush push; };
 
-// Light arriving at p from light l: direction to the light, distance, and the irradiance
-// scale (colour already in l.color) for a surface facing it.
-vec3 light_incident(GnLight l, vec3 p, out vec3 wi, out float dist)
+// Gouraud shading (Gouraud 1971): the colours glsl/vertex.comp computed at the corners,
+// interpolated with the hit's barycentrics. Each vertex has a colour per side (vcolor[2i]
+// lit with its normal, vcolor[2i+1] with the opposite one); the side is the one per-pixel
+// shading would light, where the interpolated normal faces the viewer (see surface_at).
+vec3 gouraud_color(Hit h, vec3 d)
 {
-    if (l.type == GN_LIGHT_DIRECTIONAL) {
-        wi = -l.direction;
-        dist = 1e30;
-        return l.color;
-    }
-    vec3 to = l.position - p;
-    float d2 = max(dot(to, to), 1e-12);
-    dist = sqrt(d2);
-    wi = to / dist;
-    float atten = 1.0 / d2;
-    if (l.range > 0.0) { // KHR_lights_punctual's recommended window
-        float x = dist / l.range;
-        atten *= clamp(1.0 - x * x * x * x, 0.0, 1.0) * clamp(1.0 - x * x * x * x, 0.0, 1.0);
-    }
-    if (l.type == GN_LIGHT_COSINE)
-        atten *= max(dot(l.direction, -wi), 0.0);
-    if (l.type == GN_LIGHT_SPOT) {
-        float cd = dot(l.direction, -wi);
-        atten *= smoothstep(l.outer_cos, l.inner_cos, cd);
-    }
-    return l.color * atten;
+    GnPrim pr = prims[h.tri];
+    GnVertex a = vertices[pr.i0], b = vertices[pr.i1], c = vertices[pr.i2];
+    float w = 1.0 - h.u - h.v;
+    vec3 ng = cross(b.position - a.position, c.position - a.position);
+    vec3 n = w * a.normal + h.u * b.normal + h.v * c.normal;
+    uint side = dot(n, ng) * dot(ng, d) > 0.0 ? 1u : 0u; // n and the viewer on opposite sides
+    return w * vcolor[2u * pr.i0 + side].rgb + h.u * vcolor[2u * pr.i1 + side].rgb +
+           h.v * vcolor[2u * pr.i2 + side].rgb;
 }
 
-bool shadowed(Surface s, vec3 wi, float dist)
+// Flat shading: the face normal, lit once at the centroid and seen from there, so the
+// whole triangle has one colour.
+vec3 flat_color(Hit h, vec3 d)
 {
-    if ((frame.flags & GN_FRAME_SHADOWS) == 0u)
-        return false;
-    // Offset along the geometric normal, scaled to the position's magnitude, so the
-    // shadow ray does not hit its own triangle.
-    float eps = 1e-4 * max(1.0, max(abs(s.p.x), max(abs(s.p.y), abs(s.p.z))));
-    vec3 o = s.p + s.ng * eps;
-    Hit h = bvh_trace(o, wi, 0.0, dist * (1.0 - 1e-4), true);
-    return h.tri != GN_INVALID;
-}
-
-// The Phong reflection model at s seen from direction v (towards the viewer).
-vec3 phong_shade(Surface s, vec3 v)
-{
-    GnMaterial m = materials[s.material];
-    // The glTF textures modulate the classic colours, so textured models look right.
-    vec3 tex = m.tex_base != GN_INVALID ? texture_sample(m.tex_base, s.uv, true).rgb : vec3(1.0);
-    vec3 kd = m.phong_diffuse * tex;
-    vec3 ka = m.phong_ambient * tex;
-    vec3 ks = m.phong_specular;
-    vec3 c = m.phong_emission;
-    if (m.tex_emissive != GN_INVALID)
-        c *= texture_sample(m.tex_emissive, s.uv, true).rgb;
-    c += frame.ambient * ka * s.occlusion;
-    for (uint i = 0u; i < frame.num_lights; i++) {
-        GnLight l = lights[i];
-        vec3 wi;
-        float dist;
-        vec3 E = light_incident(l, s.p, wi, dist);
-        float ndl = dot(s.n, wi);
-        if (ndl <= 0.0 || dot(s.ng, wi) <= 0.0 || dot(E, E) == 0.0)
-            continue;
-        if (shadowed(s, wi, dist))
-            continue;
-        vec3 r = 2.0 * ndl * s.n - wi; // the lecture's r(w_i)
-        float spec = pow(max(dot(r, v), 0.0), m.phong_shininess);
-        c += E * (kd * ndl + ks * spec);
-    }
-    return c;
+    GnPrim pr = prims[h.tri];
+    vec3 center = (vertices[pr.i0].position + vertices[pr.i1].position +
+                  vertices[pr.i2].position) / 3.0;
+    Surface s = surface_at(h.tri, 0.0, 1.0 / 3.0, 1.0 / 3.0, center, d);
+    return phong_shade(center, s.ng, s.ng, s.uv, s.material,
+                       normalize(frame.camera.position - center));
 }
 
 void main()
@@ -108,9 +67,12 @@ void main()
         if (MODE == GN_MODE_NORMAL) color = normal;
         else if (MODE == GN_MODE_ALBEDO) color = albedo;
         else if (MODE == GN_MODE_DEPTH) color = vec3(depth);
-        else if (MODE == GN_MODE_PHONG) color = phong_shade(s, -d);
+        else if (MODE == GN_MODE_PHONG) color = phong_shade(s.p, s.n, s.ng, s.uv, s.material, -d);
+        else if (MODE == GN_MODE_GOURAUD) color = gouraud_color(h, d);
+        else if (MODE == GN_MODE_FLAT) color = flat_color(h, d);
     } else {
-        color = MODE == GN_MODE_PHONG ? frame.env_color : vec3(0.0);
+        bool lit = MODE == GN_MODE_PHONG || MODE == GN_MODE_GOURAUD || MODE == GN_MODE_FLAT;
+        color = lit ? frame.env_color : vec3(0.0);
     }
     if (MODE == GN_MODE_COST) color = vec3(float(h.steps));
     accum[pixel] += vec4(color, h.tri != GN_INVALID ? 1.0 : 0.0); // w: coverage

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# make-images.sh: regenerates every figure in docs/img (make docs-images): the BRDF lobe
+# plots and material balls of docs/brdf.md section 6, and the shading comparison and sweep of
+# docs/shading.md. Environment: GONIO (the program; default build/gonio).
+set -eu
+cd "$(dirname "$0")/.."
+G=${GONIO:-build/gonio}
+img=docs/img
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+mkdir -p $img
+
+# ---- docs/brdf.md -------------------------------------------------------------------------
+"$G" brdf lambert --theta 30 -o $img/brdf-lambert.png
+"$G" brdf mirror --theta 40 -o $img/brdf-mirror.png
+"$G" brdf phong --diffuse 0.5 --specular 0.5 --exponent 20 --theta 30 -o $img/brdf-phong.png
+"$G" brdf blinn-phong --diffuse 0.5 --specular 0.5 --exponent 50 --theta 30 -o $img/brdf-blinn-phong.png
+"$G" brdf torrance-sparrow --diffuse 0.5 --specular 0.5 --exponent 50 --theta 45 -o $img/brdf-torrance-sparrow.png
+"$G" brdf beckmann --alpha 0.2 --theta 45 -o $img/brdf-beckmann.png
+"$G" brdf ggx --alpha 0.2 --theta 45 -o $img/brdf-ggx.png
+"$G" brdf conductor --alpha 0.2 --theta 60 -o $img/brdf-conductor.png
+"$G" brdf dielectric --theta 40 -o $img/brdf-glass.png
+"$G" brdf dielectric --alpha 0.2 --theta 40 -o $img/brdf-dielectric.png
+"$G" brdf gltf --roughness 0.4 --theta 45 -o $img/brdf-gltf.png
+ball() { # ball NAME MODEL [PARAMS...]
+    local name=$1; shift
+    "$G" brdf "$@" --sphere --size 128x128 --spp 256 -o "$tmp/ball.exr" --png $img/brdf-ball-$name.png
+}
+ball lambert lambert
+ball phong phong --diffuse 0.4,0.1,0.1 --specular 0.5 --exponent 64
+ball ggx ggx --diffuse 0.1,0.2,0.5 --specular 0.5 --alpha 0.1
+ball conductor conductor --alpha 0.2
+ball dielectric dielectric --tint 0.5,0.8,1 --alpha 0.05
+ball gltf gltf --base-color 0.8,0.3,0.1 --roughness 0.4 --metallic 0.5
+
+# ---- docs/shading.md ----------------------------------------------------------------------
+# The lecture's teapot in all four modes (path is skipped while unavailable), 320x240.
+"$G" compare scenes/teapot.gltf -o "$tmp/teapot" --spp 256 --quiet
+cp "$tmp/teapot/side-by-side.png" $img/shading-teapot.png
+rm -f $img/shading-diff-*.png
+for f in "$tmp"/teapot/diff-*.png; do cp "$f" $img/shading-$(basename "$f"); done
+cp "$tmp/teapot/metrics.csv" $img/shading-teapot-metrics.csv
+"$G" compare --sweep 1,2,4,8,16,32 teapot -o "$tmp/sweep" --quiet
+cp "$tmp/sweep/sweep.png" $img/shading-sweep.png
+cp "$tmp/sweep/sweep.csv" $img/shading-sweep.csv

@@ -1,0 +1,32 @@
+#version 450
+// vertex.comp: the per-vertex lighting pass of Gouraud shading (Gouraud 1971, "Continuous
+// shading of curved surfaces"): the Phong reflection model (glsl/phong.glsl) once per vertex,
+// with the vertex normal, the view direction from the vertex and shadow rays from the
+// vertex, as an OpenGL 1.x vertex pipeline lights them. local.comp interpolates the colours.
+//
+// vcolor holds two vec4 per vertex: [2i] the side the normal points to, [2i+1] the other
+// side (two-sided lighting: open meshes show both). The host stores the vertex's material
+// index in the bits of vcolor[2i].w; this pass writes .rgb only. One dispatch per side
+// (push.pass_flags = 0 or 1) keeps one invocation's shadow rays within the loop budget.
+#extension GL_GOOGLE_include_directive : require
+
+#include "phong.glsl"
+
+layout(local_size_x = 64) in;
+
+layout(std430, binding = GN_BIND_VCOLOR) buffer VColorBlock { vec4 vcolor[]; };
+layout(push_constant) uniform PushBlock { GnPush push; };
+
+void main()
+{
+    uint i = gl_GlobalInvocationID.x, side = push.pass_flags;
+    if (i >= uint(vcolor.length()) / 2u)
+        return;
+    GnVertex a = vertices[i];
+    uint material = floatBitsToUint(vcolor[2u * i].w);
+    vec3 n = dot(a.normal, a.normal) > 1e-20 ? normalize(a.normal) : vec3(0.0);
+    if (side == 1u)
+        n = -n;
+    vec3 v = normalize(frame.camera.position - a.position);
+    vcolor[2u * i + side].rgb = phong_shade(a.position, n, n, vec2(a.u, a.v), material, v);
+}
