@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# preview.sh: `gonio preview` in a virtual X display (xvfb-run) on lavapipe, validation on:
+# its --screenshot, the X server's own capture of the window, and the files of the P key
+# equal `gonio render` of the same view and sample count (the same kernels and samples, so
+# within one 8-bit level); keys typed with xdotool switch modes; a resize restarts at the
+# new size; without a display the error points to `gonio render` and xvfb-run.
+. "$(dirname "$0")/../lib.sh"
+G=$GONIO
+C=scenes/cornell.gltf
+
+# The rest runs inside one virtual display (-a: a free server number; 24-bit for Vulkan).
+if [ "${GONIO_PREVIEW_XVFB:-}" != 1 ]; then
+    for t in xvfb-run xauth xdotool import compare identify; do
+        command -v $t >/dev/null || skip_all "$t is missing (make test-deps installs it)"
+    done
+    GONIO_PREVIEW_XVFB=1 exec xvfb-run -a -s "-screen 0 320x240x24" "$0" "$@"
+fi
+
+check_fails "no display: exit 1" 1 env -u DISPLAY -u WAYLAND_DISPLAY "$G" preview $C
+check "no display: the message points to gonio render and xvfb-run" \
+    sh -c "grep -q 'gonio render' '$tmp/last' && grep -q xvfb-run '$tmp/last'"
+check_fails "bad --mode" 2 "$G" preview $C --mode bogus
+check_fails "no scene" 2 "$G" preview
+check_fails "missing scene" 1 "$G" preview "$tmp/nope.gltf" --frames 1
+check "missing scene: message names the file" grep -q nope.gltf "$tmp/last"
+check "preview --help lists the keys" sh -c "'$G' preview --help | grep -q Esc"
+
+# same_image A.png B.png: same size, no channel of any pixel more than one level apart, and
+# at most 1% of the pixels different at all (GLSL's float pow may round the odd value
+# otherwise than image.c's double one; a systematic error changes most pixels).
+same_image() {
+    local size e n
+    size=$(identify -format %wx%h "$1")
+    [ "$size" = "$(identify -format %wx%h "$2")" ] || return 1
+    e=$(compare -metric PAE "$1" "$2" null: 2>&1 | sed -n 's/.*(\(.*\)).*/\1/p')
+    n=$(compare -metric AE "$1" "$2" null: 2>&1)
+    echo "$1 vs $2: peak $e, $n pixel(s) differ"
+    awk -v e="$e" -v n="$n" -v s="$size" 'BEGIN { split(s, d, "x")
+        exit !(e != "" && e <= 1.5 / 255 && n + 0 <= d[1] * d[2] / 100) }'
+}
+differs() { ! same_image "$@"; }
+ref() { # ref NAME MODE WxH [render options]: the reference render, EXR and PNG
+    local n=$1 m=$2 s=$3; shift 3
+    check "render $n" "$G" render $C -o "$tmp/$n.exr" --png "$tmp/$n.png" --mode $m --size $s \
+        --spp 4 --quiet "$@"
+}
+ref phong phong 160x120
+ref phong-aces phong 160x120 --tonemap aces --exposure 1.5
+ref normal normal 160x120
+ref normal-big normal 200x150
+check "render phong, 1 spp" "$G" render $C --png "$tmp/phong-1.png" --size 160x120 --spp 1 --quiet
+
+# ---- scripted: N frames, then the screenshot ---------------------------------------------
+check "preview 8 frames at 4 spp" "$G" preview $C --size 160x120 --spp 4 --frames 8 \
+    --screenshot "$tmp/shot.png"
+check "screenshot equals gonio render" same_image "$tmp/shot.png" "$tmp/phong.png"
+check "...and the comparison can fail: 1 spp differs" differs "$tmp/shot.png" "$tmp/phong-1.png"
+check "preview with aces and exposure" "$G" preview $C --size 160x120 --spp 4 --frames 8 \
+    --tonemap aces --exposure 1.5 --screenshot "$tmp/shot-aces.png"
+check "aces screenshot equals gonio render" same_image "$tmp/shot-aces.png" "$tmp/phong-aces.png"
+
+# ---- interactive: X captures while it runs, keys, resize, P, Esc ------------------------
+timeout 120 "$G" preview $C --size 160x120 --spp 4 --frames 2400 --prefix "$tmp/saved" \
+    --screenshot "$tmp/end.png" >"$tmp/pv.out" 2>"$tmp/pv.err" &
+pid=$!
+wid=$(timeout 30 xdotool search --sync --name '^gonio preview')
+wait_title() { # wait_title PATTERN: up to 30 s for the window title to match
+    for _ in $(seq 300); do
+        xdotool getwindowname "$wid" 2>/dev/null | grep -Eq "$1" && return 0
+        sleep 0.1
+    done
+    echo "title: $(xdotool getwindowname "$wid" 2>&1)"; return 1
+}
+colours() { identify -format %k "$1"; }
+check "the window opens" test -n "$wid"
+check "title: phong, size, 4 spp" wait_title '^gonio preview: phong \| 160x120 \| 4 spp \| [0-9.]+ Mpaths/s \| [0-9.]+ ms'
+check "import the root window" import -window root "$tmp/root.png"
+check "the screen is not blank" test "$(colours "$tmp/root.png")" -gt 50
+check "import the preview window" import -window "$wid" "$tmp/win-phong.png"
+check "the window shows the render" same_image "$tmp/win-phong.png" "$tmp/phong.png"
+check "focus" xdotool windowfocus --sync "$wid"
+check "key 5" xdotool key 5
+check "title: normal" wait_title '^gonio preview: normal \| 160x120 \| 4 spp'
+check "import the window (normal)" import -window "$wid" "$tmp/win-normal.png"
+check "the window shows the normal render" same_image "$tmp/win-normal.png" "$tmp/normal.png"
+# Mode 1 (path) switches, or says it is not available and stays.
+check "key 1" xdotool key 1
+check "path, or a message" sh -c "for i in \$(seq 300); do xdotool getwindowname $wid | grep -q ': path' \
+    && exit 0; grep -q 'path is not available' '$tmp/pv.err' && exit 0; sleep 0.1; done; exit 1"
+check "key 5 again" xdotool key 5
+check "hide and show" sh -c "xdotool windowunmap --sync $wid && sleep 0.3 && xdotool windowmap --sync $wid"
+check "resize" xdotool windowsize --sync "$wid" 200 150
+check "title: restarted at the new size" wait_title '^gonio preview: normal \| 200x150 \| 4 spp'
+check "key p" xdotool key p
+check "P names its files" sh -c "for i in \$(seq 100); do grep -q 'wrote .*saved-001.exr and .*saved-001.png (normal, 4 spp)' \
+    '$tmp/pv.out' && exit 0; sleep 0.1; done; exit 1"
+check "P's EXR equals gonio render's" "$G" diff "$tmp/saved-001.exr" "$tmp/normal-big.exr" --max-error 1e-6 --quiet
+check "P's PNG equals gonio render's" same_image "$tmp/saved-001.png" "$tmp/normal-big.png"
+check "Esc" xdotool key Escape
+wait $pid
+rc=$?
+[ $rc = 0 ] && pass || { fail "preview exit status $rc"; cat "$tmp/pv.err"; }
+check "the quit screenshot shows the last view" same_image "$tmp/end.png" "$tmp/normal-big.png"
+check "no validation messages" sh -c "! grep -q validation '$tmp/pv.err'"
+kill $pid 2>/dev/null
+
+finish
