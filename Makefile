@@ -1,6 +1,6 @@
 # gonio: build, run, test, bench.
 #   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
-#   make run | test | bench | clean | install PREFIX=/usr/local
+#   make run | test | bench | docs-images | clean | install PREFIX=/usr/local
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
 # is printed and make stops.
 
@@ -65,7 +65,7 @@ TEST_DEPS_CHECK = { ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_valida
 	&& command -v exrheader && command -v xvfb-run && command -v xauth && command -v import \
 	&& command -v xwd && command -v xdotool; } >/dev/null 2>&1
 
-.PHONY: all deps test-deps run test unit regress bench clean install shaders
+.PHONY: all deps test-deps run test unit regress bench clean install shaders docs-images
 all: $(GONIO) build/gonio
 
 deps:
@@ -127,6 +127,10 @@ unit: $(UNIT)
 
 bench: all
 	@tests/bench.sh $(GONIO)
+
+# The figures of docs/ (docs/make-images.sh lists them).
+docs-images: all
+	GONIO=$(GONIO) docs/make-images.sh
 
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin

@@ -35,10 +35,13 @@ typedef uint32_t uint;
 #define GN_BIND_TEXTURES 8u  /* GnTexture[] */
 #define GN_BIND_ACCUM 9u     /* vec4[] per pixel: sum of radiance samples, w = count */
 #define GN_BIND_AOV 10u      /* vec4[3 * pixels]: normal, albedo, depth sums */
-#define GN_BIND_VCOLOR 11u   /* vec4[] per vertex: Gouraud colours */
+#define GN_BIND_VCOLOR 11u   /* vec4[2] per vertex: Gouraud colours of the front and back side;
+                                 the first one's w holds the vertex's material (uint bits) */
 #define GN_BIND_EMITTERS 12u /* GnEmitter[]: emissive triangles for light sampling */
 #define GN_BIND_STATUS 13u   /* uint[4]: [0] rays whose walk hit the traversal budget */
-#define GN_BIND_COUNT 14u
+#define GN_BIND_SQUARES 14u  /* vec4[] per pixel: sum of squared radiance samples (variance) */
+#define GN_BIND_ENV 15u      /* float[]: environment map and its sampling tables (path.comp) */
+#define GN_BIND_COUNT 16u
 
 /* Work-group size of the 2D image kernels: 8x8 matches lavapipe's 8-wide SIMD rows and is a
  * good default for GPUs (64 threads = 2 warps / 1 wavefront). */
@@ -72,6 +75,13 @@ typedef uint32_t uint;
 /* GnFrame.flags */
 #define GN_FRAME_AOV 1u       /* write normal/albedo/depth sums */
 #define GN_FRAME_SHADOWS 2u   /* ray-traced shadows in the local modes */
+#define GN_FRAME_LIGHT_ONLY 4u /* path: emitters reached only by light sampling (no MIS) */
+#define GN_FRAME_BSDF_ONLY 8u  /* path: area lights and the environment only by BSDF sampling */
+#define GN_FRAME_ENV_MAP 16u   /* path: the environment is the map in GN_BIND_ENV */
+
+/* GnEmitter.prim: a triangle (GnPrim index), a punctual light (this bit | GnLight index),
+ * or the environment (GN_INVALID). */
+#define GN_EMITTER_LIGHT 0x80000000u
 
 /* ---- BVH: both children's boxes in one 64-byte node (Aila & Laine 2009, "Understanding
  * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only
@@ -134,9 +144,10 @@ GN_STRUCT(GnLight) {
     float outer_cos; float pad0; float pad1; float pad2;
 } GN_END(GnLight); /* 64 bytes */
 
-/* One emissive triangle, for light sampling in the path tracer. */
+/* One light of the path tracer's light-selection table, chosen with probability pdf (cdf:
+ * the running sum up to and including this entry). prim: see GN_EMITTER_LIGHT. */
 GN_STRUCT(GnEmitter) {
-    uint prim; float area; float cdf; float pdf; /* prim: index into GnPrim[] */
+    uint prim; float area; float cdf; float pdf; /* area: of the triangle, else 0 */
 } GN_END(GnEmitter);
 
 /* An image in the packed texel buffer; RGBA8, rows top to bottom. */
@@ -170,7 +181,9 @@ GN_STRUCT(GnFrame) {
     vec3 env_color; uint num_nodes;      /* constant environment radiance */
     vec3 bounds_min; float depth_scale;
     vec3 bounds_max; uint traversal_budget; /* max BVH steps per ray (see DESIGN: loop cap) */
-} GN_END(GnFrame); /* 160 bytes */
+    uint env_width; uint env_height;     /* GN_FRAME_ENV_MAP: the lat-long map's size */
+    float env_select; float env_norm;    /* env's selection probability; 1 / mean map weight */
+} GN_END(GnFrame); /* 176 bytes */
 
 /* Per-dispatch values (push constants). */
 GN_STRUCT(GnPush) {
@@ -179,6 +192,20 @@ GN_STRUCT(GnPush) {
     uint pad0;
     uint pad1;
 } GN_END(GnPush);
+
+/* ---- display kernel (glsl/display.comp): accumulated radiance -> 8-bit sRGB texels ----- */
+#define GN_DISPLAY_BIND_ACCUM 0u /* vec4[] per pixel, as GN_BIND_ACCUM */
+#define GN_DISPLAY_BIND_OUT 1u   /* uint[] per pixel: packed 8-bit texels */
+#define GN_DISPLAY_BGRA 1u       /* GnDisplayPush.flags: pack B, G, R, A (byte order) */
+/* Tonemaps, the values of image_tonemap (src/image.h). */
+#define GN_TONEMAP_CLAMP 0u
+#define GN_TONEMAP_ACES 1u
+#define GN_TONEMAP_REINHARD 2u
+
+GN_STRUCT(GnDisplayPush) {
+    uint width; uint height; uint tonemap; uint flags;
+    float inv_spp; float scale; uint pad0; uint pad1; /* scale = 2^exposure */
+} GN_END(GnDisplayPush);
 
 #ifndef VULKAN
 #ifdef __cplusplus
@@ -199,9 +226,11 @@ GN_STATIC_ASSERT(sizeof(GnLight) == 64, "GnLight layout");
 GN_STATIC_ASSERT(sizeof(GnEmitter) == 16, "GnEmitter layout");
 GN_STATIC_ASSERT(sizeof(GnTexture) == 16, "GnTexture layout");
 GN_STATIC_ASSERT(sizeof(GnCamera) == 64, "GnCamera layout");
-GN_STATIC_ASSERT(sizeof(GnFrame) == 160, "GnFrame layout");
+GN_STATIC_ASSERT(sizeof(GnFrame) == 176, "GnFrame layout");
+GN_STATIC_ASSERT(offsetof(GnFrame, env_width) == 160, "GnFrame layout");
 GN_STATIC_ASSERT(offsetof(GnFrame, ambient) == 96, "GnFrame layout");
 GN_STATIC_ASSERT(sizeof(GnPush) == 16, "GnPush layout");
+GN_STATIC_ASSERT(sizeof(GnDisplayPush) == 32, "GnDisplayPush layout");
 #endif
 
 #endif /* GONIO_SHARED_H */

@@ -17,6 +17,9 @@ int cmd_diff(int argc, char **argv);
 int cmd_scene(int argc, char **argv);
 int cmd_brdf(int argc, char **argv);
 int cmd_teapot(int argc, char **argv);
+int cmd_merge(int argc, char **argv);
+int cmd_compare(int argc, char **argv);
+int cmd_preview(int argc, char **argv);
 
 /* Shared option handling. cli_value returns argv[i + 1] (advancing *i) or reports a usage
  * error naming the option; cli_usage_error prints "gonio CMD: MESSAGE" and the hint to use

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <unistd.h>
 
 #include "cli.h"
@@ -17,15 +18,20 @@ static const char render_usage[] =
     "\n"
     "  -o, --output FILE   linear float RGBA OpenEXR (written atomically)\n"
     "  --png FILE          also write a tonemapped sRGB PNG (alone: PNG only)\n"
-    "  --mode M            phong (default), normal, albedo, depth, cost\n"
-    "                      (path, gouraud, flat: see gonio --help as they arrive)\n"
+    "  --mode M            path (default: Monte Carlo path tracing), phong, gouraud, flat,\n"
+    "                      normal, albedo, depth, cost\n"
     "  --spp N             samples per pixel (default 16)\n"
     "  --time SECONDS      render for this long instead of --spp\n"
     "  --size WxH          image size (default 512x512, or the camera's aspect)\n"
     "  --camera N          the scene's N-th perspective camera (default: frame the scene)\n"
     "  --seed S            random seed (default 0); renders with different seeds merge\n"
-    "  --aov LIST          extra EXR channels: normal,albedo,depth\n"
-    "  --env R,G,B | V     constant background radiance (default 0)\n"
+    "  --aov LIST          extra EXR channels: normal,albedo,depth,variance\n"
+    "  --env R,G,B | V     constant environment radiance (default 0: black)\n"
+    "  --env FILE.exr      path: a lat-long HDR environment map (+Y up), importance sampled\n"
+    "  --max-depth N       path: at most N bounces (default 0: unbounded, roulette ends paths)\n"
+    "  --brdf MODEL[:P=V]  path: render every material with a BRDF model (see gonio brdf\n"
+    "                      --list), e.g. --brdf torrance-sparrow:exponent=128:specular=0.5\n"
+    "  --estimator E       path: mis (default), light or bsdf: one strategy only (tests)\n"
     "  --no-shadows        local modes: no shadow rays\n"
     "  --exposure E        PNG only: scale by 2^E before tonemapping (default 0)\n"
     "  --tonemap T         PNG only: clamp (default), reinhard, aces\n"
@@ -85,7 +91,9 @@ static bool check_writable(const char *path)
 int cmd_render(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_path = NULL, *png_path = NULL;
-    render_settings s = {.mode = GN_MODE_PHONG, .spp = 16, .camera = -1, .shadows = true,
+    const char *brdf = NULL, *env_path = NULL;
+    image env_map = {0};
+    render_settings s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .shadows = true,
                          .progress = true, .stop = &stop_requested};
     bool size_given = false, quiet = false, validate = false;
     int device = -1;
@@ -148,12 +156,29 @@ int cmd_render(int argc, char **argv)
                 char buf[256], *tok, *save;
                 snprintf(buf, sizeof buf, "%s", val);
                 for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save))
-                    if (strcmp(tok, "normal") && strcmp(tok, "albedo") && strcmp(tok, "depth"))
-                        return cli_usage_error("render", "--aov '%s': expected a list of normal, albedo, depth", tok);
-                s.aov = true;
+                    if (!strcmp(tok, "variance"))
+                        s.variance = true;
+                    else if (strcmp(tok, "normal") && strcmp(tok, "albedo") && strcmp(tok, "depth"))
+                        return cli_usage_error("render", "--aov '%s': expected a list of normal, albedo, depth, variance", tok);
+                    else
+                        s.aov = true;
             } else if (!strcmp(a, "--env")) {
-                if (!parse_rgb(val, s.env) || s.env[0] < 0 || s.env[1] < 0 || s.env[2] < 0)
-                    return cli_usage_error("render", "--env '%s': expected R,G,B or one value >= 0", val);
+                size_t len = strlen(val);
+                if (len > 4 && !strcasecmp(val + len - 4, ".exr"))
+                    env_path = val;
+                else if (!parse_rgb(val, s.env) || !(s.env[0] >= 0 && s.env[1] >= 0 && s.env[2] >= 0))
+                    return cli_usage_error("render", "--env '%s': expected R,G,B, one value >= 0 or FILE.exr", val);
+            } else if (!strcmp(a, "--max-depth")) {
+                if (!util_parse_int(val, 0, 1 << 20, &v))
+                    return cli_usage_error("render", "--max-depth '%s': expected an integer >= 0", val);
+                s.max_depth = (int)v;
+            } else if (!strcmp(a, "--brdf")) {
+                brdf = val;
+            } else if (!strcmp(a, "--estimator")) {
+                if (!strcmp(val, "mis")) s.strategy = 0;
+                else if (!strcmp(val, "light")) s.strategy = GN_FRAME_LIGHT_ONLY;
+                else if (!strcmp(val, "bsdf")) s.strategy = GN_FRAME_BSDF_ONLY;
+                else return cli_usage_error("render", "--estimator '%s': expected mis, light or bsdf", val);
             } else if (!strcmp(a, "--exposure")) {
                 if (!util_parse_float(val, &exposure))
                     return cli_usage_error("render", "--exposure '%s': expected a number", val);
@@ -186,6 +211,12 @@ int cmd_render(int argc, char **argv)
 
     if (!scene_load(&sc, scene_path))
         return 1;
+    if (!render_material_overrides(&sc, brdf) || (env_path && !image_read_exr(&env_map, env_path))) {
+        scene_destroy(&sc);
+        return 1;
+    }
+    if (env_path)
+        s.env_map = &env_map;
     if (!size_given) {
         float aspect = 1.0f;
         if (s.camera >= 0 && (uint32_t)s.camera < sc.num_cameras && sc.cameras[s.camera].aspect > 0)
@@ -199,10 +230,12 @@ int cmd_render(int argc, char **argv)
         util_error("%s: --camera %d: the scene has %u perspective camera(s)", scene_path,
                    s.camera, sc.num_cameras);
         scene_destroy(&sc);
+        image_destroy(&env_map);
         return 1;
     }
     if (!cli_gpu_create(&g, device, validate)) {
         scene_destroy(&sc);
+        image_destroy(&env_map);
         return 1;
     }
     signal(SIGINT, on_signal);
@@ -234,6 +267,7 @@ int cmd_render(int argc, char **argv)
         rc = ok ? 0 : 1;
     }
     image_destroy(&img);
+    image_destroy(&env_map);
     renderer_destroy(&r);
     if (!cli_gpu_finish(&g))
         rc = 1;

@@ -12,8 +12,11 @@ static const struct {
     const char *summary;
 } commands[] = {
     {"render", cmd_render, "render a glTF scene to EXR (and PNG)"},
+    {"preview", cmd_preview, "show the render converging in a window, interactive camera"},
     {"info", cmd_info, "print a scene's contents and BVH statistics"},
     {"devices", cmd_devices, "list the Vulkan devices"},
+    {"compare", cmd_compare, "flat vs Gouraud vs per-pixel Phong vs path traced, side by side"},
+    {"merge", cmd_merge, "combine renders of one scene with different seeds, exactly"},
     {"diff", cmd_diff, "compare two EXR images (RMSE, PSNR, bias); exit 1 above thresholds"},
     {"bench", cmd_bench, "measure BVH build and ray throughput"},
     {"brdf", cmd_brdf, "virtual goniophotometer: BRDF lobe plots, albedo, material balls"},

@@ -7,7 +7,10 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "brdf.h"
 #include "local.h" /* spv_local: glsl/local.comp compiled by the build */
+#include "path.h"  /* spv_path: glsl/path.comp */
+#include "vertex.h" /* spv_vertex: glsl/vertex.comp */
 #include "util.h"
 
 static const char *const mode_names[GN_MODE_COUNT] = {
@@ -85,12 +88,65 @@ static uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap)
     return n;
 }
 
+static double luminance(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+/* Squared radius of the scene's bounding sphere (1 when empty): the area through which
+ * distant lights (directional, environment) reach the scene. */
+static double scene_radius2(const scene *sc)
+{
+    double r2 = 0;
+    for (int k = 0; k < 3; k++) {
+        double e = 0.5 * ((double)sc->bounds_max[k] - sc->bounds_min[k]);
+        r2 += e > 0 ? e * e : 0;
+    }
+    return r2 > 0 ? r2 : 1;
+}
+
+/* The path tracer's light table: each emissive triangle (BVH order) and punctual light with
+ * a selection weight proportional to its power, flux / pi: L A per emitting side for a
+ * triangle (so picking one and then a uniform point has area density lum(L) sides / total),
+ * 4 I for a point light, 2 (1 - cos outer) I for a spot, E r^2 for a directional light.
+ * renderer_begin adds the environment and normalises. */
+static void build_emitters(renderer *r, const GnPrim *prims)
+{
+    const scene *sc = r->sc;
+    uint32_t cap = r->tree.num_tris + sc->num_lights + 1, n = 0;
+    r->emitter_table = util_calloc(cap, sizeof *r->emitter_table);
+    r->emitter_weight = util_calloc(cap, sizeof *r->emitter_weight);
+    for (uint32_t i = 0; i < r->tree.num_tris; i++) {
+        const GnMaterial *m = &sc->materials[prims[i].material];
+        const GnTri *t = &r->tree.tris[i];
+        double e1[3] = {t->v1.x - t->v0.x, t->v1.y - t->v0.y, t->v1.z - t->v0.z};
+        double e2[3] = {t->v2.x - t->v0.x, t->v2.y - t->v0.y, t->v2.z - t->v0.z};
+        double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
+        double area = 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        double lum = luminance(&m->emissive.x);
+        if (lum <= 0 || !(area > 0) || (m->flags & GN_MAT_UNLIT))
+            continue;
+        r->emitter_table[n] = (GnEmitter){i, (float)area, 0, 0};
+        r->emitter_weight[n++] = lum * area * (m->flags & GN_MAT_DOUBLE_SIDED ? 2 : 1);
+    }
+    for (uint32_t i = 0; i < sc->num_lights; i++) {
+        const GnLight *l = &sc->lights[i];
+        double w = luminance(&l->color.x);
+        w *= l->type == GN_LIGHT_POINT ? 4 : l->type == GN_LIGHT_SPOT ? 2 * (1 - l->outer_cos)
+                                                                         : scene_radius2(sc);
+        if (w <= 0)
+            continue;
+        r->emitter_table[n] = (GnEmitter){GN_EMITTER_LIGHT | i, 0, 0, 0};
+        r->emitter_weight[n++] = w;
+    }
+    r->num_emitters = n;
+}
+
 void renderer_create(renderer *r, gpu *g, const scene *sc)
 {
     double t0 = util_now();
     GnPrim *prims;
     GnTexture *tex;
     uint32_t *texels, total_texels = 0, *image_offset;
+    vec4 *vcolor;
     GnLight *lights;
 
     memset(r, 0, sizeof *r);
@@ -128,16 +184,25 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
 
     gpu_buffer_create(g, &r->frame, sizeof(GnFrame), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                       GPU_MEMORY_HOST);
-    gpu_buffer_create_storage(g, &r->nodes, r->tree.nodes, sizeof(GnBvhNode) * r->tree.num_nodes);
-    gpu_buffer_create_storage(g, &r->tris, r->tree.tris, sizeof(GnTri) * r->tree.num_tris);
+    gpu_buffer_create_texels(g, &r->nodes, r->tree.nodes, sizeof(GnBvhNode) * r->tree.num_nodes);
+    gpu_buffer_create_texels(g, &r->tris, r->tree.tris, sizeof(GnTri) * r->tree.num_tris);
     gpu_buffer_create_storage(g, &r->prims, prims, sizeof(GnPrim) * r->tree.num_tris);
     gpu_buffer_create_storage(g, &r->vertices, sc->vertices, sizeof(GnVertex) * sc->num_vertices);
     gpu_buffer_create_storage(g, &r->materials, sc->materials, sizeof(GnMaterial) * sc->num_materials);
     gpu_buffer_create_storage(g, &r->lights, lights, sizeof(GnLight) * r->num_lights);
     gpu_buffer_create_storage(g, &r->texels, texels, sizeof(uint32_t) * total_texels);
     gpu_buffer_create_storage(g, &r->textures, tex, sizeof(GnTexture) * sc->num_textures);
-    gpu_buffer_create_storage(g, &r->emitters, NULL, sizeof(GnEmitter));
-    gpu_buffer_create_storage(g, &r->vcolor, NULL, 16 * (VkDeviceSize)sc->num_vertices);
+    build_emitters(r, prims);
+    gpu_buffer_create_storage(g, &r->emitters, NULL, sizeof(GnEmitter) * (r->num_emitters + 1));
+    gpu_buffer_create_storage(g, &r->env, NULL, 16);
+    /* Gouraud colours, two sides per vertex; the material of each vertex rides in the bits of
+     * the first one's w for glsl/vertex.comp (a vertex belongs to one glTF primitive). */
+    vcolor = util_calloc(2 * (size_t)sc->num_vertices, sizeof *vcolor);
+    for (uint32_t t = 0; t < sc->num_triangles; t++)
+        for (int k = 0; k < 3; k++)
+            memcpy(&vcolor[2 * (size_t)sc->indices[3 * t + k]].w, &sc->tri_material[t], 4);
+    gpu_buffer_create_storage(g, &r->vcolor, vcolor, 2 * sizeof *vcolor * (VkDeviceSize)sc->num_vertices);
+    free(vcolor);
     gpu_buffer_create(g, &r->status, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
     free(prims);
     free(image_offset);
@@ -151,14 +216,18 @@ void renderer_destroy(renderer *r)
 {
     gpu_buffer *bufs[] = {&r->frame, &r->nodes, &r->tris, &r->prims, &r->vertices,
                           &r->materials, &r->lights, &r->texels, &r->textures, &r->emitters,
-                          &r->vcolor, &r->status, &r->accum, &r->aov};
+                          &r->vcolor, &r->status, &r->accum, &r->aov,
+                          &r->squares, &r->env};
     if (r->g) {
         for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
             gpu_buffer_destroy(r->g, bufs[i]);
         for (uint32_t i = 0; i < GN_MODE_COUNT; i++)
             gpu_pipeline_destroy(r->g, &r->pipelines[i]);
+        gpu_pipeline_destroy(r->g, &r->vertex_pass);
     }
     bvh_destroy(&r->tree);
+    free(r->emitter_table);
+    free(r->emitter_weight);
     memset(r, 0, sizeof *r);
 }
 
@@ -168,6 +237,11 @@ bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out)
 {
     scene_camera c;
     float aspect = (float)s->width / (float)s->height;
+    if (s->camera_override) {
+        *out = *s->camera_override;
+        out->aspect = aspect;
+        return true;
+    }
     if (s->camera >= 0) {
         if ((uint32_t)s->camera >= r->sc->num_cameras) {
             util_error("%s: --camera %d: the scene has %u perspective camera(s)", r->sc->path,
@@ -216,8 +290,8 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
 {
     const gpu_binding all[] = {
         {GN_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, &r->frame},
-        {GN_BIND_NODES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->nodes},
-        {GN_BIND_TRIS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->tris},
+        {GN_BIND_NODES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->nodes},
+        {GN_BIND_TRIS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->tris},
         {GN_BIND_PRIMS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->prims},
         {GN_BIND_VERTICES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->vertices},
         {GN_BIND_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->materials},
@@ -229,9 +303,152 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
         {GN_BIND_VCOLOR, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->vcolor},
         {GN_BIND_EMITTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->emitters},
         {GN_BIND_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->status},
+        {GN_BIND_SQUARES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->squares},
+        {GN_BIND_ENV, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->env},
     };
     memcpy(b, all, sizeof all);
     return sizeof all / sizeof *all;
+}
+
+/* Gouraud's vertex pass: lights every vertex for the frame just uploaded, one dispatch per
+ * side (glsl/vertex.comp). */
+static void light_vertices(renderer *r)
+{
+    VkCommandBuffer cmd;
+    if (!r->vertex_pass.pipeline) {
+        gpu_binding b[GN_BIND_COUNT];
+        gpu_pipeline_desc pd = {
+            .name = "vertex", .code = spv_vertex, .code_size = sizeof spv_vertex,
+            .local_size = {64, 1, 1}, .push_size = sizeof(GnPush),
+            .bindings = b, .num_bindings = renderer_bindings(r, b)};
+        gpu_pipeline_create(r->g, &r->vertex_pass, &pd);
+    }
+    cmd = gpu_begin(r->g);
+    for (uint32_t side = 0; side < 2; side++) {
+        GnPush push = {0, side, 0, 0};
+        gpu_dispatch(cmd, &r->vertex_pass, &push, r->sc->num_vertices, 1, 1);
+        gpu_barrier(cmd);
+    }
+    gpu_submit_wait(r->g, cmd);
+}
+
+/* IEEE half from float (truncating; the map's values are finite and >= 0). */
+static uint16_t half_from_float(float f)
+{
+    uint32_t x, m;
+    int e;
+    memcpy(&x, &f, 4);
+    m = x & 0x7fffff;
+    e = (int)((x >> 23) & 0xff) - 127 + 15;
+    if (e >= 31)
+        return 0x7c00;
+    if (e <= 0)
+        return e < -10 ? 0 : (uint16_t)((m | 0x800000) >> (14 - e));
+    return (uint16_t)((uint32_t)e << 10 | m >> 13);
+}
+
+/* Uploads a lat-long map for path.comp (layout there): texels as half RGB, then the
+ * marginal CDF of the rows and each row's conditional CDF, over the weights
+ * lum(texel) sin(theta) (the solid angle a texel covers). Its selection weight is the
+ * environment's flux / pi onto the bounding sphere, 4 pi r^2 mean(L), as for a constant one. */
+static bool upload_env_map(renderer *r, const image *map)
+{
+    const int w = map->width, h = map->height;
+    int cr = image_channel(map, "R"), cg = image_channel(map, "G"), cb = image_channel(map, "B");
+    const size_t n = (size_t)w * h, words = 3 * n + (size_t)h;
+    uint32_t *data;
+    float *marg, *cond;
+    double total = 0, *row = util_calloc((size_t)h, sizeof *row);
+    if (cr < 0 || cg < 0 || cb < 0)
+        cr = cg = cb = image_channel(map, "Y");
+    if (cr < 0) {
+        util_error("--env: the map has no R, G, B (or Y) channels");
+        free(row);
+        return false;
+    }
+    if (words * 4 > 128u << 20) {
+        util_error("--env: the map's %dx%d texels exceed the 128 MiB a buffer may hold", w, h);
+        free(row);
+        return false;
+    }
+    data = util_calloc(words, sizeof *data);
+    marg = (float *)(data + 2 * n);
+    cond = marg + h;
+    for (int y = 0; y < h; y++) {
+        double st = sin(M_PI * (y + 0.5) / h), sum = 0;
+        for (int x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            float c[3] = {map->planes[cr][i], map->planes[cg][i], map->planes[cb][i]};
+            uint16_t hc[3];
+            for (int k = 0; k < 3; k++) {
+                c[k] = c[k] >= 0 && c[k] < 65504.0f ? c[k] : c[k] >= 65504.0f ? 65504.0f : 0;
+                hc[k] = half_from_float(c[k]);
+            }
+            data[2 * i] = hc[0] | (uint32_t)hc[1] << 16;
+            data[2 * i + 1] = hc[2];
+            sum += luminance(c) * st;
+            cond[i] = (float)sum;
+        }
+        for (int x = 0; x < w; x++) /* an unlit row is never picked; keep its CDF valid */
+            cond[(size_t)y * w + x] = sum > 0 ? (float)(cond[(size_t)y * w + x] / sum) : (float)(x + 1) / w;
+        cond[(size_t)y * w + w - 1] = 1;
+        row[y] = sum;
+        total += sum;
+    }
+    for (int y = 0; y < h; y++) {
+        double acc = 0;
+        for (int k = 0; k <= y; k++)
+            acc += row[k];
+        marg[y] = total > 0 ? (float)(acc / total) : (float)(y + 1) / h;
+    }
+    marg[h - 1] = 1;
+    gpu_buffer_destroy(r->g, &r->env);
+    gpu_buffer_create_storage(r->g, &r->env, data, words * 4);
+    for (uint32_t i = 0; i < GN_MODE_COUNT; i++) /* their descriptor sets name the old buffer */
+        gpu_pipeline_destroy(r->g, &r->pipelines[i]);
+    /* mean L over the sphere = sum(L sin dtheta dphi) / 4 pi, dtheta dphi = 2 pi^2 / n */
+    r->env_weight = scene_radius2(r->sc) * 2 * M_PI * M_PI * total / (double)n;
+    r->env_source = map;
+    free(data);
+    free(row);
+    return true;
+}
+
+/* The path tracer's frame: the environment, the normalised light table and the budget. */
+static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
+{
+    uint32_t n = r->num_emitters;
+    double total = 0, acc = 0, env = 0;
+    if (s->env_map) {
+        if (s->env_map != r->env_source && !upload_env_map(r, s->env_map))
+            return false;
+        frame->flags |= GN_FRAME_ENV_MAP;
+        frame->env_width = (uint32_t)s->env_map->width;
+        frame->env_height = (uint32_t)s->env_map->height;
+        env = r->env_weight;
+    } else {
+        env = 4 * M_PI * scene_radius2(r->sc) * luminance(s->env);
+    }
+    if (env > 0) {
+        r->emitter_table[n] = (GnEmitter){GN_INVALID, 0, 0, 0};
+        r->emitter_weight[n++] = env;
+    }
+    for (uint32_t i = 0; i < n; i++)
+        total += r->emitter_weight[i];
+    for (uint32_t i = 0; i < n; i++) {
+        acc += r->emitter_weight[i];
+        r->emitter_table[i].pdf = (float)(r->emitter_weight[i] / total);
+        r->emitter_table[i].cdf = i + 1 == n ? 1.0f : (float)(acc / total);
+    }
+    if (n)
+        gpu_buffer_upload(r->g, &r->emitters, r->emitter_table, sizeof(GnEmitter) * n, 0);
+    frame->num_emitters = n;
+    frame->emitter_power = (float)total;
+    frame->env_select = env > 0 ? (float)(env / total) : 0;
+    frame->flags |= s->strategy;
+    /* One path per invocation: the whole path shares llvmpipe's loop cap. */
+    frame->traversal_budget = traversal_budget(r->g, 1);
+    return true;
 }
 
 bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
@@ -254,20 +471,40 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->bounds_max = v3(r->sc->bounds_max);
     frame->ambient = v3(r->sc->ambient);
     frame->traversal_budget = traversal_budget(g, 1 + (s->shadows ? r->num_lights : 0));
+    if (s->mode == GN_MODE_PATH && !path_begin(r, s, frame))
+        return false;
     gpu_buffer_upload(g, &r->frame, frame, sizeof *frame, 0);
 
     if (r->width != s->width || r->height != s->height) {
         gpu_buffer_destroy(g, &r->accum);
         gpu_buffer_destroy(g, &r->aov);
+        gpu_buffer_destroy(g, &r->squares);
+        gpu_buffer_create(g, &r->squares, 16 * pixels, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
         gpu_buffer_create(g, &r->accum, 16 * pixels, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
         gpu_buffer_create(g, &r->aov, 48 * pixels, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
         r->width = s->width;
         r->height = s->height;
+        /* The cached kernels' descriptor sets name the old buffers. */
+        for (uint32_t i = 0; i < GN_MODE_COUNT; i++)
+            gpu_pipeline_destroy(g, &r->pipelines[i]);
+        gpu_pipeline_destroy(g, &r->vertex_pass);
     }
     gpu_buffer_fill_zero(g, &r->accum);
     gpu_buffer_fill_zero(g, &r->aov);
+    gpu_buffer_fill_zero(g, &r->squares);
     gpu_buffer_fill_zero(g, &r->status);
+    if (s->mode == GN_MODE_GOURAUD)
+        light_vertices(r);
     return true;
+}
+
+const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec)
+{
+    (void)r;
+    spec->values[0] = mode;
+    spec->entries[0] = (VkSpecializationMapEntry){0, 0, sizeof(uint32_t)};
+    spec->info = (VkSpecializationInfo){1, spec->entries, sizeof spec->values, spec->values};
+    return &spec->info;
 }
 
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
@@ -275,12 +512,14 @@ gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
     gpu_pipeline *p = &r->pipelines[mode];
     if (!p->pipeline) {
         gpu_binding b[GN_BIND_COUNT];
-        VkSpecializationMapEntry entry = {0, 0, sizeof(uint32_t)};
-        VkSpecializationInfo spec = {1, &entry, sizeof mode, &mode};
+        renderer_spec spec;
         gpu_pipeline_desc pd = {
-            .name = "local", .code = spv_local, .code_size = sizeof spv_local,
+            .name = mode == GN_MODE_PATH ? "path" : "local",
+            .code = mode == GN_MODE_PATH ? spv_path : spv_local,
+            .code_size = mode == GN_MODE_PATH ? sizeof spv_path : sizeof spv_local,
             .local_size = {GN_TILE_X, GN_TILE_Y, 1}, .push_size = sizeof(GnPush),
-            .bindings = b, .num_bindings = renderer_bindings(r, b), .specialization = &spec};
+            .bindings = b, .num_bindings = renderer_bindings(r, b),
+            .specialization = renderer_specialize(r, mode, &spec)};
         gpu_pipeline_create(r->g, p, &pd);
     }
     return p;
@@ -288,7 +527,7 @@ gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
 
 bool renderer_mode_available(uint32_t mode)
 {
-    return mode != GN_MODE_PATH && mode != GN_MODE_GOURAUD && mode != GN_MODE_FLAT;
+    return mode < GN_MODE_COUNT;
 }
 
 void renderer_record_pass(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t sample_index)
@@ -317,6 +556,24 @@ void renderer_resolve(renderer *r, int spp, bool aov, image *out)
             }
             out->planes[10][p] = aovs[12 * p + 8] * inv;
         }
+    }
+}
+
+/* Appends variance.R/G/B: the unbiased variance estimate of each pixel's mean,
+ * (sum x^2 / n - mean^2) / (n - 1) (0 for n = 1), from the sums of squares. */
+static void add_variance(const renderer *r, int spp, image *out)
+{
+    static const char *const names[] = {"variance.R", "variance.G", "variance.B"};
+    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
+    const float *acc = r->accum.mapped, *sq = r->squares.mapped;
+    for (int c = 0; c < 3; c++) {
+        float *plane = util_calloc(pixels, sizeof *plane);
+        for (VkDeviceSize p = 0; spp > 1 && p < pixels; p++) {
+            double m = (double)acc[4 * p + c] / spp, v = ((double)sq[4 * p + c] / spp - m * m) / (spp - 1);
+            plane[p] = v > 0 ? (float)v : 0;
+        }
+        snprintf(out->names[out->num_channels], sizeof out->names[0], "%s", names[c]);
+        out->planes[out->num_channels++] = plane;
     }
 }
 
@@ -379,5 +636,94 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
         util_warn("%s: %u ray(s) needed more BVH steps than the per-ray budget (%u) and may be "
                   "wrong", r->sc->path, stats->truncated, frame.traversal_budget);
     renderer_resolve(r, done, s->aov, out);
+    if (s->variance)
+        add_variance(r, done, out);
+    return true;
+}
+
+/* Sets m's model from a setting: the glTF model writes the material's own fields back. */
+static void apply_setting(GnMaterial *m, const brdf_setting *st)
+{
+    memcpy(&m->base_color.x, st->v, 3 * sizeof(float));
+    memcpy(&m->brdf_params.x, st->v + BRDF_SLOT_PARAMS, 4 * sizeof(float));
+    m->brdf = st->model->id;
+    if (st->model->id == BRDF_GLTF) {
+        m->metallic = st->v[BRDF_SLOT_PARAMS];
+        m->roughness = st->v[BRDF_SLOT_PARAMS + 1];
+        m->specular = st->v[BRDF_SLOT_PARAMS + 2];
+        m->ior = st->v[BRDF_SLOT_PARAMS + 3];
+        memcpy(&m->specular_color.x, st->v + BRDF_SLOT_EXTRA, 3 * sizeof(float));
+        m->transmission = st->v[BRDF_SLOT_EXTRA + 3];
+    }
+}
+
+/* A setting of `model` that starts from m: its colour is the material's base colour (but a
+ * conductor's, its complex index, keeps the model's default); glTF starts from every field. */
+static void setting_from_material(brdf_setting *st, const brdf_model *model, const GnMaterial *m)
+{
+    brdf_setting_init(st, model);
+    if (model->id != BRDF_CONDUCTOR)
+        memcpy(st->v, &m->base_color.x, 3 * sizeof(float));
+    if (model->id == BRDF_GLTF) {
+        st->v[BRDF_SLOT_PARAMS] = m->metallic;
+        st->v[BRDF_SLOT_PARAMS + 1] = m->roughness;
+        st->v[BRDF_SLOT_PARAMS + 2] = m->specular;
+        st->v[BRDF_SLOT_PARAMS + 3] = m->ior;
+        memcpy(st->v + BRDF_SLOT_EXTRA, &m->specular_color.x, 3 * sizeof(float));
+        st->v[BRDF_SLOT_EXTRA + 3] = m->transmission;
+    }
+}
+
+bool render_material_overrides(scene *sc, const char *brdf)
+{
+    char spec[256], *name, *save;
+    const brdf_model *global = NULL;
+    if (brdf) {
+        snprintf(spec, sizeof spec, "%s", brdf);
+        name = strtok_r(spec, ":", &save);
+        if (!name || !(global = brdf_model_find(name)))
+            return false;
+    }
+    for (uint32_t i = 0; i < sc->num_materials; i++) {
+        GnMaterial *m = &sc->materials[i];
+        const scene_material_extras *x = &sc->material_extras[i];
+        brdf_setting st;
+        if (global) {
+            char *kv, *rest = NULL;
+            snprintf(spec, sizeof spec, "%s", brdf);
+            strtok_r(spec, ":", &rest);
+            setting_from_material(&st, global, m);
+            for (kv = strtok_r(NULL, ":", &rest); kv; kv = strtok_r(NULL, ":", &rest)) {
+                char *eq = strchr(kv, '=');
+                if (!eq) {
+                    util_error("--brdf '%s': expected MODEL[:PARAM=VALUE...], not '%s'", brdf, kv);
+                    return false;
+                }
+                *eq = 0;
+                if (!brdf_setting_set(&st, kv, eq + 1))
+                    return false;
+            }
+        } else if (x->brdf[0]) {
+            const brdf_model *model = brdf_model_find(x->brdf);
+            if (!model) {
+                util_error("%s: material '%s': extras.gonio.brdf names no BRDF model", sc->path,
+                           sc->material_names[i]);
+                return false;
+            }
+            setting_from_material(&st, model, m);
+            for (int k = 0; k < x->num_params; k++) {
+                char value[32];
+                snprintf(value, sizeof value, "%.9g", x->param_values[k]);
+                if (!brdf_setting_set(&st, x->param_names[k], value)) {
+                    util_error("%s: material '%s': bad extras.gonio parameter '%s'", sc->path,
+                               sc->material_names[i], x->param_names[k]);
+                    return false;
+                }
+            }
+        } else {
+            continue;
+        }
+        apply_setting(m, &st);
+    }
     return true;
 }

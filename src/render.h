@@ -28,6 +28,10 @@ typedef struct render_settings {
     float env[3];           /* constant environment radiance */
     bool progress;          /* progress bar on stderr */
     volatile sig_atomic_t *stop; /* set asynchronously to end after the current pass */
+    const GnCamera *camera_override; /* non-NULL: this camera (aspect from the image), not `camera` */
+    const image *env_map;   /* path: lat-long radiance map (R, G, B or Y), replaces env */
+    uint32_t strategy;      /* path: 0 = MIS, GN_FRAME_LIGHT_ONLY or GN_FRAME_BSDF_ONLY */
+    bool variance;          /* add variance.R/G/B: the estimated variance of each pixel's mean */
 } render_settings;
 
 typedef struct render_stats {
@@ -48,6 +52,12 @@ typedef struct renderer {
         emitters, vcolor, status;
     gpu_buffer accum, aov;  /* sized for the current image */
     gpu_pipeline pipelines[GN_MODE_COUNT]; /* created on first use */
+    gpu_pipeline vertex_pass; /* Gouraud's per-vertex lighting (glsl/vertex.comp) */
+    gpu_buffer squares, env; /* path: per-pixel sums of squares; the environment map */
+    GnEmitter *emitter_table; /* path: lights, then a slot for the environment */
+    double *emitter_weight;   /* their selection weights (flux / pi) */
+    const image *env_source;  /* the map now in `env` */
+    double env_weight;        /* its selection weight */
     int width, height;
     double setup_seconds;
 } renderer;
@@ -66,6 +76,15 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame);
 /* The descriptor bindings of every render kernel (up to GN_BIND_COUNT entries). */
 uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
 
+/* Specialization constants of the render kernels: constant 0 = mode (or a kernel's own
+ * variant). */
+typedef struct renderer_spec {
+    uint32_t values[1];
+    VkSpecializationMapEntry entries[1];
+    VkSpecializationInfo info;
+} renderer_spec;
+const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec);
+
 /* The kernel of a mode (created on first use, kept until renderer_destroy). */
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode);
 bool renderer_mode_available(uint32_t mode);
@@ -78,6 +97,12 @@ void renderer_resolve(renderer *r, int spp, bool aov, image *out);
 /* Renders and fills `out` with R, G, B, A (A = coverage) and, with s->aov, the channels
  * normal.X/Y/Z, albedo.R/G/B and depth.Z (depth along the camera axis, 0 on a miss). */
 bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats);
+
+/* Applies BRDF-model overrides to the scene's materials (GnMaterial.brdf, brdf_params and
+ * the model's colour): each material's extras {"gonio": {"brdf": NAME, PARAM: VALUE...}}
+ * and, when brdf is not NULL, "NAME[:PARAM=VALUE...]" for every material (winning over
+ * extras). False with an error naming the scene and material on a bad name or value. */
+bool render_material_overrides(scene *sc, const char *brdf);
 
 /* Name <-> GN_MODE_* ("path", "phong", ...); -1 when unknown. */
 int render_mode_from_name(const char *name);

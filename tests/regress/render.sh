@@ -56,7 +56,7 @@ check "deterministic: identical pixels" "$G" diff "$tmp/c.exr" "$tmp/c2.exr" --m
 check "render with another seed" "$G" render $C -o "$tmp/c3.exr" --spp 4 --size 64x64 --seed 8 --quiet
 check_fails "another seed gives other pixels" 1 "$G" diff "$tmp/c.exr" "$tmp/c3.exr" --max-error 0 --quiet
 # The summary line: seconds, spp and Mrays/s.
-"$G" render $C -o "$tmp/s.exr" --spp 2 --size 32x32 2>"$tmp/summary.txt"
+"$G" render $C -o "$tmp/s.exr" --mode phong --spp 2 --size 32x32 2>"$tmp/summary.txt"
 check "summary line" grep -Eq 'phong, 2 spp in [0-9.]+ s \([0-9.]+ Mrays/s' "$tmp/summary.txt"
 
 check "gonio info" sh -c "'$G' info $C >'$tmp/info.txt'"

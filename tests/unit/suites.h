@@ -5,3 +5,5 @@
 #include "suite_gpu.h"
 #include "suite_gen.h"
 #include "suite_brdf.h"
+#include "suite_shading.h"
+#include "suite_path.h"
