@@ -43,3 +43,7 @@ cp "$tmp/teapot/metrics.csv" $img/shading-teapot-metrics.csv
 "$G" compare --sweep 1,2,4,8,16,32 teapot -o "$tmp/sweep" --quiet
 cp "$tmp/sweep/sweep.png" $img/shading-sweep.png
 cp "$tmp/sweep/sweep.csv" $img/shading-sweep.csv
+
+# ---- README.md and docs/path-tracing.md ------------------------------------------------
+"$G" render scenes/cornell.gltf -o "$tmp/cornell.exr" --png $img/cornell.png --size 320x320 --spp 256 --quiet
+"$G" render scenes/cornell.gltf -o "$tmp/cornell-phong.exr" --png $img/cornell-phong.png --mode phong --size 320x320 --spp 16 --quiet

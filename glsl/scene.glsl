@@ -6,7 +6,10 @@
 
 #include "shared.h"
 
-layout(std140, binding = GN_BIND_FRAME) uniform FrameBlock { GnFrame frame; };
+// GnFrame is read from a storage buffer, not a uniform buffer: lavapipe inlines uniform
+// values that steer loops and re-specializes the shader whenever they change, which cost
+// ~18 ms per dispatch of the path kernel (7x the whole render of a 32x32 image).
+layout(std430, binding = GN_BIND_FRAME) readonly buffer FrameBlock { GnFrame frame; };
 // The BVH nodes (GnBvhNode = 4 texels) and triangle corners (GnTri = 3 texels) are read as
 // RGBA32F texel buffers, not storage buffers: llvmpipe fetches a storage buffer with
 // per-lane offsets one lane and one component at a time, a texel buffer with vector

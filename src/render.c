@@ -182,7 +182,7 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     memcpy(lights, sc->lights, sizeof *lights * sc->num_lights);
     r->num_lights = sc->num_lights ? sc->num_lights : emissive_lights(sc, lights, 16);
 
-    gpu_buffer_create(g, &r->frame, sizeof(GnFrame), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+    gpu_buffer_create(g, &r->frame, sizeof(GnFrame), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       GPU_MEMORY_HOST);
     gpu_buffer_create_texels(g, &r->nodes, r->tree.nodes, sizeof(GnBvhNode) * r->tree.num_nodes);
     gpu_buffer_create_texels(g, &r->tris, r->tree.tris, sizeof(GnTri) * r->tree.num_tris);
@@ -289,7 +289,7 @@ static void progress_bar(int done, int total, double elapsed)
 uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
 {
     const gpu_binding all[] = {
-        {GN_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, &r->frame},
+        {GN_BIND_FRAME, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->frame},
         {GN_BIND_NODES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->nodes},
         {GN_BIND_TRIS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->tris},
         {GN_BIND_PRIMS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->prims},

@@ -48,7 +48,7 @@ static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any
     GnFrame f = {0};
     int dispatches = 0;
     f.traversal_budget = budget;
-    gpu_buffer_create(g, &frame, sizeof f, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, GPU_MEMORY_HOST);
+    gpu_buffer_create(g, &frame, sizeof f, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
     gpu_buffer_upload(g, &frame, &f, sizeof f, 0);
     gpu_buffer_create_texels(g, &nodes, b->nodes, sizeof(GnBvhNode) * b->num_nodes);
     gpu_buffer_create_texels(g, &tris, b->tris, sizeof(GnTri) * b->num_tris);
@@ -58,7 +58,7 @@ static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any
     gpu_buffer_create(g, &status, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
     {
         const gpu_binding bind[] = {
-            {GN_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, &frame},
+            {GN_BIND_FRAME, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &frame},
             {GN_BIND_NODES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &nodes},
             {GN_BIND_TRIS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &tris},
             {GN_BIND_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &rbuf},
