@@ -22,7 +22,9 @@
 /* Build tunables. SAH constants C_trav = C_isect = 1: one GnBvhNode visit (two box tests)
  * costs about one watertight triangle test. */
 #define BVH_BINS 16      /* per axis; Wald 2007 finds 16 as good as a full sweep */
-#define BVH_MIN_LEAF 2   /* up to this many triangles always a leaf; above, the SAH decides */
+#define BVH_MIN_LEAF 4   /* up to this many triangles always a leaf; above, the SAH decides.
+                            4 rather than 2: the build is 25% faster (5.5 vs 4.4 M tri/s on
+                            250k) and lavapipe traces as fast (gonio bench --generate 250000) */
 #define BVH_MAX_LEAF 8   /* above this a node is split even when the SAH prefers a leaf */
 #define BVH_MAX_DEPTH 64 /* GnBvhNode levels; the traversal stack (64) never overflows */
 /* Threads: the top levels are built on one thread until there are a few subtrees per thread
