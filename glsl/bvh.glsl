@@ -143,6 +143,18 @@ void walk_start(float tmax)
     walk.sp = 0;
 }
 
+// Tests the triangles of a leaf against the ray, keeping the nearest hit in walk.hit.
+void leaf_hits(RayPre r, uint first, uint count, float tmin)
+{
+    for (uint i = first; i < first + count; i++) {
+        GnTri tri = bvh_tri(i);
+        float t, u, v;
+        if (tri_intersect(r, tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, tmin, walk.hit.t, t, u, v)) {
+            walk.hit.t = t; walk.hit.u = u; walk.hit.v = v; walk.hit.tri = i;
+        }
+    }
+}
+
 // Continues `walk` for at most `budget` more node visits. Closest hit (any_hit false) or
 // the first hit found (any_hit true) with t in (tmin, walk.hit.t). On return either
 // walk.node is GN_INVALID (done) or walk.hit.truncated is set (budget spent; call again).
@@ -159,23 +171,13 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
         float eb = n.b_index == GN_INVALID ? 1e38 : box_enter(r, n.b_min, n.b_max, tmin, w.hit.t);
         // Leaves are intersected right away; only inner children go on.
         if (ea < 1e38 && n.a_count > 0u) {
-            for (uint i = n.a_index; i < n.a_index + n.a_count; i++) {
-                float t, u, v;
-                if (tri_intersect(r, texelFetch(tri_texels, int(3u * i)).xyz, texelFetch(tri_texels, int(3u * i) + 1).xyz, texelFetch(tri_texels, int(3u * i) + 2).xyz, tmin, w.hit.t, t, u, v)) {
-                    w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = i;
-                }
-            }
+            leaf_hits(r, n.a_index, n.a_count, tmin);
             ea = 1e38;
             if (any_hit && w.hit.tri != GN_INVALID) { w.node = GN_INVALID; return; }
         }
         if (eb < 1e38 && eb > w.hit.t) eb = 1e38;
         if (eb < 1e38 && n.b_count > 0u) {
-            for (uint i = n.b_index; i < n.b_index + n.b_count; i++) {
-                float t, u, v;
-                if (tri_intersect(r, texelFetch(tri_texels, int(3u * i)).xyz, texelFetch(tri_texels, int(3u * i) + 1).xyz, texelFetch(tri_texels, int(3u * i) + 2).xyz, tmin, w.hit.t, t, u, v)) {
-                    w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = i;
-                }
-            }
+            leaf_hits(r, n.b_index, n.b_count, tmin);
             eb = 1e38;
             if (any_hit && w.hit.tri != GN_INVALID) { w.node = GN_INVALID; return; }
         }

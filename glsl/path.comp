@@ -36,7 +36,7 @@ bool truncated; // a walk ran out of budget: the path was cut short
 
 vec4 rng(uint pixel, uint dim)
 {
-    return vec4(pcg4d(uvec4(pixel, push.sample_index, dim, frame.seed)) >> 8u) * (1.0 / 16777216.0);
+    return rng_uniform4(pixel, push.sample_index, dim, frame.seed);
 }
 
 float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }

@@ -5,6 +5,7 @@
 #define GONIO_SCENE_GLSL
 
 #include "shared.h"
+#include "sampling.glsl"
 
 // GnFrame is read from a storage buffer, not a uniform buffer: lavapipe inlines uniform
 // values that steer loops and re-specializes the shader whenever they change, which cost
@@ -26,23 +27,15 @@ layout(std430, binding = GN_BIND_TEXTURES) readonly buffer TextureBlock { GnText
 const float PI = 3.14159265358979323846;
 
 // ---- random numbers that depend only on (pixel, sample, dimension, seed) ---------------
-// pcg4d of Jarzynski & Olano, "Hash Functions for GPU Rendering" (JCGT 2020): a hash, not a
+// Random numbers are rng_pcg4d hashes (sampling.glsl; Jarzynski & Olano, "Hash Functions
+// for GPU Rendering", JCGT 2020) of (pixel, sample, dimension, seed): a hash, not a
 // sequence, so any sample of any pixel is computed independently (reproducible, splittable
 // across processes by seed).
-uvec4 pcg4d(uvec4 v)
-{
-    v = v * 1664525u + 1013904223u;
-    v.x += v.y * v.w; v.y += v.z * v.x; v.z += v.x * v.y; v.w += v.y * v.z;
-    v ^= v >> 16u;
-    v.x += v.y * v.w; v.y += v.z * v.x; v.z += v.x * v.y; v.w += v.y * v.z;
-    return v;
-}
 
 // Two independent uniforms in [0, 1) for dimensions (2 dim2, 2 dim2 + 1).
 vec2 rand2(uint pixel, uint sample_index, uint dim2)
 {
-    uvec4 h = pcg4d(uvec4(pixel, sample_index, dim2, frame.seed));
-    return vec2(h.xy >> 8u) * (1.0 / 16777216.0);
+    return rng_uniform4(pixel, sample_index, dim2, frame.seed).xy;
 }
 
 // ---- camera ------------------------------------------------------------------------------
