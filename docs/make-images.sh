@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # make-images.sh: regenerates every figure in docs/img (make docs-images): the BRDF lobe
-# plots and material balls of docs/brdf.md section 6, and the shading comparison and sweep of
-# docs/shading.md. Environment: GONIO (the program; default build/gonio).
+# plots and material balls of docs/brdf.md section 6, the shading comparison and sweep of
+# docs/shading.md, and the path-traced scenes of docs/path-tracing.md (the glTF sample
+# models are skipped when ../shared/assets is absent). Environment: GONIO (the program;
+# default build/gonio), GONIO_ASSETS (default ../shared/assets).
 set -eu
 cd "$(dirname "$0")/.."
 G=${GONIO:-build/gonio}
@@ -47,3 +49,19 @@ cp "$tmp/sweep/sweep.csv" $img/shading-sweep.csv
 # ---- README.md and docs/path-tracing.md ------------------------------------------------
 "$G" render scenes/cornell.gltf -o "$tmp/cornell.exr" --png $img/cornell.png --size 320x320 --spp 256 --quiet
 "$G" render scenes/cornell.gltf -o "$tmp/cornell-phong.exr" --png $img/cornell-phong.png --mode phong --size 320x320 --spp 16 --quiet
+
+# glass, metals and a textured model under a sky: a lat-long map made here (blue zenith to a
+# white horizon, a dark ground), rendered from the glTF sample models in place.
+assets=${GONIO_ASSETS:-../shared/assets}/gltf
+if [ -d "$assets" ]; then
+    convert -size 512x128 gradient:'#5a8ee0'-'#f0f0ff' \( -size 512x128 gradient:'#505048'-'#100c08' \) \
+        -append "$tmp/sky.exr"
+    sky() { # sky MODEL OUT.png [OPTIONS...]
+        local model=$1 out=$2; shift 2
+        "$G" render "$assets/$model/glTF/$model.gltf" --env "$tmp/sky.exr" -o "$tmp/sky-render.exr" \
+            --png $img/$out "$@" --quiet
+    }
+    sky TransmissionTest path-glass.png --camera 0 --size 320x180 --spp 128
+    sky MetalRoughSpheresNoTextures path-metals.png --size 256x256 --spp 64
+    sky DamagedHelmet path-helmet.png --size 256x256 --spp 128
+fi

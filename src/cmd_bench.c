@@ -1,5 +1,6 @@
 /* cmd_bench.c: `gonio bench`: BVH build rate, primary and diffuse-bounce ray throughput
- * of the GLSL traversal, and the time from start to the first finished pixel. */
+ * of the GLSL traversal, the time from start to the first finished pixel, and (--paths)
+ * the path tracer's paths per second and time to reach an RMSE against a reference. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,9 +24,18 @@ static const char bench_usage[] =
     "primary (camera) rays and diffuse bounce rays (cosine-distributed from the primary\n"
     "hits) through the GPU traversal. Default scene: scenes/cornell.gltf.\n"
     "\n"
+    "With --paths, the path tracer instead (--mode path: unbounded depth, MIS): the time to\n"
+    "the first finished path pass, paths per second, and the time and spp at which a\n"
+    "progressive render's RMSE (linear RGB) against a high-spp reference (with the\n"
+    "reference's own estimated noise removed) first falls below 0.05 and 0.02 (times count\n"
+    "the passes, not the RMSE checks).\n"
+    "\n"
     "  --generate N     a procedural mesh of about N triangles instead of a scene\n"
-    "  --size WxH       rays per pass (default 512x512)\n"
+    "  --size WxH       rays per pass (default 512x512; --paths: 256x256)\n"
     "  --seconds S      measure each rate for about S seconds (default 3)\n"
+    "  --paths          measure the path tracer\n"
+    "  --env V          --paths: constant environment radiance (default 0)\n"
+    "  --reference WxH:SPP  --paths: the RMSE reference (default 128x128:512)\n"
     "  --device N       Vulkan device index\n"
     "  --validate       enable the Vulkan validation layer\n";
 
@@ -72,21 +82,118 @@ static bool build_scene(scene *sc, const char *path, long generate)
     return true;
 }
 
+/* The BVH build time, best of 3 (after the timed passes: it must not delay the first pixel). */
+static void print_build(const scene *sc)
+{
+    double best = 1e30;
+    for (int i = 0; i < 3; i++) {
+        bvh b = {0};
+        bvh_build(&b, &sc->vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc->indices,
+                  sc->num_triangles);
+        if (b.build_seconds < best)
+            best = b.build_seconds;
+        bvh_destroy(&b);
+    }
+    printf("bvh build          %.2f ms (%.2f M triangles/s)\n", best * 1e3,
+           sc->num_triangles / best * 1e-6);
+}
+
+/* One path pass (sample `pass`) through r's current image; returns its seconds. */
+static double path_pass(renderer *r, uint32_t pass)
+{
+    double t0 = util_now();
+    VkCommandBuffer cmd = gpu_begin(r->g);
+    renderer_record_pass(r, cmd, GN_MODE_PATH, pass);
+    gpu_submit_wait(r->g, cmd);
+    return util_now() - t0;
+}
+
+/* --paths: prints the path tracer's first pixel, paths/s at s's size and the time to reach
+ * each RMSE against a reference of ref_w x ref_h at ref_spp (seed 1; the timed render uses
+ * seed 0). False when renderer_begin fails. */
+static bool bench_paths(renderer *r, render_settings *s, double t_start, float seconds,
+                        int ref_w, int ref_h, int ref_spp)
+{
+    static const double thresholds[] = {0.05, 0.02};
+    GnFrame frame;
+    image ref = {0};
+    double t_first, t_paths = 0, t_ref, t_run = 0, ref_noise = 0, rmse;
+    int passes = 0, k = 0;
+
+    if (!renderer_begin(r, s, &frame))
+        return false;
+    /* Pass 0 compiles the kernel and defines time to first pixel. */
+    path_pass(r, 0);
+    t_first = util_now() - t_start;
+    for (uint32_t pass = 1; t_paths < seconds || passes < 2; pass++, passes++)
+        t_paths += path_pass(r, pass);
+    printf("first pixel        %.3f s after start (path, %dx%d)\n", t_first, s->width, s->height);
+    printf("paths              %.3f M paths/s (%dx%d, %d passes, unbounded depth, MIS)\n",
+           (double)s->width * s->height * passes / t_paths * 1e-6, s->width, s->height, passes);
+    fflush(stdout);
+
+    s->width = ref_w;
+    s->height = ref_h;
+    s->seed = 1;
+    if (!renderer_begin(r, s, &frame))
+        return false;
+    t_ref = util_now();
+    for (int pass = 0; pass < ref_spp; pass++)
+        path_pass(r, (uint32_t)pass);
+    t_ref = util_now() - t_ref;
+    renderer_resolve(r, ref_spp, false, &ref);
+    /* The reference's own noise: the mean over pixels and RGB of its estimated variance
+     * (sum x^2 / n - mean^2) / (n - 1), subtracted from each squared RMSE below, so the
+     * figures estimate the error against the converged image. */
+    for (int p = 0; ref_spp > 1 && p < ref_w * ref_h; p++)
+        for (int c = 0; c < 3; c++) {
+            double m = ref.planes[c][p], sq = ((const float *)r->squares.mapped)[4 * p + c];
+            ref_noise += (sq / ref_spp - m * m) / (ref_spp - 1);
+        }
+    ref_noise /= 3.0 * ref_w * ref_h;
+    printf("reference          %dx%d, %d spp in %.1f s (its own rmse %.4f)\n", ref_w, ref_h,
+           ref_spp, t_ref, sqrt(ref_noise));
+
+    /* The progressive render stops at the reference's spp: beyond it the error left is
+     * below the reference's own, and only the noise estimate subtracted stands for it. */
+    s->seed = 0;
+    if (!renderer_begin(r, s, &frame)) {
+        image_destroy(&ref);
+        return false;
+    }
+    for (int spp = 1; spp <= ref_spp && k < 2; spp++) {
+        image img = {0};
+        image_metrics m;
+        t_run += path_pass(r, (uint32_t)(spp - 1));
+        renderer_resolve(r, spp, false, &img);
+        image_compare(&img, &ref, &m);
+        image_destroy(&img);
+        rmse = sqrt(fmax(0.0, m.rmse * m.rmse - ref_noise));
+        for (; k < 2 && rmse < thresholds[k]; k++)
+            printf("rmse < %.2f        %.2f s (%d spp, rmse %.4f, %dx%d)\n", thresholds[k], t_run,
+                   spp, rmse, ref_w, ref_h);
+    }
+    for (; k < 2; k++)
+        printf("rmse < %.2f        not reached in %d spp (%.2f s)\n", thresholds[k], ref_spp, t_run);
+    image_destroy(&ref);
+    return true;
+}
+
 int cmd_bench(int argc, char **argv)
 {
     const double t_start = util_now();
     const char *path = "scenes/cornell.gltf";
     long generate = 0, v;
-    float seconds = 3;
-    int device = -1, w = 512, h = 512;
-    bool validate = false;
+    float seconds = 3, env = 0;
+    int device = -1, w = 0, h = 0, ref_w = 128, ref_h = 128, ref_spp = 512;
+    bool validate = false, paths = false;
     scene sc = {0};
     gpu g = {0};
     renderer r = {0};
     gpu_pipeline pipes[2] = {{0}};
     render_settings s = {.mode = GN_MODE_PHONG, .camera = -1};
     GnFrame frame;
-    double best_build = 1e30, t_first = 0, t_primary = 0, t_diffuse = 0;
+    double t_first = 0, t_primary = 0, t_diffuse = 0;
     uint64_t n_primary = 0, n_diffuse = 0;
     int passes = 0;
 
@@ -97,6 +204,8 @@ int cmd_bench(int argc, char **argv)
             return 0;
         } else if (!strcmp(a, "--validate")) {
             validate = true;
+        } else if (!strcmp(a, "--paths")) {
+            paths = true;
         } else if (a[0] == '-' && a[1]) {
             if (!(val = cli_value(argc, argv, &i)))
                 return 2;
@@ -109,6 +218,18 @@ int cmd_bench(int argc, char **argv)
             } else if (!strcmp(a, "--seconds")) {
                 if (!util_parse_float(val, &seconds) || seconds <= 0)
                     return cli_usage_error("bench", "--seconds '%s': expected a number > 0", val);
+            } else if (!strcmp(a, "--env")) {
+                if (!util_parse_float(val, &env) || !(env >= 0))
+                    return cli_usage_error("bench", "--env '%s': expected a radiance >= 0", val);
+            } else if (!strcmp(a, "--reference")) {
+                char size[64];
+                const char *colon = strchr(val, ':');
+                if (!colon || colon - val >= (long)sizeof size ||
+                    !(snprintf(size, sizeof size, "%.*s", (int)(colon - val), val),
+                      util_parse_size(size, &ref_w, &ref_h)) ||
+                    !util_parse_int(colon + 1, 1, 1 << 20, &v))
+                    return cli_usage_error("bench", "--reference '%s': expected WxH:SPP", val);
+                ref_spp = (int)v;
             } else if (!strcmp(a, "--device")) {
                 if (!util_parse_int(val, 0, 64, &v))
                     return cli_usage_error("bench", "--device '%s': expected an index", val);
@@ -128,10 +249,28 @@ int cmd_bench(int argc, char **argv)
         return 1;
     }
     renderer_create(&r, &g, &sc);
+    printf("scene              %s\n", generate ? "generated mesh" : path);
+    printf("device             %s\n", g.props.deviceName);
+    printf("triangles          %u\n", sc.num_triangles);
+    printf("bvh nodes          %u (depth %u, SAH cost %.1f)\n", r.tree.num_nodes, r.tree.depth,
+           r.tree.sah_cost);
+    fflush(stdout);
+    if (!w)
+        w = h = paths ? 256 : 512;
     s.width = w;
     s.height = h;
     s.camera = sc.num_cameras ? 0 : -1;
     s.shadows = false;
+    if (paths) {
+        bool ok;
+        s.mode = GN_MODE_PATH;
+        s.env[0] = s.env[1] = s.env[2] = env;
+        ok = bench_paths(&r, &s, t_start, seconds, ref_w, ref_h, ref_spp);
+        print_build(&sc);
+        renderer_destroy(&r);
+        scene_destroy(&sc);
+        return cli_gpu_finish(&g) && ok ? 0 : 1;
+    }
     if (!renderer_begin(&r, &s, &frame)) {
         renderer_destroy(&r);
         gpu_destroy(&g);
@@ -177,27 +316,12 @@ int cmd_bench(int argc, char **argv)
         if (t_primary + t_diffuse >= 2.0 * seconds && passes >= 2)
             break;
     }
-    for (int i = 0; i < 3; i++) {
-        bvh b = {0};
-        bvh_build(&b, &sc.vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc.indices,
-                  sc.num_triangles);
-        if (b.build_seconds < best_build)
-            best_build = b.build_seconds;
-        bvh_destroy(&b);
-    }
-
-    printf("scene              %s\n", generate ? "generated mesh" : path);
-    printf("device             %s\n", g.props.deviceName);
-    printf("triangles          %u\n", sc.num_triangles);
-    printf("bvh nodes          %u (depth %u, SAH cost %.1f)\n", r.tree.num_nodes, r.tree.depth,
-           r.tree.sah_cost);
-    printf("bvh build          %.2f ms (%.2f M triangles/s)\n", best_build * 1e3,
-           sc.num_triangles / best_build * 1e-6);
     printf("first pixel        %.3f s after start\n", t_first);
     printf("primary rays       %.2f Mrays/s (%dx%d, %d passes)\n", n_primary / t_primary * 1e-6,
            w, h, passes);
     printf("diffuse rays       %.2f Mrays/s (%.0f%% of pixels hit)\n",
            n_diffuse / t_diffuse * 1e-6, 100.0 * n_diffuse / n_primary);
+    print_build(&sc);
     for (int i = 0; i < 2; i++)
         gpu_pipeline_destroy(&g, &pipes[i]);
     renderer_destroy(&r);

@@ -18,7 +18,7 @@ static const struct {
     {"compare", cmd_compare, "flat vs Gouraud vs per-pixel Phong vs path traced, side by side"},
     {"merge", cmd_merge, "combine renders of one scene with different seeds, exactly"},
     {"diff", cmd_diff, "compare two EXR images (RMSE, PSNR, bias); exit 1 above thresholds"},
-    {"bench", cmd_bench, "measure BVH build and ray throughput"},
+    {"bench", cmd_bench, "measure BVH build, ray throughput and path tracing (--paths)"},
     {"brdf", cmd_brdf, "virtual goniophotometer: BRDF lobe plots, albedo, material balls"},
     {"scene", cmd_scene, "write a built-in scene (cornell, teapot) as glTF"},
     {"teapot", cmd_teapot, "write the Utah teapot at a tessellation level as glTF"},

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # bench.sh GONIO: make bench. BVH build rate, ray throughput and time to first pixel on the
 # Cornell box, the largest glTF sample model in ../shared/assets (when present), and a
-# generated mesh of about 250k triangles.
+# generated mesh of about 250k triangles; then the path tracer (bench --paths: paths/s at
+# 256x256, first pixel, time to an RMSE) on the Cornell box and a textured sample model.
 set -u
 G=${1:-build/gonio}
 assets=${GONIO_ASSETS:-../shared/assets}/gltf
@@ -20,3 +21,12 @@ else
 fi
 echo "== generated mesh, 250k triangles"
 "$G" bench --generate 250000 || exit 1
+echo "== path tracing: scenes/cornell.gltf, 256x256"
+"$G" bench scenes/cornell.gltf --paths --size 256x256 || exit 1
+helmet=$assets/DamagedHelmet/glTF/DamagedHelmet.gltf
+if [ -f "$helmet" ]; then
+    echo "== path tracing: $helmet (textured), 256x256, white environment"
+    "$G" bench "$helmet" --paths --size 256x256 --env 1 || exit 1
+else
+    echo "== $helmet is absent: skipping the textured path-tracing benchmark"
+fi
