@@ -260,10 +260,11 @@ int cmd_render(int argc, char **argv)
             ok = image_write_png_from(&img, png_path, exposure, tm);
         snprintf(seconds, sizeof seconds, "%.2f", st.seconds);
         if (ok && !quiet)
-            fprintf(stderr, "gonio: %s %dx%d, %s, %d spp in %s s (%.2f Mrays/s primary), setup %.2f s\n",
+            /* One camera ray per pixel and sample: a whole path in path mode. */
+            fprintf(stderr, "gonio: %s %dx%d, %s, %d spp in %s s (%.2f %s), setup %.2f s\n",
                     out_path ? out_path : png_path, s.width, s.height, render_mode_name(s.mode),
                     st.spp, seconds, st.seconds > 0 ? (double)st.rays / st.seconds * 1e-6 : 0.0,
-                    st.setup_seconds);
+                    s.mode == GN_MODE_PATH ? "M paths/s" : "Mrays/s primary", st.setup_seconds);
         rc = ok ? 0 : 1;
     }
     image_destroy(&img);

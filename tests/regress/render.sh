@@ -58,6 +58,8 @@ check_fails "another seed gives other pixels" 1 "$G" diff "$tmp/c.exr" "$tmp/c3.
 # The summary line: seconds, spp and Mrays/s.
 "$G" render $C -o "$tmp/s.exr" --mode phong --spp 2 --size 32x32 2>"$tmp/summary.txt"
 check "summary line" grep -Eq 'phong, 2 spp in [0-9.]+ s \([0-9.]+ Mrays/s' "$tmp/summary.txt"
+"$G" render $C -o "$tmp/s.exr" --spp 2 --size 32x32 2>"$tmp/summary.txt"
+check "summary line of the path tracer" grep -Eq 'path, 2 spp in [0-9.]+ s \([0-9.]+ M paths/s' "$tmp/summary.txt"
 
 check "gonio info" sh -c "'$G' info $C >'$tmp/info.txt'"
 for f in triangles meshes materials lights 'bvh nodes' 'bvh depth' 'sah cost' 'bvh build'; do
