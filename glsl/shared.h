@@ -24,7 +24,7 @@ typedef uint32_t uint;
 #endif
 
 /* ---- descriptor bindings (set 0) of the render kernels -------------------------------- */
-#define GN_BIND_FRAME 0u     /* uniform GnFrame */
+#define GN_BIND_FRAME 0u     /* GnFrame (a read-only storage buffer: see glsl/scene.glsl) */
 #define GN_BIND_NODES 1u     /* GnBvhNode[] */
 #define GN_BIND_TRIS 2u      /* GnTri[] (BVH order) */
 #define GN_BIND_PRIMS 3u     /* GnPrim[] (BVH order) */
@@ -33,7 +33,7 @@ typedef uint32_t uint;
 #define GN_BIND_LIGHTS 6u    /* GnLight[] */
 #define GN_BIND_TEXELS 7u    /* uint[]: RGBA8 texels of every image, packed */
 #define GN_BIND_TEXTURES 8u  /* GnTexture[] */
-#define GN_BIND_ACCUM 9u     /* vec4[] per pixel: sum of radiance samples, w = count */
+#define GN_BIND_ACCUM 9u     /* vec4[] per pixel: sum of radiance samples, w = coverage */
 #define GN_BIND_AOV 10u      /* vec4[3 * pixels]: normal, albedo, depth sums */
 #define GN_BIND_VCOLOR 11u   /* vec4[2] per vertex: Gouraud colours of the front and back side;
                                  the first one's w holds the vertex's material (uint bits) */
@@ -172,7 +172,7 @@ GN_STRUCT(GnCamera) {
     vec3 forward; float zfar;
 } GN_END(GnCamera); /* 64 bytes */
 
-/* Constant for a whole render (uniform buffer). */
+/* Constant for a whole render (read-only storage buffer, std430). */
 GN_STRUCT(GnFrame) {
     GnCamera camera;
     uint width; uint height; uint seed; uint mode;
