@@ -204,11 +204,8 @@ static bool write_metrics(const char *path, const compare_row *rows, int n, bool
     char tmp[4200];
     FILE *f;
     bool ok;
-    util_tmp_path(tmp, sizeof tmp, path);
-    if (!(f = fopen(tmp, "w"))) {
-        util_error("%s: cannot write: %s", path, strerror(errno));
+    if (!(f = util_tmp_open(tmp, sizeof tmp, path, "w")))
         return false;
-    }
     fprintf(f, "mode,reference,rmse,rel_bias,max_err\n");
     if (print)
         printf("%-8s %-9s %10s %10s %10s\n", "mode", "reference", "rmse", "rel_bias", "max_err");
@@ -398,11 +395,8 @@ static bool write_sweep_csv(const char *path, const sweep_row *rows, int n, bool
     char tmp[4200];
     FILE *f;
     bool ok;
-    util_tmp_path(tmp, sizeof tmp, path);
-    if (!(f = fopen(tmp, "w"))) {
-        util_error("%s: cannot write: %s", path, strerror(errno));
+    if (!(f = util_tmp_open(tmp, sizeof tmp, path, "w")))
         return false;
-    }
     fprintf(f, "level,triangles,gouraud_rmse,gouraud_rel_bias,gouraud_max_err,"
                "flat_rmse,flat_rel_bias,flat_max_err\n");
     if (print)

@@ -403,10 +403,8 @@ bool gltf_write_file(const char *path, const gltf_write_desc *desc)
     uint8_t *buf = make_buffer(desc, &size);
     FILE *f;
     bool ok;
-    util_tmp_path(tmp, sizeof tmp, path);
-    f = fopen(tmp, "wb");
+    f = util_tmp_open(tmp, sizeof tmp, path, "wb");
     if (!f) {
-        util_error("%s: cannot write: %s", path, strerror(errno));
         free(buf);
         return false;
     }

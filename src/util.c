@@ -160,6 +160,15 @@ void util_tmp_path(char *out, size_t cap, const char *final_path)
              (long)getpid());
 }
 
+FILE *util_tmp_open(char *tmp, size_t cap, const char *final_path, const char *mode)
+{
+    FILE *f;
+    util_tmp_path(tmp, cap, final_path);
+    if (!(f = fopen(tmp, mode)))
+        util_error("%s: cannot write: %s", final_path, strerror(errno));
+    return f;
+}
+
 bool util_commit_file(const char *tmp_path, const char *final_path, bool ok)
 {
     if (ok && rename(tmp_path, final_path) != 0) {

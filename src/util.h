@@ -10,6 +10,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #if defined(__GNUC__)
 #define UTIL_PRINTF(a, b) __attribute__((format(printf, a, b)))
@@ -50,5 +51,7 @@ void *util_read_file(const char *path, size_t *size);
  * A failed or interrupted write therefore never leaves a half-written output. */
 void util_tmp_path(char *out, size_t cap, const char *final_path);
 bool util_commit_file(const char *tmp_path, const char *final_path, bool ok);
+/* util_tmp_path, then fopen(tmp, mode); NULL with an error naming final_path on failure. */
+FILE *util_tmp_open(char *tmp, size_t cap, const char *final_path, const char *mode);
 
 #endif

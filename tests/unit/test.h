@@ -35,6 +35,11 @@ void test_skip(const char *why);
  * $GONIO_ASSETS); NULL when absent, in which case tests that need it call test_skip. */
 const char *test_assets_dir(void);
 
+/* The Vulkan device for GPU tests (validation on when GONIO_VALIDATE=1); a failed CHECK
+ * and false when there is none. Defined in test_gpu.c. */
+struct gpu;
+bool test_open_gpu(struct gpu *g);
+
 /* Every suite file defines its tests and lists them in tests/unit/suites.h. */
 typedef void (*test_fn)(void);
 

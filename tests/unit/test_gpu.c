@@ -28,7 +28,7 @@ typedef struct gpu_hit {
 /* A Walk of bvh.glsl in std430: Hit (6 words), node, sp, stack[64]. */
 #define WALK_BYTES (4 * (6 + 2 + 64))
 
-static bool open_gpu(gpu *g)
+bool test_open_gpu(gpu *g)
 {
     const char *env = getenv("GONIO_VALIDATE");
     gpu_desc d = {.device_index = -1, .validate = env && !strcmp(env, "1")};
@@ -170,7 +170,7 @@ void test_gpu_traversal_random(void)
     const float lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
     meshgen_mesh m = meshgen_random_triangles(3000, 7, lo, hi);
     ray *r = malloc(sizeof *r * 8192);
-    if (!open_gpu(&g))
+    if (!test_open_gpu(&g))
         return;
     random_rays(r, 8192, lo, hi);
     compare_mesh(&g, "random", &m, r, 8192);
@@ -186,7 +186,7 @@ void test_gpu_traversal_sphere(void)
     const float c[3] = {0.1f, -0.2f, 0.3f}, lo[3] = {-0.9f, -1.2f, -0.7f}, hi[3] = {1.1f, 0.8f, 1.3f};
     meshgen_mesh m = meshgen_uv_sphere(c, 1.0f, 64, 32);
     ray *r = malloc(sizeof *r * 8192);
-    if (!open_gpu(&g))
+    if (!test_open_gpu(&g))
         return;
     random_rays(r, 8192, lo, hi);
     compare_mesh(&g, "sphere", &m, r, 8192);
@@ -207,7 +207,7 @@ void test_gpu_traversal_edges(void)
     bvh b = {0};
     int leaks = 0;
     float center[3] = {0, 0, 0};
-    if (!open_gpu(&g))
+    if (!test_open_gpu(&g))
         return;
     for (uint32_t v = 0; v < m.num_vertices; v++)
         for (int k = 0; k < 3; k++)
@@ -260,7 +260,7 @@ void test_gpu_traversal_deep(void)
     gpu_hit h[64];
     uint32_t steps_c = 0;
     int dispatches;
-    if (!open_gpu(&g))
+    if (!test_open_gpu(&g))
         return;
     CHECK(bvh_build(&b, m.positions, 3, m.indices, m.num_triangles));
     for (int i = 0; i < 64; i++) {

@@ -22,15 +22,6 @@
 
 #define Z_MAX 5.0 /* |z| above this fails: 1 in 1.7 million for a true Gaussian statistic */
 
-static bool open_gpu(gpu *g)
-{
-    const char *env = getenv("GONIO_VALIDATE");
-    gpu_desc d = {.device_index = -1, .validate = env && !strcmp(env, "1")};
-    bool ok = gpu_create(g, &d);
-    CHECKF(ok, "no Vulkan device");
-    return ok;
-}
-
 /* Renders a scene file with the path tracer; brdf as for render_material_overrides. */
 static bool render_file(gpu *g, const char *path, const char *brdf, render_settings s, image *out)
 {
@@ -109,7 +100,7 @@ void test_path_furnace(void)
     };
     char path[256];
     gpu g = {0};
-    if (!open_gpu(&g))
+    if (!test_open_gpu(&g))
         return;
     tmp_file(path, sizeof path, "furnace.gltf");
     for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
@@ -154,7 +145,7 @@ void test_path_env_map(void)
     render_settings s = {.width = 32, .height = 32, .spp = 64, .camera = 0, .seed = 3};
     int n;
     double se, mean;
-    if (!open_gpu(&g))
+    if (!test_open_gpu(&g))
         return;
     tmp_file(scene_path, sizeof scene_path, "env.gltf");
     tmp_file(map_path, sizeof map_path, "env.exr");
@@ -229,7 +220,7 @@ void test_path_estimators(void)
     gpu g = {0};
     image img[3] = {{0}}, direct = {0};
     render_settings s = {.width = 32, .height = 32, .spp = 256, .camera = 0};
-    if (!open_gpu(&g))
+    if (!test_open_gpu(&g))
         return;
     for (int i = 0; i < 3; i++) {
         s.strategy = strategies[i];
@@ -273,7 +264,7 @@ void test_path_convergence(void)
     image ref = {0};
     render_settings s = {.width = 32, .height = 32, .spp = 512, .camera = 0, .seed = 100};
     double ref_var = 0, x[3], y[3], sx = 0, sy = 0, sxx = 0, sxy = 0, slope;
-    if (!open_gpu(&g))
+    if (!test_open_gpu(&g))
         return;
     if (!render_file(&g, "scenes/cornell.gltf", NULL, s, &ref)) {
         gpu_destroy(&g);
@@ -450,7 +441,7 @@ void test_path_cornell_reference(void)
             }
         }
     scene_destroy(&sc);
-    if (open_gpu(&g) && render_file(&g, "scenes/cornell.gltf", NULL, s, &gpu_img)) {
+    if (test_open_gpu(&g) && render_file(&g, "scenes/cornell.gltf", NULL, s, &gpu_img)) {
         double z = max_block_z(&gpu_img, &ref, 4), mg = 0, mr = 0;
         for (int p = 0; p < W * H; p++)
             mg += gpu_img.planes[1][p], mr += ref.planes[1][p];
@@ -468,7 +459,7 @@ void test_path_determinism(void)
     gpu g = {0};
     image a = {0}, b = {0};
     render_settings s = {.width = 24, .height = 24, .spp = 8, .camera = 0, .seed = 9, .aov = true};
-    if (!open_gpu(&g))
+    if (!test_open_gpu(&g))
         return;
     if (render_file(&g, "scenes/cornell.gltf", NULL, s, &a) &&
         render_file(&g, "scenes/cornell.gltf", NULL, s, &b)) {
