@@ -183,10 +183,8 @@ int cmd_render(int argc, char **argv)
                 if (!util_parse_float(val, &exposure))
                     return cli_usage_error("render", "--exposure '%s': expected a number", val);
             } else if (!strcmp(a, "--tonemap")) {
-                if (!strcmp(val, "clamp")) tm = IMAGE_TONEMAP_CLAMP;
-                else if (!strcmp(val, "reinhard")) tm = IMAGE_TONEMAP_REINHARD;
-                else if (!strcmp(val, "aces")) tm = IMAGE_TONEMAP_ACES;
-                else return cli_usage_error("render", "--tonemap '%s': expected clamp, reinhard or aces", val);
+                if (!image_tonemap_from_name(val, &tm))
+                    return cli_usage_error("render", "--tonemap '%s': expected clamp, reinhard or aces", val);
             } else if (!strcmp(a, "--device")) {
                 if (!util_parse_int(val, 0, 64, &v))
                     return cli_usage_error("render", "--device '%s': expected an index (see gonio devices)", val);

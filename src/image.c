@@ -498,3 +498,17 @@ bool image_compare_channels(const image *a, const image *b, const char *const *n
     compare_planes(a, b, ca, cb, n, m);
     return true;
 }
+
+static const char *const tonemap_names[] = {"clamp", "aces", "reinhard"};
+
+bool image_tonemap_from_name(const char *name, image_tonemap *out)
+{
+    for (int i = 0; i < 3; i++)
+        if (!strcmp(name, tonemap_names[i])) {
+            *out = (image_tonemap)i;
+            return true;
+        }
+    return false;
+}
+
+const char *image_tonemap_name(image_tonemap tm) { return tonemap_names[tm]; }

@@ -47,6 +47,10 @@ bool image_exr_attr_string(const char *path, const char *name, char *out, int ca
 
 typedef enum image_tonemap { IMAGE_TONEMAP_CLAMP, IMAGE_TONEMAP_ACES, IMAGE_TONEMAP_REINHARD } image_tonemap;
 
+/* "clamp", "aces", "reinhard" <-> image_tonemap; false for an unknown name. */
+bool image_tonemap_from_name(const char *name, image_tonemap *out);
+const char *image_tonemap_name(image_tonemap tm);
+
 /* Linear RGB planes -> 8-bit sRGB RGBA (alpha 255): scale by 2^exposure, tonemap, sRGB
  * transfer function, round. NaN maps to 0. */
 void image_to_srgb8(const float *r, const float *g, const float *b, int width, int height,

@@ -67,7 +67,6 @@ static const char keys_help[] =
 static const uint32_t mode_keys[8] = {GN_MODE_PATH,   GN_MODE_PHONG,  GN_MODE_GOURAUD,
                                       GN_MODE_FLAT,   GN_MODE_NORMAL, GN_MODE_ALBEDO,
                                       GN_MODE_DEPTH,  GN_MODE_COST};
-static const char *const tonemap_names[3] = {"clamp", "aces", "reinhard"};
 
 typedef struct preview {
     scene sc;
@@ -531,7 +530,7 @@ static void update_title(preview *p)
     char t[sizeof p->title];
     snprintf(t, sizeof t, "gonio preview: %s | %dx%d | %d spp | %.2f Mpaths/s | %.1f ms | EV %+.1f %s",
              render_mode_name(p->s.mode), p->r.width, p->r.height, p->spp, p->paths_per_second * 1e-6,
-             p->frame_seconds * 1e3, p->exposure, tonemap_names[p->tonemap]);
+             p->frame_seconds * 1e3, p->exposure, image_tonemap_name(p->tonemap));
     if (strcmp(t, p->title)) {
         strcpy(p->title, t);
         glfwSetWindowTitle(p->window, t);
@@ -793,10 +792,8 @@ int cmd_preview(int argc, char **argv)
                 if (!util_parse_float(val, &p->exposure))
                     return cli_usage_error("preview", "--exposure '%s': expected a number", val);
             } else if (!strcmp(a, "--tonemap")) {
-                if (!strcmp(val, "clamp")) p->tonemap = IMAGE_TONEMAP_CLAMP;
-                else if (!strcmp(val, "reinhard")) p->tonemap = IMAGE_TONEMAP_REINHARD;
-                else if (!strcmp(val, "aces")) p->tonemap = IMAGE_TONEMAP_ACES;
-                else return cli_usage_error("preview", "--tonemap '%s': expected clamp, reinhard or aces", val);
+                if (!image_tonemap_from_name(val, &p->tonemap))
+                    return cli_usage_error("preview", "--tonemap '%s': expected clamp, reinhard or aces", val);
             } else if (!strcmp(a, "--prefix")) {
                 p->prefix = val;
             } else if (!strcmp(a, "--frames")) {
