@@ -179,7 +179,8 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     }
 
     lights = util_calloc(sc->num_lights + 16, sizeof *lights);
-    memcpy(lights, sc->lights, sizeof *lights * sc->num_lights);
+    if (sc->num_lights)
+        memcpy(lights, sc->lights, sizeof *lights * sc->num_lights);
     r->num_lights = sc->num_lights ? sc->num_lights : emissive_lights(sc, lights, 16);
 
     gpu_buffer_create(g, &r->frame, sizeof(GnFrame), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
