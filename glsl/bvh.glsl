@@ -1,11 +1,14 @@
 // bvh.glsl: closest-hit and any-hit BVH traversal over GnBvhNode (both children's boxes in
 // one node, Aila & Laine 2009) with the watertight ray-triangle test of Woop, Benthin &
-// Wald (JCGT 2013). The C traversal in src/bvh.c is the same algorithm and the reference in
-// the tests; keep the two in step (including what counts as a step).
+// Wald (JCGT 2013). The C traversal in src/bvh.c, the reference in the tests, uses the same
+// boxes, triangle test and step count; it tests leaves as it meets them, this walk postpones
+// them (below), so the two visit the same nodes in a different order.
 //
-// llvmpipe ends an invocation's loops silently after 65,535 iterations in total (DESIGN.md).
-// A walk is bounded by frame.traversal_budget node visits: a ray that needs more reports
-// `truncated` instead of a silently wrong answer, and the host counts those.
+// llvmpipe ends an invocation's loops silently after 65,535 iterations in total (DESIGN.md;
+// the count is per SIMD group of 8 invocations). A walk is bounded by
+// frame.traversal_budget node visits, sized so that the cap is not reached in practice;
+// a walk stopped by either reports `truncated` instead of a silently wrong answer, keeps
+// its state for a resume, and the host counts those.
 #ifndef GONIO_BVH_GLSL
 #define GONIO_BVH_GLSL
 
@@ -122,11 +125,20 @@ float box_enter(RayPre r, vec3 bmin, vec3 bmax, float tmin, float tmax)
     return enter <= leave ? enter : 1e38;
 }
 
+// A walk's position: an inner node's index, or a leaf packed as GN_WALK_LEAF | (count - 1)
+// << 27 | first triangle (the builder keeps leaves to 8 triangles; scenes stay under 2^27
+// triangles: the glTF loader stops at 2^26, and renderer_create asserts it).
+#define GN_WALK_LEAF 0x80000000u
+uint walk_entry(uint index, uint count)
+{
+    return count == 0u ? index : GN_WALK_LEAF | ((count - 1u) << 27) | index;
+}
+
 // The state of a walk, so one that runs out of budget can be resumed later (the unit tests
 // resume walks across dispatches to get exact answers on meshes beyond llvmpipe's loop cap).
 struct Walk {
     Hit hit;
-    uint node;      // next node to visit, GN_INVALID when the walk is over
+    uint node;      // next entry (walk_entry) to visit, GN_INVALID when the walk is over
     int sp;
     uint stack[BVH_STACK];
 };
@@ -143,59 +155,59 @@ void walk_start(float tmax)
     walk.sp = 0;
 }
 
-// Tests the triangles of a leaf against the ray, keeping the nearest hit in walk.hit.
-void leaf_hits(RayPre r, uint first, uint count, float tmin)
-{
-    for (uint i = first; i < first + count; i++) {
-        GnTri tri = bvh_tri(i);
-        float t, u, v;
-        if (tri_intersect(r, tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, tmin, walk.hit.t, t, u, v)) {
-            walk.hit.t = t; walk.hit.u = u; walk.hit.v = v; walk.hit.tri = i;
-        }
-    }
-}
-
 // Continues `walk` for at most `budget` more node visits. Closest hit (any_hit false) or
 // the first hit found (any_hit true) with t in (tmin, walk.hit.t). On return either
 // walk.node is GN_INVALID (done) or walk.hit.truncated is set (budget spent; call again).
+//
+// The loop is "while-while" (Aila & Laine 2009): inner nodes until the ray holds a leaf,
+// then that leaf's triangles. llvmpipe runs both sides of every branch with lanes masked
+// off (it never jumps over an `if`), so a loop body that tested nodes and leaves together
+// would pay a triangle test on every node visit; split, a node visit pays only its own
+// work, and the triangle loop runs once per leaf.
 void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
 {
 #define w walk
     uint end = w.hit.steps + budget;
     w.hit.truncated = false;
     while (w.node != GN_INVALID) {
-        if (w.hit.steps >= end) { w.hit.truncated = true; return; }
-        w.hit.steps++;
-        GnBvhNode n = bvh_node(w.node);
-        float ea = n.a_index == GN_INVALID ? 1e38 : box_enter(r, n.a_min, n.a_max, tmin, w.hit.t);
-        float eb = n.b_index == GN_INVALID ? 1e38 : box_enter(r, n.b_min, n.b_max, tmin, w.hit.t);
-        // Leaves are intersected right away; only inner children go on.
-        if (ea < 1e38 && n.a_count > 0u) {
-            leaf_hits(r, n.a_index, n.a_count, tmin);
-            ea = 1e38;
-            if (any_hit && w.hit.tri != GN_INVALID) { w.node = GN_INVALID; return; }
+        while (w.node != GN_INVALID && (w.node & GN_WALK_LEAF) == 0u) {
+            if (w.hit.steps >= end) { w.hit.truncated = true; return; }
+            w.hit.steps++;
+            GnBvhNode n = bvh_node(w.node);
+            float ea = n.a_index == GN_INVALID ? 1e38 : box_enter(r, n.a_min, n.a_max, tmin, w.hit.t);
+            float eb = n.b_index == GN_INVALID ? 1e38 : box_enter(r, n.b_min, n.b_max, tmin, w.hit.t);
+            uint ca = walk_entry(n.a_index, n.a_count), cb = walk_entry(n.b_index, n.b_count);
+            if (ea < 1e38 && eb < 1e38) {
+                // Both: go to the nearer (a on a tie), keep the farther.
+                bool a_first = ea <= eb;
+                if (w.sp == BVH_STACK) { w.hit.truncated = true; w.node = GN_INVALID; return; }
+                w.stack[w.sp++] = a_first ? cb : ca;
+                w.node = a_first ? ca : cb;
+            } else if (ea < 1e38 || eb < 1e38) {
+                w.node = ea < 1e38 ? ca : cb;
+            } else {
+                w.node = w.sp == 0 ? GN_INVALID : w.stack[--w.sp];
+            }
         }
-        if (eb < 1e38 && eb > w.hit.t) eb = 1e38;
-        if (eb < 1e38 && n.b_count > 0u) {
-            leaf_hits(r, n.b_index, n.b_count, tmin);
-            eb = 1e38;
-            if (any_hit && w.hit.tri != GN_INVALID) { w.node = GN_INVALID; return; }
+        // A leaf, unless llvmpipe's loop cap ended the loop above early (see below).
+        bool leaf = w.node != GN_INVALID && (w.node & GN_WALK_LEAF) != 0u;
+        uint first = w.node & 0x07ffffffu, last = first + ((w.node >> 27) & 15u);
+        for (uint i = first; leaf && i <= last; i++) {
+            GnTri tri = bvh_tri(i);
+            float t, u, v;
+            if (tri_intersect(r, tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, tmin, w.hit.t, t, u, v)) {
+                w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = i;
+            }
         }
-        if (ea < 1e38 && ea > w.hit.t) ea = 1e38;
-        if (ea < 1e38 && eb < 1e38) {
-            // Both inner children: descend into the nearer, keep the farther.
-            bool a_first = ea <= eb;
-            if (w.sp == BVH_STACK) { w.hit.truncated = true; w.node = GN_INVALID; return; }
-            w.stack[w.sp++] = a_first ? n.b_index : n.a_index;
-            w.node = a_first ? n.a_index : n.b_index;
-        } else if (ea < 1e38) {
-            w.node = n.a_index;
-        } else if (eb < 1e38) {
-            w.node = n.b_index;
-        } else {
+        if (leaf && any_hit && w.hit.tri != GN_INVALID) { w.node = GN_INVALID; return; }
+        if (leaf)
             w.node = w.sp == 0 ? GN_INVALID : w.stack[--w.sp];
-        }
     }
+    // The loop ends with the walk over, or else because llvmpipe's loop cap stopped it: the
+    // state is still whole (the cap ends loops between iterations), so say so and the
+    // caller can resume instead of taking a silent miss.
+    if (w.node != GN_INVALID)
+        w.hit.truncated = true;
 #undef w
 }
 

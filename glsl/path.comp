@@ -27,7 +27,7 @@ layout(push_constant) uniform PushBlock { GnPush push; };
 #define ROULETTE_DEPTH 3u
 #define MAX_BOUNCES 4096u // never reached: roulette and the step budget end paths first
 // A ray's own loop iterations besides its walk (light selection, map searches), in node
-// visits (a visit costs up to 17 iterations): charged so the whole path stays under
+// visits (a visit costs up to 19 iterations): charged so the whole path stays under
 // llvmpipe's loop cap with frame.traversal_budget node visits per invocation.
 #define TRACE_OVERHEAD 4u
 

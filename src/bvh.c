@@ -761,7 +761,8 @@ static bool leaf_hit(const bvh *b, const ray *r, uint32_t first, uint32_t count,
     return found;
 }
 
-/* The walk the GPU does (glsl/bvh.glsl must match it step for step):
+/* The reference walk for glsl/bvh.glsl: the same tree, boxes and triangle test, so the
+ * same closest hit (up to ties between triangles at one t).
  *   node = 0; loop: read node (ONE STEP), slab-test child a and child b (b only when
  *   b_index != GN_INVALID) against (tmin, closest t);
  *   a hit leaf child is intersected at once (a before b; b skipped if a's hits moved the
@@ -770,7 +771,9 @@ static bool leaf_hit(const bvh *b, const ray *r, uint32_t first, uint32_t count,
  *   there; none: pop until an entry <= closest t is found (dropped entries are not read and
  *   not counted), or end when the stack is empty.
  * So *steps = number of GnBvhNode reads = loop iterations, node 0 included; triangle tests
- * are not steps. Any-hit walks stop at the first triangle hit. */
+ * are not steps. Any-hit walks stop at the first triangle hit. The GPU walk differs in
+ * order only: it postpones leaves (pushing them like nodes) and tests them between runs of
+ * node visits, which suits SIMD lanes that execute both sides of every branch. */
 static bvh_hit traverse(const bvh *b, const float org[3], const float dir[3], float tmin,
                         float tmax, bool any_hit, uint32_t *steps)
 {
