@@ -213,11 +213,11 @@ bool brdf_refract(vec3 wo, vec3 n, float eta, out vec3 wt)
 // The lobe's Fresnel factor times its weight, at cos = wo.wh.
 vec3 brdf_lobe_fresnel(Bsdf b, float c)
 {
-    if (b.fresnel == BRDF_FRESNEL_DIELECTRIC)
+    if (GN_HAS(GN_FEAT_FRESNEL_DIELECTRIC) && b.fresnel == BRDF_FRESNEL_DIELECTRIC)
         return b.specular * brdf_fresnel_dielectric(c, b.ior);
-    if (b.fresnel == BRDF_FRESNEL_CONDUCTOR)
+    if (GN_HAS(GN_FEAT_FRESNEL_CONDUCTOR) && b.fresnel == BRDF_FRESNEL_CONDUCTOR)
         return b.specular * brdf_fresnel_conductor(c, b.eta, b.k);
-    if (b.fresnel == BRDF_FRESNEL_SCHLICK)
+    if (GN_HAS(GN_FEAT_FRESNEL_SCHLICK) && b.fresnel == BRDF_FRESNEL_SCHLICK)
         return brdf_fresnel_schlick(c, b.specular, b.f90);
     return b.specular;
 }
@@ -228,6 +228,8 @@ vec3 brdf_lobe_fresnel(Bsdf b, float c)
 // the plain Lambert kd/pi.
 vec3 brdf_diffuse(Bsdf b, float co, float ci)
 {
+    if (!GN_HAS(GN_FEAT_COUPLED)) // couple_f0 = couple_f90 = 0: exactly the plain Lambert
+        return b.diffuse / BRDF_PI;
     vec3 fo = brdf_fresnel_schlick(co, b.couple_f0, b.couple_f90);
     vec3 fi = brdf_fresnel_schlick(ci, b.couple_f0, b.couple_f90);
     vec3 avg = b.couple_f0 + (b.couple_f90 - b.couple_f0) / 21.0;
@@ -242,7 +244,7 @@ void brdf_lobe(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
     float n = b.shape;
     if (b.lobe == BRDF_LOBE_NONE || b.lobe == BRDF_LOBE_MIRROR)
         return;
-    if (b.lobe == BRDF_LOBE_PHONG) {
+    if (GN_HAS(GN_FEAT_PHONG) && b.lobe == BRDF_LOBE_PHONG) {
         // (n+2)/(2 pi) cos^n of the angle between r(wi) and wo: albedo ks at normal
         // incidence and less elsewhere; sampled about r(wo) with (n+1)/(2 pi) cos^n.
         float v = brdf_pow(dot(vec3(-wi.xy, wi.z), wo), n);
@@ -250,9 +252,11 @@ void brdf_lobe(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
         pdf = (n + 1.0) / (2.0 * BRDF_PI) * v;
         return;
     }
+    if (!GN_HAS(GN_FEAT_BLINN | GN_FEAT_TS | GN_FEAT_BECKMANN | GN_FEAT_GGX))
+        return;
     vec3 h = normalize(wo + wi);
     float oh = dot(wo, h);
-    if (b.lobe == BRDF_LOBE_BLINN) {
+    if (GN_HAS(GN_FEAT_BLINN) && b.lobe == BRDF_LOBE_BLINN) {
         // Normalised so the albedo at normal incidence is exactly ks (docs/brdf.md): the
         // usual (n+8)/(8 pi) exceeds 1 by up to 7%.
         float v = brdf_pow(h.z, n);
@@ -261,19 +265,21 @@ void brdf_lobe(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
         pdf = (n + 1.0) / (2.0 * BRDF_PI) * v / (4.0 * oh);
         return;
     }
+    if (!GN_HAS(GN_FEAT_TS | GN_FEAT_BECKMANN | GN_FEAT_GGX))
+        return;
     vec3 fr = brdf_lobe_fresnel(b, oh);
-    float dv, pdf_h; // D G / (4 cos_o cos_i); pdf of the normal h
-    if (b.lobe == BRDF_LOBE_TS) {
+    float dv = 0.0, pdf_h = 0.0; // D G / (4 cos_o cos_i); pdf of the normal h
+    if (GN_HAS(GN_FEAT_TS) && b.lobe == BRDF_LOBE_TS) {
         float d = brdf_d_blinn(h.z, n);
         float g = min(1.0, 2.0 * h.z * min(wo.z, wi.z) / oh);
         dv = d * g / (4.0 * wo.z * wi.z);
         pdf_h = d * h.z;
-    } else if (b.lobe == BRDF_LOBE_BECKMANN) {
+    } else if (GN_HAS(GN_FEAT_BECKMANN) && b.lobe == BRDF_LOBE_BECKMANN) {
         float d = brdf_d_beckmann(h, n);
         float g = 1.0 / (1.0 + brdf_lambda_beckmann(wo, n) + brdf_lambda_beckmann(wi, n));
         dv = d * g / (4.0 * wo.z * wi.z);
         pdf_h = d * h.z;
-    } else {
+    } else if (GN_HAS(GN_FEAT_GGX) && b.lobe == BRDF_LOBE_GGX) {
         float d = brdf_d_ggx(h, n);
         dv = d * brdf_v_ggx(wo, wi, n);
         pdf_h = brdf_g1_ggx(wo, n) * oh * d / wo.z;
@@ -286,20 +292,20 @@ void brdf_lobe(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
 vec3 brdf_lobe_sample(Bsdf b, vec3 wo, vec2 u)
 {
     float n = b.shape, phi = 2.0 * BRDF_PI * u.y;
-    if (b.lobe == BRDF_LOBE_PHONG) {
+    if (GN_HAS(GN_FEAT_PHONG) && b.lobe == BRDF_LOBE_PHONG) {
         vec3 r = vec3(-wo.xy, wo.z), t, bt;
         sampling_basis(r, t, bt);
         float c = pow(u.x, 1.0 / (n + 1.0)), s = sqrt(max(0.0, 1.0 - c * c));
         return (t * cos(phi) + bt * sin(phi)) * s + r * c;
     }
-    vec3 h;
-    if (b.lobe == BRDF_LOBE_GGX) {
+    vec3 h = vec3(0.0, 0.0, 1.0);
+    if (GN_HAS(GN_FEAT_GGX) && b.lobe == BRDF_LOBE_GGX) {
         h = brdf_ggx_sample_vndf(wo, n, u);
-    } else {
+    } else if (GN_HAS(GN_FEAT_BLINN | GN_FEAT_TS | GN_FEAT_BECKMANN)) {
         float c; // cos of the normal: density (n+1)/(2pi) c^n, D c for TS and Beckmann
-        if (b.lobe == BRDF_LOBE_BLINN)
+        if (GN_HAS(GN_FEAT_BLINN) && b.lobe == BRDF_LOBE_BLINN)
             c = pow(u.x, 1.0 / (n + 1.0));
-        else if (b.lobe == BRDF_LOBE_TS)
+        else if (GN_HAS(GN_FEAT_TS) && b.lobe == BRDF_LOBE_TS)
             c = pow(u.x, 1.0 / (n + 2.0));
         else
             c = inversesqrt(1.0 - n * n * log(1.0 - u.x));
@@ -353,12 +359,12 @@ vec3 brdf_part_probs(Bsdf b, vec3 wo)
     if (wo.z > 0.0) {
         vec3 d = b.diffuse * (1.0 - brdf_fresnel_schlick(wo.z, b.couple_f0, b.couple_f90));
         p.x = (d.r + d.g + d.b) / 3.0;
-        if (b.lobe != BRDF_LOBE_NONE) {
+        if (GN_HAS(GN_FEAT_LOBES) && b.lobe != BRDF_LOBE_NONE) {
             vec3 s = brdf_lobe_fresnel(b, wo.z);
             p.y = (s.r + s.g + s.b) / 3.0;
         }
     }
-    if (wo.z != 0.0)
+    if (GN_HAS(GN_FEAT_GLASS) && wo.z != 0.0)
         p.z = b.dielectric;
     float sum = p.x + p.y + p.z;
     return sum > 0.0 ? p / sum : vec3(0.0);
@@ -380,7 +386,7 @@ void bsdf_eval_pdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
         f = brdf_diffuse(b, wo.z, wi.z) + fl;
         pdf = p.x * wi.z / BRDF_PI + p.y * pl;
     }
-    if (b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN) {
+    if (GN_HAS(GN_FEAT_ROUGH_GLASS) && b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN) {
         vec3 ft;
         float pt;
         brdf_rough_dielectric(b, wo, wi, ft, pt);
@@ -421,8 +427,8 @@ BsdfSample bsdf_sample(Bsdf b, vec3 wo, vec3 u)
                          // lands on the other side is no sample of it (pbrt-v4 does the same)
     if (u.x < p.x) {
         wi = sampling_cosine_hemisphere(u.yz);
-    } else if (u.x < p.x + p.y) {
-        if (b.lobe == BRDF_LOBE_MIRROR) {
+    } else if (GN_HAS(GN_FEAT_LOBES) && u.x < p.x + p.y) {
+        if (GN_HAS(GN_FEAT_MIRROR) && b.lobe == BRDF_LOBE_MIRROR) {
             s.wi = vec3(-wo.xy, wo.z);
             s.pdf = p.y;
             s.weight = brdf_lobe_fresnel(b, wo.z) / p.y;
@@ -430,9 +436,9 @@ BsdfSample bsdf_sample(Bsdf b, vec3 wo, vec3 u)
             return s;
         }
         wi = brdf_lobe_sample(b, wo, u.yz);
-    } else if (p.z > 0.0) {
+    } else if (GN_HAS(GN_FEAT_GLASS) && p.z > 0.0) {
         float x = min((u.x - p.x - p.y) / p.z, 1.0);
-        if (b.shape < BRDF_ALPHA_MIN) {
+        if (GN_HAS(GN_FEAT_SMOOTH_GLASS) && b.shape < BRDF_ALPHA_MIN) {
             float fr = brdf_fresnel_dielectric(wo.z, b.ior);
             if (x < fr) {
                 s.wi = vec3(-wo.xy, wo.z);
@@ -446,6 +452,8 @@ BsdfSample bsdf_sample(Bsdf b, vec3 wo, vec3 u)
             }
             return s;
         }
+        if (!GN_HAS(GN_FEAT_ROUGH_GLASS))
+            return s;
         vec3 wm = brdf_ggx_sample_vndf(wo.z >= 0.0 ? wo : -wo, b.shape, u.yz);
         float mo = dot(wo, wm);
         reflect = x < brdf_fresnel_dielectric(mo, b.ior);

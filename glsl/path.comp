@@ -9,6 +9,12 @@
 // docs/path-tracing.md derives the estimator and names the tests that check it.
 #extension GL_GOOGLE_include_directive : require
 
+// Specialised on the scene's features (GN_FEAT_* in shared.h): code no lane can need is
+// compiled away, which llvmpipe (running both sides of every branch) needs most.
+#define GN_HAS(f) ((FEATURES & (f)) != 0u)
+#include "shared.h"
+layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
+
 #include "bvh.glsl"
 #include "brdf.glsl"
 
@@ -77,7 +83,9 @@ float env_pdf_uv(ivec2 xy)
 
 vec3 env_radiance(vec3 d)
 {
-    if ((frame.flags & GN_FRAME_ENV_MAP) == 0u)
+    if (!GN_HAS(GN_FEAT_ENV))
+        return vec3(0.0);
+    if (!GN_HAS(GN_FEAT_ENV_MAP) || (frame.flags & GN_FRAME_ENV_MAP) == 0u)
         return frame.env_color;
     float st;
     ivec2 xy = env_texel(d, st);
@@ -88,7 +96,7 @@ vec3 env_radiance(vec3 d)
 // Solid-angle density with which light sampling picks direction d toward the environment.
 float env_pdf(vec3 d)
 {
-    if ((frame.flags & GN_FRAME_ENV_MAP) == 0u)
+    if (!GN_HAS(GN_FEAT_ENV_MAP) || (frame.flags & GN_FRAME_ENV_MAP) == 0u)
         return frame.env_select / (4.0 * PI);
     float st;
     ivec2 xy = env_texel(d, st);
@@ -142,7 +150,7 @@ vec3 tri_emission(uint prim, float u, float v, vec3 d, vec3 ng)
     if (dot(ng, d) >= 0.0 && (m.flags & GN_MAT_DOUBLE_SIDED) == 0u)
         return vec3(0.0);
     vec3 e = m.emissive;
-    if (m.tex_emissive != GN_INVALID) {
+    if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_emissive != GN_INVALID) {
         GnVertex a = vertices[pr.i0], b = vertices[pr.i1], c = vertices[pr.i2];
         vec2 uv = (1.0 - u - v) * vec2(a.u, a.v) + u * vec2(b.u, b.v) + v * vec2(c.u, c.v);
         e *= texture_sample(m.tex_emissive, uv, true).rgb;
@@ -180,22 +188,25 @@ LightSample light_sample(vec3 p, vec3 u)
     s.delta = false;
     s.L = vec3(0.0);
     uint lo = 0u, hi = frame.num_emitters - 1u;
-    while (lo < hi) {
+    while (GN_HAS(GN_FEAT_LIGHT_SEARCH) && lo < hi) {
         uint mid = (lo + hi) / 2u;
         if (emitters[mid].cdf > u.x) hi = mid; else lo = mid + 1u;
     }
     GnEmitter e = emitters[lo];
-    if (e.prim == GN_INVALID) {
+    if (GN_HAS(GN_FEAT_ENV) && e.prim == GN_INVALID) {
         float pdf = 1.0 / (4.0 * PI);
-        s.wi = (frame.flags & GN_FRAME_ENV_MAP) != 0u ? env_sample(u.yz, pdf) : sampling_uniform_sphere(u.yz);
+        if (GN_HAS(GN_FEAT_ENV_MAP) && (frame.flags & GN_FRAME_ENV_MAP) != 0u)
+            s.wi = env_sample(u.yz, pdf);
+        else
+            s.wi = sampling_uniform_sphere(u.yz);
         s.dist = 1e30;
         s.L = env_radiance(s.wi);
         s.pdf = e.pdf * pdf;
-    } else if ((e.prim & GN_EMITTER_LIGHT) != 0u) {
+    } else if (GN_HAS(GN_FEAT_PUNCTUAL) && (e.prim & GN_EMITTER_LIGHT) != 0u) {
         s.L = punctual_incident(lights[e.prim & ~GN_EMITTER_LIGHT], p, s.wi, s.dist);
         s.pdf = e.pdf;
         s.delta = true;
-    } else {
+    } else if (GN_HAS(GN_FEAT_EMISSIVE)) {
         GnTri t = bvh_tri(e.prim);
         float su = sqrt(u.y), b1 = 1.0 - su, b2 = u.z * su;
         vec3 q = (1.0 - b1 - b2) * t.v0.xyz + b1 * t.v1.xyz + b2 * t.v2.xyz;
@@ -216,7 +227,7 @@ LightSample light_sample(vec3 p, vec3 u)
 // ---- materials ------------------------------------------------------------------------------
 Bsdf material_bsdf(Surface s, GnMaterial m)
 {
-    if (m.brdf != BRDF_GLTF) // the colour of a conductor is its index, never a texture's
+    if (GN_HAS(GN_FEAT_MODELS) && (!GN_HAS(GN_FEAT_GLTF) || m.brdf != BRDF_GLTF)) // the colour of a conductor is its index, never a texture's
         return bsdf_from_model(m.brdf, m.brdf == BRDF_CONDUCTOR ? m.base_color.rgb : s.base, m.brdf_params);
     return bsdf_gltf(s.base, s.metallic, s.roughness, m.specular, m.specular_color, m.ior, m.transmission);
 }
@@ -243,8 +254,8 @@ void main()
     if (px.x >= frame.width || px.y >= frame.height)
         return;
     uint pixel = px.y * frame.width + px.x;
-    bool light_only = (frame.flags & GN_FRAME_LIGHT_ONLY) != 0u;
-    bool bsdf_only = (frame.flags & GN_FRAME_BSDF_ONLY) != 0u;
+    bool light_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_LIGHT_ONLY) != 0u;
+    bool bsdf_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_BSDF_ONLY) != 0u;
     budget = frame.traversal_budget;
     truncated = false;
 
@@ -266,24 +277,25 @@ void main()
         if (h.tri == GN_INVALID) {
             vec3 le = env_radiance(d);
             float w = 1.0;
-            if (!prev_delta && frame.env_select > 0.0)
+            if (GN_HAS(GN_FEAT_ENV) && !prev_delta && frame.env_select > 0.0)
                 w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, env_pdf(d));
             radiance += beta * le * w;
             break;
         }
         Surface s = surface_at(h.tri, h.t, h.u, h.v, o, d);
         GnMaterial m = materials[s.material];
-        if (depth == 0u) {
-            covered = true;
+        covered = covered || depth == 0u;
+        if (GN_HAS(GN_FEAT_AOV) && depth == 0u) {
             normal = s.n;
             albedo = s.base;
             depth_aov = h.t * dot(d, frame.camera.forward);
         }
-        if ((m.flags & GN_MAT_UNLIT) != 0u) { // KHR_materials_unlit: the colour is the radiance
+        if (GN_HAS(GN_FEAT_UNLIT) && (m.flags & GN_MAT_UNLIT) != 0u) { // KHR_materials_unlit: the colour is the radiance
             radiance += beta * s.base;
             break;
         }
-        if ((s.front || (m.flags & GN_MAT_DOUBLE_SIDED) != 0u) && luminance(m.emissive) > 0.0) {
+        if (GN_HAS(GN_FEAT_EMISSIVE) && (s.front || (m.flags & GN_MAT_DOUBLE_SIDED) != 0u) &&
+            luminance(m.emissive) > 0.0) {
             float w = 1.0;
             if (!prev_delta) {
                 float pl = luminance(m.emissive) * area_sides(m) / frame.emitter_power * h.t * h.t /
@@ -347,7 +359,7 @@ void main()
         radiance = vec3(0.0);
     accum[pixel] += vec4(radiance, covered ? 1.0 : 0.0);
     squares[pixel] += vec4(radiance * radiance, 0.0);
-    if ((frame.flags & GN_FRAME_AOV) != 0u) {
+    if (GN_HAS(GN_FEAT_AOV) && (frame.flags & GN_FRAME_AOV) != 0u) {
         aov[3u * pixel + 0u] += vec4(normal, 0.0);
         aov[3u * pixel + 1u] += vec4(albedo, 0.0);
         aov[3u * pixel + 2u] += vec4(depth_aov, 0.0, 0.0, 0.0);

@@ -138,24 +138,24 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     GnMaterial m = materials[pr.material];
     s.material = pr.material;
     vec4 base = m.base_color;
-    if (m.tex_base != GN_INVALID)
+    if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_base != GN_INVALID)
         base *= texture_sample(m.tex_base, s.uv, true);
     s.base = base.rgb;
     s.alpha = base.a;
     s.metallic = m.metallic;
     s.roughness = m.roughness;
-    if (m.tex_mr != GN_INVALID) {
+    if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_mr != GN_INVALID) {
         vec4 mr = texture_sample(m.tex_mr, s.uv, false);
         s.roughness *= mr.g;
         s.metallic *= mr.b;
     }
     s.emission = m.emissive;
-    if (m.tex_emissive != GN_INVALID)
+    if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_emissive != GN_INVALID)
         s.emission *= texture_sample(m.tex_emissive, s.uv, true).rgb;
     s.occlusion = 1.0;
-    if (m.tex_occlusion != GN_INVALID)
+    if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_occlusion != GN_INVALID)
         s.occlusion = 1.0 + m.occlusion_strength * (texture_sample(m.tex_occlusion, s.uv, false).r - 1.0);
-    if (m.tex_normal != GN_INVALID) {
+    if (GN_HAS(GN_FEAT_NORMAL_MAP) && m.tex_normal != GN_INVALID) {
         // Tangent frame: the vertex tangents when the mesh has them, else the triangle's
         // uv gradient (glTF asks for MikkTSpace; per-triangle is its flat approximation).
         vec4 tg = w * a.tangent + u * b.tangent + v * c.tangent;

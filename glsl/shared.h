@@ -12,6 +12,11 @@
 #ifdef VULKAN /* defined by glslang when compiling GLSL for Vulkan */
 #define GN_STRUCT(name) struct name
 #define GN_END(name)
+/* GN_HAS(GN_FEAT_x): may this kernel meet feature x? A kernel specialised on features
+ * defines it before including this header (path.comp); elsewhere everything may occur. */
+#ifndef GN_HAS
+#define GN_HAS(f) true
+#endif
 #else
 #include <stdint.h>
 typedef struct { float x, y; } vec2;
@@ -82,6 +87,41 @@ typedef uint32_t uint;
 /* GnEmitter.prim: a triangle (GnPrim index), a punctual light (this bit | GnLight index),
  * or the environment (GN_INVALID). */
 #define GN_EMITTER_LIGHT 0x80000000u
+
+/* Features of the path kernel (its specialization constant 1): what a scene and a render
+ * can need. llvmpipe never jumps over an `if` (both sides run, lanes masked), so code for a
+ * BRDF lobe, a light type or texturing costs every path vertex whether or not any lane
+ * uses it; the host sets only the bits its materials, lights and settings need, and the
+ * driver compiles the rest away. Each bit only removes code that cannot change the result
+ * for a scene without the feature (src/render.c: path_features). */
+#define GN_FEAT_GLTF (1u << 0)          /* glTF materials (bsdf_gltf) */
+#define GN_FEAT_MODELS (1u << 1)        /* BRDF-model overrides (bsdf_from_model) */
+#define GN_FEAT_MIRROR (1u << 2)        /* a Dirac mirror lobe */
+#define GN_FEAT_PHONG (1u << 3)         /* lobes: normalised Phong, */
+#define GN_FEAT_BLINN (1u << 4)         /* Blinn-Phong, */
+#define GN_FEAT_TS (1u << 5)            /* Torrance-Sparrow, */
+#define GN_FEAT_BECKMANN (1u << 6)      /* Beckmann, */
+#define GN_FEAT_GGX (1u << 7)           /* GGX */
+#define GN_FEAT_FRESNEL_DIELECTRIC (1u << 8)
+#define GN_FEAT_FRESNEL_CONDUCTOR (1u << 9)
+#define GN_FEAT_FRESNEL_SCHLICK (1u << 10)
+#define GN_FEAT_COUPLED (1u << 11)      /* a diffuse layer under a Schlick layer */
+#define GN_FEAT_SMOOTH_GLASS (1u << 12)
+#define GN_FEAT_ROUGH_GLASS (1u << 13)
+#define GN_FEAT_TEXTURES (1u << 14)     /* base colour, metal-rough, emissive, occlusion maps */
+#define GN_FEAT_NORMAL_MAP (1u << 15)
+#define GN_FEAT_UNLIT (1u << 16)
+#define GN_FEAT_EMISSIVE (1u << 17)     /* emissive triangles */
+#define GN_FEAT_PUNCTUAL (1u << 18)     /* KHR_lights_punctual lights */
+#define GN_FEAT_ENV (1u << 19)          /* an environment (constant or map) */
+#define GN_FEAT_ENV_MAP (1u << 20)
+#define GN_FEAT_LIGHT_SEARCH (1u << 21) /* more than one light to choose from */
+#define GN_FEAT_STRATEGY (1u << 22)     /* light-only or BSDF-only estimators */
+#define GN_FEAT_AOV (1u << 23)
+#define GN_FEAT_LOBES (GN_FEAT_MIRROR | GN_FEAT_PHONG | GN_FEAT_BLINN | GN_FEAT_TS | \
+                       GN_FEAT_BECKMANN | GN_FEAT_GGX)
+#define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
+#define GN_FEAT_ALL 0x00ffffffu
 
 /* ---- BVH: both children's boxes in one 64-byte node (Aila & Laine 2009, "Understanding
  * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only

@@ -103,6 +103,80 @@ static double scene_radius2(const scene *sc)
     return r2 > 0 ? r2 : 1;
 }
 
+static float clamp01(float x) { return x < 0 ? 0 : x > 1 ? 1 : x; }
+
+/* The GN_FEAT_* that material m can need in the path kernel: the parts of the Bsdf that
+ * bsdf_gltf or bsdf_from_model (glsl/brdf.glsl) can build from it with a nonzero weight,
+ * its textures, emission and unlit flag. Where a texture can change a value (roughness,
+ * metalness) every value it can reach counts. */
+static uint32_t material_features(const GnMaterial *m)
+{
+    const float alpha_min = 1e-3f; /* BRDF_ALPHA_MIN */
+    uint32_t f = 0;
+    bool textured = m->tex_base != GN_INVALID || m->tex_mr != GN_INVALID ||
+                    m->tex_emissive != GN_INVALID || m->tex_occlusion != GN_INVALID;
+    if (textured)
+        f |= GN_FEAT_TEXTURES;
+    if (m->tex_normal != GN_INVALID)
+        f |= GN_FEAT_NORMAL_MAP | GN_FEAT_TEXTURES;
+    if (m->flags & GN_MAT_UNLIT)
+        f |= GN_FEAT_UNLIT;
+    if (luminance(&m->emissive.x) > 0)
+        f |= GN_FEAT_EMISSIVE;
+    switch (m->brdf) {
+    case BRDF_GLTF: {
+        /* bsdf_gltf: a GGX lobe (a mirror below alpha_min) with Schlick's F of weight
+         * wd f0 + m base and F90 wd specular + m; the diffuse coupled to that layer when
+         * specular > 0; glass of weight (1 - m) t. The texture scales roughness and
+         * metalness by [0, 1]. */
+        float metal_hi = clamp01(m->metallic), metal_lo = m->tex_mr != GN_INVALID ? 0 : metal_hi;
+        float rough_hi = clamp01(m->roughness), rough_lo = m->tex_mr != GN_INVALID ? 0 : rough_hi;
+        float t = clamp01(m->transmission);
+        bool smooth = rough_lo * rough_lo < alpha_min, rough = rough_hi * rough_hi >= alpha_min;
+        f |= GN_FEAT_GLTF;
+        if (m->specular != 0 || metal_hi > 0) {
+            f |= GN_FEAT_FRESNEL_SCHLICK | (smooth ? GN_FEAT_MIRROR : 0u) | (rough ? GN_FEAT_GGX : 0u);
+            if (m->specular != 0)
+                f |= GN_FEAT_COUPLED;
+        }
+        if (t > 0 && metal_lo < 1)
+            f |= (smooth ? GN_FEAT_SMOOTH_GLASS : 0u) | (rough ? GN_FEAT_ROUGH_GLASS : 0u);
+        break;
+    }
+    case BRDF_LAMBERT:
+        break;
+    case BRDF_MIRROR:
+        f |= GN_FEAT_MIRROR;
+        break;
+    case BRDF_PHONG:
+        f |= GN_FEAT_PHONG;
+        break;
+    case BRDF_BLINN_PHONG:
+        f |= GN_FEAT_BLINN;
+        break;
+    case BRDF_TORRANCE_SPARROW:
+        f |= GN_FEAT_TS | GN_FEAT_FRESNEL_DIELECTRIC;
+        break;
+    case BRDF_BECKMANN:
+        f |= GN_FEAT_BECKMANN | GN_FEAT_MIRROR | GN_FEAT_FRESNEL_DIELECTRIC;
+        break;
+    case BRDF_GGX:
+        f |= GN_FEAT_GGX | GN_FEAT_MIRROR | GN_FEAT_FRESNEL_DIELECTRIC;
+        break;
+    case BRDF_CONDUCTOR:
+        f |= GN_FEAT_GGX | GN_FEAT_MIRROR | GN_FEAT_FRESNEL_CONDUCTOR;
+        break;
+    case BRDF_DIELECTRIC:
+        f |= GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS;
+        break;
+    default:
+        f |= GN_FEAT_ALL; /* unknown to this table: keep every feature */
+    }
+    if (m->brdf != BRDF_GLTF)
+        f |= GN_FEAT_MODELS;
+    return f;
+}
+
 /* The path tracer's light table: each emissive triangle (BVH order) and punctual light with
  * a selection weight proportional to its power, flux / pi: L A per emitting side for a
  * triangle (so picking one and then a uniform point has area density lum(L) sides / total),
@@ -156,6 +230,9 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     bvh_build(&r->tree, &sc->vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc->indices,
               sc->num_triangles);
     assert(r->tree.num_tris < (1u << 27)); /* glsl/bvh.glsl packs leaves' first triangles in 27 bits */
+    for (uint32_t i = 0; i < sc->num_materials; i++)
+        r->material_features |= material_features(&sc->materials[i]);
+    r->path_features = r->material_features;
 
     prims = util_malloc(sizeof *prims * r->tree.num_tris);
     for (uint32_t i = 0; i < r->tree.num_tris; i++) {
@@ -452,6 +529,17 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->emitter_power = (float)total;
     frame->env_select = env > 0 ? (float)(env / total) : 0;
     frame->flags |= s->strategy;
+    r->path_features = r->material_features | (s->aov ? GN_FEAT_AOV : 0u) |
+                       (s->strategy ? GN_FEAT_STRATEGY : 0u) | (n > 1 ? GN_FEAT_LIGHT_SEARCH : 0u) |
+                       (env > 0 || s->env[0] != 0 || s->env[1] != 0 || s->env[2] != 0 ? GN_FEAT_ENV : 0u) |
+                       (s->env_map ? GN_FEAT_ENV | GN_FEAT_ENV_MAP : 0u);
+    for (uint32_t i = 0; i < n; i++)
+        if (r->emitter_table[i].prim != GN_INVALID && (r->emitter_table[i].prim & GN_EMITTER_LIGHT))
+            r->path_features |= GN_FEAT_PUNCTUAL;
+    /* The unspecialised kernel, for checking that specialisation changes nothing
+     * (tests/regress/path.sh) and for ruling it out when chasing a bug. */
+    if (getenv("GONIO_ALL_FEATURES"))
+        r->path_features = GN_FEAT_ALL;
     /* One path per invocation: the whole path shares llvmpipe's loop cap. */
     frame->traversal_budget = traversal_budget(r->g, 1);
     return true;
@@ -506,17 +594,22 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
 
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec)
 {
-    (void)r;
     spec->values[0] = mode;
+    spec->values[1] = mode == GN_MODE_PATH ? r->path_features : GN_FEAT_ALL;
     spec->entries[0] = (VkSpecializationMapEntry){0, 0, sizeof(uint32_t)};
-    spec->info = (VkSpecializationInfo){1, spec->entries, sizeof spec->values, spec->values};
+    spec->entries[1] = (VkSpecializationMapEntry){1, sizeof(uint32_t), sizeof(uint32_t)};
+    spec->info = (VkSpecializationInfo){2, spec->entries, sizeof spec->values, spec->values};
     return &spec->info;
 }
 
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
 {
     gpu_pipeline *p = &r->pipelines[mode];
+    uint32_t features = mode == GN_MODE_PATH ? r->path_features : GN_FEAT_ALL;
+    if (p->pipeline && r->pipeline_features[mode] != features)
+        gpu_pipeline_destroy(r->g, p); /* built for other features: a new kernel */
     if (!p->pipeline) {
+        r->pipeline_features[mode] = features;
         gpu_binding b[GN_BIND_COUNT];
         renderer_spec spec;
         gpu_pipeline_desc pd = {

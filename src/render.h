@@ -60,6 +60,9 @@ typedef struct renderer {
     double env_weight;        /* its selection weight */
     int width, height;
     double setup_seconds;
+    uint32_t material_features; /* GN_FEAT_* the materials need (renderer_create) */
+    uint32_t path_features;     /* ... and the current path render (renderer_begin) */
+    uint32_t pipeline_features[GN_MODE_COUNT]; /* what each cached kernel was built for */
 } renderer;
 
 /* Builds the BVH and uploads the scene. */
@@ -77,10 +80,10 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame);
 uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
 
 /* Specialization constants of the render kernels: constant 0 = mode (or a kernel's own
- * variant). */
+ * variant); constant 1 = the GN_FEAT_* set (the path kernel reads it; others ignore it). */
 typedef struct renderer_spec {
-    uint32_t values[1];
-    VkSpecializationMapEntry entries[1];
+    uint32_t values[2];
+    VkSpecializationMapEntry entries[2];
     VkSpecializationInfo info;
 } renderer_spec;
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec);

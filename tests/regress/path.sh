@@ -17,6 +17,38 @@ check_fails "an unknown BRDF model is a usage error" 1 "$G" render $C -o "$tmp/x
 check "the message names the models" grep -q 'torrance-sparrow' "$tmp/last"
 check_fails "a missing environment map fails" 1 "$G" render $C -o "$tmp/x.exr" --env "$tmp/none.exr" --quiet
 
+# The path kernel is specialised on what the scene needs (GN_FEAT_* in glsl/shared.h):
+# removing code must not change a single pixel. Each case renders specialised and with
+# every feature (GONIO_ALL_FEATURES) and demands the same image, for every BRDF model, each
+# estimator, the AOVs, both kinds of environment, and sample models with textures, normal
+# maps, glass and punctual lights.
+same_as_unspecialised() { # NAME SCENE FLAGS...
+    local what=$1 scene=$2; shift 2
+    if "$G" render "$scene" -o "$tmp/spec.exr" --spp 3 --size 24x24 --quiet "$@" 2>"$tmp/spec.err" &&
+        GONIO_ALL_FEATURES=1 "$G" render "$scene" -o "$tmp/all.exr" --spp 3 --size 24x24 --quiet "$@" \
+            2>>"$tmp/spec.err"; then
+        check_fails "specialised = unspecialised: $what" 0 "$G" diff "$tmp/spec.exr" "$tmp/all.exr" \
+            --max-error 0
+    else
+        fail "specialised = unspecialised: $what (render failed)"; sed 's/^/    /' "$tmp/spec.err"
+    fi
+}
+same_as_unspecialised "Cornell box" $C
+for model in lambert mirror phong blinn-phong torrance-sparrow beckmann ggx conductor \
+    conductor:alpha=0 dielectric dielectric:alpha=0.3 \
+    gltf:metallic=0.5:roughness=0.02 gltf:transmission=1:roughness=0.4; do
+    same_as_unspecialised "--brdf $model" $C --brdf "$model" --env 0.2
+done
+same_as_unspecialised "light sampling only" $C --estimator light
+same_as_unspecialised "BSDF sampling only" $C --estimator bsdf
+same_as_unspecialised "AOVs" $C --aov albedo,normal,depth,variance
+same_as_unspecialised "an environment map" scenes/teapot.gltf --env "$tmp/d.exr"
+A=${GONIO_ASSETS:-}/gltf
+for m in DamagedHelmet TransmissionRoughnessTest LightsPunctualLamp NormalTangentTest; do
+    f=$A/$m/glTF/$m.gltf
+    [ -f "$f" ] && same_as_unspecialised "$m" "$f" --env 0.5
+done
+
 # Ctrl-C: the render stops after the current pass and writes what it has.
 "$G" render $C -o "$tmp/int.exr" --time 60 --size 32x32 --quiet &
 pid=$!
