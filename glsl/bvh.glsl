@@ -19,16 +19,16 @@
 GnBvhNode bvh_node(uint i)
 {
     int k = int(4u * i);
-    vec4 t0 = texelFetch(node_texels, k), t1 = texelFetch(node_texels, k + 1);
-    vec4 t2 = texelFetch(node_texels, k + 2), t3 = texelFetch(node_texels, k + 3);
-    return GnBvhNode(t0.xyz, floatBitsToUint(t0.w), t1.xyz, floatBitsToUint(t1.w),
-                     t2.xyz, floatBitsToUint(t2.w), t3.xyz, floatBitsToUint(t3.w));
+    uvec4 t0 = texelFetch(node_texels, k), t1 = texelFetch(node_texels, k + 1);
+    uvec4 t2 = texelFetch(node_texels, k + 2), t3 = texelFetch(node_texels, k + 3);
+    return GnBvhNode(uintBitsToFloat(t0.xyz), t0.w, uintBitsToFloat(t1.xyz), t1.w,
+                     uintBitsToFloat(t2.xyz), t2.w, uintBitsToFloat(t3.xyz), t3.w);
 }
 
 GnTri bvh_tri(uint i)
 {
-    int k = int(3u * i);
-    return GnTri(texelFetch(tri_texels, k), texelFetch(tri_texels, k + 1), texelFetch(tri_texels, k + 2));
+    uint k = 3u * i;
+    return GnTri(texel_f(tri_texels, k), texel_f(tri_texels, k + 1u), texel_f(tri_texels, k + 2u));
 }
 
 struct Hit {

@@ -23,8 +23,8 @@ layout(push_constant) uniform PushBlock { GnPush push; };
 // shading would light, where the interpolated normal faces the viewer (see surface_at).
 vec3 gouraud_color(Hit h, vec3 d)
 {
-    GnPrim pr = prims[h.tri];
-    GnVertex a = vertices[pr.i0], b = vertices[pr.i1], c = vertices[pr.i2];
+    GnPrim pr = prim_at(h.tri);
+    GnVertex a = vertex_at(pr.i0), b = vertex_at(pr.i1), c = vertex_at(pr.i2);
     float w = 1.0 - h.u - h.v;
     vec3 ng = cross(b.position - a.position, c.position - a.position);
     vec3 n = w * a.normal + h.u * b.normal + h.v * c.normal;
@@ -37,9 +37,9 @@ vec3 gouraud_color(Hit h, vec3 d)
 // whole triangle has one colour.
 vec3 flat_color(Hit h, vec3 d)
 {
-    GnPrim pr = prims[h.tri];
-    vec3 center = (vertices[pr.i0].position + vertices[pr.i1].position +
-                  vertices[pr.i2].position) / 3.0;
+    GnPrim pr = prim_at(h.tri);
+    vec3 center = (vertex_at(pr.i0).position + vertex_at(pr.i1).position +
+                  vertex_at(pr.i2).position) / 3.0;
     Surface s = surface_at(h.tri, 0.0, 1.0 / 3.0, 1.0 / 3.0, center, d);
     return phong_shade(center, s.ng, s.ng, s.uv, s.material,
                        normalize(frame.camera.position - center));

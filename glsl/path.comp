@@ -145,13 +145,13 @@ float area_sides(GnMaterial m) { return (m.flags & GN_MAT_DOUBLE_SIDED) != 0u ? 
 // single-sided material (glTF: back faces are culled).
 vec3 tri_emission(uint prim, float u, float v, vec3 d, vec3 ng)
 {
-    GnPrim pr = prims[prim];
-    GnMaterial m = materials[pr.material];
+    GnPrim pr = prim_at(prim);
+    GnMaterial m = material_at(pr.material);
     if (dot(ng, d) >= 0.0 && (m.flags & GN_MAT_DOUBLE_SIDED) == 0u)
         return vec3(0.0);
     vec3 e = m.emissive;
     if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_emissive != GN_INVALID) {
-        GnVertex a = vertices[pr.i0], b = vertices[pr.i1], c = vertices[pr.i2];
+        GnVertex a = vertex_at(pr.i0), b = vertex_at(pr.i1), c = vertex_at(pr.i2);
         vec2 uv = (1.0 - u - v) * vec2(a.u, a.v) + u * vec2(b.u, b.v) + v * vec2(c.u, c.v);
         e *= texture_sample(m.tex_emissive, uv, true).rgb;
     }
@@ -283,7 +283,7 @@ void main()
             break;
         }
         Surface s = surface_at(h.tri, h.t, h.u, h.v, o, d);
-        GnMaterial m = materials[s.material];
+        GnMaterial m = material_at(s.material);
         covered = covered || depth == 0u;
         if (GN_HAS(GN_FEAT_AOV) && depth == 0u) {
             normal = s.n;

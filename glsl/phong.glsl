@@ -51,7 +51,7 @@ bool shadowed(vec3 p, vec3 ng, vec3 wi, float dist)
 // texture coordinates uv, seen from direction v (unit, towards the viewer).
 vec3 phong_shade(vec3 p, vec3 n, vec3 ng, vec2 uv, uint material, vec3 v)
 {
-    GnMaterial m = materials[material];
+    GnMaterial m = material_at(material);
     // The glTF textures modulate the classic colours, so textured models look right.
     vec3 tex = m.tex_base != GN_INVALID ? texture_sample(m.tex_base, uv, true).rgb : vec3(1.0);
     vec3 kd = m.phong_diffuse * tex;

@@ -11,20 +11,54 @@
 // values that steer loops and re-specializes the shader whenever they change, which cost
 // ~18 ms per dispatch of the path kernel (7x the whole render of a 32x32 image).
 layout(std430, binding = GN_BIND_FRAME) readonly buffer FrameBlock { GnFrame frame; };
-// The BVH nodes (GnBvhNode = 4 texels) and triangle corners (GnTri = 3 texels) are read as
-// RGBA32F texel buffers, not storage buffers: llvmpipe fetches a storage buffer with
+// The BVH nodes (GnBvhNode = 4 texels), triangle corners (GnTri = 3), shading triangles
+// (GnPrim = 1), vertices (GnVertex = 3) and materials (GnMaterial = 12) are read from
+// RGBA32UI texel buffers, not storage buffers: llvmpipe fetches a storage buffer with
 // per-lane offsets one lane and one component at a time, a texel buffer with vector
 // gathers, which makes the walk several times faster there; GPUs read both at full speed.
-layout(binding = GN_BIND_NODES) uniform samplerBuffer node_texels;
-layout(binding = GN_BIND_TRIS) uniform samplerBuffer tri_texels;
-layout(std430, binding = GN_BIND_PRIMS) readonly buffer PrimBlock { GnPrim prims[]; };
-layout(std430, binding = GN_BIND_VERTICES) readonly buffer VertexBlock { GnVertex vertices[]; };
-layout(std430, binding = GN_BIND_MATERIALS) readonly buffer MaterialBlock { GnMaterial materials[]; };
+// An integer format passes every bit through (a float format may flush the denormals that
+// small integers stored as floats are); floats come back with uintBitsToFloat.
+layout(binding = GN_BIND_NODES) uniform usamplerBuffer node_texels;
+layout(binding = GN_BIND_TRIS) uniform usamplerBuffer tri_texels;
+layout(binding = GN_BIND_PRIMS) uniform usamplerBuffer prim_texels;
+layout(binding = GN_BIND_VERTICES) uniform usamplerBuffer vertex_texels;
+layout(binding = GN_BIND_MATERIALS) uniform usamplerBuffer material_texels;
 layout(std430, binding = GN_BIND_LIGHTS) readonly buffer LightBlock { GnLight lights[]; };
 layout(std430, binding = GN_BIND_TEXELS) readonly buffer TexelBlock { uint texels[]; };
 layout(std430, binding = GN_BIND_TEXTURES) readonly buffer TextureBlock { GnTexture textures[]; };
 
 const float PI = 3.14159265358979323846;
+
+vec4 texel_f(usamplerBuffer b, uint i) { return uintBitsToFloat(texelFetch(b, int(i))); }
+
+GnPrim prim_at(uint i)
+{
+    uvec4 t = texelFetch(prim_texels, int(i));
+    return GnPrim(t.x, t.y, t.z, t.w);
+}
+
+GnVertex vertex_at(uint i)
+{
+    vec4 a = texel_f(vertex_texels, 3u * i), b = texel_f(vertex_texels, 3u * i + 1u);
+    return GnVertex(a.xyz, a.w, b.xyz, b.w, texel_f(vertex_texels, 3u * i + 2u));
+}
+
+// Fields a kernel does not read are never fetched: the compiler drops unused texel loads.
+GnMaterial material_at(uint i)
+{
+    uint k = 12u * i;
+    vec4 t0 = texel_f(material_texels, k), t1 = texel_f(material_texels, k + 1u);
+    vec4 t2 = texel_f(material_texels, k + 2u), t3 = texel_f(material_texels, k + 3u);
+    uvec4 t4 = texelFetch(material_texels, int(k + 4u)), t5 = texelFetch(material_texels, int(k + 5u));
+    uvec4 t6 = texelFetch(material_texels, int(k + 6u));
+    vec4 t7 = texel_f(material_texels, k + 7u), t8 = texel_f(material_texels, k + 8u);
+    vec4 t9 = texel_f(material_texels, k + 9u), t10 = texel_f(material_texels, k + 10u);
+    vec4 t11 = texel_f(material_texels, k + 11u);
+    return GnMaterial(t0, t1.xyz, t1.w, t2.xyz, t2.w, t3.x, t3.y, t3.z, t3.w,
+                      uintBitsToFloat(t4.x), uintBitsToFloat(t4.y), t4.z, t4.w,
+                      t5.x, t5.y, t5.z, t5.w, t6.x, t6.y, t6.z, t6.w,
+                      t7, t8.xyz, t8.w, t9.xyz, t9.w, t10.xyz, t10.w, t11.xyz, t11.w);
+}
 
 // ---- random numbers that depend only on (pixel, sample, dimension, seed) ---------------
 // Random numbers are rng_pcg4d hashes (sampling.glsl; Jarzynski & Olano, "Hash Functions
@@ -119,8 +153,8 @@ struct Surface {
 Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
 {
     Surface s;
-    GnPrim pr = prims[tri];
-    GnVertex a = vertices[pr.i0], b = vertices[pr.i1], c = vertices[pr.i2];
+    GnPrim pr = prim_at(tri);
+    GnVertex a = vertex_at(pr.i0), b = vertex_at(pr.i1), c = vertex_at(pr.i2);
     float w = 1.0 - u - v;
     s.p = o + t * d;
     vec3 e1 = b.position - a.position, e2 = c.position - a.position;
@@ -135,7 +169,7 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     s.ng = ng;
     s.uv = w * vec2(a.u, a.v) + u * vec2(b.u, b.v) + v * vec2(c.u, c.v);
 
-    GnMaterial m = materials[pr.material];
+    GnMaterial m = material_at(pr.material);
     s.material = pr.material;
     vec4 base = m.base_color;
     if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_base != GN_INVALID)

@@ -30,6 +30,8 @@ typedef uint32_t uint;
 
 /* ---- descriptor bindings (set 0) of the render kernels -------------------------------- */
 #define GN_BIND_FRAME 0u     /* GnFrame (a read-only storage buffer: see glsl/scene.glsl) */
+/* Bindings 1-5 are RGBA32UI uniform texel buffers (16 bytes a texel), read through
+ * bvh_node, bvh_tri, prim_at, vertex_at and material_at (glsl/bvh.glsl, glsl/scene.glsl). */
 #define GN_BIND_NODES 1u     /* GnBvhNode[] */
 #define GN_BIND_TRIS 2u      /* GnTri[] (BVH order) */
 #define GN_BIND_PRIMS 3u     /* GnPrim[] (BVH order) */

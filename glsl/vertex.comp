@@ -22,7 +22,7 @@ void main()
     uint i = gl_GlobalInvocationID.x, side = push.pass_flags;
     if (i >= uint(vcolor.length()) / 2u)
         return;
-    GnVertex a = vertices[i];
+    GnVertex a = vertex_at(i);
     uint material = floatBitsToUint(vcolor[2u * i].w);
     vec3 n = dot(a.normal, a.normal) > 1e-20 ? normalize(a.normal) : vec3(0.0);
     if (side == 1u)

@@ -367,7 +367,7 @@ void gpu_buffer_create_texels(gpu *g, gpu_buffer *b, const void *data, VkDeviceS
     else
         gpu_buffer_fill_zero(g, b);
     vci.buffer = b->buffer;
-    vci.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    vci.format = VK_FORMAT_R32G32B32A32_UINT; /* bits pass through unchanged */
     vci.range = b->size;
     GPU_CHECK(vkCreateBufferView(g->device, &vci, NULL, &b->view));
 }

@@ -266,9 +266,9 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
                       GPU_MEMORY_HOST);
     gpu_buffer_create_texels(g, &r->nodes, r->tree.nodes, sizeof(GnBvhNode) * r->tree.num_nodes);
     gpu_buffer_create_texels(g, &r->tris, r->tree.tris, sizeof(GnTri) * r->tree.num_tris);
-    gpu_buffer_create_storage(g, &r->prims, prims, sizeof(GnPrim) * r->tree.num_tris);
-    gpu_buffer_create_storage(g, &r->vertices, sc->vertices, sizeof(GnVertex) * sc->num_vertices);
-    gpu_buffer_create_storage(g, &r->materials, sc->materials, sizeof(GnMaterial) * sc->num_materials);
+    gpu_buffer_create_texels(g, &r->prims, prims, sizeof(GnPrim) * r->tree.num_tris);
+    gpu_buffer_create_texels(g, &r->vertices, sc->vertices, sizeof(GnVertex) * sc->num_vertices);
+    gpu_buffer_create_texels(g, &r->materials, sc->materials, sizeof(GnMaterial) * sc->num_materials);
     gpu_buffer_create_storage(g, &r->lights, lights, sizeof(GnLight) * r->num_lights);
     gpu_buffer_create_storage(g, &r->texels, texels, sizeof(uint32_t) * total_texels);
     gpu_buffer_create_storage(g, &r->textures, tex, sizeof(GnTexture) * sc->num_textures);
@@ -375,9 +375,9 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
         {GN_BIND_FRAME, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->frame},
         {GN_BIND_NODES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->nodes},
         {GN_BIND_TRIS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->tris},
-        {GN_BIND_PRIMS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->prims},
-        {GN_BIND_VERTICES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->vertices},
-        {GN_BIND_MATERIALS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->materials},
+        {GN_BIND_PRIMS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->prims},
+        {GN_BIND_VERTICES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->vertices},
+        {GN_BIND_MATERIALS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->materials},
         {GN_BIND_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->lights},
         {GN_BIND_TEXELS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->texels},
         {GN_BIND_TEXTURES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->textures},
