@@ -46,6 +46,7 @@ struct Hit {
 struct RayPre {
     vec3 o;
     vec3 inv;       // 1 / d, with zero components replaced by a huge finite value
+    bvec3 neg;      // inv < 0: a box's near plane on that axis is its max
     vec3 sx, sy, sz;
 };
 
@@ -66,6 +67,7 @@ RayPre ray_pre(vec3 o, vec3 d)
     r.sz = Sz * ez;
     r.inv = vec3(1.0) / mix(d, sign(d) * 1e-30 + vec3(equal(d, vec3(0.0))) * 1e-30,
                             lessThan(ad, vec3(1e-30)));
+    r.neg = lessThan(r.inv, vec3(0.0));
     return r;
 }
 
@@ -114,14 +116,20 @@ bool tri_intersect(RayPre r, vec3 p0, vec3 p1, vec3 p2, float tmin, float tmax,
     return true;
 }
 
+// max and min of numbers that are never NaN here: GLSL's max and min must return the
+// non-NaN operand, which costs llvmpipe a compare and a blend more than a plain select.
+precise float max_nn(float a, float b) { return a > b ? a : b; }
+precise float min_nn(float a, float b) { return a < b ? a : b; }
+
 // Slab test of one child box: entry distance, or +inf on a miss. The far distance is
 // scaled by 1 + 2 gamma(3) (Ize 2013) so rounding never loses a box the triangle test hits.
 float box_enter(RayPre r, vec3 bmin, vec3 bmax, float tmin, float tmax)
 {
-    vec3 t0 = (bmin - r.o) * r.inv, t1 = (bmax - r.o) * r.inv;
-    vec3 lo = min(t0, t1), hi = max(t0, t1);
-    float enter = max(max(lo.x, lo.y), max(lo.z, tmin));
-    float leave = min(min(hi.x, hi.y), min(hi.z, tmax)) * 1.0000004;
+    // The near and far planes by the sign of the direction: the same values as min and
+    // max of the two slab distances (boxes have min <= max), for fewer SIMD instructions.
+    vec3 lo = (mix(bmin, bmax, r.neg) - r.o) * r.inv, hi = (mix(bmax, bmin, r.neg) - r.o) * r.inv;
+    float enter = max_nn(max_nn(lo.x, lo.y), max_nn(lo.z, tmin));
+    float leave = min_nn(min_nn(hi.x, hi.y), min_nn(hi.z, tmax)) * 1.0000004;
     return enter <= leave ? enter : 1e38;
 }
 

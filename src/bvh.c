@@ -729,7 +729,9 @@ bool bvh_tri_intersect(const float org[3], const float dir[3], const float v0[3]
 
 /* Slab test (Ize 2013): *enter = entry distance; hit when the entry is not past the exit,
  * the exit scaled by 1 + 2 gamma(3) to cover rounding. Zero direction components give
- * +-BVH_PARALLEL_INV and rely on the box padding (see there): no inf, no NaN. */
+ * +-BVH_PARALLEL_INV and rely on the box padding (see there): no inf, no NaN. The GPU picks
+ * the near and far planes by the direction's sign instead of min/max: the same values for
+ * boxes with lo <= hi. */
 static inline bool box_enter(const ray *r, const vec3 *lo, const vec3 *hi, float tmin,
                              float tmax, float *enter)
 {
