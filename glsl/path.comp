@@ -31,7 +31,6 @@ layout(std430, binding = GN_BIND_ENV) readonly buffer EnvBlock { uint envdata[];
 layout(push_constant) uniform PushBlock { GnPush push; };
 
 #define ROULETTE_DEPTH 3u
-#define MAX_BOUNCES 4096u // never reached: roulette and the step budget end paths first
 // A ray's own loop iterations besides its walk (light selection, map searches), in node
 // visits (a visit costs up to 19 iterations): charged so the whole path stays under
 // llvmpipe's loop cap with frame.traversal_budget node visits per invocation.
@@ -40,9 +39,10 @@ layout(push_constant) uniform PushBlock { GnPush push; };
 uint budget;    // node visits left to this invocation
 bool truncated; // a walk ran out of budget: the path was cut short
 
+uint sample_now; // the sample index of the path being traced
 vec4 rng(uint pixel, uint dim)
 {
-    return rng_uniform4(pixel, push.sample_index, dim, frame.seed);
+    return rng_uniform4(pixel, sample_now, dim, frame.seed);
 }
 
 float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
@@ -248,120 +248,184 @@ vec3 offset_origin(vec3 p, vec3 ng, vec3 w)
     return p + ng * (dot(ng, w) >= 0.0 ? eps : -eps);
 }
 
+// ---- the paths of an invocation --------------------------------------------------------------
+// An invocation takes push.pad0 samples of its pixel (sample indices push.sample_index on),
+// starting the next path as soon as one ends ("regeneration"). The 8 lanes of a SIMD group
+// run in step until the longest of their paths ends, and roulette makes path lengths vary
+// a lot; a lane that starts its next path at once, instead of idling, keeps the group busy.
+// Every sample is still the same function of (pixel, sample index, dimension).
+//
+// After each vertex path_step adds up a finished sample and starts the next path; the loop
+// ends once this invocation has taken all its samples.
+uvec2 px;
+uint pixel;
+uint samples, taken;
+vec4 sum;
+vec3 sum_sq, sum_n, sum_a;
+float sum_depth;
+// The current path.
+uint depth;
+vec3 o, d, radiance, beta, normal, albedo;
+float tmin, prev_pdf, depth_aov;
+bool prev_delta, covered, ended;
+
+void path_start()
+{
+    sample_now = push.sample_index + taken;
+    depth = 0u;
+    o = frame.camera.position;
+    d = camera_dir(vec2(px) + rng(pixel, 0u).xy);
+    tmin = frame.camera.znear / dot(d, frame.camera.forward);
+    radiance = vec3(0.0);
+    beta = vec3(1.0);
+    prev_pdf = 0.0;
+    prev_delta = true; // the camera ray: what it sees has one strategy only
+    covered = false;
+    normal = vec3(0.0);
+    albedo = vec3(0.0);
+    depth_aov = 0.0;
+    ended = false;
+}
+
+// After a path vertex: the next vertex, or (the path ended) the sample added up and the
+// next path started.
+uint path_step()
+{
+    if (!ended) {
+        depth++;
+        return taken;
+    }
+    // A NaN or infinity from a degenerate configuration would poison the pixel for good.
+    if (any(isnan(radiance)) || any(isinf(radiance)))
+        radiance = vec3(0.0);
+    sum += vec4(radiance, covered ? 1.0 : 0.0);
+    sum_sq += radiance * radiance;
+    sum_n += normal;
+    sum_a += albedo;
+    sum_depth += depth_aov;
+    taken++;
+    if (taken < samples)
+        path_start();
+    return taken;
+}
+
 void main()
 {
-    uvec2 px = gl_GlobalInvocationID.xy;
+    px = gl_GlobalInvocationID.xy;
     if (px.x >= frame.width || px.y >= frame.height)
         return;
-    uint pixel = px.y * frame.width + px.x;
+    pixel = px.y * frame.width + px.x;
     bool light_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_LIGHT_ONLY) != 0u;
     bool bsdf_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_BSDF_ONLY) != 0u;
     budget = frame.traversal_budget;
     truncated = false;
+    samples = max(push.pad0, 1u);
+    taken = 0u;
+    sum = vec4(0.0);
+    sum_sq = sum_n = sum_a = vec3(0.0);
+    sum_depth = 0.0;
 
-    vec3 o = frame.camera.position;
-    vec3 d = camera_dir(vec2(px) + rng(pixel, 0u).xy);
-    float tmin = frame.camera.znear / dot(d, frame.camera.forward);
-    vec3 radiance = vec3(0.0), beta = vec3(1.0);
-    float prev_pdf = 0.0;
-    bool prev_delta = true; // the camera ray: what it sees has one strategy only
-    bool covered = false;
-    vec3 normal = vec3(0.0), albedo = vec3(0.0);
-    float depth_aov = 0.0;
-
-    for (uint depth = 0u; depth < MAX_BOUNCES; depth++) {
-        Hit h = trace(o, d, tmin, 1e30, false);
-        tmin = 0.0;
-        if (h.truncated)
-            break;
-        if (h.tri == GN_INVALID) {
-            vec3 le = env_radiance(d);
-            float w = 1.0;
-            if (GN_HAS(GN_FEAT_ENV) && !prev_delta && frame.env_select > 0.0)
-                w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, env_pdf(d));
-            radiance += beta * le * w;
-            break;
-        }
-        Surface s = surface_at(h.tri, h.t, h.u, h.v, o, d);
-        GnMaterial m = material_at(s.material);
-        covered = covered || depth == 0u;
-        if (GN_HAS(GN_FEAT_AOV) && depth == 0u) {
-            normal = s.n;
-            albedo = s.base;
-            depth_aov = h.t * dot(d, frame.camera.forward);
-        }
-        if (GN_HAS(GN_FEAT_UNLIT) && (m.flags & GN_MAT_UNLIT) != 0u) { // KHR_materials_unlit: the colour is the radiance
-            radiance += beta * s.base;
-            break;
-        }
-        if (GN_HAS(GN_FEAT_EMISSIVE) && (s.front || (m.flags & GN_MAT_DOUBLE_SIDED) != 0u) &&
-            luminance(m.emissive) > 0.0) {
-            float w = 1.0;
-            if (!prev_delta) {
-                float pl = luminance(m.emissive) * area_sides(m) / frame.emitter_power * h.t * h.t /
-                           abs(dot(s.ng, d));
-                w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, pl);
+    path_start();
+    while (true) {
+        // One path vertex, in a loop of one iteration: a path's end is a `break` out of it.
+        // (llvmpipe masks lanes for a break cheaply; a continue or an early return masks
+        // every later statement again and cost a third of the speed.)
+        ended = true;
+        do {
+            Hit h = trace(o, d, tmin, 1e30, false);
+            tmin = 0.0;
+            if (h.truncated)
+                break;
+            if (h.tri == GN_INVALID) {
+                vec3 le = env_radiance(d);
+                float w = 1.0;
+                if (GN_HAS(GN_FEAT_ENV) && !prev_delta && frame.env_select > 0.0)
+                    w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, env_pdf(d));
+                radiance += beta * le * w;
+                break;
             }
-            radiance += beta * s.emission * w;
-        }
-        if (frame.max_depth != 0u && depth >= frame.max_depth)
-            break;
+            Surface s = surface_at(h.tri, h.t, h.u, h.v, o, d);
+            GnMaterial m = material_at(s.material);
+            covered = covered || depth == 0u;
+            if (GN_HAS(GN_FEAT_AOV) && depth == 0u) {
+                normal = s.n;
+                albedo = s.base;
+                depth_aov = h.t * dot(d, frame.camera.forward);
+            }
+            if (GN_HAS(GN_FEAT_UNLIT) && (m.flags & GN_MAT_UNLIT) != 0u) { // KHR_materials_unlit: the colour is the radiance
+                radiance += beta * s.base;
+                break;
+            }
+            if (GN_HAS(GN_FEAT_EMISSIVE) && (s.front || (m.flags & GN_MAT_DOUBLE_SIDED) != 0u) &&
+                luminance(m.emissive) > 0.0) {
+                float w = 1.0;
+                if (!prev_delta) {
+                    float pl = luminance(m.emissive) * area_sides(m) / frame.emitter_power * h.t * h.t /
+                               abs(dot(s.ng, d));
+                    w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, pl);
+                }
+                radiance += beta * s.emission * w;
+            }
+            if (frame.max_depth != 0u && depth >= frame.max_depth)
+                break;
 
-        Bsdf b = material_bsdf(s, m);
-        // A transmitting surface needs the side: brdf.glsl's normal points outside.
-        bool flip = b.dielectric > 0.0 && !s.front;
-        vec3 n = flip ? -s.n : s.n, ng = flip ? -s.ng : s.ng, tx, ty;
-        sampling_basis(n, tx, ty);
-        vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
-        vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
+            Bsdf b = material_bsdf(s, m);
+            // A transmitting surface needs the side: brdf.glsl's normal points outside.
+            bool flip = b.dielectric > 0.0 && !s.front;
+            vec3 n = flip ? -s.n : s.n, ng = flip ? -s.ng : s.ng, tx, ty;
+            sampling_basis(n, tx, ty);
+            vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
+            vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
 
-        if (frame.num_emitters > 0u && bsdf_has_smooth(b)) {
-            LightSample ls = light_sample(s.p, ul.xyz);
-            vec3 wi = vec3(dot(ls.wi, tx), dot(ls.wi, ty), dot(ls.wi, n));
-            // The shading and geometric normals must agree on the side of wi (no light leaks).
-            if (ls.pdf > 0.0 && !(bsdf_only && !ls.delta) && dot(ng, ls.wi) * wi.z > 0.0 &&
-                luminance(ls.L) > 0.0) {
-                vec3 f;
-                float pb;
-                bsdf_eval_pdf(b, wo, wi, f, pb);
-                float w = ls.delta || light_only ? 1.0 : power_heuristic(ls.pdf, pb);
-                vec3 c = beta * f * abs(wi.z) * ls.L * (w / ls.pdf);
-                if (luminance(c) > 0.0) {
-                    Hit sh = trace(offset_origin(s.p, ng, ls.wi), ls.wi, 0.0, ls.dist * (1.0 - 1e-3), true);
-                    if (sh.tri == GN_INVALID && !sh.truncated)
-                        radiance += c;
+            if (frame.num_emitters > 0u && bsdf_has_smooth(b)) {
+                LightSample ls = light_sample(s.p, ul.xyz);
+                vec3 wi = vec3(dot(ls.wi, tx), dot(ls.wi, ty), dot(ls.wi, n));
+                // The shading and geometric normals must agree on the side of wi (no light leaks).
+                if (ls.pdf > 0.0 && !(bsdf_only && !ls.delta) && dot(ng, ls.wi) * wi.z > 0.0 &&
+                    luminance(ls.L) > 0.0) {
+                    vec3 f;
+                    float pb;
+                    bsdf_eval_pdf(b, wo, wi, f, pb);
+                    float w = ls.delta || light_only ? 1.0 : power_heuristic(ls.pdf, pb);
+                    vec3 c = beta * f * abs(wi.z) * ls.L * (w / ls.pdf);
+                    if (luminance(c) > 0.0) {
+                        Hit sh = trace(offset_origin(s.p, ng, ls.wi), ls.wi, 0.0, ls.dist * (1.0 - 1e-3), true);
+                        if (sh.tri == GN_INVALID && !sh.truncated)
+                            radiance += c;
+                    }
                 }
             }
-        }
 
-        BsdfSample bs = bsdf_sample(b, wo, ub.xyz);
-        if (bs.flags == 0u)
-            break;
-        vec3 wi = bs.wi.x * tx + bs.wi.y * ty + bs.wi.z * n;
-        if (dot(ng, wi) * bs.wi.z <= 0.0)
-            break;
-        beta *= bs.weight;
-        prev_delta = (bs.flags & BRDF_FLAG_DELTA) != 0u;
-        prev_pdf = bs.pdf;
-        o = offset_origin(s.p, ng, wi);
-        d = wi;
-        if (depth + 1u >= ROULETTE_DEPTH) {
-            float q = min(max(beta.r, max(beta.g, beta.b)), 0.95);
-            if (ul.w >= q)
+            BsdfSample bs = bsdf_sample(b, wo, ub.xyz);
+            if (bs.flags == 0u)
                 break;
-            beta /= q;
-        }
+            vec3 wi = bs.wi.x * tx + bs.wi.y * ty + bs.wi.z * n;
+            if (dot(ng, wi) * bs.wi.z <= 0.0)
+                break;
+            beta *= bs.weight;
+            prev_delta = (bs.flags & BRDF_FLAG_DELTA) != 0u;
+            prev_pdf = bs.pdf;
+            o = offset_origin(s.p, ng, wi);
+            d = wi;
+            if (depth + 1u >= ROULETTE_DEPTH) {
+                float q = min(max(beta.r, max(beta.g, beta.b)), 0.95);
+                if (ul.w >= q)
+                    break;
+                beta /= q;
+            }
+            ended = false;
+        } while (false);
+        if (path_step() == samples)
+            break;
     }
-    if (truncated)
+    // Fewer samples than asked for: llvmpipe's loop cap ended the loop (the rest count 0).
+    if (truncated || taken < samples)
         atomicAdd(status[0], 1u);
-    // A NaN or infinity from a degenerate configuration would poison the pixel for good.
-    if (any(isnan(radiance)) || any(isinf(radiance)))
-        radiance = vec3(0.0);
-    accum[pixel] += vec4(radiance, covered ? 1.0 : 0.0);
-    squares[pixel] += vec4(radiance * radiance, 0.0);
+    accum[pixel] += sum;
+    squares[pixel] += vec4(sum_sq, 0.0);
     if (GN_HAS(GN_FEAT_AOV) && (frame.flags & GN_FRAME_AOV) != 0u) {
-        aov[3u * pixel + 0u] += vec4(normal, 0.0);
-        aov[3u * pixel + 1u] += vec4(albedo, 0.0);
-        aov[3u * pixel + 2u] += vec4(depth_aov, 0.0, 0.0, 0.0);
+        aov[3u * pixel + 0u] += vec4(sum_n, 0.0);
+        aov[3u * pixel + 1u] += vec4(sum_a, 0.0);
+        aov[3u * pixel + 2u] += vec4(sum_depth, 0.0, 0.0, 0.0);
     }
 }

@@ -52,6 +52,9 @@ typedef uint32_t uint;
 
 /* Work-group size of the 2D image kernels: 8x8 matches lavapipe's 8-wide SIMD rows and is a
  * good default for GPUs (64 threads = 2 warps / 1 wavefront). */
+/* The most samples per pixel one dispatch of the path kernel takes (glsl/path.comp;
+ * src/render.c: path_samples picks the number for a scene). */
+#define GN_PATH_SAMPLES 16u
 #define GN_TILE_X 8u
 #define GN_TILE_Y 8u
 
@@ -229,9 +232,9 @@ GN_STRUCT(GnFrame) {
 
 /* Per-dispatch values (push constants). */
 GN_STRUCT(GnPush) {
-    uint sample_index;   /* index of the sample this pass takes in every pixel */
+    uint sample_index;   /* index of the (first) sample this pass takes in every pixel */
     uint pass_flags;
-    uint pad0;
+    uint pad0;           /* path.comp: how many samples, sample_index on (1..GN_PATH_SAMPLES) */
     uint pad1;
 } GN_END(GnPush);
 

@@ -100,12 +100,13 @@ static void print_build(const scene *sc)
            sc->num_triangles / best * 1e-6);
 }
 
-/* One path pass (sample `pass`) through r's current image; returns its seconds. */
-static double path_pass(renderer *r, uint32_t pass)
+/* Samples [first, first + count) of every pixel of r's current image, as `gonio render`
+ * takes them (GN_PATH_SAMPLES per dispatch); returns the seconds. */
+static double path_pass(renderer *r, uint32_t first, uint32_t count)
 {
     double t0 = util_now();
     VkCommandBuffer cmd = gpu_begin(r->g);
-    renderer_record_pass(r, cmd, GN_MODE_PATH, pass);
+    renderer_record_samples(r, cmd, GN_MODE_PATH, first, count);
     gpu_submit_wait(r->g, cmd);
     return util_now() - t0;
 }
@@ -120,18 +121,19 @@ static bool bench_paths(renderer *r, render_settings *s, double t_start, float s
     GnFrame frame;
     image ref = {0};
     double t_first, t_paths = 0, t_ref, t_run = 0, ref_noise = 0, rmse;
-    int passes = 0, k = 0;
+    int samples = 0, k = 0;
 
     if (!renderer_begin(r, s, &frame))
         return false;
-    /* Pass 0 compiles the kernel and defines time to first pixel. */
-    path_pass(r, 0);
+    /* Sample 0 compiles the kernel and defines time to first pixel. */
+    path_pass(r, 0, 1);
     t_first = util_now() - t_start;
-    for (uint32_t pass = 1; t_paths < seconds || passes < 2; pass++, passes++)
-        t_paths += path_pass(r, pass);
+    for (uint32_t first = 1; t_paths < seconds || samples < 2 * (int)r->path_samples;
+         first += r->path_samples, samples += (int)r->path_samples)
+        t_paths += path_pass(r, first, r->path_samples);
     printf("first pixel        %.3f s after start (path, %dx%d)\n", t_first, s->width, s->height);
-    printf("paths              %.3f M paths/s (%dx%d, %d passes, unbounded depth, MIS)\n",
-           (double)s->width * s->height * passes / t_paths * 1e-6, s->width, s->height, passes);
+    printf("paths              %.3f M paths/s (%dx%d, %d spp, unbounded depth, MIS)\n",
+           (double)s->width * s->height * samples / t_paths * 1e-6, s->width, s->height, samples);
     fflush(stdout);
 
     s->width = ref_w;
@@ -140,8 +142,7 @@ static bool bench_paths(renderer *r, render_settings *s, double t_start, float s
     if (!renderer_begin(r, s, &frame))
         return false;
     t_ref = util_now();
-    for (int pass = 0; pass < ref_spp; pass++)
-        path_pass(r, (uint32_t)pass);
+    path_pass(r, 0, (uint32_t)ref_spp);
     t_ref = util_now() - t_ref;
     renderer_resolve(r, ref_spp, false, &ref);
     /* The reference's own noise: the mean over pixels and RGB of its estimated variance
@@ -163,10 +164,12 @@ static bool bench_paths(renderer *r, render_settings *s, double t_start, float s
         image_destroy(&ref);
         return false;
     }
-    for (int spp = 1; spp <= ref_spp && k < 2; spp++) {
+    for (int spp = 0; spp < ref_spp && k < 2;) {
         image img = {0};
         image_metrics m;
-        t_run += path_pass(r, (uint32_t)(spp - 1));
+        int n = ref_spp - spp < (int)r->path_samples ? ref_spp - spp : (int)r->path_samples;
+        t_run += path_pass(r, (uint32_t)spp, (uint32_t)n);
+        spp += n;
         renderer_resolve(r, spp, false, &img);
         image_compare(&img, &ref, &m);
         image_destroy(&img);

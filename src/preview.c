@@ -485,8 +485,7 @@ static void record_frame(preview *p, VkImage target, int passes)
                 p->format.format == VK_FORMAT_B8G8R8A8_SRGB;
 
     GPU_CHECK(vkBeginCommandBuffer(cmd, &bi));
-    for (int i = 0; i < passes; i++)
-        renderer_record_pass(&p->r, cmd, p->s.mode, (uint32_t)(p->spp + i));
+    renderer_record_samples(&p->r, cmd, p->s.mode, (uint32_t)p->spp, (uint32_t)passes);
     push.width = (uint32_t)p->r.width;
     push.height = (uint32_t)p->r.height;
     push.tonemap = (uint32_t)p->tonemap;

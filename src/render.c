@@ -103,6 +103,20 @@ static double scene_radius2(const scene *sc)
     return r2 > 0 ? r2 : 1;
 }
 
+static uint32_t traversal_budget(const gpu *g, uint32_t rays_per_invocation);
+
+/* How many samples one invocation of the path kernel takes per dispatch: as many as fit
+ * the per-invocation walk budget (llvmpipe's loop cap) with room to spare, taking a path as
+ * 16 rays (8 vertices, each with a shadow ray) of sah_cost node visits each, from 1 to
+ * GN_PATH_SAMPLES. More samples per invocation keep the SIMD lanes busier (glsl/path.comp);
+ * a budget spent early would cut later paths short, so large scenes take fewer. */
+static uint32_t path_samples(const renderer *r)
+{
+    double per_path = 16.0 * (r->tree.sah_cost > 1 ? r->tree.sah_cost : 1);
+    double n = floor((double)traversal_budget(r->g, 1) / per_path);
+    return n < 1 ? 1u : n > GN_PATH_SAMPLES ? GN_PATH_SAMPLES : (uint32_t)n;
+}
+
 static float clamp01(float x) { return x < 0 ? 0 : x > 1 ? 1 : x; }
 
 /* The GN_FEAT_* that material m can need in the path kernel: the parts of the Bsdf that
@@ -232,6 +246,7 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     assert(r->tree.num_tris < (1u << 27)); /* glsl/bvh.glsl packs leaves' first triangles in 27 bits */
     for (uint32_t i = 0; i < sc->num_materials; i++)
         r->material_features |= material_features(&sc->materials[i]);
+    r->path_samples = path_samples(r);
     r->path_features = r->material_features;
 
     prims = util_malloc(sizeof *prims * r->tree.num_tris);
@@ -540,7 +555,7 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
      * (tests/regress/path.sh) and for ruling it out when chasing a bug. */
     if (getenv("GONIO_ALL_FEATURES"))
         r->path_features = GN_FEAT_ALL;
-    /* One path per invocation: the whole path shares llvmpipe's loop cap. */
+    /* An invocation's paths (up to r->path_samples) share llvmpipe's loop cap. */
     frame->traversal_budget = traversal_budget(r->g, 1);
     return true;
 }
@@ -629,11 +644,17 @@ bool renderer_mode_available(uint32_t mode)
     return mode < GN_MODE_COUNT;
 }
 
-void renderer_record_pass(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t sample_index)
+void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,
+                             uint32_t count)
 {
-    GnPush push = {sample_index, 0, 0, 0};
-    gpu_dispatch(cmd, renderer_pipeline(r, mode), &push, (uint32_t)r->width, (uint32_t)r->height, 1);
-    gpu_barrier(cmd);
+    /* The path kernel takes up to GN_PATH_SAMPLES samples per dispatch (glsl/path.comp:
+     * a lane whose path ends starts its next one); the others one. */
+    uint32_t per = mode == GN_MODE_PATH ? r->path_samples : 1u;
+    for (uint32_t i = 0; i < count; i += per) {
+        GnPush push = {first + i, 0, count - i < per ? count - i : per, 0};
+        gpu_dispatch(cmd, renderer_pipeline(r, mode), &push, (uint32_t)r->width, (uint32_t)r->height, 1);
+        gpu_barrier(cmd);
+    }
 }
 
 void renderer_resolve(renderer *r, int spp, bool aov, image *out)
@@ -702,8 +723,7 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
         int n = batch;
         if (s->time_limit <= 0 && n > s->spp - done)
             n = s->spp - done;
-        for (int i = 0; i < n; i++)
-            renderer_record_pass(r, cmd, s->mode, (uint32_t)(done + i));
+        renderer_record_samples(r, cmd, s->mode, (uint32_t)done, (uint32_t)n);
         gpu_submit_wait(g, cmd);
         done += n;
         if (done == n)

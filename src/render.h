@@ -63,6 +63,7 @@ typedef struct renderer {
     uint32_t material_features; /* GN_FEAT_* the materials need (renderer_create) */
     uint32_t path_features;     /* ... and the current path render (renderer_begin) */
     uint32_t pipeline_features[GN_MODE_COUNT]; /* what each cached kernel was built for */
+    uint32_t path_samples;      /* samples per path dispatch (1..GN_PATH_SAMPLES) */
 } renderer;
 
 /* Builds the BVH and uploads the scene. */
@@ -93,7 +94,8 @@ gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode);
 bool renderer_mode_available(uint32_t mode);
 /* Records one sample pass (sample `sample_index` in every pixel) and a barrier. Call
  * renderer_begin first. */
-void renderer_record_pass(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t sample_index);
+void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,
+                             uint32_t count);
 /* The accumulated image divided by spp: R, G, B, A and, with aov, the AOV channels. */
 void renderer_resolve(renderer *r, int spp, bool aov, image *out);
 
