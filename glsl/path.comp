@@ -33,10 +33,10 @@ layout(push_constant) uniform PushBlock { GnPush push; };
 #define ROULETTE_DEPTH 3u
 // A ray's own loop iterations besides its walk (light selection, map searches), in node
 // visits (a visit costs up to 19 iterations): charged so the whole path stays under
-// llvmpipe's loop cap with frame.traversal_budget node visits per invocation.
+// llvmpipe's loop cap with frame.traversal_budget node visits per path.
 #define TRACE_OVERHEAD 4u
 
-uint budget;    // node visits left to this invocation
+uint budget;    // node visits left to this path
 bool truncated; // a walk ran out of budget: the path was cut short
 
 uint sample_now; // the sample index of the path being traced
@@ -272,6 +272,7 @@ bool prev_delta, covered, ended;
 void path_start()
 {
     sample_now = push.sample_index + taken;
+    budget = frame.traversal_budget;
     depth = 0u;
     o = frame.camera.position;
     d = camera_dir(vec2(px) + rng(pixel, 0u).xy);
@@ -317,7 +318,6 @@ void main()
     pixel = px.y * frame.width + px.x;
     bool light_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_LIGHT_ONLY) != 0u;
     bool bsdf_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_BSDF_ONLY) != 0u;
-    budget = frame.traversal_budget;
     truncated = false;
     samples = max(push.pad0, 1u);
     taken = 0u;

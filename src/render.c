@@ -103,17 +103,22 @@ static double scene_radius2(const scene *sc)
     return r2 > 0 ? r2 : 1;
 }
 
+#define GN_UNBOUNDED_BUDGET (1u << 30) /* traversal_budget on devices without a loop cap */
 static uint32_t traversal_budget(const gpu *g, uint32_t rays_per_invocation);
 
-/* How many samples one invocation of the path kernel takes per dispatch: as many as fit
- * the per-invocation walk budget (llvmpipe's loop cap) with room to spare, taking a path as
- * 16 rays (8 vertices, each with a shadow ray) of sah_cost node visits each, from 1 to
- * GN_PATH_SAMPLES. More samples per invocation keep the SIMD lanes busier (glsl/path.comp);
- * a budget spent early would cut later paths short, so large scenes take fewer. */
+/* How many samples one invocation of the path kernel takes per dispatch, 1 to
+ * GN_PATH_SAMPLES. More keep the SIMD lanes busier (glsl/path.comp). Each path has its own
+ * walk budget, but on llvmpipe all of them share the loop cap (65,535 iterations per SIMD
+ * group), so the number is what fits half the cap for typical paths: 16 rays (8 vertices,
+ * each with a shadow ray) of sah_cost node visits, about 3 loop iterations a visit, and 2
+ * for the lanes of a group not walking in step. A path that goes beyond is still counted
+ * and reported, never silently cut (glsl/bvh.glsl). */
 static uint32_t path_samples(const renderer *r)
 {
-    double per_path = 16.0 * (r->tree.sah_cost > 1 ? r->tree.sah_cost : 1);
-    double n = floor((double)traversal_budget(r->g, 1) / per_path);
+    double per_path = 16.0 * (r->tree.sah_cost > 1 ? r->tree.sah_cost : 1) * 3 * 2;
+    double n = floor(30000.0 / per_path);
+    if (traversal_budget(r->g, 1) == GN_UNBOUNDED_BUDGET) /* no loop cap */
+        return GN_PATH_SAMPLES;
     return n < 1 ? 1u : n > GN_PATH_SAMPLES ? GN_PATH_SAMPLES : (uint32_t)n;
 }
 
@@ -368,7 +373,7 @@ static uint32_t traversal_budget(const gpu *g, uint32_t rays_per_invocation)
                                       .pNext = &drv};
     vkGetPhysicalDeviceProperties2(g->physical, &p2);
     if (drv.driverID != VK_DRIVER_ID_MESA_LLVMPIPE)
-        return 1u << 30;
+        return GN_UNBOUNDED_BUDGET;
     /* A node visit costs one iteration and opens at most two leaves, each one more
      * iteration plus max_leaf_size (8 at most, the builder's cap): 19. The count is shared
      * by the 8 invocations of a SIMD group, so this keeps typical work well under the cap,
@@ -555,7 +560,8 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
      * (tests/regress/path.sh) and for ruling it out when chasing a bug. */
     if (getenv("GONIO_ALL_FEATURES"))
         r->path_features = GN_FEAT_ALL;
-    /* An invocation's paths (up to r->path_samples) share llvmpipe's loop cap. */
+    /* Each path gets the budget of one ray per invocation; path_samples keeps the
+     * invocation's paths together under llvmpipe's loop cap. */
     frame->traversal_budget = traversal_budget(r->g, 1);
     return true;
 }
