@@ -200,7 +200,7 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
         // A leaf, unless llvmpipe's loop cap ended the loop above early (see below).
         bool leaf = w.node != GN_INVALID && (w.node & GN_WALK_LEAF) != 0u;
         uint first = w.node & 0x07ffffffu, last = first + ((w.node >> 27) & 15u);
-        for (uint i = first; leaf && i <= last; i++) {
+        for (uint i = first; leaf && i <= last && !(any_hit && w.hit.tri != GN_INVALID); i++) {
             GnTri tri = bvh_tri(i);
             float t, u, v;
             if (tri_intersect(r, tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, tmin, w.hit.t, t, u, v)) {
