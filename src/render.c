@@ -720,8 +720,9 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
     if (!renderer_begin(r, s, &frame))
         return false;
 
-    /* Passes are submitted in batches sized to take about 0.1 s each: short enough for a
-     * responsive progress bar and an early stop, long enough to hide submission costs. */
+    /* Passes are submitted in batches sized to take 0.1 to 0.4 s each: short enough for a
+     * responsive progress bar and an early stop, long enough to hide submission costs and
+     * to let the path kernel take several samples per dispatch (renderer_record_samples). */
     t0 = util_now();
     while (s->time_limit > 0 || done < s->spp) {
         VkCommandBuffer cmd = gpu_begin(g);
@@ -735,9 +736,9 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
         if (done == n)
             stats->first_pass_seconds = util_now() - t0;
         tb = util_now() - tb;
-        if (tb < 0.05 && batch < 1024)
+        if (tb < 0.1 && batch < 1024)
             batch *= 2;
-        else if (tb > 0.2 && batch > 1)
+        else if (tb > 0.4 && batch > 1)
             batch /= 2;
         if (show_progress && util_now() - last_progress > 0.1) {
             last_progress = util_now();
