@@ -33,6 +33,7 @@ static const char render_usage[] =
     "                      --list), e.g. --brdf torrance-sparrow:exponent=128:specular=0.5\n"
     "  --estimator E       path: mis (default), light or bsdf: one strategy only (tests)\n"
     "  --no-shadows        local modes: no shadow rays\n"
+    "  --ambient R,G,B | V local modes: the Phong model's global ambient light (default 0)\n"
     "  --exposure E        PNG only: scale by 2^E before tonemapping (default 0)\n"
     "  --tonemap T         PNG only: clamp (default), reinhard, aces\n"
     "  --device N          Vulkan device index (see gonio devices)\n"
@@ -168,6 +169,11 @@ int cmd_render(int argc, char **argv)
                     env_path = val;
                 else if (!parse_rgb(val, s.env) || !(s.env[0] >= 0 && s.env[1] >= 0 && s.env[2] >= 0))
                     return cli_usage_error("render", "--env '%s': expected R,G,B, one value >= 0 or FILE.exr", val);
+            } else if (!strcmp(a, "--ambient")) {
+                if (!parse_rgb(val, s.ambient) ||
+                    !(s.ambient[0] >= 0 && s.ambient[1] >= 0 && s.ambient[2] >= 0))
+                    return cli_usage_error("render", "--ambient '%s': expected R,G,B or one value >= 0", val);
+                s.ambient_set = true;
             } else if (!strcmp(a, "--max-depth")) {
                 if (!util_parse_int(val, 0, 1 << 20, &v))
                     return cli_usage_error("render", "--max-depth '%s': expected an integer >= 0", val);

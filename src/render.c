@@ -584,7 +584,7 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->num_nodes = r->tree.num_nodes;
     frame->bounds_min = v3(r->sc->bounds_min);
     frame->bounds_max = v3(r->sc->bounds_max);
-    frame->ambient = v3(r->sc->ambient);
+    frame->ambient = v3(s->ambient_set ? s->ambient : r->sc->ambient);
     frame->traversal_budget = traversal_budget(g, 1 + (s->shadows ? r->num_lights : 0));
     if (s->mode == GN_MODE_PATH && !path_begin(r, s, frame))
         return false;

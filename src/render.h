@@ -26,6 +26,8 @@ typedef struct render_settings {
     bool shadows;           /* ray-traced shadows in the local modes (default on) */
     int max_depth;          /* path tracer: 0 = unbounded (roulette only) */
     float env[3];           /* constant environment radiance */
+    bool ambient_set;       /* local modes: ambient replaces the scene's global ambient light */
+    float ambient[3];
     bool progress;          /* progress bar on stderr */
     volatile sig_atomic_t *stop; /* set asynchronously to end after the current pass */
     const GnCamera *camera_override; /* non-NULL: this camera (aspect from the image), not `camera` */

@@ -110,4 +110,14 @@ for bad in nan huge empty; do
     else fail "$bad.gltf: expected exit 1, a message naming the file, no output (got $rc)"; cat "$tmp/out"; fi
 done
 
+# --ambient: the Phong model's global ambient light A adds A * ka to every lit pixel. The
+# teapot's material says ka = 0.2 (its extras), so A = 0.2 adds exactly 0.04 where the
+# teapot covers a pixel: the largest difference is 0.04, not more, not less.
+T=scenes/teapot.gltf
+check "phong without ambient" "$G" render $T --mode phong -o "$tmp/amb0.exr" --spp 4 --size 48x48 --quiet
+check "phong with --ambient 0.2" "$G" render $T --mode phong --ambient 0.2 -o "$tmp/amb2.exr" --spp 4 --size 48x48 --quiet
+check "ambient adds at most A ka = 0.04" "$G" diff "$tmp/amb0.exr" "$tmp/amb2.exr" --max-error 0.0401
+check_fails "ambient adds A ka = 0.04 somewhere" 1 "$G" diff "$tmp/amb0.exr" "$tmp/amb2.exr" --max-error 0.0399
+check "gouraud with --ambient" "$G" render $T --mode gouraud --ambient 0.2,0.2,0.2 -o "$tmp/amb3.exr" --spp 1 --size 48x48 --quiet
+check_fails "a negative --ambient is a usage error" 2 "$G" render $T --mode phong --ambient -1 -o "$tmp/x.exr" --quiet
 finish
