@@ -758,7 +758,11 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
     stats->rays = (uint64_t)pixels * (uint64_t)done;
     stats->setup_seconds = r->setup_seconds;
     stats->truncated = ((const uint32_t *)r->status.mapped)[0];
-    if (stats->truncated)
+    if (stats->truncated && s->mode == GN_MODE_PATH)
+        util_warn("%s: in %u pixel pass(es) a path needed more BVH steps than its budget (%u "
+                  "node visits) and was cut short; the image is slightly too dark there",
+                  r->sc->path, stats->truncated, frame.traversal_budget);
+    else if (stats->truncated)
         util_warn("%s: %u ray(s) needed more BVH steps than the per-ray budget (%u) and may be "
                   "wrong", r->sc->path, stats->truncated, frame.traversal_budget);
     renderer_resolve(r, done, s->aov, out);

@@ -42,7 +42,7 @@ typedef struct render_stats {
     double first_pass_seconds;
     double setup_seconds;   /* BVH build and upload */
     uint64_t rays;          /* camera rays traced (pixels * spp) */
-    uint32_t truncated;     /* rays whose BVH walk hit the traversal budget */
+    uint32_t truncated;     /* rays (path: pixel passes) cut short by the traversal budget */
 } render_stats;
 
 typedef struct renderer {
