@@ -41,7 +41,7 @@ vec3 flat_color(Hit h, vec3 d)
     vec3 center = (vertex_at(pr.i0).position + vertex_at(pr.i1).position +
                   vertex_at(pr.i2).position) / 3.0;
     Surface s = surface_at(h.tri, 0.0, 1.0 / 3.0, 1.0 / 3.0, center, d);
-    return phong_shade(center, s.ng, s.ng, s.uv, s.material,
+    return phong_shade(center, s.ng, s.ng, s.uv, s.vcolor, s.material,
                        normalize(frame.camera.position - center));
 }
 
@@ -67,7 +67,7 @@ void main()
         if (MODE == GN_MODE_NORMAL) color = normal;
         else if (MODE == GN_MODE_ALBEDO) color = albedo;
         else if (MODE == GN_MODE_DEPTH) color = vec3(depth);
-        else if (MODE == GN_MODE_PHONG) color = phong_shade(s.p, s.n, s.ng, s.uv, s.material, -d);
+        else if (MODE == GN_MODE_PHONG) color = phong_shade(s.p, s.n, s.ng, s.uv, s.vcolor, s.material, -d);
         else if (MODE == GN_MODE_GOURAUD) color = gouraud_color(h, d);
         else if (MODE == GN_MODE_FLAT) color = flat_color(h, d);
     } else {

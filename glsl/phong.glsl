@@ -48,12 +48,15 @@ bool shadowed(vec3 p, vec3 ng, vec3 wi, float dist)
 
 // The Phong reflection model at p with shading normal n (unit, or zero: then no light but
 // ambient and emission), geometric normal ng on the same side (light below it is cut off),
-// texture coordinates uv, seen from direction v (unit, towards the viewer).
-vec3 phong_shade(vec3 p, vec3 n, vec3 ng, vec2 uv, uint material, vec3 v)
+// texture coordinates uv and vertex colour vcolor (1 without), seen from direction v (unit,
+// towards the viewer).
+vec3 phong_shade(vec3 p, vec3 n, vec3 ng, vec2 uv, vec3 vcolor, uint material, vec3 v)
 {
     GnMaterial m = material_at(material);
-    // The glTF textures modulate the classic colours, so textured models look right.
+    // The glTF base-colour texture and vertex colours modulate the classic colours, as they
+    // do glTF's base colour, so textured and painted models look right.
     vec3 tex = m.tex_base != GN_INVALID ? texture_sample(m.tex_base, uv, true).rgb : vec3(1.0);
+    tex *= vcolor;
     vec3 kd = m.phong_diffuse * tex;
     vec3 ka = m.phong_ambient * tex;
     vec3 ks = m.phong_specular;

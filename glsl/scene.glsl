@@ -39,9 +39,13 @@ GnPrim prim_at(uint i)
 
 GnVertex vertex_at(uint i)
 {
-    vec4 a = texel_f(vertex_texels, 3u * i), b = texel_f(vertex_texels, 3u * i + 1u);
-    return GnVertex(a.xyz, a.w, b.xyz, b.w, texel_f(vertex_texels, 3u * i + 2u));
+    vec4 a = texel_f(vertex_texels, 4u * i), b = texel_f(vertex_texels, 4u * i + 1u);
+    return GnVertex(a.xyz, a.w, b.xyz, b.w, texel_f(vertex_texels, 4u * i + 2u),
+                    texel_f(vertex_texels, 4u * i + 3u));
 }
+
+// Does the scene have vertex colours (glTF COLOR_0)? Without, GnVertex.color is not read.
+bool vertex_colors() { return GN_HAS(GN_FEAT_VERTEX_COLOR) && (frame.flags & GN_FRAME_VERTEX_COLOR) != 0u; }
 
 // Fields a kernel does not read are never fetched: the compiler drops unused texel loads.
 GnMaterial material_at(uint i)
@@ -139,7 +143,8 @@ struct Surface {
     vec3 ng;          // geometric normal, facing the incoming ray
     vec3 n;           // shading normal (interpolated, normal-mapped), same side as ng
     vec2 uv;
-    vec3 base;        // linear base colour (factor * texture)
+    vec3 base;        // linear base colour (factor * texture * vertex colour)
+    vec3 vcolor;      // the interpolated vertex colour (1 without COLOR_0)
     float alpha;
     float metallic;
     float roughness;
@@ -174,6 +179,11 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     vec4 base = m.base_color;
     if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_base != GN_INVALID)
         base *= texture_sample(m.tex_base, s.uv, true);
+    vec4 vc = vec4(1.0);
+    if (vertex_colors())
+        vc = w * a.color + u * b.color + v * c.color;
+    base *= vc;
+    s.vcolor = vc.rgb;
     s.base = base.rgb;
     s.alpha = base.a;
     s.metallic = m.metallic;

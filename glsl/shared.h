@@ -88,6 +88,7 @@ typedef uint32_t uint;
 #define GN_FRAME_LIGHT_ONLY 4u /* path: emitters reached only by light sampling (no MIS) */
 #define GN_FRAME_BSDF_ONLY 8u  /* path: area lights and the environment only by BSDF sampling */
 #define GN_FRAME_ENV_MAP 16u   /* path: the environment is the map in GN_BIND_ENV */
+#define GN_FRAME_VERTEX_COLOR 32u /* the scene has vertex colours (GnVertex.color) */
 
 /* GnEmitter.prim: a triangle (GnPrim index), a punctual light (this bit | GnLight index),
  * or the environment (GN_INVALID). */
@@ -123,10 +124,11 @@ typedef uint32_t uint;
 #define GN_FEAT_LIGHT_SEARCH (1u << 21) /* more than one light to choose from */
 #define GN_FEAT_STRATEGY (1u << 22)     /* light-only or BSDF-only estimators */
 #define GN_FEAT_AOV (1u << 23)
+#define GN_FEAT_VERTEX_COLOR (1u << 24) /* glTF COLOR_0 */
 #define GN_FEAT_LOBES (GN_FEAT_MIRROR | GN_FEAT_PHONG | GN_FEAT_BLINN | GN_FEAT_TS | \
                        GN_FEAT_BECKMANN | GN_FEAT_GGX)
 #define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
-#define GN_FEAT_ALL 0x00ffffffu
+#define GN_FEAT_ALL 0x01ffffffu
 
 /* ---- BVH: both children's boxes in one 64-byte node (Aila & Laine 2009, "Understanding
  * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only
@@ -159,7 +161,9 @@ GN_STRUCT(GnVertex) {
     vec3 position; float u;
     vec3 normal; float v;
     vec4 tangent; /* xyz tangent, w handedness; all zero when the mesh has none */
-} GN_END(GnVertex); /* 48 bytes */
+    vec4 color;   /* glTF COLOR_0 (linear RGBA; 1 when the mesh has none), read only when
+                     GnFrame.flags has GN_FRAME_VERTEX_COLOR */
+} GN_END(GnVertex); /* 64 bytes */
 
 /* glTF metallic-roughness material plus the classic (OpenGL 1.x) Phong parameters used by
  * the local shading modes, and an optional BRDF-model override for the path tracer.
@@ -263,7 +267,7 @@ GN_STATIC_ASSERT(sizeof(GnBvhNode) == 64, "GnBvhNode layout");
 GN_STATIC_ASSERT(offsetof(GnBvhNode, b_min) == 32, "GnBvhNode layout");
 GN_STATIC_ASSERT(sizeof(GnTri) == 48, "GnTri layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");
-GN_STATIC_ASSERT(sizeof(GnVertex) == 48, "GnVertex layout");
+GN_STATIC_ASSERT(sizeof(GnVertex) == 64, "GnVertex layout");
 GN_STATIC_ASSERT(sizeof(GnMaterial) == 192, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, brdf_params) == 112, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, phong_ambient) == 128, "GnMaterial layout");

@@ -28,5 +28,6 @@ void main()
     if (side == 1u)
         n = -n;
     vec3 v = normalize(frame.camera.position - a.position);
-    vcolor[2u * i + side].rgb = phong_shade(a.position, n, n, vec2(a.u, a.v), material, v);
+    vec3 vc = vertex_colors() ? a.color.rgb : vec3(1.0);
+    vcolor[2u * i + side].rgb = phong_shade(a.position, n, n, vec2(a.u, a.v), vc, material, v);
 }

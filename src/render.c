@@ -251,6 +251,8 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     assert(r->tree.num_tris < (1u << 27)); /* glsl/bvh.glsl packs leaves' first triangles in 27 bits */
     for (uint32_t i = 0; i < sc->num_materials; i++)
         r->material_features |= material_features(&sc->materials[i]);
+    if (sc->vertex_colors)
+        r->material_features |= GN_FEAT_VERTEX_COLOR;
     r->path_samples = path_samples(r);
     r->path_features = r->material_features;
 
@@ -579,7 +581,8 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->mode = s->mode;
     frame->max_depth = (uint32_t)s->max_depth;
     frame->num_lights = r->num_lights;
-    frame->flags = (s->aov ? GN_FRAME_AOV : 0u) | (s->shadows ? GN_FRAME_SHADOWS : 0u);
+    frame->flags = (s->aov ? GN_FRAME_AOV : 0u) | (s->shadows ? GN_FRAME_SHADOWS : 0u) |
+                   (r->sc->vertex_colors ? GN_FRAME_VERTEX_COLOR : 0u);
     frame->env_color = (vec3){s->env[0], s->env[1], s->env[2]};
     frame->num_nodes = r->tree.num_nodes;
     frame->bounds_min = v3(r->sc->bounds_min);

@@ -72,6 +72,7 @@ typedef struct scene {
 
     float bounds_min[3], bounds_max[3]; /* of all triangles; min > max when empty */
     float ambient[3];           /* global ambient light of the Phong model (default 0) */
+    bool vertex_colors;         /* some mesh has COLOR_0 (GnVertex.color; 1 elsewhere) */
 } scene;
 
 /* Loads a .gltf or .glb file (GLB chosen by its magic, or by the extension). Every buffer,

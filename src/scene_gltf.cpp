@@ -44,6 +44,7 @@ struct Prim {                 /* one triangle primitive of a glTF mesh, in the m
     std::vector<float> nrm;   /* 3 per vertex */
     std::vector<float> uv;    /* 2 per vertex, empty without TEXCOORD_0 */
     std::vector<float> tan;   /* 4 per vertex, empty without TANGENT */
+    std::vector<float> col;   /* 4 per vertex (RGBA), empty without COLOR_0 */
     std::vector<uint32_t> idx; /* 3 per triangle */
     uint32_t material;        /* glTF material, or GN_INVALID for the default one */
 };
@@ -62,7 +63,7 @@ struct Ctx {
     std::vector<bool> camera_ok, light_ok;   /* per glTF camera / light: values usable */
     std::vector<std::vector<Prim>> meshes;   /* per glTF mesh */
     std::vector<uint32_t> image_map, texture_map; /* glTF index -> scene index or GN_INVALID */
-    bool warned_skin = false, warned_targets = false, warned_color = false;
+    bool warned_skin = false, warned_targets = false;
 };
 
 void vreport(const Ctx &c, bool error, const char *fmt, va_list ap)
@@ -837,6 +838,34 @@ void read_tangents(Ctx &c, const std::string &what, int acc, Prim &out)
     out.tan = to_float(d);
 }
 
+/* COLOR_0 (glTF 2.0, "Meshes"): linear RGB or RGBA, float or normalised integers, which
+ * multiplies the base colour. RGB gets alpha 1; values outside [0, 1] are clamped, with a
+ * warning, and non-finite ones make the attribute ignored. */
+void read_colors(Ctx &c, const std::string &what, int acc, Prim &out)
+{
+    const auto &a = c.m.accessors[size_t(acc)];
+    size_t nc = num_comps(a), nv = out.pos.size() / 3;
+    if (a.count != nv) {
+        warn(c, "%s: COLOR_0 has %zu elements for %zu vertices (ignored)", what.c_str(), size_t(a.count), nv);
+        return;
+    }
+    std::vector<double> d = read_accessor(c, acc);
+    if (!all_finite(d)) {
+        warn(c, "%s: COLOR_0 has non-finite values (ignored)", what.c_str());
+        return;
+    }
+    bool clamped = false;
+    out.col.resize(nv * 4);
+    for (size_t v = 0; v < nv; v++)
+        for (size_t k = 0; k < 4; k++) {
+            double x = k < nc ? d[v * nc + k] : 1.0;
+            clamped = clamped || x < 0 || x > 1;
+            out.col[v * 4 + k] = float(std::fmin(std::fmax(x, 0.0), 1.0));
+        }
+    if (clamped)
+        warn(c, "%s: COLOR_0 values outside [0, 1] were clamped", what.c_str());
+}
+
 /* glTF 2.0, "Meshes": without NORMAL, flat normals are used, so every triangle gets its own
  * three vertices. */
 void make_flat(Prim &p)
@@ -848,6 +877,8 @@ void make_flat(Prim &p)
     f.nrm.resize(nt * 9);
     if (!p.uv.empty())
         f.uv.resize(nt * 6);
+    if (!p.col.empty())
+        f.col.resize(nt * 12);
     f.idx.resize(nt * 3);
     for (size_t t = 0; t < nt; t++) {
         for (size_t k = 0; k < 3; k++) {
@@ -855,6 +886,8 @@ void make_flat(Prim &p)
             std::copy(&p.pos[v * 3], &p.pos[v * 3] + 3, &f.pos[o * 3]);
             if (!p.uv.empty())
                 std::copy(&p.uv[v * 2], &p.uv[v * 2] + 2, &f.uv[o * 2]);
+            if (!p.col.empty())
+                std::copy(&p.col[v * 4], &p.col[v * 4] + 4, &f.col[o * 4]);
             f.idx[o] = uint32_t(o);
         }
         const float *a = &f.pos[t * 9], *b = a + 3, *cc = a + 6;
@@ -896,6 +929,7 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
         return it == p.attributes.end() ? -1 : it->second;
     };
     int pos = attr("POSITION"), nrm = attr("NORMAL"), tan = attr("TANGENT"), uv = attr("TEXCOORD_0");
+    int col = attr("COLOR_0");
     if (pos < 0) {
         warn(c, "%s has no POSITION (skipped)", what.c_str());
         return false;
@@ -903,10 +937,6 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
     if (!p.targets.empty() && !c.warned_targets) {
         warn(c, "morph targets are not supported (meshes drawn with their base shapes)");
         c.warned_targets = true;
-    }
-    if (attr("COLOR_0") >= 0 && !c.warned_color) {
-        warn(c, "vertex colours (COLOR_0) are ignored");
-        c.warned_color = true;
     }
     size_t nv = c.m.accessors[size_t(pos)].count;
     std::vector<uint32_t> seq;
@@ -965,6 +995,8 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
         else
             warn(c, "%s: TEXCOORD_0 has non-finite values (ignored)", what.c_str());
     }
+    if (col >= 0)
+        read_colors(c, what, col, out);
     if (out.nrm.empty())
         make_flat(out);
     return true;
@@ -1106,6 +1138,12 @@ bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
                 if (!p.uv.empty()) {
                     o.u = p.uv[v * 2];
                     o.v = p.uv[v * 2 + 1];
+                }
+                if (!p.col.empty()) {
+                    o.color = vec4{p.col[v * 4], p.col[v * 4 + 1], p.col[v * 4 + 2], p.col[v * 4 + 3]};
+                    out->vertex_colors = true;
+                } else {
+                    o.color = vec4{1, 1, 1, 1};
                 }
                 if (!p.tan.empty()) {
                     const double t0[3] = {p.tan[v * 4], p.tan[v * 4 + 1], p.tan[v * 4 + 2]};

@@ -17,6 +17,7 @@ void scene_from_mesh(scene *out, const char *name, uint32_t num_vertices, const 
     for (uint32_t i = 0; i < num_vertices; i++) {
         GnVertex *v = &out->vertices[i];
         v->position = (vec3){positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]};
+        v->color = (vec4){1, 1, 1, 1};
         if (normals)
             v->normal = (vec3){normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]};
     }

@@ -21,7 +21,7 @@ check_fails "a missing environment map fails" 1 "$G" render $C -o "$tmp/x.exr" -
 # removing code must not change a single pixel. Each case renders specialised and with
 # every feature (GONIO_ALL_FEATURES) and demands the same image, for every BRDF model, each
 # estimator, the AOVs, both kinds of environment, and sample models with textures, normal
-# maps, glass and punctual lights.
+# maps, glass, punctual lights and vertex colours.
 same_as_unspecialised() { # NAME SCENE FLAGS...
     local what=$1 scene=$2; shift 2
     if "$G" render "$scene" -o "$tmp/spec.exr" --spp 3 --size 24x24 --quiet "$@" 2>"$tmp/spec.err" &&
@@ -48,6 +48,8 @@ for m in DamagedHelmet TransmissionRoughnessTest LightsPunctualLamp NormalTangen
     f=$A/$m/glTF/$m.gltf
     [ -f "$f" ] && same_as_unspecialised "$m" "$f" --env 0.5
 done
+f=${GONIO_ASSETS:-}/asset-generator/Material_MetallicRoughness/Material_MetallicRoughness_01.gltf
+[ -f "$f" ] && same_as_unspecialised "vertex colours (Asset Generator)" "$f" --env 0.5
 
 # Ctrl-C: the render stops after the current pass and writes what it has.
 "$G" render $C -o "$tmp/int.exr" --time 60 --size 32x32 --quiet &

@@ -120,4 +120,32 @@ check "ambient adds at most A ka = 0.04" "$G" diff "$tmp/amb0.exr" "$tmp/amb2.ex
 check_fails "ambient adds A ka = 0.04 somewhere" 1 "$G" diff "$tmp/amb0.exr" "$tmp/amb2.exr" --max-error 0.0399
 check "gouraud with --ambient" "$G" render $T --mode gouraud --ambient 0.2,0.2,0.2 -o "$tmp/amb3.exr" --spp 1 --size 48x48 --quiet
 check_fails "a negative --ambient is a usage error" 2 "$G" render $T --mode phong --ambient -1 -o "$tmp/x.exr" --quiet
+# Vertex colours (glTF COLOR_0) multiply the base colour: a triangle painted red through
+# COLOR_0 (float RGB, or normalised unsigned-byte RGBA) under a white material renders
+# exactly like the same triangle with a red base colour, in every mode that shows it.
+col_gltf() { # col_gltf FILE BASE_RGB COLOR_ATTRIBUTE_JSON COLOR_ACCESSOR_JSON COLOR_BYTES_PRINTF COLOR_BYTE_LENGTH
+    cat >"$1" <<EOF
+{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+ "materials":[{"pbrMetallicRoughness":{"baseColorFactor":[$2,1],"metallicFactor":0}}],
+ "meshes":[{"primitives":[{"attributes":{"POSITION":0$3},"material":0}]}],
+ "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}$4],
+ "bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":$6}],
+ "buffers":[{"byteLength":$((36 + $6)),"uri":"data:application/octet-stream;base64,$(b64 "$zero$zero$zero$one$zero$zero$zero$one$zero$5")"}]}
+EOF
+}
+red_f="$one$zero$zero"; red_u8='\377\000\000\377'
+col_gltf "$tmp/col_base.gltf" "1,0,0" "" "" "$zero" 4
+col_gltf "$tmp/col_f.gltf" "1,1,1" ',"COLOR_0":1' \
+    ',{"bufferView":1,"componentType":5126,"count":3,"type":"VEC3"}' "$red_f$red_f$red_f" 36
+col_gltf "$tmp/col_u8.gltf" "1,1,1" ',"COLOR_0":1' \
+    ',{"bufferView":1,"componentType":5121,"normalized":true,"count":3,"type":"VEC4"}' "$red_u8$red_u8$red_u8" 12
+for mode in albedo phong gouraud flat path; do
+    for f in col_base col_f col_u8; do
+        check "COLOR_0: $f renders in $mode" "$G" render "$tmp/$f.gltf" -o "$tmp/$f-$mode.exr" --mode $mode \
+            --size 24x24 --spp 2 --env 1 --ambient 1 --quiet
+    done
+    check "COLOR_0 float RGB = base colour ($mode)" "$G" diff "$tmp/col_f-$mode.exr" "$tmp/col_base-$mode.exr" --max-error 1e-6
+    check "COLOR_0 unorm8 RGBA = base colour ($mode)" "$G" diff "$tmp/col_u8-$mode.exr" "$tmp/col_base-$mode.exr" --max-error 1e-6
+done
+check_fails "and the red is there: white differs" 1 "$G" diff "$tmp/col_f-albedo.exr" "$tmp/ok.exr" --max-error 0.5
 finish
