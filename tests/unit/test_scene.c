@@ -109,7 +109,7 @@ static bool winding_matches_normals(const scene *s)
 /* Invariants every loaded scene must satisfy, whatever the file. */
 static void check_invariants(const scene *s, const char *name)
 {
-    bool idx_ok = true, mat_ok = true, vert_ok = true, tex_ok = true;
+    bool idx_ok = true, mat_ok = true, vert_ok = true, tex_ok = true, col_ok = true;
     for (uint32_t i = 0; i < 3 * s->num_triangles; i++)
         idx_ok &= s->indices[i] < s->num_vertices;
     for (uint32_t t = 0; t < s->num_triangles; t++)
@@ -121,6 +121,10 @@ static void check_invariants(const scene *s, const char *name)
         vert_ok &= isfinite(g->position.x) && isfinite(g->position.y) && isfinite(g->position.z) &&
                    isfinite(g->u) && isfinite(g->v) && fabsf(nl - 1) < 1e-4f &&
                    ((tl == 0 && g->tangent.w == 0) || (fabsf(tl - 1) < 1e-4f && fabsf(g->tangent.w) == 1));
+        /* COLOR_0 in [0, 1]; without vertex colours in the scene, every one is white */
+        const float *c = &g->color.x;
+        for (int k = 0; k < 4; k++)
+            col_ok &= s->vertex_colors ? c[k] >= 0 && c[k] <= 1 : c[k] == 1;
     }
     for (uint32_t m = 0; m < s->num_materials; m++) {
         const GnMaterial *g = &s->materials[m];
@@ -135,6 +139,7 @@ static void check_invariants(const scene *s, const char *name)
     CHECKF(mat_ok, "%s: material out of range", name);
     CHECKF(vert_ok, "%s: non-finite vertex or non-unit normal/tangent", name);
     CHECKF(tex_ok, "%s: texture or image reference out of range", name);
+    CHECKF(col_ok, "%s: a vertex colour outside [0, 1] (or not white without COLOR_0)", name);
     CHECKF(s->bounds_min[0] <= s->bounds_max[0] && s->bounds_min[1] <= s->bounds_max[1] &&
                s->bounds_min[2] <= s->bounds_max[2], "%s: empty bounds", name);
 }
@@ -656,7 +661,7 @@ void test_scene_asset_generator(void)
         test_skip("no test assets");
         return;
     }
-    int loaded = 0;
+    int loaded = 0, coloured = 0;
     for (int i = 0; i < 2; i++) {
         char dir[4096];
         snprintf(dir, sizeof dir, "%s/asset-generator/%s", test_assets_dir(), sets[i]);
@@ -674,12 +679,15 @@ void test_scene_asset_generator(void)
             if (ok)
                 check_invariants(&s, path);
             loaded += ok;
+            coloured += ok && s.vertex_colors;
             scene_destroy(&s);
         }
         if (d)
             closedir(d);
     }
     CHECKF(loaded == 19, "%d asset-generator models loaded", loaded);
+    /* Material_MetallicRoughness_01, _07 and _11 have COLOR_0 */
+    CHECKF(coloured == 3, "%d asset-generator models with vertex colours, expected 3", coloured);
 }
 
 /* ---- the glTF-Validator's invalid corpus ---------------------------------------------------- */
