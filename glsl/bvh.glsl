@@ -141,6 +141,8 @@ uint walk_entry(uint index, uint count)
 {
     return count == 0u ? index : GN_WALK_LEAF | ((count - 1u) << 27) | index;
 }
+uint walk_leaf_first(uint entry) { return entry & 0x07ffffffu; }
+uint walk_leaf_last(uint entry) { return walk_leaf_first(entry) + ((entry >> 27) & 15u); }
 
 // The state of a walk, so one that runs out of budget can be resumed later (the unit tests
 // resume walks across dispatches to get exact answers on meshes beyond llvmpipe's loop cap).
@@ -199,8 +201,8 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
         }
         // A leaf, unless llvmpipe's loop cap ended the loop above early (see below).
         bool leaf = w.node != GN_INVALID && (w.node & GN_WALK_LEAF) != 0u;
-        uint first = w.node & 0x07ffffffu, last = first + ((w.node >> 27) & 15u);
-        for (uint i = first; leaf && i <= last && !(any_hit && w.hit.tri != GN_INVALID); i++) {
+        uint last = walk_leaf_last(w.node);
+        for (uint i = walk_leaf_first(w.node); leaf && i <= last && !(any_hit && w.hit.tri != GN_INVALID); i++) {
             GnTri tri = bvh_tri(i);
             float t, u, v;
             if (tri_intersect(r, tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, tmin, w.hit.t, t, u, v)) {

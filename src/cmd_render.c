@@ -48,26 +48,6 @@ static void on_signal(int sig)
     stop_requested = 1;
 }
 
-/* A value, or "R,G,B". */
-static bool parse_rgb(const char *s, float out[3])
-{
-    char buf[128];
-    char *a, *b;
-    if (strlen(s) >= sizeof buf)
-        return false;
-    strcpy(buf, s);
-    a = strchr(buf, ',');
-    if (!a)
-        return util_parse_float(buf, &out[0]) && (out[1] = out[2] = out[0], true);
-    *a++ = 0;
-    b = strchr(a, ',');
-    if (!b)
-        return false;
-    *b++ = 0;
-    return util_parse_float(buf, &out[0]) && util_parse_float(a, &out[1]) &&
-           util_parse_float(b, &out[2]);
-}
-
 /* Fails early when the directory of an output file cannot be written, rather than after a
  * long render. */
 static bool check_writable(const char *path)
@@ -167,11 +147,10 @@ int cmd_render(int argc, char **argv)
                 size_t len = strlen(val);
                 if (len > 4 && !strcasecmp(val + len - 4, ".exr"))
                     env_path = val;
-                else if (!parse_rgb(val, s.env) || !(s.env[0] >= 0 && s.env[1] >= 0 && s.env[2] >= 0))
+                else if (!util_parse_rgb(val, s.env))
                     return cli_usage_error("render", "--env '%s': expected R,G,B, one value >= 0 or FILE.exr", val);
             } else if (!strcmp(a, "--ambient")) {
-                if (!parse_rgb(val, s.ambient) ||
-                    !(s.ambient[0] >= 0 && s.ambient[1] >= 0 && s.ambient[2] >= 0))
+                if (!util_parse_rgb(val, s.ambient))
                     return cli_usage_error("render", "--ambient '%s': expected R,G,B or one value >= 0", val);
                 s.ambient_set = true;
             } else if (!strcmp(a, "--max-depth")) {

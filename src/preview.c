@@ -627,18 +627,6 @@ static bool idle(const preview *p)
     return p->max_spp > 0 && p->spp >= p->max_spp && !p->restart && !p->save && !p->redraw;
 }
 
-static bool parse_rgb(const char *s, float out[3])
-{
-    int n = 0;
-    char tail;
-    if (sscanf(s, "%f,%f,%f%c", &out[0], &out[1], &out[2], &tail) == 3)
-        n = 3;
-    else if (util_parse_float(s, &out[0]))
-        n = 1, out[1] = out[2] = out[0];
-    return n > 0 && isfinite(out[0]) && isfinite(out[1]) && isfinite(out[2]) && out[0] >= 0 &&
-           out[1] >= 0 && out[2] >= 0;
-}
-
 static bool setup(preview *p, int device, bool validate, int width, int height)
 {
     const char *env = getenv("GONIO_VALIDATE");
@@ -785,7 +773,7 @@ int cmd_preview(int argc, char **argv)
                     return cli_usage_error("preview", "--max-depth '%s': expected an integer >= 0", val);
                 p->s.max_depth = (int)v;
             } else if (!strcmp(a, "--env")) {
-                if (!parse_rgb(val, p->s.env))
+                if (!util_parse_rgb(val, p->s.env))
                     return cli_usage_error("preview", "--env '%s': expected R,G,B or one value >= 0", val);
             } else if (!strcmp(a, "--exposure")) {
                 if (!util_parse_float(val, &p->exposure))

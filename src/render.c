@@ -103,8 +103,16 @@ static double scene_radius2(const scene *sc)
     return r2 > 0 ? r2 : 1;
 }
 
-#define GN_UNBOUNDED_BUDGET (1u << 30) /* traversal_budget on devices without a loop cap */
-static uint32_t traversal_budget(const gpu *g, uint32_t rays_per_invocation);
+/* llvmpipe (lavapipe) ends an invocation's loops silently after 65,535 iterations; real
+ * GPUs have no such cap. */
+static bool loop_capped(const gpu *g)
+{
+    VkPhysicalDeviceDriverProperties drv = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceProperties2 p2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2,
+                                      .pNext = &drv};
+    vkGetPhysicalDeviceProperties2(g->physical, &p2);
+    return drv.driverID == VK_DRIVER_ID_MESA_LLVMPIPE;
+}
 
 /* How many samples one invocation of the path kernel takes per dispatch, 1 to
  * GN_PATH_SAMPLES. More keep the SIMD lanes busier (glsl/path.comp). Each path has its own
@@ -115,10 +123,10 @@ static uint32_t traversal_budget(const gpu *g, uint32_t rays_per_invocation);
  * and reported, never silently cut (glsl/bvh.glsl). */
 static uint32_t path_samples(const renderer *r)
 {
+    if (!loop_capped(r->g))
+        return GN_PATH_SAMPLES;
     double per_path = 16.0 * (r->tree.sah_cost > 1 ? r->tree.sah_cost : 1) * 3 * 2;
     double n = floor(30000.0 / per_path);
-    if (traversal_budget(r->g, 1) == GN_UNBOUNDED_BUDGET) /* no loop cap */
-        return GN_PATH_SAMPLES;
     return n < 1 ? 1u : n > GN_PATH_SAMPLES ? GN_PATH_SAMPLES : (uint32_t)n;
 }
 
@@ -221,6 +229,7 @@ static void build_emitters(renderer *r, const GnPrim *prims)
         r->emitter_table[n] = (GnEmitter){i, (float)area, 0, 0};
         r->emitter_weight[n++] = lum * area * (m->flags & GN_MAT_DOUBLE_SIDED ? 2 : 1);
     }
+    r->num_area_emitters = n;
     for (uint32_t i = 0; i < sc->num_lights; i++) {
         const GnLight *l = &sc->lights[i];
         double w = luminance(&l->color.x);
@@ -370,12 +379,8 @@ bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out)
  * ray gets a share of that which leaves room for its shadow rays. Real GPUs have no such cap. */
 static uint32_t traversal_budget(const gpu *g, uint32_t rays_per_invocation)
 {
-    VkPhysicalDeviceDriverProperties drv = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
-    VkPhysicalDeviceProperties2 p2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2,
-                                      .pNext = &drv};
-    vkGetPhysicalDeviceProperties2(g->physical, &p2);
-    if (drv.driverID != VK_DRIVER_ID_MESA_LLVMPIPE)
-        return GN_UNBOUNDED_BUDGET;
+    if (!loop_capped(g))
+        return 1u << 30;
     /* A node visit costs one iteration and opens at most two leaves, each one more
      * iteration plus max_leaf_size (8 at most, the builder's cap): 19. The count is shared
      * by the 8 invocations of a SIMD group, so this keeps typical work well under the cap,
@@ -555,9 +560,8 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
                        (s->strategy ? GN_FEAT_STRATEGY : 0u) | (n > 1 ? GN_FEAT_LIGHT_SEARCH : 0u) |
                        (env > 0 || s->env[0] != 0 || s->env[1] != 0 || s->env[2] != 0 ? GN_FEAT_ENV : 0u) |
                        (s->env_map ? GN_FEAT_ENV | GN_FEAT_ENV_MAP : 0u);
-    for (uint32_t i = 0; i < n; i++)
-        if (r->emitter_table[i].prim != GN_INVALID && (r->emitter_table[i].prim & GN_EMITTER_LIGHT))
-            r->path_features |= GN_FEAT_PUNCTUAL;
+    if (r->num_emitters > r->num_area_emitters) /* punctual lights follow the triangles */
+        r->path_features |= GN_FEAT_PUNCTUAL;
     /* The unspecialised kernel, for checking that specialisation changes nothing
      * (tests/regress/path.sh) and for ruling it out when chasing a bug. */
     if (getenv("GONIO_ALL_FEATURES"))
@@ -616,10 +620,16 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     return true;
 }
 
+/* The GN_FEAT_* a mode's kernel is built for: only the path kernel is specialised. */
+static uint32_t kernel_features(const renderer *r, uint32_t mode)
+{
+    return mode == GN_MODE_PATH ? r->path_features : GN_FEAT_ALL;
+}
+
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec)
 {
     spec->values[0] = mode;
-    spec->values[1] = mode == GN_MODE_PATH ? r->path_features : GN_FEAT_ALL;
+    spec->values[1] = kernel_features(r, mode);
     spec->entries[0] = (VkSpecializationMapEntry){0, 0, sizeof(uint32_t)};
     spec->entries[1] = (VkSpecializationMapEntry){1, sizeof(uint32_t), sizeof(uint32_t)};
     spec->info = (VkSpecializationInfo){2, spec->entries, sizeof spec->values, spec->values};
@@ -629,7 +639,7 @@ const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
 {
     gpu_pipeline *p = &r->pipelines[mode];
-    uint32_t features = mode == GN_MODE_PATH ? r->path_features : GN_FEAT_ALL;
+    uint32_t features = kernel_features(r, mode);
     if (p->pipeline && r->pipeline_features[mode] != features)
         gpu_pipeline_destroy(r->g, p); /* built for other features: a new kernel */
     if (!p->pipeline) {

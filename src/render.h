@@ -50,6 +50,7 @@ typedef struct renderer {
     const scene *sc;
     bvh tree;
     uint32_t num_lights, num_emitters;
+    uint32_t num_area_emitters; /* the emitter table's triangles, before its punctual lights */
     gpu_buffer frame, nodes, tris, prims, vertices, materials, lights, texels, textures,
         emitters, vcolor, status;
     gpu_buffer accum, aov;  /* sized for the current image */

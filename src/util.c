@@ -105,6 +105,28 @@ bool util_parse_float(const char *s, float *out)
     return true;
 }
 
+bool util_parse_rgb(const char *s, float out[3])
+{
+    char buf[128], *g, *b;
+    if (!s || strlen(s) >= sizeof buf)
+        return false;
+    strcpy(buf, s);
+    if (!(g = strchr(buf, ','))) {
+        if (!util_parse_float(buf, &out[0]))
+            return false;
+        out[1] = out[2] = out[0];
+    } else {
+        *g++ = 0;
+        if (!(b = strchr(g, ',')))
+            return false;
+        *b++ = 0;
+        if (!util_parse_float(buf, &out[0]) || !util_parse_float(g, &out[1]) ||
+            !util_parse_float(b, &out[2]))
+            return false;
+    }
+    return out[0] >= 0 && out[1] >= 0 && out[2] >= 0;
+}
+
 bool util_parse_size(const char *s, int *w, int *h)
 {
     char buf[64];

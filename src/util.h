@@ -40,6 +40,8 @@ void *util_realloc(void *ptr, size_t size);
 /* Strict number parsing: the whole string must be a number in range; false otherwise. */
 bool util_parse_int(const char *s, long min, long max, long *out);
 bool util_parse_float(const char *s, float *out);
+/* "R,G,B" or one value V (= V,V,V), each finite and >= 0: a colour or a radiance. */
+bool util_parse_rgb(const char *s, float out[3]);
 /* "WxH" -> width, height (each 1..16384). */
 bool util_parse_size(const char *s, int *w, int *h);
 
