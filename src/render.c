@@ -723,6 +723,7 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
     const VkDeviceSize pixels = (VkDeviceSize)s->width * s->height;
     double t0, last_progress = 0;
     int done = 0, batch = 1;
+    const int per = s->mode == GN_MODE_PATH ? (int)r->path_samples : 1;
     bool show_progress = s->progress && isatty(2);
 
     memset(stats, 0, sizeof *stats);
@@ -735,12 +736,15 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
 
     /* Passes are submitted in batches sized to take 0.1 to 0.4 s each: short enough for a
      * responsive progress bar and an early stop, long enough to hide submission costs and
-     * to let the path kernel take several samples per dispatch (renderer_record_samples). */
+     * to let the path kernel take several samples per dispatch (renderer_record_samples).
+     * A batch is a whole number of dispatches of `per` samples, so dispatches always start
+     * at multiples of `per`: each pixel's samples are summed in the same groups and order
+     * however long the batches took, and the same command gives the same bits. */
     t0 = util_now();
     while (s->time_limit > 0 || done < s->spp) {
         VkCommandBuffer cmd = gpu_begin(g);
         double tb = util_now();
-        int n = batch;
+        int n = batch * per;
         if (s->time_limit <= 0 && n > s->spp - done)
             n = s->spp - done;
         renderer_record_samples(r, cmd, s->mode, (uint32_t)done, (uint32_t)n);
