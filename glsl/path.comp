@@ -22,7 +22,14 @@ layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
 
 layout(std430, binding = GN_BIND_ACCUM) buffer AccumBlock { vec4 accum[]; };
 layout(std430, binding = GN_BIND_AOV) buffer AovBlock { vec4 aov[]; };
-layout(std430, binding = GN_BIND_EMITTERS) readonly buffer EmitterBlock { GnEmitter emitters[]; };
+// GnEmitter[] as one RGBA32UI texel each (a storage buffer read with per-lane indices costs
+// llvmpipe a scalar load per lane and component: scene.glsl).
+layout(binding = GN_BIND_EMITTERS) uniform usamplerBuffer emitter_texels;
+GnEmitter emitter_at(uint i)
+{
+    uvec4 t = texelFetch(emitter_texels, int(i));
+    return GnEmitter(t.x, uintBitsToFloat(t.y), uintBitsToFloat(t.z), uintBitsToFloat(t.w));
+}
 layout(std430, binding = GN_BIND_STATUS) buffer StatusBlock { uint status[]; };
 layout(std430, binding = GN_BIND_SQUARES) buffer SquaresBlock { vec4 squares[]; };
 // Lat-long map: 2 words (RGB as half floats) per texel, rows top (+Y) to bottom, then the
@@ -190,9 +197,9 @@ LightSample light_sample(vec3 p, vec3 u)
     uint lo = 0u, hi = frame.num_emitters - 1u;
     while (GN_HAS(GN_FEAT_LIGHT_SEARCH) && lo < hi) {
         uint mid = (lo + hi) / 2u;
-        if (emitters[mid].cdf > u.x) hi = mid; else lo = mid + 1u;
+        if (emitter_at(mid).cdf > u.x) hi = mid; else lo = mid + 1u;
     }
-    GnEmitter e = emitters[lo];
+    GnEmitter e = emitter_at(lo);
     if (GN_HAS(GN_FEAT_ENV) && e.prim == GN_INVALID) {
         float pdf = 1.0 / (4.0 * PI);
         if (GN_HAS(GN_FEAT_ENV_MAP) && (frame.flags & GN_FRAME_ENV_MAP) != 0u)

@@ -304,7 +304,7 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     gpu_buffer_create_storage(g, &r->texels, texels, sizeof(uint32_t) * total_texels);
     gpu_buffer_create_storage(g, &r->textures, tex, sizeof(GnTexture) * sc->num_textures);
     build_emitters(r, prims);
-    gpu_buffer_create_storage(g, &r->emitters, NULL, sizeof(GnEmitter) * (r->num_emitters + 1));
+    gpu_buffer_create_texels(g, &r->emitters, NULL, sizeof(GnEmitter) * (r->num_emitters + 1));
     gpu_buffer_create_storage(g, &r->env, NULL, 16);
     /* Gouraud colours, two sides per vertex; the material of each vertex rides in the bits of
      * the first one's w for glsl/vertex.comp (a vertex belongs to one glTF primitive). */
@@ -411,7 +411,7 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
         {GN_BIND_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->accum},
         {GN_BIND_AOV, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->aov},
         {GN_BIND_VCOLOR, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->vcolor},
-        {GN_BIND_EMITTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->emitters},
+        {GN_BIND_EMITTERS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->emitters},
         {GN_BIND_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->status},
         {GN_BIND_SQUARES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->squares},
         {GN_BIND_ENV, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->env},
