@@ -17,7 +17,7 @@ layout(push_constant) uniform PushBlock { GnPush push; };
 
 void main()
 {
-    uvec2 px = gl_GlobalInvocationID.xy;
+    uvec2 px = tile_pixel();
     if (px.x >= frame.width || px.y >= frame.height)
         return;
     uint pixel = px.y * frame.width + px.x;

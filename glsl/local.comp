@@ -47,7 +47,7 @@ vec3 flat_color(Hit h, vec3 d)
 
 void main()
 {
-    uvec2 px = gl_GlobalInvocationID.xy;
+    uvec2 px = tile_pixel();
     if (px.x >= frame.width || px.y >= frame.height)
         return;
     uint pixel = px.y * frame.width + px.x;

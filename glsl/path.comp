@@ -319,7 +319,7 @@ uint path_step()
 
 void main()
 {
-    px = gl_GlobalInvocationID.xy;
+    px = tile_pixel();
     if (px.x >= frame.width || px.y >= frame.height)
         return;
     pixel = px.y * frame.width + px.x;

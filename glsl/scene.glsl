@@ -230,4 +230,14 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     return s;
 }
 
+// The pixel of this invocation. lavapipe runs a work group as SIMD groups of 8 consecutive
+// invocations; laid out as 4x2 blocks of the 8x8 tile (not rows of 8), the rays of a SIMD
+// group start closer together and walk more of the same nodes.
+uvec2 tile_pixel()
+{
+    uint l = gl_LocalInvocationIndex, c = l >> 3u, j = l & 7u;
+    return gl_WorkGroupID.xy * uvec2(GN_TILE_X, GN_TILE_Y) +
+           uvec2((c & 1u) * 4u + (j & 3u), (c >> 1u) * 2u + (j >> 2u));
+}
+
 #endif
