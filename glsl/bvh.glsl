@@ -14,8 +14,6 @@
 
 #include "scene.glsl"
 
-#define BVH_STACK 64
-
 GnBvhNode bvh_node(uint i)
 {
     int k = int(4u * i);
@@ -149,8 +147,11 @@ uint walk_leaf_last(uint entry) { return walk_leaf_first(entry) + ((entry >> 27)
 struct Walk {
     Hit hit;
     uint node;      // next entry (walk_entry) to visit, GN_INVALID when the walk is over
-    int sp;
-    uint stack[BVH_STACK];
+    int sp;         // stack entries in use, the sentinel included
+    // stack[0] is a sentinel (GN_INVALID: popping it ends the walk), stack[1, sp) the nodes
+    // put off for later; bvh_walk writes stack[sp] on every node visit, so a full stack
+    // keeps one entry free: at most GN_WALK_STACK - 2 nodes.
+    uint stack[GN_WALK_STACK];
 };
 
 // The walk of this invocation: a private global that bvh_walk works on in place (as a
@@ -162,7 +163,8 @@ void walk_start(float tmax)
     walk.hit.t = tmax; walk.hit.u = 0.0; walk.hit.v = 0.0; walk.hit.tri = GN_INVALID;
     walk.hit.steps = 0u; walk.hit.truncated = false;
     walk.node = 0u;
-    walk.sp = 0;
+    walk.sp = 1;
+    walk.stack[0] = GN_INVALID;
 }
 
 // Continues `walk` for at most `budget` more node visits. Closest hit (any_hit false) or
@@ -187,17 +189,18 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
             float ea = n.a_index == GN_INVALID ? 1e38 : box_enter(r, n.a_min, n.a_max, tmin, w.hit.t);
             float eb = n.b_index == GN_INVALID ? 1e38 : box_enter(r, n.b_min, n.b_max, tmin, w.hit.t);
             uint ca = walk_entry(n.a_index, n.a_count), cb = walk_entry(n.b_index, n.b_count);
-            if (ea < 1e38 && eb < 1e38) {
-                // Both: go to the nearer (a on a tie), keep the farther.
-                bool a_first = ea <= eb;
-                if (w.sp == BVH_STACK) { w.hit.truncated = true; w.node = GN_INVALID; return; }
-                w.stack[w.sp++] = a_first ? cb : ca;
-                w.node = a_first ? ca : cb;
-            } else if (ea < 1e38 || eb < 1e38) {
-                w.node = ea < 1e38 ? ca : cb;
-            } else {
-                w.node = w.sp == 0 ? GN_INVALID : w.stack[--w.sp];
-            }
+            bool hit_a = ea < 1e38, hit_b = eb < 1e38, both = hit_a && hit_b;
+            if (both && w.sp == GN_WALK_STACK - 1) { w.hit.truncated = true; w.node = GN_INVALID; return; }
+            // Both: go to the nearer (a on a tie), keep the farther; one: go there; none: pop.
+            // The stack is read and written by every lane, whatever its case (the write lands
+            // above the top when nothing is pushed): llvmpipe stores and loads an array at
+            // per-lane indices one lane at a time, branching on each lane's mask, and a mask
+            // that follows the case of each lane is one the branch predictor cannot learn.
+            bool a_first = hit_a && (!hit_b || ea <= eb);
+            uint top = w.stack[w.sp - 1];
+            w.stack[w.sp] = a_first ? cb : ca;
+            w.node = (hit_a || hit_b) ? (a_first ? ca : cb) : top;
+            w.sp = both ? w.sp + 1 : (hit_a || hit_b) ? w.sp : max(w.sp - 1, 1);
         }
         // A leaf, unless llvmpipe's loop cap ended the loop above early (see below).
         bool leaf = w.node != GN_INVALID && (w.node & GN_WALK_LEAF) != 0u;
@@ -210,8 +213,11 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
             }
         }
         if (leaf && any_hit && w.hit.tri != GN_INVALID) { w.node = GN_INVALID; return; }
-        if (leaf)
-            w.node = w.sp == 0 ? GN_INVALID : w.stack[--w.sp];
+        uint top = w.stack[w.sp - 1]; // read by every lane, as above
+        if (leaf) {
+            w.node = top;
+            w.sp = max(w.sp - 1, 1);
+        }
     }
     // The loop ends with the walk over, or else because llvmpipe's loop cap stopped it: the
     // state is still whole (the cap ends loops between iterations), so say so and the

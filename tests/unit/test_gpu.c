@@ -25,8 +25,8 @@ typedef struct gpu_hit {
     float steps, unfinished, pad0, pad1;
 } gpu_hit;
 
-/* A Walk of bvh.glsl in std430: Hit (6 words), node, sp, stack[64]. */
-#define WALK_BYTES (4 * (6 + 2 + 64))
+/* A Walk of bvh.glsl in std430: Hit (6 words), node, sp, stack. */
+#define WALK_BYTES (4 * (6 + 2 + GN_WALK_STACK))
 
 bool test_open_gpu(gpu *g)
 {
