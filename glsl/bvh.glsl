@@ -181,16 +181,17 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
 #define w walk
     uint end = w.hit.steps + budget;
     w.hit.truncated = false;
-    while (w.node != GN_INVALID) {
+    // No early returns: llvmpipe masks every statement after one again; a break costs less.
+    while (w.node != GN_INVALID && !w.hit.truncated) {
         while (w.node != GN_INVALID && (w.node & GN_WALK_LEAF) == 0u) {
-            if (w.hit.steps >= end) { w.hit.truncated = true; return; }
+            if (w.hit.steps >= end) { w.hit.truncated = true; break; }
             w.hit.steps++;
             GnBvhNode n = bvh_node(w.node);
             float ea = n.a_index == GN_INVALID ? 1e38 : box_enter(r, n.a_min, n.a_max, tmin, w.hit.t);
             float eb = n.b_index == GN_INVALID ? 1e38 : box_enter(r, n.b_min, n.b_max, tmin, w.hit.t);
             uint ca = walk_entry(n.a_index, n.a_count), cb = walk_entry(n.b_index, n.b_count);
             bool hit_a = ea < 1e38, hit_b = eb < 1e38, both = hit_a && hit_b;
-            if (both && w.sp == GN_WALK_STACK - 1) { w.hit.truncated = true; w.node = GN_INVALID; return; }
+            if (both && w.sp == GN_WALK_STACK - 1) { w.hit.truncated = true; w.node = GN_INVALID; break; }
             // Both: go to the nearer (a on a tie), keep the farther; one: go there; none: pop.
             // The stack is read and written by every lane, whatever its case (the write lands
             // above the top when nothing is pushed): llvmpipe stores and loads an array at
@@ -202,7 +203,7 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
             w.node = (hit_a || hit_b) ? (a_first ? ca : cb) : top;
             w.sp = both ? w.sp + 1 : (hit_a || hit_b) ? w.sp : max(w.sp - 1, 1);
         }
-        // A leaf, unless llvmpipe's loop cap ended the loop above early (see below).
+        // A leaf, unless the budget or llvmpipe's loop cap ended the loop above early.
         bool leaf = w.node != GN_INVALID && (w.node & GN_WALK_LEAF) != 0u;
         uint last = walk_leaf_last(w.node);
         for (uint i = walk_leaf_first(w.node); leaf && i <= last && !(any_hit && w.hit.tri != GN_INVALID); i++) {
@@ -212,10 +213,10 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
                 w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = i;
             }
         }
-        if (leaf && any_hit && w.hit.tri != GN_INVALID) { w.node = GN_INVALID; return; }
+        bool found = any_hit && w.hit.tri != GN_INVALID; // any hit: the walk is over
         uint top = w.stack[w.sp - 1]; // read by every lane, as above
         if (leaf) {
-            w.node = top;
+            w.node = found ? GN_INVALID : top;
             w.sp = max(w.sp - 1, 1);
         }
     }
