@@ -12,10 +12,12 @@
 // ~18 ms per dispatch of the path kernel (7x the whole render of a 32x32 image).
 layout(std430, binding = GN_BIND_FRAME) readonly buffer FrameBlock { GnFrame frame; };
 // The BVH nodes (GnBvhNode = 4 texels), triangle corners (GnTri = 3), shading triangles
-// (GnPrim = 1), vertices (GnVertex = 3) and materials (GnMaterial = 12) are read from
-// RGBA32UI texel buffers, not storage buffers: llvmpipe fetches a storage buffer with
-// per-lane offsets one lane and one component at a time, a texel buffer with vector
-// gathers, which makes the walk several times faster there; GPUs read both at full speed.
+// (GnPrim = 1), vertices (GnVertex = 4), materials (GnMaterial = 12), textures (GnTexture =
+// 1; their RGBA8 images: R32UI) and path.comp's lights (GnEmitter = 1) are read from texel
+// buffers, not storage buffers: llvmpipe fetches a storage buffer with per-lane offsets one
+// lane and one component at a time, branching on each lane's mask, a texel buffer with
+// one load per lane and no branches, which makes the walk several times faster there;
+// GPUs read both at full speed.
 // An integer format passes every bit through (a float format may flush the denormals that
 // small integers stored as floats are); floats come back with uintBitsToFloat.
 layout(binding = GN_BIND_NODES) uniform usamplerBuffer node_texels;
@@ -24,8 +26,8 @@ layout(binding = GN_BIND_PRIMS) uniform usamplerBuffer prim_texels;
 layout(binding = GN_BIND_VERTICES) uniform usamplerBuffer vertex_texels;
 layout(binding = GN_BIND_MATERIALS) uniform usamplerBuffer material_texels;
 layout(std430, binding = GN_BIND_LIGHTS) readonly buffer LightBlock { GnLight lights[]; };
-layout(std430, binding = GN_BIND_TEXELS) readonly buffer TexelBlock { uint texels[]; };
-layout(std430, binding = GN_BIND_TEXTURES) readonly buffer TextureBlock { GnTexture textures[]; };
+layout(binding = GN_BIND_TEXELS) uniform usamplerBuffer texels; // R32UI: one RGBA8 texel each
+layout(binding = GN_BIND_TEXTURES) uniform usamplerBuffer texture_texels; // GnTexture[]
 
 const float PI = 3.14159265358979323846;
 
@@ -90,7 +92,7 @@ vec3 camera_dir(vec2 p)
 // so an arbitrary number of textures cannot be bound as samplers), filtered here ----------
 vec4 texel_fetch(GnTexture t, ivec2 p)
 {
-    uint c = texels[t.offset + uint(p.y) * t.width + uint(p.x)];
+    uint c = texelFetch(texels, int(t.offset + uint(p.y) * t.width + uint(p.x))).x;
     return vec4(c & 255u, (c >> 8u) & 255u, (c >> 16u) & 255u, c >> 24u) * (1.0 / 255.0);
 }
 
@@ -115,7 +117,8 @@ vec4 srgb_to_linear(vec4 c)
 // Bilinear (or nearest) lookup; srgb decodes before filtering, as GPUs do.
 vec4 texture_sample(uint index, vec2 uv, bool srgb)
 {
-    GnTexture t = textures[index];
+    uvec4 tt = texelFetch(texture_texels, int(index));
+    GnTexture t = GnTexture(tt.x, tt.y, tt.z, tt.w);
     int w = int(t.width), h = int(t.height);
     uint ws = t.flags & 3u, wt = (t.flags >> 2u) & 3u;
     vec2 p = uv * vec2(w, h) - 0.5;

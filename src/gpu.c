@@ -360,6 +360,12 @@ void gpu_buffer_create(gpu *g, gpu_buffer *b, VkDeviceSize size, VkBufferUsageFl
 
 void gpu_buffer_create_texels(gpu *g, gpu_buffer *b, const void *data, VkDeviceSize size)
 {
+    gpu_buffer_create_texels_as(g, b, data, size, VK_FORMAT_R32G32B32A32_UINT);
+}
+
+void gpu_buffer_create_texels_as(gpu *g, gpu_buffer *b, const void *data, VkDeviceSize size,
+                                 VkFormat format)
+{
     VkBufferViewCreateInfo vci = {.sType = VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
     gpu_buffer_create(g, b, size, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT, GPU_MEMORY_DEVICE);
     if (data)
@@ -367,7 +373,7 @@ void gpu_buffer_create_texels(gpu *g, gpu_buffer *b, const void *data, VkDeviceS
     else
         gpu_buffer_fill_zero(g, b);
     vci.buffer = b->buffer;
-    vci.format = VK_FORMAT_R32G32B32A32_UINT; /* bits pass through unchanged */
+    vci.format = format;
     vci.range = b->size;
     GPU_CHECK(vkCreateBufferView(g->device, &vci, NULL, &b->view));
 }

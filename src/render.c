@@ -278,6 +278,7 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
         total_texels += sc->images[i].width * sc->images[i].height;
     }
     texels = util_malloc(sizeof *texels * (total_texels + 1));
+    texels[total_texels] = 0; /* the buffer is never empty */
     for (uint32_t i = 0; i < sc->num_images; i++)
         memcpy(texels + image_offset[i], sc->images[i].rgba8,
                (size_t)sc->images[i].width * sc->images[i].height * 4);
@@ -301,8 +302,9 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     gpu_buffer_create_texels(g, &r->vertices, sc->vertices, sizeof(GnVertex) * sc->num_vertices);
     gpu_buffer_create_texels(g, &r->materials, sc->materials, sizeof(GnMaterial) * sc->num_materials);
     gpu_buffer_create_storage(g, &r->lights, lights, sizeof(GnLight) * r->num_lights);
-    gpu_buffer_create_storage(g, &r->texels, texels, sizeof(uint32_t) * total_texels);
-    gpu_buffer_create_storage(g, &r->textures, tex, sizeof(GnTexture) * sc->num_textures);
+    gpu_buffer_create_texels_as(g, &r->texels, texels, sizeof(uint32_t) * (total_texels + 1),
+                                VK_FORMAT_R32_UINT);
+    gpu_buffer_create_texels(g, &r->textures, tex, sizeof(GnTexture) * (sc->num_textures + 1));
     build_emitters(r, prims);
     gpu_buffer_create_texels(g, &r->emitters, NULL, sizeof(GnEmitter) * (r->num_emitters + 1));
     gpu_buffer_create_storage(g, &r->env, NULL, 16);
@@ -406,8 +408,8 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
         {GN_BIND_VERTICES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->vertices},
         {GN_BIND_MATERIALS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->materials},
         {GN_BIND_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->lights},
-        {GN_BIND_TEXELS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->texels},
-        {GN_BIND_TEXTURES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->textures},
+        {GN_BIND_TEXELS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->texels},
+        {GN_BIND_TEXTURES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->textures},
         {GN_BIND_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->accum},
         {GN_BIND_AOV, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->aov},
         {GN_BIND_VCOLOR, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->vcolor},
