@@ -34,7 +34,9 @@ layout(std430, binding = GN_BIND_STATUS) buffer StatusBlock { uint status[]; };
 layout(std430, binding = GN_BIND_SQUARES) buffer SquaresBlock { vec4 squares[]; };
 // Lat-long map: 2 words (RGB as half floats) per texel, rows top (+Y) to bottom, then the
 // marginal CDF of the rows (env_height floats), then each row's conditional CDF.
-layout(std430, binding = GN_BIND_ENV) readonly buffer EnvBlock { uint envdata[]; };
+// (An R32UI texel buffer: a storage buffer's per-lane reads cost llvmpipe a branch per lane.)
+layout(binding = GN_BIND_ENV) uniform usamplerBuffer env_texels;
+uint envdata(uint i) { return texelFetch(env_texels, int(i)).x; }
 layout(push_constant) uniform PushBlock { GnPush push; };
 
 #define ROULETTE_DEPTH 3u
@@ -76,7 +78,7 @@ ivec2 env_texel(vec3 d, out float sin_theta)
                  min(uint(v * float(frame.env_height)), frame.env_height - 1u));
 }
 
-float env_cdf(uint i) { return uintBitsToFloat(envdata[i]); }
+float env_cdf(uint i) { return uintBitsToFloat(envdata(i)); }
 
 // Density (over the unit square) of the map's sampler in texel xy: exactly the mass the
 // CDFs give the texel, times the texel count.
@@ -97,7 +99,7 @@ vec3 env_radiance(vec3 d)
     float st;
     ivec2 xy = env_texel(d, st);
     uint i = 2u * (uint(xy.y) * frame.env_width + uint(xy.x));
-    return vec3(unpackHalf2x16(envdata[i]), unpackHalf2x16(envdata[i + 1u]).x);
+    return vec3(unpackHalf2x16(envdata(i)), unpackHalf2x16(envdata(i + 1u)).x);
 }
 
 // Solid-angle density with which light sampling picks direction d toward the environment.

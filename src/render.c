@@ -307,7 +307,7 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     gpu_buffer_create_texels(g, &r->textures, tex, sizeof(GnTexture) * (sc->num_textures + 1));
     build_emitters(r, prims);
     gpu_buffer_create_texels(g, &r->emitters, NULL, sizeof(GnEmitter) * (r->num_emitters + 1));
-    gpu_buffer_create_storage(g, &r->env, NULL, 16);
+    gpu_buffer_create_texels_as(g, &r->env, NULL, 16, VK_FORMAT_R32_UINT);
     /* Gouraud colours, two sides per vertex; the material of each vertex rides in the bits of
      * the first one's w for glsl/vertex.comp (a vertex belongs to one glTF primitive). */
     vcolor = util_calloc(2 * (size_t)sc->num_vertices, sizeof *vcolor);
@@ -416,7 +416,7 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
         {GN_BIND_EMITTERS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->emitters},
         {GN_BIND_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->status},
         {GN_BIND_SQUARES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->squares},
-        {GN_BIND_ENV, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->env},
+        {GN_BIND_ENV, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->env},
     };
     memcpy(b, all, sizeof all);
     return sizeof all / sizeof *all;
@@ -478,8 +478,10 @@ static bool upload_env_map(renderer *r, const image *map)
         free(row);
         return false;
     }
-    if (words * 4 > 128u << 20) {
-        util_error("--env: the map's %dx%d texels exceed the 128 MiB a buffer may hold", w, h);
+    if (words > r->g->props.limits.maxTexelBufferElements) {
+        util_error("--env: the map's %dx%d texels and tables need %zu words, more than the %u "
+                   "of a texel buffer on this device", w, h, words,
+                   r->g->props.limits.maxTexelBufferElements);
         free(row);
         return false;
     }
@@ -515,7 +517,7 @@ static bool upload_env_map(renderer *r, const image *map)
     }
     marg[h - 1] = 1;
     gpu_buffer_destroy(r->g, &r->env);
-    gpu_buffer_create_storage(r->g, &r->env, data, words * 4);
+    gpu_buffer_create_texels_as(r->g, &r->env, data, words * 4, VK_FORMAT_R32_UINT);
     for (uint32_t i = 0; i < GN_MODE_COUNT; i++) /* their descriptor sets name the old buffer */
         gpu_pipeline_destroy(r->g, &r->pipelines[i]);
     /* mean L over the sphere = sum(L sin dtheta dphi) / 4 pi, dtheta dphi = 2 pi^2 / n */
