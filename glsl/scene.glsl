@@ -5,6 +5,7 @@
 #define GONIO_SCENE_GLSL
 
 #include "shared.h"
+#include "wrap.glsl"
 #include "sampling.glsl"
 
 // GnFrame is read from a storage buffer, not a uniform buffer: lavapipe inlines uniform
@@ -94,18 +95,6 @@ vec4 texel_fetch(GnTexture t, ivec2 p)
 {
     uint c = texelFetch(texels, int(t.offset + uint(p.y) * t.width + uint(p.x))).x;
     return vec4(c & 255u, (c >> 8u) & 255u, (c >> 16u) & 255u, c >> 24u) * (1.0 / 255.0);
-}
-
-int tex_wrap(int i, int n, uint mode)
-{
-    if (mode == GN_WRAP_CLAMP)
-        return clamp(i, 0, n - 1);
-    if (mode == GN_WRAP_MIRROR) {
-        int period = 2 * n;
-        int m = ((i % period) + period) % period;
-        return m < n ? m : period - 1 - m;
-    }
-    return ((i % n) + n) % n;
 }
 
 vec4 srgb_to_linear(vec4 c)

@@ -14,6 +14,7 @@
 #include "scene_mesh.h"
 #include "test.h"
 #include "trace_test.h" /* spv_trace_test: glsl/trace_test.comp compiled by the build */
+#include "wrap_test.h"  /* spv_wrap_test: glsl/wrap_test.comp */
 
 typedef struct ray {
     float o[3], tmin, d[3], tmax;
@@ -300,5 +301,71 @@ void test_gpu_traversal_deep(void)
            h[0].tri, h[0].t, c0.t);
     bvh_destroy(&b);
     meshgen_destroy(&m);
+    gpu_destroy(&g);
+}
+
+/* Texture wrapping (glsl/wrap.glsl computes the modulo through a float quotient) against
+ * integer arithmetic: every mode, texture sizes from 1 to 2^13 + 1, indices around multiples
+ * of the period, negative ones and ones near 2^24 (the function's exact range). */
+static int wrap_reference(int i, int n, int mode)
+{
+    int p = mode == 2 ? 2 * n : n, m;
+    if (mode == 1)
+        return i < 0 ? 0 : i >= n ? n - 1 : i;
+    m = i % p;
+    m = m < 0 ? m + p : m;
+    return mode == 2 && m >= n ? p - 1 - m : m;
+}
+
+void test_gpu_texture_wrap(void)
+{
+    static const int sizes[] = {1, 2, 3, 5, 7, 64, 100, 255, 1000, 2048, 4095, 8193};
+    static const int centres[] = {0, 1, -1, 1 << 12, -(1 << 12), (1 << 24) - 20000, -(1 << 24) + 20000};
+    enum { SPAN = 40 };
+    const uint32_t n = 3 * (sizeof sizes / sizeof *sizes) * (sizeof centres / sizeof *centres) * 3 * SPAN;
+    gpu g = {0};
+    gpu_buffer q, out;
+    gpu_pipeline p;
+    uint32_t k = 0, bad = 0, first_bad = 0;
+    if (!test_open_gpu(&g))
+        return;
+    gpu_buffer_create(&g, &q, 16 * (VkDeviceSize)n, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+    gpu_buffer_create(&g, &out, 4 * (VkDeviceSize)n, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+    int32_t *qs = q.mapped;
+    for (int mode = 0; mode < 3; mode++)
+        for (size_t a = 0; a < sizeof sizes / sizeof *sizes; a++)
+            for (size_t c = 0; c < sizeof centres / sizeof *centres; c++)
+                for (int j = -SPAN; j < 2 * SPAN; j++) {
+                    /* around the centre and around the centre's multiple of the period */
+                    int per = mode == 2 ? 2 * sizes[a] : sizes[a];
+                    int base = j < SPAN / 2 ? centres[c] : centres[c] - centres[c] % per;
+                    qs[4 * k] = base + j;
+                    qs[4 * k + 1] = sizes[a];
+                    qs[4 * k + 2] = mode;
+                    qs[4 * k + 3] = 0;
+                    k++;
+                }
+    {
+        const gpu_binding bind[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &q},
+                                    {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &out}};
+        gpu_pipeline_desc pd = {.name = "wrap_test", .code = spv_wrap_test, .code_size = sizeof spv_wrap_test,
+                                .local_size = {64, 1, 1}, .push_size = 4, .bindings = bind, .num_bindings = 2};
+        VkCommandBuffer cmd;
+        gpu_pipeline_create(&g, &p, &pd);
+        cmd = gpu_begin(&g);
+        gpu_dispatch(cmd, &p, &k, k, 1, 1);
+        gpu_submit_wait(&g, cmd);
+    }
+    for (uint32_t i = 0; i < k; i++)
+        if (((int32_t *)out.mapped)[i] != wrap_reference(qs[4 * i], qs[4 * i + 1], qs[4 * i + 2]))
+            first_bad = bad++ ? first_bad : i;
+    CHECKF(bad == 0, "%u of %u wraps wrong, first: mode %d, i %d, n %d: %d, not %d", bad, k,
+           qs[4 * first_bad + 2], qs[4 * first_bad], qs[4 * first_bad + 1],
+           ((int32_t *)out.mapped)[first_bad],
+           wrap_reference(qs[4 * first_bad], qs[4 * first_bad + 1], qs[4 * first_bad + 2]));
+    printf("    texture wrap: %u queries\n", k);
+    gpu_pipeline_destroy(&g, &p);
+    gpu_buffer_destroy(&g, &out);
+    gpu_buffer_destroy(&g, &q);
     gpu_destroy(&g);
 }
