@@ -155,7 +155,7 @@ struct Walk {
 };
 
 // The walk of this invocation: a private global that bvh_walk works on in place (as a
-// function parameter its 64-entry stack would be copied in and out on every trace).
+// function parameter its stack would be copied in and out on every trace).
 Walk walk;
 
 void walk_start(float tmax)

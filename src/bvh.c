@@ -31,6 +31,7 @@
                             250k) and lavapipe traces as fast (gonio bench --generate 250000) */
 #define BVH_MAX_LEAF 8   /* above this a node is split even when the SAH prefers a leaf */
 #define BVH_MAX_DEPTH 64 /* GnBvhNode levels; the traversal stack (64) never overflows */
+_Static_assert(GN_WALK_STACK - 2 >= BVH_MAX_DEPTH - 1, "glsl/bvh.glsl's stack must hold a deepest walk");
 /* Threads: the top levels are built on one thread until there are a few subtrees per thread
  * (at most BVH_SUBTREES), which the threads then share; below BVH_PARALLEL_MIN triangles
  * threads cost more than they save. */
