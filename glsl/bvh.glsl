@@ -80,6 +80,8 @@ float diff_of_products(float a, float b, float c, float d)
 
 // Watertight test: vertices relative to the origin, sheared so the ray is +z; the edge
 // functions decide inside-ness exactly consistently on shared edges.
+// Branch-free (llvmpipe runs every side of every branch anyway, and masks each assignment
+// after an early return): one result at the end.
 bool tri_intersect(RayPre r, vec3 p0, vec3 p1, vec3 p2, float tmin, float tmax,
                    out float t, out float u, out float v)
 {
@@ -87,31 +89,22 @@ bool tri_intersect(RayPre r, vec3 p0, vec3 p1, vec3 p2, float tmin, float tmax,
     float Ax = dot(r.sx, A), Ay = dot(r.sy, A);
     float Bx = dot(r.sx, B), By = dot(r.sy, B);
     float Cx = dot(r.sx, C), Cy = dot(r.sy, C);
-    float U = Cx * By - Cy * Bx;
-    float V = Ax * Cy - Ay * Cx;
-    float W = Bx * Ay - By * Ax;
-    // On an edge (a zero), Woop et al. recompute in double precision; many GPUs have no
-    // fp64, and Kahan's FMA form is within 1.5 ulp of exact, so its sign (and zero) is the
-    // exact one.
-    if (U == 0.0 || V == 0.0 || W == 0.0) {
-        U = diff_of_products(Cx, By, Cy, Bx);
-        V = diff_of_products(Ax, Cy, Ay, Cx);
-        W = diff_of_products(Bx, Ay, By, Ax);
-    }
-    if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0))
-        return false;
+    // The edge functions in Kahan's FMA form, within 1.5 ulp of exact, so each has the sign
+    // (and zero) of the exact value: Woop et al. recompute in double precision when a plain
+    // product difference is 0, but many GPUs have no fp64, and an exact sign every time
+    // costs llvmpipe less than a test and a masked recomputation.
+    float U = diff_of_products(Cx, By, Cy, Bx);
+    float V = diff_of_products(Ax, Cy, Ay, Cx);
+    float W = diff_of_products(Bx, Ay, By, Ax);
+    bool outside = (U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0);
     float det = U + V + W;
-    if (det == 0.0)
-        return false;
     float Az = dot(r.sz, A), Bz = dot(r.sz, B), Cz = dot(r.sz, C);
     float T = U * Az + V * Bz + W * Cz;
     float rcp = 1.0 / det;
     t = T * rcp;
-    if (!(t > tmin && t < tmax))
-        return false;
     u = V * rcp;
     v = W * rcp;
-    return true;
+    return !outside && det != 0.0 && t > tmin && t < tmax;
 }
 
 // max and min of numbers that are never NaN here: GLSL's max and min must return the
