@@ -176,15 +176,15 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
     w.hit.truncated = false;
     // No early returns: llvmpipe masks every statement after one again; a break costs less.
     while (w.node != GN_INVALID && !w.hit.truncated) {
-        while (w.node != GN_INVALID && (w.node & GN_WALK_LEAF) == 0u) {
-            if (w.hit.steps >= end) { w.hit.truncated = true; break; }
+        // Inner nodes while the budget lasts (in the loop's condition: a `break` in the body
+        // would mask every statement after it).
+        while (w.node != GN_INVALID && (w.node & GN_WALK_LEAF) == 0u && w.hit.steps < end) {
             w.hit.steps++;
             GnBvhNode n = bvh_node(w.node);
             float ea = n.a_index == GN_INVALID ? 1e38 : box_enter(r, n.a_min, n.a_max, tmin, w.hit.t);
             float eb = n.b_index == GN_INVALID ? 1e38 : box_enter(r, n.b_min, n.b_max, tmin, w.hit.t);
             uint ca = walk_entry(n.a_index, n.a_count), cb = walk_entry(n.b_index, n.b_count);
             bool hit_a = ea < 1e38, hit_b = eb < 1e38, both = hit_a && hit_b;
-            if (both && w.sp == GN_WALK_STACK - 1) { w.hit.truncated = true; w.node = GN_INVALID; break; }
             // Both: go to the nearer (a on a tie), keep the farther; one: go there; none: pop.
             // The stack is read and written by every lane, whatever its case (the write lands
             // above the top when nothing is pushed): llvmpipe stores and loads an array at
@@ -194,8 +194,12 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
             uint top = w.stack[w.sp - 1];
             w.stack[w.sp] = a_first ? cb : ca;
             w.node = (hit_a || hit_b) ? (a_first ? ca : cb) : top;
+            // The stack cannot overflow: the builder's trees are at most BVH_MAX_DEPTH levels
+            // deep, which src/bvh.c checks against GN_WALK_STACK at compile time.
             w.sp = both ? w.sp + 1 : (hit_a || hit_b) ? w.sp : max(w.sp - 1, 1);
         }
+        bool inner = w.node != GN_INVALID && (w.node & GN_WALK_LEAF) == 0u;
+        w.hit.truncated = inner; // the budget ran out before a leaf
         // A leaf, unless the budget or llvmpipe's loop cap ended the loop above early.
         bool leaf = w.node != GN_INVALID && (w.node & GN_WALK_LEAF) != 0u;
         uint last = walk_leaf_last(w.node);
