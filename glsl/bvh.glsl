@@ -124,22 +124,16 @@ float box_enter(RayPre r, vec3 bmin, vec3 bmax, float tmin, float tmax)
     return enter <= leave ? enter : 1e38;
 }
 
-// A walk's position: an inner node's index, or a leaf packed as GN_WALK_LEAF | (count - 1)
-// << 27 | first triangle (the builder keeps leaves to 8 triangles; scenes stay under 2^27
-// triangles: the glTF loader stops at 2^26, and renderer_create asserts it).
-#define GN_WALK_LEAF 0x80000000u
-uint walk_entry(uint index, uint count)
-{
-    return count == 0u ? index : GN_WALK_LEAF | ((count - 1u) << 27) | index;
-}
-uint walk_leaf_first(uint entry) { return entry & 0x07ffffffu; }
-uint walk_leaf_last(uint entry) { return walk_leaf_first(entry) + ((entry >> 27) & 15u); }
+// A walk's position: a child index as GnBvhNode stores it (glsl/shared.h): an inner node's
+// index, or a leaf with GN_BVH_LEAF set and its count and first triangle packed.
+uint walk_leaf_first(uint entry) { return entry & GN_BVH_FIRST; }
+uint walk_leaf_last(uint entry) { return walk_leaf_first(entry) + ((entry >> GN_BVH_COUNT_SHIFT) & 15u); }
 
 // The state of a walk, so one that runs out of budget can be resumed later (the unit tests
 // resume walks across dispatches to get exact answers on meshes beyond llvmpipe's loop cap).
 struct Walk {
     Hit hit;
-    uint node;      // next entry (walk_entry) to visit, GN_INVALID when the walk is over
+    uint node;      // next child index to visit, GN_INVALID when the walk is over
     int sp;         // stack entries in use, the sentinel included
     // stack[0] is a sentinel (GN_INVALID: popping it ends the walk), stack[1, sp) the nodes
     // put off for later; bvh_walk writes stack[sp] on every node visit, so a full stack
@@ -178,12 +172,13 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
     while (w.node != GN_INVALID && !w.hit.truncated) {
         // Inner nodes while the budget lasts (in the loop's condition: a `break` in the body
         // would mask every statement after it).
-        while (w.node != GN_INVALID && (w.node & GN_WALK_LEAF) == 0u && w.hit.steps < end) {
+        while (w.node != GN_INVALID && (w.node & GN_BVH_LEAF) == 0u && w.hit.steps < end) {
             w.hit.steps++;
             GnBvhNode n = bvh_node(w.node);
-            float ea = n.a_index == GN_INVALID ? 1e38 : box_enter(r, n.a_min, n.a_max, tmin, w.hit.t);
-            float eb = n.b_index == GN_INVALID ? 1e38 : box_enter(r, n.b_min, n.b_max, tmin, w.hit.t);
-            uint ca = walk_entry(n.a_index, n.a_count), cb = walk_entry(n.b_index, n.b_count);
+            // (an empty child b has an inverted box: box_enter misses it)
+            float ea = box_enter(r, n.a_min, n.a_max, tmin, w.hit.t);
+            float eb = box_enter(r, n.b_min, n.b_max, tmin, w.hit.t);
+            uint ca = n.a_index, cb = n.b_index;
             bool hit_a = ea < 1e38, hit_b = eb < 1e38, both = hit_a && hit_b;
             // Both: go to the nearer (a on a tie), keep the farther; one: go there; none: pop.
             // The stack is read and written by every lane, whatever its case (the write lands
@@ -198,10 +193,10 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
             // deep, which src/bvh.c checks against GN_WALK_STACK at compile time.
             w.sp = both ? w.sp + 1 : (hit_a || hit_b) ? w.sp : max(w.sp - 1, 1);
         }
-        bool inner = w.node != GN_INVALID && (w.node & GN_WALK_LEAF) == 0u;
+        bool inner = w.node != GN_INVALID && (w.node & GN_BVH_LEAF) == 0u;
         w.hit.truncated = inner; // the budget ran out before a leaf
         // A leaf, unless the budget or llvmpipe's loop cap ended the loop above early.
-        bool leaf = w.node != GN_INVALID && (w.node & GN_WALK_LEAF) != 0u;
+        bool leaf = w.node != GN_INVALID && (w.node & GN_BVH_LEAF) != 0u;
         uint last = walk_leaf_last(w.node);
         for (uint i = walk_leaf_first(w.node); leaf && i <= last && !(any_hit && w.hit.tri != GN_INVALID); i++) {
             GnTri tri = bvh_tri(i);

@@ -137,9 +137,19 @@ typedef uint32_t uint;
  * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only
  * pushes the farther hit child. Node 0 holds the root's two children.
  * For child a (and likewise b):
- *   a_count > 0                       leaf: triangles [a_index, a_index + a_count) of GnTri[]
- *   a_count == 0, a_index != INVALID  inner: GnBvhNode[a_index]
- *   a_count == 0, a_index == INVALID  empty (only when the whole scene is one leaf) */
+ *   a_count > 0                       leaf: a_index = GN_BVH_LEAF | (a_count - 1) <<
+ *                                     GN_BVH_COUNT_SHIFT | first, for triangles [first,
+ *                                     first + a_count) of GnTri[]: glsl/bvh.glsl's walk keeps
+ *                                     child indices as they are, with no unpacking
+ *   a_count == 0, a_index != INVALID  inner: GnBvhNode[a_index] (below GN_BVH_LEAF)
+ *   a_count == 0, a_index == INVALID  empty (only b, when the whole scene is one leaf); its
+ *                                     box is inverted (min FLT_MAX, max -FLT_MAX), so the
+ *                                     walk's slab test never enters it and needs no check
+ * Leaves hold at most 8 triangles and scenes at most 2^26 (src/scene_gltf.cpp), so first
+ * fits in 27 bits. */
+#define GN_BVH_LEAF 0x80000000u
+#define GN_BVH_COUNT_SHIFT 27
+#define GN_BVH_FIRST 0x07ffffffu
 GN_STRUCT(GnBvhNode) {
     vec3 a_min; uint a_index;
     vec3 a_max; uint a_count;

@@ -7,6 +7,7 @@
 #include "bvh.h"
 
 #include <assert.h>
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -232,9 +233,12 @@ static float next_up(float x) /* nextafterf(x, INFINITY) for finite x, without t
 static float pad_up(float x) { return maxf(next_up(x), x + BVH_BOX_PAD); }
 static float pad_down(float x) { return -pad_up(-x); }
 
-/* Writes child `slot` (0 = a, 1 = b) of a node. */
+/* Writes child `slot` (0 = a, 1 = b) of a node: a leaf's index is the walk's entry for it
+ * (glsl/shared.h). */
 static void set_child(GnBvhNode *n, uint32_t slot, const aabb *box, uint32_t index, uint32_t count)
 {
+    if (count > 0)
+        index |= GN_BVH_LEAF | (count - 1) << GN_BVH_COUNT_SHIFT;
     vec3 lo = {pad_down(box->lo[0]), pad_down(box->lo[1]), pad_down(box->lo[2])};
     vec3 hi = {pad_up(box->hi[0]), pad_up(box->hi[1]), pad_up(box->hi[2])};
     if (slot == 0) {
@@ -378,6 +382,8 @@ static int process(builder *bd, const task *t, task *l, task *r, uint32_t *next_
         if (t->parent == GN_INVALID) { /* the whole scene is one leaf: node 0, b empty */
             parent = &bd->nodes[(*next_node)++];
             parent->b_index = GN_INVALID;
+            parent->b_min = (vec3){FLT_MAX, FLT_MAX, FLT_MAX}; /* inverted: never hit */
+            parent->b_max = (vec3){-FLT_MAX, -FLT_MAX, -FLT_MAX};
         } else {
             parent = &bd->nodes[t->parent];
         }
@@ -796,12 +802,14 @@ static bvh_hit traverse(const bvh *b, const float org[3], const float dir[3], fl
         bool hb = n->b_index != GN_INVALID &&
                   box_enter(&r, &n->b_min, &n->b_max, tmin, hit.t, &eb);
         if (ha && n->a_count > 0) {
-            if (leaf_hit(b, &r, n->a_index, n->a_count, tmin, any_hit, &hit) && any_hit)
+            if (leaf_hit(b, &r, n->a_index & GN_BVH_FIRST, n->a_count, tmin, any_hit, &hit) &&
+                any_hit)
                 break;
             ha = false;
         }
         if (hb && n->b_count > 0) {
-            if (eb <= hit.t && leaf_hit(b, &r, n->b_index, n->b_count, tmin, any_hit, &hit) &&
+            if (eb <= hit.t &&
+                leaf_hit(b, &r, n->b_index & GN_BVH_FIRST, n->b_count, tmin, any_hit, &hit) &&
                 any_hit)
                 break;
             hb = false;

@@ -95,17 +95,21 @@ static void check_structure(const bvh *b, const meshgen_mesh *m)
         visited++;
         depth = lv > depth ? lv : depth;
         for (int c = 0; c < 2; c++) {
-            if (index[c] == GN_INVALID) { /* empty: only b of a root leaf */
-                bad_leaf += !(c == 1 && i == 0 && count[0] == n && count[1] == 0);
+            if (index[c] == GN_INVALID) { /* empty: only b of a root leaf, an inverted box */
+                bad_leaf += !(c == 1 && i == 0 && count[0] == n && count[1] == 0 &&
+                              lo[c]->x > hi[c]->x && lo[c]->y > hi[c]->y && lo[c]->z > hi[c]->z);
                 continue;
             }
             if (count[c] > 0) {
+                /* a leaf's index is the walk's entry: flag, count - 1, first triangle */
+                uint32_t first = index[c] & GN_BVH_FIRST;
                 max_leaf = count[c] > max_leaf ? count[c] : max_leaf;
-                if (index[c] + count[c] > n) {
+                if (first + count[c] > n ||
+                    index[c] != (GN_BVH_LEAF | (count[c] - 1) << GN_BVH_COUNT_SHIFT | first)) {
                     bad_leaf++;
                     continue;
                 }
-                for (uint32_t t = index[c]; t < index[c] + count[c]; t++) {
+                for (uint32_t t = first; t < first + count[c]; t++) {
                     const vec4 *v[3] = {&b->tris[t].v0, &b->tris[t].v1, &b->tris[t].v2};
                     bad_leaf += seen_tri[t]++ != 0;
                     for (int k = 0; k < 3; k++)
@@ -327,7 +331,7 @@ void test_bvh_single_triangle(void)
     uint32_t steps = 0;
     CHECK(bvh_build(&b, pos, 3, idx, 1));
     CHECK(b.num_nodes == 1 && b.depth == 1 && b.max_leaf_size == 1);
-    CHECK(b.nodes[0].a_count == 1 && b.nodes[0].a_index == 0);
+    CHECK(b.nodes[0].a_count == 1 && b.nodes[0].a_index == GN_BVH_LEAF); /* first 0, count 1 */
     CHECK(b.nodes[0].b_count == 0 && b.nodes[0].b_index == GN_INVALID);
     CHECKF(fabsf(b.sah_cost - 1) < 1e-5f, "sah %g", b.sah_cost); /* one leaf of one triangle */
     bvh_hit h = bvh_intersect(&b, org, dir, 0, INFINITY, &steps);
