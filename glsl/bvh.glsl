@@ -89,10 +89,14 @@ bool tri_intersect(RayPre r, vec3 p0, vec3 p1, vec3 p2, float tmin, float tmax,
     float Ax = dot(r.sx, A), Ay = dot(r.sy, A);
     float Bx = dot(r.sx, B), By = dot(r.sy, B);
     float Cx = dot(r.sx, C), Cy = dot(r.sy, C);
-    // The edge functions in Kahan's FMA form, within 1.5 ulp of exact, so each has the sign
-    // (and zero) of the exact value: Woop et al. recompute in double precision when a plain
-    // product difference is 0, but many GPUs have no fp64, and an exact sign every time
-    // costs llvmpipe less than a test and a masked recomputation.
+    // The edge functions in Kahan's FMA form (Woop et al. recompute in double precision when
+    // a plain product difference is 0; many GPUs have no fp64). Where fma is fused (GPUs),
+    // each is within 1.5 ulp of exact and so has the exact sign. Vulkan lets fma round twice,
+    // and llvmpipe does (its JIT code multiplies, then adds): the error term is then 0 and
+    // this is the plain difference of the two rounded products, which still keeps shared
+    // edges watertight: the neighbour computes the same two products and the difference
+    // negates exactly. Either way the form costs llvmpipe less than a zero test and a
+    // masked recomputation, which it would run on every triangle.
     float U = diff_of_products(Cx, By, Cy, Bx);
     float V = diff_of_products(Ax, Cy, Ay, Cx);
     float W = diff_of_products(Bx, Ay, By, Ax);

@@ -694,14 +694,19 @@ static bool tri_hit(const ray *r, const float *v0, const float *v1, const float 
     const float Cx = C[r->kx] - r->sx * C[r->kz], Cy = C[r->ky] - r->sy * C[r->kz];
     /* 3. Edge functions: twice the signed areas of the sub-triangles (origin, edge). Two
      * triangles sharing an edge compute that edge's function from the same two sheared
-     * vertices, so its value is the same number with opposite sign: no ray slips between.
-     * 4. Each with its exact sign: float * float is exact in double, so the one rounding of
-     * the difference keeps the sign (and a zero) exact. Woop et al. do this only when the
-     * float result is 0; glsl/bvh.glsl always does it (Kahan's FMA form), and so does this
-     * reference, so that both decide every near-edge case the same way. */
-    float U = (float)((double)Cx * (double)By - (double)Cy * (double)Bx);
-    float V = (float)((double)Ax * (double)Cy - (double)Ay * (double)Cx);
-    float W = (float)((double)Bx * (double)Ay - (double)By * (double)Ax);
+     * vertices, so its value is the same number with opposite sign: no ray slips between. */
+    float U = Cx * By - Cy * Bx;
+    float V = Ax * Cy - Ay * Cx;
+    float W = Bx * Ay - By * Ax;
+    /* 4. A zero may be a rounded-away sign: redo all three exactly. float * float is exact in
+     * double, so the one rounding of the difference keeps the sign exact. (glsl/bvh.glsl
+     * uses Kahan's FMA form instead, which is this plain difference where fma rounds twice,
+     * as on llvmpipe, and has the exact sign where it is fused.) */
+    if (U == 0.0f || V == 0.0f || W == 0.0f) {
+        U = (float)((double)Cx * (double)By - (double)Cy * (double)Bx);
+        V = (float)((double)Ax * (double)Cy - (double)Ay * (double)Cx);
+        W = (float)((double)Bx * (double)Ay - (double)By * (double)Ax);
+    }
     /* 5. Inside when all three have the same sign (either sign: both faces hit); zeros are
      * edges and count as inside. */
     if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f))
