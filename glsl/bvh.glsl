@@ -172,11 +172,12 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
 #define w walk
     uint end = w.hit.steps + budget;
     w.hit.truncated = false;
-    // No early returns: llvmpipe masks every statement after one again; a break costs less.
+    // No early returns and no breaks: llvmpipe masks every later statement of a loop body
+    // again after either, so the loop conditions end the walk. An index without
+    // GN_BVH_LEAF is an inner node (GN_INVALID has that bit set too).
     while (w.node != GN_INVALID && !w.hit.truncated) {
-        // Inner nodes while the budget lasts (in the loop's condition: a `break` in the body
-        // would mask every statement after it).
-        while (w.node != GN_INVALID && (w.node & GN_BVH_LEAF) == 0u && w.hit.steps < end) {
+        // Inner nodes while the budget lasts.
+        while ((w.node & GN_BVH_LEAF) == 0u && w.hit.steps < end) {
             w.hit.steps++;
             GnBvhNode n = bvh_node(w.node);
             // (an empty child b has an inverted box: box_enter misses it)
@@ -197,10 +198,9 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
             // deep, which src/bvh.c checks against GN_WALK_STACK at compile time.
             w.sp = both ? w.sp + 1 : (hit_a || hit_b) ? w.sp : max(w.sp - 1, 1);
         }
-        bool inner = w.node != GN_INVALID && (w.node & GN_BVH_LEAF) == 0u;
-        w.hit.truncated = inner; // the budget ran out before a leaf
-        // A leaf, unless the budget or llvmpipe's loop cap ended the loop above early.
-        bool leaf = w.node != GN_INVALID && (w.node & GN_BVH_LEAF) != 0u;
+        // An inner node here: the budget (or llvmpipe's loop cap) ended the loop above early.
+        w.hit.truncated = (w.node & GN_BVH_LEAF) == 0u;
+        bool leaf = !w.hit.truncated && w.node != GN_INVALID;
         uint last = walk_leaf_last(w.node);
         for (uint i = walk_leaf_first(w.node); leaf && i <= last && !(any_hit && w.hit.tri != GN_INVALID); i++) {
             GnTri tri = bvh_tri(i);
