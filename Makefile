@@ -58,12 +58,16 @@ TESTTOOL := $(BUILD)/testtool
 # ---- Debian packages -------------------------------------------------------------------
 DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
 	libopenexr-dev libtinygltf-dev libpng-dev zlib1g-dev mesa-vulkan-drivers
-DEB_TEST := vulkan-validationlayers openexr xvfb xauth imagemagick x11-apps xdotool
+# libmagickcore-6.q16-6-extra: ImageMagick's EXR coder (only a recommendation of imagemagick,
+# which --no-install-recommends leaves out); tests/regress/diff.sh writes EXRs with it.
+DEB_TEST := vulkan-validationlayers openexr xvfb xauth imagemagick libmagickcore-6.q16-6-extra \
+	x11-apps xdotool
 DEPS_CHECK = { command -v glslangValidator && command -v spirv-val && command -v pkg-config \
 	&& pkg-config --exists $(PKGS) && ls /usr/share/vulkan/icd.d/lvp_icd*.json; } >/dev/null 2>&1
 TEST_DEPS_CHECK = { ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json \
 	&& command -v exrheader && command -v xvfb-run && command -v xauth && command -v import \
-	&& command -v xwd && command -v xdotool; } >/dev/null 2>&1
+	&& command -v xwd && command -v xdotool \
+	&& convert -list format | grep -q 'EXR.*rw'; } >/dev/null 2>&1
 
 .PHONY: all deps test-deps run test unit regress bench clean install shaders docs-images
 all: $(GONIO) build/gonio
