@@ -30,8 +30,9 @@ void main()
             rays[2u * pixel + 1u] = vec4(0.0, 0.0, 1.0, -1.0);
             return;
         }
-        GnTri t = bvh_tri(h.tri);
-        vec3 n = normalize(cross(t.v1.xyz - t.v0.xyz, t.v2.xyz - t.v0.xyz));
+        vec3 c0, c1, c2;
+        tri_corners(h.tri, c0, c1, c2);
+        vec3 n = normalize(cross(c1 - c0, c2 - c0));
         if (dot(n, d) > 0.0) n = -n;
         vec2 u = rand2(pixel, push.sample_index, 1u);
         // cosine-weighted direction about n (Malley's method on a concentric-free disk)

@@ -23,15 +23,18 @@ GnBvhNode bvh_node(uint i)
                      uintBitsToFloat(t2.xyz), t2.w, uintBitsToFloat(t3.xyz), t3.w);
 }
 
-GnTri bvh_tri(uint i)
+GnTriPair bvh_pair(uint i)
 {
-    uint k = 3u * i;
-    return GnTri(texel_f(tri_texels, k), texel_f(tri_texels, k + 1u), texel_f(tri_texels, k + 2u));
+    int k = int(4u * i);
+    uvec4 t0 = texelFetch(tri_texels, k), t1 = texelFetch(tri_texels, k + 1);
+    uvec4 t2 = texelFetch(tri_texels, k + 2), t3 = texelFetch(tri_texels, k + 3);
+    return GnTriPair(uintBitsToFloat(t0.xyz), t0.w, uintBitsToFloat(t1.xyz), t1.w,
+                     uintBitsToFloat(t2.xyz), t2.w, uintBitsToFloat(t3.xyz), t3.w);
 }
 
 struct Hit {
     float t, u, v;
-    uint tri;       // BVH-order triangle, GN_INVALID on a miss
+    uint tri;       // BVH-order triangle (GnPrim order), GN_INVALID on a miss
     uint steps;     // GnBvhNode visits
     bool truncated; // the budget ran out: the result may be wrong
 };
@@ -78,17 +81,19 @@ float diff_of_products(float a, float b, float c, float d)
     return dop + err;
 }
 
-// Watertight test: vertices relative to the origin, sheared so the ray is +z; the edge
-// functions decide inside-ness exactly consistently on shared edges.
+// Watertight test of a GnTriPair's triangles A = (p0, p1, p2) and B = (p0, p2, p3):
+// corners relative to the origin, sheared so the ray is +z; the edge functions decide
+// inside-ness exactly consistently on shared edges. Returns the nearer hit in (tmin, tmax)
+// (A on a tie, as src/bvh.c's leaf_hit), with which = 1 for B and the test's barycentrics
+// (of p1, p2 for A; of p2, p3 for B).
 // Branch-free (llvmpipe runs every side of every branch anyway, and masks each assignment
 // after an early return): one result at the end.
-bool tri_intersect(RayPre r, vec3 p0, vec3 p1, vec3 p2, float tmin, float tmax,
-                   out float t, out float u, out float v)
+bool pair_intersect(RayPre r, GnTriPair q, float tmin, float tmax,
+                    out float t, out float u, out float v, out uint which)
 {
-    vec3 A = p0 - r.o, B = p1 - r.o, C = p2 - r.o;
-    float Ax = dot(r.sx, A), Ay = dot(r.sy, A);
-    float Bx = dot(r.sx, B), By = dot(r.sy, B);
-    float Cx = dot(r.sx, C), Cy = dot(r.sy, C);
+    vec3 P0 = q.p0 - r.o, P1 = q.p1 - r.o, P2 = q.p2 - r.o, P3 = q.p3 - r.o;
+    float x0 = dot(r.sx, P0), y0 = dot(r.sy, P0), x1 = dot(r.sx, P1), y1 = dot(r.sy, P1);
+    float x2 = dot(r.sx, P2), y2 = dot(r.sy, P2), x3 = dot(r.sx, P3), y3 = dot(r.sy, P3);
     // The edge functions in Kahan's FMA form (Woop et al. recompute in double precision when
     // a plain product difference is 0; many GPUs have no fp64). Where fma is fused (GPUs),
     // each is within 1.5 ulp of exact and so has the exact sign. Vulkan lets fma round twice,
@@ -97,18 +102,38 @@ bool tri_intersect(RayPre r, vec3 p0, vec3 p1, vec3 p2, float tmin, float tmax,
     // edges watertight: the neighbour computes the same two products and the difference
     // negates exactly. Either way the form costs llvmpipe less than a zero test and a
     // masked recomputation, which it would run on every triangle.
-    float U = diff_of_products(Cx, By, Cy, Bx);
-    float V = diff_of_products(Ax, Cy, Ay, Cx);
-    float W = diff_of_products(Bx, Ay, By, Ax);
-    bool outside = (U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0);
-    float det = U + V + W;
-    float Az = dot(r.sz, A), Bz = dot(r.sz, B), Cz = dot(r.sz, C);
-    float T = U * Az + V * Bz + W * Cz;
-    float rcp = 1.0 / det;
-    t = T * rcp;
-    u = V * rcp;
-    v = W * rcp;
-    return !outside && det != 0.0 && t > tmin && t < tmax;
+    // A: U weighs p0, V p1, W p2 (src/bvh.c's tri_hit with v0, v1, v2 = p0, p1, p2).
+    float Ua = diff_of_products(x2, y1, y2, x1);
+    float Va = diff_of_products(x0, y2, y0, x2);
+    float Wa = diff_of_products(x1, y0, y1, x0);
+    // B = (p0, p2, p3): its edge (p2, p0) is A's edge (p0, p2) reversed, so B's W is -Va:
+    // the exact negation of the plain difference B would compute itself, and of the exact
+    // sign where fma is fused.
+    float Ub = diff_of_products(x3, y2, y3, x2);
+    float Vb = diff_of_products(x0, y3, y0, x3);
+    float Wb = -Va;
+    bool out_a = (Ua < 0.0 || Va < 0.0 || Wa < 0.0) && (Ua > 0.0 || Va > 0.0 || Wa > 0.0);
+    bool out_b = (Ub < 0.0 || Vb < 0.0 || Wb < 0.0) && (Ub > 0.0 || Vb > 0.0 || Wb > 0.0);
+    float det_a = Ua + Va + Wa, det_b = Ub + Vb + Wb;
+    float z0 = dot(r.sz, P0), z1 = dot(r.sz, P1), z2 = dot(r.sz, P2), z3 = dot(r.sz, P3);
+    float ra = 1.0 / det_a, rb = 1.0 / det_b;
+    float ta = (Ua * z0 + Va * z1 + Wa * z2) * ra, tb = (Ub * z0 + Vb * z2 + Wb * z3) * rb;
+    bool hit_a = !out_a && det_a != 0.0 && ta > tmin && ta < tmax;
+    bool hit_b = (q.codes & GN_PAIR_HAS_B) != 0u && !out_b && det_b != 0.0 && tb > tmin && tb < tmax;
+    bool b_wins = hit_b && (!hit_a || tb < ta);
+    t = b_wins ? tb : ta;
+    u = b_wins ? Vb * rb : Va * ra;
+    v = b_wins ? Wb * rb : Wa * ra;
+    which = b_wins ? 1u : 0u;
+    return hit_a || hit_b;
+}
+
+// The hit's barycentrics in its triangle's own corner order (GnTriPair's corner codes).
+vec2 pair_decode(uint code, float u, float v)
+{
+    uint c1 = code & 3u, c2 = (code >> 2u) & 3u;
+    float w = 1.0 - u - v;
+    return vec2(c1 == 0u ? w : c1 == 1u ? u : v, c2 == 0u ? w : c2 == 1u ? u : v);
 }
 
 // max and min of numbers that are never NaN here: GLSL's max and min must return the
@@ -203,10 +228,12 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
         bool leaf = !w.hit.truncated && w.node != GN_INVALID;
         uint last = walk_leaf_last(w.node);
         for (uint i = walk_leaf_first(w.node); leaf && i <= last && !(any_hit && w.hit.tri != GN_INVALID); i++) {
-            GnTri tri = bvh_tri(i);
+            GnTriPair q = bvh_pair(i);
             float t, u, v;
-            if (tri_intersect(r, tri.v0.xyz, tri.v1.xyz, tri.v2.xyz, tmin, w.hit.t, t, u, v)) {
-                w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = i;
+            uint which;
+            if (pair_intersect(r, q, tmin, w.hit.t, t, u, v, which)) {
+                vec2 uv = pair_decode(q.codes >> (4u * which), u, v);
+                w.hit.t = t; w.hit.u = uv.x; w.hit.v = uv.y; w.hit.tri = q.tri + which;
             }
         }
         bool found = any_hit && w.hit.tri != GN_INVALID; // any hit: the walk is over

@@ -216,10 +216,11 @@ LightSample light_sample(vec3 p, vec3 u)
         s.pdf = e.pdf;
         s.delta = true;
     } else if (GN_HAS(GN_FEAT_EMISSIVE)) {
-        GnTri t = bvh_tri(e.prim);
+        vec3 c0, c1, c2;
+        tri_corners(e.prim, c0, c1, c2);
         float su = sqrt(u.y), b1 = 1.0 - su, b2 = u.z * su;
-        vec3 q = (1.0 - b1 - b2) * t.v0.xyz + b1 * t.v1.xyz + b2 * t.v2.xyz;
-        vec3 ng = normalize(cross(t.v1.xyz - t.v0.xyz, t.v2.xyz - t.v0.xyz));
+        vec3 q = (1.0 - b1 - b2) * c0 + b1 * c1 + b2 * c2;
+        vec3 ng = normalize(cross(c1 - c0, c2 - c0));
         vec3 to = q - p;
         float d2 = dot(to, to);
         s.dist = sqrt(d2);

@@ -12,7 +12,7 @@
 // values that steer loops and re-specializes the shader whenever they change, which cost
 // ~18 ms per dispatch of the path kernel (7x the whole render of a 32x32 image).
 layout(std430, binding = GN_BIND_FRAME) readonly buffer FrameBlock { GnFrame frame; };
-// The BVH nodes (GnBvhNode = 4 texels), triangle corners (GnTri = 3), shading triangles
+// The BVH nodes (GnBvhNode = 4 texels), triangle pairs (GnTriPair = 4), shading triangles
 // (GnPrim = 1), vertices (GnVertex = 4), materials (GnMaterial = 12), textures (GnTexture =
 // 1; their RGBA8 images: R32UI) and path.comp's lights (GnEmitter = 1) are read from texel
 // buffers, not storage buffers: llvmpipe fetches a storage buffer with per-lane offsets one
@@ -45,6 +45,16 @@ GnVertex vertex_at(uint i)
     vec4 a = texel_f(vertex_texels, 4u * i), b = texel_f(vertex_texels, 4u * i + 1u);
     return GnVertex(a.xyz, a.w, b.xyz, b.w, texel_f(vertex_texels, 4u * i + 2u),
                     texel_f(vertex_texels, 4u * i + 3u));
+}
+
+// The corners of BVH-order triangle i (the walk's GnTriPairs hold them too, but a pair has
+// no index by triangle).
+void tri_corners(uint i, out vec3 a, out vec3 b, out vec3 c)
+{
+    GnPrim pr = prim_at(i);
+    a = texel_f(vertex_texels, 4u * pr.i0).xyz;
+    b = texel_f(vertex_texels, 4u * pr.i1).xyz;
+    c = texel_f(vertex_texels, 4u * pr.i2).xyz;
 }
 
 // Does the scene have vertex colours (glTF COLOR_0)? Without, GnVertex.color is not read.

@@ -31,9 +31,9 @@ typedef uint32_t uint;
 /* ---- descriptor bindings (set 0) of the render kernels -------------------------------- */
 #define GN_BIND_FRAME 0u     /* GnFrame (a read-only storage buffer: see glsl/scene.glsl) */
 /* Bindings 1-5 are RGBA32UI uniform texel buffers (16 bytes a texel), read through
- * bvh_node, bvh_tri, prim_at, vertex_at and material_at (glsl/bvh.glsl, glsl/scene.glsl). */
+ * bvh_node, bvh_pair, prim_at, vertex_at and material_at (glsl/bvh.glsl, glsl/scene.glsl). */
 #define GN_BIND_NODES 1u     /* GnBvhNode[] */
-#define GN_BIND_TRIS 2u      /* GnTri[] (BVH order) */
+#define GN_BIND_TRIS 2u      /* GnTriPair[] (leaf order) */
 #define GN_BIND_PRIMS 3u     /* GnPrim[] (BVH order) */
 #define GN_BIND_VERTICES 4u  /* GnVertex[] */
 #define GN_BIND_MATERIALS 5u /* GnMaterial[] */
@@ -138,15 +138,15 @@ typedef uint32_t uint;
  * pushes the farther hit child. Node 0 holds the root's two children.
  * For child a (and likewise b):
  *   a_count > 0                       leaf: a_index = GN_BVH_LEAF | (a_count - 1) <<
- *                                     GN_BVH_COUNT_SHIFT | first, for triangles [first,
- *                                     first + a_count) of GnTri[]: glsl/bvh.glsl's walk keeps
+ *                                     GN_BVH_COUNT_SHIFT | first, for the triangle pairs
+ *                                     [first, first + a_count) of GnTriPair[]: the walk keeps
  *                                     child indices as they are, with no unpacking
  *   a_count == 0, a_index != INVALID  inner: GnBvhNode[a_index] (below GN_BVH_LEAF)
  *   a_count == 0, a_index == INVALID  empty (only b, when the whole scene is one leaf); its
  *                                     box is inverted (min FLT_MAX, max -FLT_MAX), so the
  *                                     walk's slab test never enters it and needs no check
- * Leaves hold at most 8 triangles and scenes at most 2^26 (src/scene_gltf.cpp), so first
- * fits in 27 bits. */
+ * Leaves hold at most 8 pairs and scenes at most 2^26 triangles (src/scene_gltf.cpp), so
+ * first fits in 27 bits. */
 #define GN_BVH_LEAF 0x80000000u
 #define GN_BVH_COUNT_SHIFT 27
 #define GN_BVH_FIRST 0x07ffffffu
@@ -157,15 +157,30 @@ GN_STRUCT(GnBvhNode) {
     vec3 b_max; uint b_count;
 } GN_END(GnBvhNode); /* 64 bytes */
 
-/* Triangle corners in BVH leaf order, for the watertight test (Woop, Benthin & Wald 2013).
- * w is unused (0). Hit barycentrics (u, v): p = (1-u-v) v0 + u v1 + v v2. */
-GN_STRUCT(GnTri) {
-    vec4 v0;
-    vec4 v1;
-    vec4 v2;
-} GN_END(GnTri); /* 48 bytes */
+/* The walk's leaf primitive: one triangle, or two that share an edge, for the watertight
+ * test (Woop, Benthin & Wald 2013). Triangle A = (p0, p1, p2), triangle B = (p0, p2, p3):
+ * B's edge (p0, p2) is A's, so the walk transforms four corners instead of six, computes
+ * that edge's function once (negated for B: the very number B's own would be) and fetches
+ * four texels for two triangles instead of six; texel fetches are most of what the walk
+ * costs on lavapipe (docs/architecture.md). The pairs are consecutive triangles of the
+ * index buffer (2k, 2k + 1) that share an edge, as meshes made of quads come
+ * (src/bvh.c: pair_of); a triangle without a partner has p3 = p2 and no B.
+ *   tri     the BVH-order index (GnPrim order) of A; B is tri + 1
+ *   codes   bits 0-3: A's corner code, bits 4-7: B's, bit 8 (GN_PAIR_HAS_B): B exists.
+ *           A corner code maps the test's barycentrics back to the triangle's own corner
+ *           order (the walk stores p0.. in the order that puts the shared edge at p2-p0):
+ *           with the test's weights w = (1-u'-v', u', v') of its corners, the hit's
+ *           (u, v) = (w[code & 3], w[code >> 2]): the weights of the triangle's own
+ *           second and third corners. */
+#define GN_PAIR_HAS_B 0x100u
+GN_STRUCT(GnTriPair) {
+    vec3 p0; uint tri;
+    vec3 p1; uint codes;
+    vec3 p2; uint pad0;
+    vec3 p3; uint pad1;
+} GN_END(GnTriPair); /* 64 bytes */
 
-/* Shading data of a triangle, in the same (BVH) order as GnTri. */
+/* Shading data of a triangle, in BVH order (GnTriPair.tri and the walk's hits count in it). */
 GN_STRUCT(GnPrim) {
     uint i0; uint i1; uint i2; uint material;
 } GN_END(GnPrim); /* 16 bytes */
@@ -278,7 +293,7 @@ GN_STRUCT(GnDisplayPush) {
 #include <stddef.h>
 GN_STATIC_ASSERT(sizeof(GnBvhNode) == 64, "GnBvhNode layout");
 GN_STATIC_ASSERT(offsetof(GnBvhNode, b_min) == 32, "GnBvhNode layout");
-GN_STATIC_ASSERT(sizeof(GnTri) == 48, "GnTri layout");
+GN_STATIC_ASSERT(sizeof(GnTriPair) == 64, "GnTriPair layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");
 GN_STATIC_ASSERT(sizeof(GnVertex) == 64, "GnVertex layout");
 GN_STATIC_ASSERT(sizeof(GnMaterial) == 192, "GnMaterial layout");

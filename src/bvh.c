@@ -20,16 +20,16 @@
 
 #include "util.h"
 
-/* Build tunables. SAH constants C_trav = 2, C_isect = 1: on lavapipe a GnBvhNode visit (four
- * texel fetches, two box tests, the stack) costs about two watertight triangle tests (three
- * fetches), measured in the JIT code with perf. The shallower trees took the Cornell box's
- * path tracer from 1.46 to 1.67 M paths/s; the 250k mesh traces as fast as with C_trav = 1.
+/* Build tunables. The build's primitives are GnTriPairs (a triangle or two). SAH constants
+ * C_trav = 1, C_isect = 1 per pair: on lavapipe a GnBvhNode visit and a pair test both cost
+ * four texel fetches, which is most of either (with single triangles of three fetches,
+ * C_trav = 2 had measured best). Leaves of 2-4 or 1-4 pairs and C_trav 1.5-2 were tried: no
+ * better on the Cornell box's paths or the 250k mesh's rays, and slower to build.
  * (`gonio info` reports the SAH cost with both constants 1, for comparing trees.) */
-#define BVH_SAH_TRAVERSAL 2.0f
+#define BVH_SAH_TRAVERSAL 1.0f
 #define BVH_BINS 16      /* per axis; Wald 2007 finds 16 as good as a full sweep */
-#define BVH_MIN_LEAF 4   /* up to this many triangles always a leaf; above, the SAH decides.
-                            4 rather than 2: the build is 25% faster (5.5 vs 4.4 M tri/s on
-                            250k) and lavapipe traces as fast (gonio bench --generate 250000) */
+#define BVH_MIN_LEAF 4   /* up to this many pairs always a leaf; above, the SAH decides
+                            (4 rather than 2: a faster build, and lavapipe traces as fast) */
 #define BVH_MAX_LEAF 8   /* above this a node is split even when the SAH prefers a leaf */
 #define BVH_MAX_DEPTH 64 /* GnBvhNode levels; the traversal stack (64) never overflows */
 _Static_assert(GN_WALK_STACK - 2 >= BVH_MAX_DEPTH - 1, "glsl/bvh.glsl's stack must hold a deepest walk");
@@ -39,7 +39,9 @@ _Static_assert(GN_WALK_STACK - 2 >= BVH_MAX_DEPTH - 1, "glsl/bvh.glsl's stack mu
 #define BVH_MAX_THREADS 8
 #define BVH_SUBTREES 16
 #define BVH_PARALLEL_MIN 50000
-#define BVH_SETUP_CHUNK 16384
+#define BVH_SETUP_CHUNK 16384 /* triangles */
+/* builder.rec: the record holds triangles (index) and (index + 1) */
+#define BVH_REC_PAIR 0x80000000u
 
 /* Traversal constants, shared with glsl/bvh.glsl. */
 #define BVH_STACK 64
@@ -300,11 +302,12 @@ typedef struct builder {
     const float *positions;
     size_t stride;
     const uint32_t *indices;
-    uint32_t num_tris, threads;
+    uint32_t num_tris, num_recs, threads;
+    uint32_t *rec;         /* record (the build's primitive) -> A's triangle | BVH_REC_PAIR */
+    uint32_t *chunk_first; /* setup chunk -> its first record */
     prim *prims;
     GnBvhNode *nodes;
-    GnTri *tris;
-    uint32_t *tri_index;
+    GnTriPair *pairs;
     uint32_t num_top, num_pending;
     task pending[BVH_SUBTREES];
     uint32_t subtree_size[BVH_SUBTREES];
@@ -338,35 +341,141 @@ static const float *vertex(const builder *bd, uint32_t tri, int k)
     return bd->positions + (size_t)bd->indices[3 * (size_t)tri + k] * bd->stride;
 }
 
-/* Triangle boxes, BVH_SETUP_CHUNK triangles at a time. */
+/* Triangles t and t + 1 of the index buffer make one GnTriPair when they share exactly one
+ * edge (by vertex index; neither repeats an index) and the pair's box is no larger (in
+ * surface area) than the two boxes together: the SAH's view, since a pair costs the walk
+ * about what one triangle does (four texel fetches) and is entered whenever a ray enters its
+ * box. (Without that test, the few folded pairs of the 250k bench mesh made its rays 15%
+ * slower.) Only neighbours in the index buffer are paired: meshes built from quads list a
+ * quad's two triangles together (Embree's triangle pairing makes the same assumption), so
+ * one pass finds them with no search. */
+static bool pairs_with_next(const builder *bd, uint32_t t)
+{
+    if ((uint64_t)t + 1 >= bd->num_tris)
+        return false;
+    const uint32_t *a = bd->indices + 3 * (size_t)t, *b = a + 3;
+    if (a[0] == a[1] || a[1] == a[2] || a[2] == a[0] || b[0] == b[1] || b[1] == b[2] || b[2] == b[0])
+        return false;
+    int shared = 0;
+    for (int k = 0; k < 3; k++)
+        shared += (a[k] == b[0]) + (a[k] == b[1]) + (a[k] == b[2]);
+    if (shared != 2)
+        return false;
+    aabb ba = empty_box, bb = empty_box, bu;
+    for (int k = 0; k < 3; k++) {
+        const float *x = vertex(bd, t, k), *y = vertex(bd, t + 1, k);
+        v4f vx = {x[0], x[1], x[2], 0}, vy = {y[0], y[1], y[2], 0};
+        grow_box(&ba, vx, vx);
+        grow_box(&bb, vy, vy);
+    }
+    bu = ba;
+    grow_box(&bu, bb.lo, bb.hi);
+    return half_area(&bu) <= half_area(&ba) + half_area(&bb);
+}
+
+/* Setup, BVH_SETUP_CHUNK triangles at a time: first each chunk's record count
+ * (count_worker), then, from each chunk's first record, the records and their boxes
+ * (setup_worker). Within a chunk the pairing is greedy from its first triangle (a pair,
+ * else a single), so it depends on the chunk boundaries only, not on the threads. */
+static uint32_t chunk_range(builder *bd, uint32_t *begin, uint32_t *end)
+{
+    uint64_t c = atomic_fetch_add(&bd->next_work, 1), b = c * BVH_SETUP_CHUNK;
+    if (b >= bd->num_tris)
+        return GN_INVALID;
+    *begin = (uint32_t)b;
+    *end = b + BVH_SETUP_CHUNK < bd->num_tris ? (uint32_t)(b + BVH_SETUP_CHUNK) : bd->num_tris;
+    return (uint32_t)c;
+}
+
+static void *count_worker(void *arg)
+{
+    builder *bd = ((worker *)arg)->bd;
+    uint32_t begin, end, c;
+    while ((c = chunk_range(bd, &begin, &end)) != GN_INVALID) {
+        uint32_t n = 0;
+        for (uint32_t t = begin; t < end; n++)
+            t += t + 1 < end && pairs_with_next(bd, t) ? 2 : 1;
+        bd->chunk_first[c] = n;
+    }
+    return NULL;
+}
+
 static void *setup_worker(void *arg)
 {
     worker *w = arg;
     builder *bd = w->bd;
-    uint64_t begin;
-    while ((begin = (uint64_t)atomic_fetch_add(&bd->next_work, 1) * BVH_SETUP_CHUNK) <
-           bd->num_tris) {
-        uint64_t end = begin + BVH_SETUP_CHUNK;
-        end = end < bd->num_tris ? end : bd->num_tris;
-        for (uint32_t i = (uint32_t)begin; i < end; i++) {
-            prim *p = &bd->prims[i];
-            const float *v0 = vertex(bd, i, 0), *v1 = vertex(bd, i, 1), *v2 = vertex(bd, i, 2);
-            for (int a = 0; a < 3; a++) {
-                p->lo3[a] = minf(minf(v0[a], v1[a]), v2[a]);
-                p->hi3[a] = maxf(maxf(v0[a], v1[a]), v2[a]);
-            }
-            p->id = i;
+    uint32_t begin, end, c;
+    while ((c = chunk_range(bd, &begin, &end)) != GN_INVALID) {
+        uint32_t r = bd->chunk_first[c];
+        for (uint32_t t = begin; t < end; r++) {
+            bool pair = t + 1 < end && pairs_with_next(bd, t);
+            prim *p = &bd->prims[r];
+            bd->rec[r] = t | (pair ? BVH_REC_PAIR : 0u);
+            for (int a = 0; a < 3; a++)
+                p->lo3[a] = INFINITY, p->hi3[a] = -INFINITY;
+            for (uint32_t k = t; k <= t + pair; k++)
+                for (int v = 0; v < 3; v++) {
+                    const float *x = vertex(bd, k, v);
+                    for (int a = 0; a < 3; a++) {
+                        p->lo3[a] = minf(p->lo3[a], x[a]);
+                        p->hi3[a] = maxf(p->hi3[a], x[a]);
+                    }
+                }
+            p->id = r;
             p->pad = 0;
             v4f c4 = centroid(p);
             grow_box(&w->box, prim_lo(p), p->hi);
             grow_box(&w->cbox, c4, c4);
+            t += pair ? 2 : 1;
         }
     }
     return NULL;
 }
 
+/* Writes record `rec`'s corners into q: A rotated so that the shared edge is (p2, p0), B's
+ * third corner as p3, and the corner codes (glsl/shared.h). q->tri and q->pad0 hold the
+ * original indices of A and B until number_triangles() renumbers them in BVH order. */
+static void write_pair(const builder *bd, uint32_t rec, GnTriPair *q)
+{
+    uint32_t ta = rec & ~BVH_REC_PAIR, tb = ta + 1;
+    const uint32_t *a = bd->indices + 3 * (size_t)ta, *b = a + 3;
+    uint32_t rot = 0, idx[4], codes;
+    if (rec & BVH_REC_PAIR) {
+        /* the edge (a[k], a[k + 1]) in B: rotate so that it is (p2, p0) */
+        for (uint32_t k = 0; k < 3; k++) {
+            uint32_t x = a[k], y = a[(k + 1) % 3];
+            bool in_b = (x == b[0] || x == b[1] || x == b[2]) && (y == b[0] || y == b[1] || y == b[2]);
+            if (in_b)
+                rot = (k + 1) % 3;
+        }
+    }
+    for (uint32_t k = 0; k < 3; k++)
+        idx[k] = a[(rot + k) % 3];
+    idx[3] = idx[2];
+    /* A's own corner m is the test's corner (m - rot) mod 3 */
+    codes = (1 + 3 - rot) % 3 | ((2 + 3 - rot) % 3) << 2;
+    if (rec & BVH_REC_PAIR) {
+        uint32_t pos[3];
+        for (int k = 0; k < 3; k++)
+            if (b[k] != idx[0] && b[k] != idx[2])
+                idx[3] = b[k];
+        for (int k = 0; k < 3; k++) /* B is tested as (p0, p2, p3) */
+            pos[k] = b[k] == idx[0] ? 0 : b[k] == idx[2] ? 1 : 2;
+        codes |= (pos[1] | pos[2] << 2) << 4 | GN_PAIR_HAS_B;
+    }
+    vec3 *p[4] = {&q->p0, &q->p1, &q->p2, &q->p3};
+    for (int k = 0; k < 4; k++) {
+        const float *x = bd->positions + (size_t)idx[k] * bd->stride;
+        *p[k] = (vec3){x[0], x[1], x[2]};
+    }
+    q->tri = ta;
+    q->codes = codes;
+    q->pad0 = rec & BVH_REC_PAIR ? tb : GN_INVALID;
+    q->pad1 = 0;
+}
+
 /* Decides and performs one node, numbering new nodes from *next_node: a leaf goes into its
- * parent's slot and its triangles into tris (0 returned); an inner node is created, the
+ * parent's slot and its records into pairs (0 returned); an inner node is created, the
  * range partitioned and the two children returned in l, r (2). */
 static int process(builder *bd, const task *t, task *l, task *r, uint32_t *next_node)
 {
@@ -388,13 +497,8 @@ static int process(builder *bd, const task *t, task *l, task *r, uint32_t *next_
             parent = &bd->nodes[t->parent];
         }
         set_child(parent, t->slot, &t->box, t->begin, n);
-        for (uint32_t i = t->begin; i < t->end; i++) {
-            uint32_t id = bd->prims[i].id;
-            const float *v0 = vertex(bd, id, 0), *v1 = vertex(bd, id, 1), *v2 = vertex(bd, id, 2);
-            bd->tris[i] = (GnTri){{v0[0], v0[1], v0[2], 0}, {v1[0], v1[1], v1[2], 0},
-                                  {v2[0], v2[1], v2[2], 0}};
-            bd->tri_index[i] = id;
-        }
+        for (uint32_t i = t->begin; i < t->end; i++)
+            write_pair(bd, bd->rec[bd->prims[i].id], &bd->pairs[i]);
         return 0;
     }
     uint32_t self = (*next_node)++;
@@ -541,6 +645,22 @@ static uint32_t pack_nodes(builder *bd)
     return lay.next;
 }
 
+/* BVH order of the triangles: the pairs' triangles in leaf order, A before B. Replaces the
+ * original indices that write_pair left in each pair by the BVH-order index of A. */
+static void number_triangles(bvh *out)
+{
+    uint32_t next = 0;
+    for (uint32_t i = 0; i < out->num_pairs; i++) {
+        GnTriPair *q = &out->pairs[i];
+        out->tri_index[next] = q->tri;
+        q->tri = next++;
+        if (q->codes & GN_PAIR_HAS_B)
+            out->tri_index[next++] = q->pad0;
+        q->pad0 = 0;
+    }
+    assert(next == out->num_tris);
+}
+
 static double box_area(const vec3 *lo, const vec3 *hi)
 {
     double dx = (double)hi->x - lo->x, dy = (double)hi->y - lo->y, dz = (double)hi->z - lo->z;
@@ -607,14 +727,22 @@ bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
     bd.threads = num_triangles < BVH_PARALLEL_MIN || cpus <= 1 ? 1
                  : cpus > BVH_MAX_THREADS                     ? BVH_MAX_THREADS
                                                               : (uint32_t)cpus;
-    bd.prims = util_malloc(num_triangles * sizeof *bd.prims);
-    assert((uintptr_t)bd.prims % sizeof(v4f) == 0);
-    bd.nodes = util_calloc(BVH_SUBTREES + (size_t)num_triangles, sizeof *bd.nodes);
-    bd.tris = util_malloc(num_triangles * sizeof *bd.tris);
-    bd.tri_index = util_malloc(num_triangles * sizeof *bd.tri_index);
+    uint32_t chunks = (uint32_t)(((uint64_t)num_triangles + BVH_SETUP_CHUNK - 1) / BVH_SETUP_CHUNK);
+    bd.chunk_first = util_malloc(chunks * sizeof *bd.chunk_first);
     atomic_init(&bd.next_work, 0);
+    run_workers(&bd, count_worker, w);
+    for (uint32_t c = 0; c < chunks; c++) {
+        uint32_t n = bd.chunk_first[c];
+        bd.chunk_first[c] = bd.num_recs;
+        bd.num_recs += n;
+    }
+    bd.rec = util_malloc(bd.num_recs * sizeof *bd.rec);
+    bd.prims = util_malloc(bd.num_recs * sizeof *bd.prims);
+    assert((uintptr_t)bd.prims % sizeof(v4f) == 0);
+    bd.nodes = util_calloc(BVH_SUBTREES + (size_t)bd.num_recs, sizeof *bd.nodes);
+    bd.pairs = util_malloc(bd.num_recs * sizeof *bd.pairs);
 
-    task root = {.begin = 0, .end = num_triangles, .level = 1, .parent = GN_INVALID,
+    task root = {.begin = 0, .end = bd.num_recs, .level = 1, .parent = GN_INVALID,
                  .box = empty_box, .cbox = empty_box};
     run_workers(&bd, setup_worker, w);
     for (uint32_t i = 0; i < bd.threads; i++) {
@@ -625,10 +753,14 @@ bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
     run_workers(&bd, subtree_worker, w);
     out->num_nodes = pack_nodes(&bd);
     out->nodes = util_realloc(bd.nodes, out->num_nodes * sizeof *out->nodes);
-    out->tris = bd.tris;
-    out->tri_index = bd.tri_index;
+    out->pairs = bd.pairs;
+    out->num_pairs = bd.num_recs;
     out->num_tris = num_triangles;
+    out->tri_index = util_malloc(num_triangles * sizeof *out->tri_index);
+    number_triangles(out);
     free(bd.prims);
+    free(bd.rec);
+    free(bd.chunk_first);
     measure(out);
     out->build_seconds = util_now() - t0;
     return true;
@@ -637,7 +769,7 @@ bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
 void bvh_destroy(bvh *b)
 {
     free(b->nodes);
-    free(b->tris);
+    free(b->pairs);
     free(b->tri_index);
     memset(b, 0, sizeof *b);
 }
@@ -757,17 +889,35 @@ static inline bool box_enter(const ray *r, const vec3 *lo, const vec3 *hi, float
     return tn <= minf(tf, tmax);
 }
 
-/* Tests leaf triangles [first, first + count); true when one was hit. */
+/* The hit's barycentrics in its triangle's own corner order, from the test's (u', v') and
+ * the triangle's corner code (glsl/shared.h, GnTriPair). */
+static void pair_decode(uint32_t code, float *u, float *v)
+{
+    const float w[3] = {1.0f - *u - *v, *u, *v};
+    *u = w[code & 3];
+    *v = w[(code >> 2) & 3];
+}
+
+/* Tests leaf pairs [first, first + count): A = (p0, p1, p2), then B = (p0, p2, p3) against
+ * the range A's hit left (as the GPU keeps A on a tie); true when one was hit. */
 static bool leaf_hit(const bvh *b, const ray *r, uint32_t first, uint32_t count, float tmin,
                      bool any_hit, bvh_hit *hit)
 {
     bool found = false;
     for (uint32_t i = first; i < first + count; i++) {
-        const GnTri *tri = &b->tris[i];
+        const GnTriPair *q = &b->pairs[i];
+        const float *p0 = &q->p0.x, *p1 = &q->p1.x, *p2 = &q->p2.x, *p3 = &q->p3.x;
         float t, u, v;
-        if (tri_hit(r, (const float *)&tri->v0, (const float *)&tri->v1, (const float *)&tri->v2,
-                    tmin, hit->t, &t, &u, &v)) {
-            *hit = (bvh_hit){t, u, v, i};
+        if (tri_hit(r, p0, p1, p2, tmin, hit->t, &t, &u, &v)) {
+            pair_decode(q->codes, &u, &v);
+            *hit = (bvh_hit){t, u, v, q->tri};
+            found = true;
+            if (any_hit)
+                break;
+        }
+        if ((q->codes & GN_PAIR_HAS_B) && tri_hit(r, p0, p2, p3, tmin, hit->t, &t, &u, &v)) {
+            pair_decode(q->codes >> 4, &u, &v);
+            *hit = (bvh_hit){t, u, v, q->tri + 1};
             found = true;
             if (any_hit)
                 break;

@@ -14,22 +14,24 @@
 typedef struct bvh {
     GnBvhNode *nodes;
     uint32_t num_nodes;
-    GnTri *tris;            /* triangle corners in leaf order */
-    uint32_t *tri_index;    /* leaf slot -> original triangle index */
+    GnTriPair *pairs;       /* the leaves' primitives in leaf order: a triangle or two */
+    uint32_t num_pairs;
+    uint32_t *tri_index;    /* BVH-order triangle (GnTriPair.tri, +1 for B) -> original index */
     uint32_t num_tris;
     uint32_t depth;         /* longest root-to-leaf path, in GnBvhNode levels */
-    uint32_t max_leaf_size;
-    float sah_cost;         /* SAH cost with C_trav = 1, C_isect = 1, relative to root area */
+    uint32_t max_leaf_size; /* in GnTriPairs */
+    float sah_cost;         /* SAH cost with C_trav = 1, C_isect = 1 per GnTriPair, relative
+                               to the root's area */
     double build_seconds;
 } bvh;
 
 typedef struct bvh_hit {
     float t, u, v;          /* p = (1-u-v) v0 + u v1 + v v2 */
-    uint32_t tri;           /* leaf slot (index into tris / GnPrim order), GN_INVALID: miss */
+    uint32_t tri;           /* BVH-order triangle (GnPrim order, tri_index), GN_INVALID: miss */
 } bvh_hit;
 
 /* Builds over num_triangles triangles given by positions (xyz floats) and indices (3 per
- * triangle). Triangles must have finite vertices (scene_load guarantees it). Returns false
+ * triangle); triangles 2k and 2k + 1 that share an edge (by index) become one GnTriPair. Triangles must have finite vertices (scene_load guarantees it). Returns false
  * only when num_triangles == 0. Deterministic: the same input gives the same tree. */
 bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
                const uint32_t *indices, uint32_t num_triangles);

@@ -257,6 +257,8 @@ int cmd_bench(int argc, char **argv)
     printf("scene              %s\n", generate ? "generated mesh" : path);
     printf("device             %s\n", g.props.deviceName);
     printf("triangles          %u\n", sc.num_triangles);
+    printf("bvh leaf prims     %u (%u triangle pairs, %u single triangles)\n", r.tree.num_pairs,
+           r.tree.num_tris - r.tree.num_pairs, 2 * r.tree.num_pairs - r.tree.num_tris);
     printf("bvh nodes          %u (depth %u, SAH cost %.1f)\n", r.tree.num_nodes, r.tree.depth,
            r.tree.sah_cost);
     fflush(stdout);

@@ -296,8 +296,10 @@ int cmd_info(int argc, char **argv)
     printf("bounds         (%g, %g, %g) - (%g, %g, %g)\n", sc.bounds_min[0], sc.bounds_min[1],
            sc.bounds_min[2], sc.bounds_max[0], sc.bounds_max[1], sc.bounds_max[2]);
     printf("bvh nodes      %u (%zu bytes each)\n", b.num_nodes, sizeof(GnBvhNode));
+    printf("bvh leaf prims %u (%u triangle pairs sharing an edge, %u single triangles)\n",
+           b.num_pairs, b.num_tris - b.num_pairs, 2 * b.num_pairs - b.num_tris);
     printf("bvh depth      %u\n", b.depth);
-    printf("bvh max leaf   %u triangles\n", b.max_leaf_size);
+    printf("bvh max leaf   %u triangle pairs\n", b.max_leaf_size);
     printf("bvh sah cost   %.2f\n", b.sah_cost);
     printf("bvh build      %.2f ms (%.2f M triangles/s)\n", b.build_seconds * 1e3,
            b.build_seconds > 0 ? sc.num_triangles / b.build_seconds * 1e-6 : 0.0);

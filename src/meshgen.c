@@ -130,6 +130,59 @@ meshgen_mesh meshgen_random_triangles(uint32_t n, uint64_t seed, const float box
     return m;
 }
 
+meshgen_mesh meshgen_quad_soup(uint32_t n, uint64_t seed, const float box_min[3],
+                               const float box_max[3])
+{
+    assert(n >= 1 && n <= UINT32_MAX / 12);
+    meshgen_mesh m = mesh_alloc(4 * n + 3 * (n / 4 + 1), 2 * n + n / 4 + 1, 0);
+    uint64_t rng = seed;
+    uint32_t nv = 0, nt = 0;
+    float ext[3];
+    for (int a = 0; a < 3; a++)
+        ext[a] = box_max[a] - box_min[a];
+    for (uint32_t q = 0; q < n; q++) {
+        /* corners c0..c3 of a parallelogram, or bent out of its plane (every third) */
+        float o[3], e1[3], e2[3], size = 0.2f * rand01(&rng) + 0.02f;
+        uint32_t c = nv, kind = (uint32_t)(splitmix64(&rng) % 6);
+        for (int a = 0; a < 3; a++) {
+            o[a] = box_min[a] + ext[a] * rand01(&rng);
+            e1[a] = size * ext[a] * (2 * rand01(&rng) - 1);
+            e2[a] = size * ext[a] * (2 * rand01(&rng) - 1);
+        }
+        if (kind == 5) /* an axis-aligned rectangle, as walls are */
+            e1[1] = e1[2] = e2[0] = e2[2] = 0;
+        for (int a = 0; a < 3; a++) {
+            float bend = q % 3 == 0 ? 0.5f * size * ext[a] * (2 * rand01(&rng) - 1) : 0;
+            m.positions[3 * (nv + 0) + a] = o[a];
+            m.positions[3 * (nv + 1) + a] = o[a] + e1[a];
+            m.positions[3 * (nv + 2) + a] = o[a] + e1[a] + e2[a] + bend;
+            m.positions[3 * (nv + 3) + a] = o[a] + e2[a];
+        }
+        nv += 4;
+        /* triangles (c0 c1 c2) and (c0 c2 c3), each in a random rotation, the second in
+         * either winding */
+        uint32_t t[2][3] = {{c, c + 1, c + 2}, {c, c + 2, c + 3}};
+        if (splitmix64(&rng) & 1) {
+            uint32_t x = t[1][1];
+            t[1][1] = t[1][2], t[1][2] = x;
+        }
+        for (int k = 0; k < 2; k++) {
+            uint32_t r = (uint32_t)(splitmix64(&rng) % 3);
+            set3u(m.indices + 3 * (size_t)nt++, t[k][r], t[k][(r + 1) % 3], t[k][(r + 2) % 3]);
+        }
+        if (q % 4 == 1) { /* a lone triangle between quads: the pairs shift by one */
+            for (int k = 0; k < 3; k++)
+                for (int a = 0; a < 3; a++)
+                    m.positions[3 * (nv + k) + a] = o[a] + size * ext[a] * rand01(&rng);
+            set3u(m.indices + 3 * (size_t)nt++, nv, nv + 1, nv + 2);
+            nv += 3;
+        }
+    }
+    m.num_vertices = nv;
+    m.num_triangles = nt;
+    return m;
+}
+
 meshgen_mesh meshgen_comb(uint32_t n)
 {
     assert(n >= 1 && n <= UINT32_MAX / 3);

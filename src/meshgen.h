@@ -25,6 +25,13 @@ meshgen_mesh meshgen_uv_sphere(const float center[3], float radius, uint32_t sli
 meshgen_mesh meshgen_random_triangles(uint32_t n, uint64_t seed, const float box_min[3],
                                       const float box_max[3]);
 
+/* n quads inside [box_min, box_max] (no normals), each two triangles sharing a diagonal,
+ * listed one after the other in random corner rotations and either relative winding:
+ * parallelograms, axis-aligned rectangles and quads bent out of their plane; a lone
+ * triangle after every fourth quad. For the BVH's pairing of triangles (src/bvh.c). */
+meshgen_mesh meshgen_quad_soup(uint32_t n, uint64_t seed, const float box_min[3],
+                               const float box_max[3]);
+
 /* Worst case for traversal: n - 1 slanted slivers stacked along +z (triangle k in the
  * vertical plane x + y = -0.8, z in [k, k + 0.5]) whose boxes all contain the line x = y = 0
  * while the triangles do not, then one triangle at z = n - 1 crossing that line. The ray

@@ -217,9 +217,10 @@ static void build_emitters(renderer *r, const GnPrim *prims)
     r->emitter_weight = util_calloc(cap, sizeof *r->emitter_weight);
     for (uint32_t i = 0; i < r->tree.num_tris; i++) {
         const GnMaterial *m = &sc->materials[prims[i].material];
-        const GnTri *t = &r->tree.tris[i];
-        double e1[3] = {t->v1.x - t->v0.x, t->v1.y - t->v0.y, t->v1.z - t->v0.z};
-        double e2[3] = {t->v2.x - t->v0.x, t->v2.y - t->v0.y, t->v2.z - t->v0.z};
+        const vec3 *p0 = &sc->vertices[prims[i].i0].position, *p1 = &sc->vertices[prims[i].i1].position,
+                   *p2 = &sc->vertices[prims[i].i2].position;
+        double e1[3] = {p1->x - p0->x, p1->y - p0->y, p1->z - p0->z};
+        double e2[3] = {p2->x - p0->x, p2->y - p0->y, p2->z - p0->z};
         double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
                        e1[0] * e2[1] - e1[1] * e2[0]};
         double area = 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
@@ -297,7 +298,7 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     gpu_buffer_create(g, &r->frame, sizeof(GnFrame), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       GPU_MEMORY_HOST);
     gpu_buffer_create_texels(g, &r->nodes, r->tree.nodes, sizeof(GnBvhNode) * r->tree.num_nodes);
-    gpu_buffer_create_texels(g, &r->tris, r->tree.tris, sizeof(GnTri) * r->tree.num_tris);
+    gpu_buffer_create_texels(g, &r->tris, r->tree.pairs, sizeof(GnTriPair) * r->tree.num_pairs);
     gpu_buffer_create_texels(g, &r->prims, prims, sizeof(GnPrim) * r->tree.num_tris);
     gpu_buffer_create_texels(g, &r->vertices, sc->vertices, sizeof(GnVertex) * sc->num_vertices);
     gpu_buffer_create_texels(g, &r->materials, sc->materials, sizeof(GnMaterial) * sc->num_materials);

@@ -45,7 +45,7 @@ static void mesh_bounds(const meshgen_mesh *m, float lo[3], float hi[3])
         }
 }
 
-static bool box_has_point(const vec3 *lo, const vec3 *hi, const vec4 *p)
+static bool box_has_point(const vec3 *lo, const vec3 *hi, const vec3 *p)
 {
     return p->x >= lo->x && p->y >= lo->y && p->z >= lo->z && p->x <= hi->x && p->y <= hi->y &&
            p->z <= hi->z;
@@ -57,29 +57,64 @@ static bool box_has_box(const vec3 *lo, const vec3 *hi, const vec3 *clo, const v
            chi->y <= hi->y && chi->z <= hi->z;
 }
 
-/* Walks the whole tree and checks every invariant of the GnBvhNode layout against the mesh. */
+/* The corners of triangle `which` (0: A, 1: B) of a pair in the triangle's own order, from
+ * its corner code (glsl/shared.h, GnTriPair); false when the code is not a permutation. */
+static bool pair_corners(const GnTriPair *q, int which, const vec3 *own[3])
+{
+    const vec3 *test[3] = {&q->p0, which ? &q->p2 : &q->p1, which ? &q->p3 : &q->p2};
+    uint32_t code = (q->codes >> (4 * which)) & 15, c1 = code & 3, c2 = code >> 2;
+    if (c1 > 2 || c2 > 2 || c1 == c2)
+        return false;
+    own[0] = test[3 - c1 - c2], own[1] = test[c1], own[2] = test[c2];
+    return true;
+}
+
+/* Walks the whole tree and checks every invariant of the GnBvhNode and GnTriPair layouts
+ * against the mesh. */
 static void check_structure(const bvh *b, const meshgen_mesh *m)
 {
     uint32_t n = m->num_triangles;
     uint8_t *seen_tri = calloc(n, 1), *seen_node = calloc(b->num_nodes, 1);
-    uint32_t stack[256], level[256], sp = 0, depth = 0, max_leaf = 0, visited = 0;
-    int bad_perm = 0, bad_tri = 0, bad_box = 0, bad_order = 0, bad_leaf = 0;
+    uint8_t *seen_pair = calloc(b->num_pairs, 1);
+    uint32_t stack[256], level[256], sp = 0, depth = 0, max_leaf = 0, visited = 0, next = 0;
+    int bad_perm = 0, bad_tri = 0, bad_box = 0, bad_order = 0, bad_leaf = 0, bad_pair = 0;
 
-    CHECK(b->num_tris == n);
+    CHECK(b->num_tris == n && b->num_pairs <= n && 2 * b->num_pairs >= n);
     for (uint32_t i = 0; i < n; i++) {
         uint32_t id = b->tri_index[i];
-        if (id >= n || seen_tri[id]++) {
+        if (id >= n || seen_tri[id]++)
             bad_perm++;
-            continue;
+    }
+    /* pairs number the triangles in order, A then B; B is the index buffer's next triangle
+     * and shares an edge (p0, p2) with A; the corners are the mesh's, in each triangle's
+     * own order through its code */
+    for (uint32_t i = 0; i < b->num_pairs && !bad_perm; i++) {
+        const GnTriPair *q = &b->pairs[i];
+        int tris = q->codes & GN_PAIR_HAS_B ? 2 : 1;
+        bad_pair += q->tri != next || q->pad0 != 0 || q->pad1 != 0 || (q->codes & ~0x1ffu) != 0;
+        if (q->tri != next || next + tris > n) {
+            bad_pair++;
+            break;
         }
-        const float *c[3] = {corner(m, id, 0), corner(m, id, 1), corner(m, id, 2)};
-        const vec4 *t[3] = {&b->tris[i].v0, &b->tris[i].v1, &b->tris[i].v2};
-        for (int k = 0; k < 3; k++)
-            bad_tri += t[k]->x != c[k][0] || t[k]->y != c[k][1] || t[k]->z != c[k][2] ||
-                       t[k]->w != 0;
+        bad_pair += tris == 2 && b->tri_index[next + 1] != b->tri_index[next] + 1;
+        bad_pair += tris == 1 && memcmp(&q->p2, &q->p3, sizeof q->p2) != 0;
+        for (int k = 0; k < tris; k++) {
+            uint32_t id = b->tri_index[next + k];
+            const vec3 *own[3];
+            if (!pair_corners(q, k, own)) {
+                bad_pair++;
+                continue;
+            }
+            for (int c = 0; c < 3; c++)
+                bad_tri += own[c]->x != corner(m, id, c)[0] || own[c]->y != corner(m, id, c)[1] ||
+                           own[c]->z != corner(m, id, c)[2];
+        }
+        next += (uint32_t)tris;
     }
     CHECKF(bad_perm == 0, "%d tri_index entries are not a permutation", bad_perm);
-    CHECKF(bad_tri == 0, "%d GnTri corners differ from the mesh", bad_tri);
+    CHECKF(bad_pair == 0 && next == n, "%d GnTriPair records malformed (%u of %u triangles)",
+           bad_pair, next, n);
+    CHECKF(bad_tri == 0, "%d GnTriPair corners differ from the mesh", bad_tri);
 
     memset(seen_tri, 0, n);
     stack[sp] = 0, level[sp++] = 1;
@@ -104,15 +139,16 @@ static void check_structure(const bvh *b, const meshgen_mesh *m)
                 /* a leaf's index is the walk's entry: flag, count - 1, first triangle */
                 uint32_t first = index[c] & GN_BVH_FIRST;
                 max_leaf = count[c] > max_leaf ? count[c] : max_leaf;
-                if (first + count[c] > n ||
+                if (first + count[c] > b->num_pairs ||
                     index[c] != (GN_BVH_LEAF | (count[c] - 1) << GN_BVH_COUNT_SHIFT | first)) {
                     bad_leaf++;
                     continue;
                 }
                 for (uint32_t t = first; t < first + count[c]; t++) {
-                    const vec4 *v[3] = {&b->tris[t].v0, &b->tris[t].v1, &b->tris[t].v2};
-                    bad_leaf += seen_tri[t]++ != 0;
-                    for (int k = 0; k < 3; k++)
+                    const GnTriPair *q = &b->pairs[t];
+                    const vec3 *v[4] = {&q->p0, &q->p1, &q->p2, &q->p3};
+                    bad_leaf += seen_pair[t]++ != 0;
+                    for (int k = 0; k < 4; k++)
                         bad_box += !box_has_point(lo[c], hi[c], v[k]);
                 }
             } else {
@@ -129,11 +165,11 @@ static void check_structure(const bvh *b, const meshgen_mesh *m)
             }
         }
     }
-    for (uint32_t t = 0; t < n; t++)
-        bad_leaf += seen_tri[t] != 1;
+    for (uint32_t t = 0; t < b->num_pairs; t++)
+        bad_leaf += seen_pair[t] != 1;
     CHECKF(bad_order == 0 && visited == b->num_nodes, "%d bad node links, %u of %u nodes reached",
            bad_order, visited, b->num_nodes);
-    CHECKF(bad_leaf == 0, "%d leaf slots wrong (each triangle in exactly one leaf)", bad_leaf);
+    CHECKF(bad_leaf == 0, "%d leaf slots wrong (each pair in exactly one leaf)", bad_leaf);
     CHECKF(bad_box == 0, "%d boxes do not contain their children or triangles", bad_box);
     CHECKF(depth == b->depth, "depth %u, bvh says %u", depth, b->depth);
     CHECKF(max_leaf == b->max_leaf_size, "largest leaf %u, bvh says %u", max_leaf,
@@ -141,6 +177,7 @@ static void check_structure(const bvh *b, const meshgen_mesh *m)
     CHECK(b->depth <= 64 && b->max_leaf_size <= 8);
     free(seen_tri);
     free(seen_node);
+    free(seen_pair);
 }
 
 /* Zero area up to rounding: |cross| tiny against the squared longest edge. */
@@ -315,7 +352,7 @@ void test_bvh_empty(void)
     const float org[3] = {0, 0, 0}, dir[3] = {0, 0, 1};
     memset(&b, 0xab, sizeof b);
     CHECK(!bvh_build(&b, NULL, 3, NULL, 0));
-    CHECK(b.num_nodes == 0 && b.nodes == NULL && b.tris == NULL);
+    CHECK(b.num_nodes == 0 && b.nodes == NULL && b.pairs == NULL);
     CHECK(bvh_intersect(&b, org, dir, 0, INFINITY, NULL).tri == GN_INVALID);
     CHECK(!bvh_occluded(&b, org, dir, 0, INFINITY));
     bvh_destroy(&b);
@@ -351,6 +388,27 @@ void test_bvh_random_soup(void)
         CHECK(build_mesh(&b, &m));
         check_structure(&b, &m);
         check_rays(&b, &m, 1000, seed);
+        bvh_destroy(&b);
+        meshgen_destroy(&m);
+    }
+}
+
+/* Triangle pairs in every corner rotation and both relative windings, lone triangles that
+ * shift the pairing by one, and bent quads: the pairs' corner codes must give each hit's
+ * barycentrics in the triangle's own order (check_rays rebuilds the hit point from them). */
+void test_bvh_pairs(void)
+{
+    const float lo[3] = {-2, -1, -1}, hi[3] = {2, 1, 3};
+    for (uint64_t seed = 1; seed <= 3; seed++) {
+        uint32_t quads = seed == 1 ? 2000 : 60;
+        meshgen_mesh m = meshgen_quad_soup(quads, seed, lo, hi);
+        bvh b;
+        CHECK(build_mesh(&b, &m));
+        check_structure(&b, &m);
+        check_rays(&b, &m, 2000, seed);
+        /* most quads pair; the lone triangles and the most folded quads do not */
+        uint32_t paired = m.num_triangles - b.num_pairs;
+        CHECKF(paired > quads / 2 && paired <= quads, "%u pairs of %u quads", paired, quads);
         bvh_destroy(&b);
         meshgen_destroy(&m);
     }
@@ -602,7 +660,7 @@ void test_bvh_determinism(void)
         CHECK(a.num_nodes == o->num_nodes && a.depth == o->depth && a.sah_cost == o->sah_cost &&
               a.max_leaf_size == o->max_leaf_size);
         CHECK(!memcmp(a.nodes, o->nodes, a.num_nodes * sizeof *a.nodes));
-        CHECK(!memcmp(a.tris, o->tris, a.num_tris * sizeof *a.tris));
+        CHECK(a.num_pairs == o->num_pairs && !memcmp(a.pairs, o->pairs, a.num_pairs * sizeof *a.pairs));
         CHECK(!memcmp(a.tri_index, o->tri_index, a.num_tris * sizeof *a.tri_index));
     }
     meshgen_mesh m2 = meshgen_bench_mesh(60000);

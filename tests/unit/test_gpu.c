@@ -52,7 +52,7 @@ static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any
     gpu_buffer_create(g, &frame, sizeof f, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
     gpu_buffer_upload(g, &frame, &f, sizeof f, 0);
     gpu_buffer_create_texels(g, &nodes, b->nodes, sizeof(GnBvhNode) * b->num_nodes);
-    gpu_buffer_create_texels(g, &tris, b->tris, sizeof(GnTri) * b->num_tris);
+    gpu_buffer_create_texels(g, &tris, b->pairs, sizeof(GnTriPair) * b->num_pairs);
     gpu_buffer_create_storage(g, &rbuf, rays, sizeof(ray) * n);
     gpu_buffer_create(g, &hbuf, sizeof(gpu_hit) * n, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
     gpu_buffer_create_storage(g, &wbuf, NULL, (VkDeviceSize)WALK_BYTES * n);
@@ -127,7 +127,8 @@ static void random_rays(ray *r, uint32_t n, const float lo[3], const float hi[3]
 static bool same_t(float a, float b) { return fabsf(a - b) <= 1e-5f * fmaxf(1.0f, fabsf(b)); }
 
 /* GPU closest hits equal the C traversal's and brute force's (t within rounding; the same
- * triangle unless two tie at that t); any-hit agrees on occlusion. */
+ * triangle, at the same barycentrics, unless two tie at that t); any-hit agrees on
+ * occlusion. */
 static void compare_mesh(gpu *g, const char *what, const meshgen_mesh *m, const ray *rays,
                          uint32_t n)
 {
@@ -149,13 +150,17 @@ static void compare_mesh(gpu *g, const char *what, const meshgen_mesh *m, const 
             hits++;
             ok = same_t(closest[i].t, c.t) && same_t(c.t, bf.t) &&
                  (b.tri_index[gtri] == b.tri_index[c.tri] || same_t(closest[i].t, bf.t));
+            /* the same triangle: the same point on it, in its own corner order */
+            ok = ok && (gtri != c.tri || (fabsf(closest[i].u - c.u) <= 1e-4f &&
+                                          fabsf(closest[i].v - c.v) <= 1e-4f));
         }
         ok = ok && ((any[i].tri != GN_INVALID) == (c.tri != GN_INVALID));
         ok = ok && closest[i].unfinished == 0.0f;
         if (!ok) {
             bad++;
-            fprintf(stderr, "  %s ray %u: gpu tri %u t %.9g, C tri %u t %.9g, brute tri %u t %.9g, any %u\n",
-                    what, i, gtri, closest[i].t, c.tri, c.t, bf.tri, bf.t, any[i].tri);
+            fprintf(stderr, "  %s ray %u: gpu tri %u t %.9g uv %g %g, C tri %u t %.9g uv %g %g, "
+                    "brute tri %u t %.9g, any %u\n", what, i, gtri, closest[i].t, closest[i].u,
+                    closest[i].v, c.tri, c.t, c.u, c.v, bf.tri, bf.t, any[i].tri);
         }
     }
     CHECKF(bad == 0, "%s: %d rays disagree", what, bad);
