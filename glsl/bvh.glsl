@@ -14,6 +14,13 @@
 
 #include "scene.glsl"
 
+// The walk's stack: 0, an array (GN_WALK_STACK entries, in memory); K > 0, its entries in K
+// registers, for trees of at most K levels (the host sets it from the tree: src/render.c).
+// llvmpipe keeps a private array that is indexed per lane in memory and reads and writes it
+// one lane at a time with a branch on each lane's mask; a shift register of K values costs
+// it 2K vector selects a node visit instead (Cornell box paths: +6%).
+layout(constant_id = GN_SPEC_WALK_REGS) const uint WALK_REGS = 0u;
+
 GnBvhNode bvh_node(uint i)
 {
     int k = int(4u * i);
@@ -168,6 +175,10 @@ struct Walk {
     // put off for later; bvh_walk writes stack[sp] on every node visit, so a full stack
     // keeps one entry free: at most GN_WALK_STACK - 2 nodes.
     uint stack[GN_WALK_STACK];
+    // WALK_REGS > 0: the stack instead, top first, GN_INVALID below the last entry (popping
+    // past the end reads GN_INVALID and ends the walk, like the sentinel). Only constant
+    // indices reach it, so the compiler keeps it in registers.
+    uint regs[GN_WALK_REGS_MAX];
 };
 
 // The walk of this invocation: a private global that bvh_walk works on in place (as a
@@ -180,7 +191,22 @@ void walk_start(float tmax)
     walk.hit.steps = 0u; walk.hit.truncated = false;
     walk.node = 0u;
     walk.sp = 1;
-    walk.stack[0] = GN_INVALID;
+    if (WALK_REGS == 0u)
+        walk.stack[0] = GN_INVALID;
+    for (uint k = 0u; k < WALK_REGS; k++)
+        walk.regs[k] = GN_INVALID;
+}
+
+// The register stack after a node visit: push x (push) or pop (pop), else unchanged.
+void walk_regs_update(bool push, bool pop, uint x)
+{
+    uint old[GN_WALK_REGS_MAX];
+    for (uint k = 0u; k < WALK_REGS; k++)
+        old[k] = walk.regs[k];
+    for (uint k = 0u; k < WALK_REGS; k++) {
+        uint above = k > 0u ? old[k - 1u] : x, below = k + 1u < WALK_REGS ? old[k + 1u] : GN_INVALID;
+        walk.regs[k] = push ? above : pop ? below : old[k];
+    }
 }
 
 // Continues `walk` for at most `budget` more node visits. Closest hit (any_hit false) or
@@ -216,12 +242,18 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
             // per-lane indices one lane at a time, branching on each lane's mask, and a mask
             // that follows the case of each lane is one the branch predictor cannot learn.
             bool a_first = hit_a && (!hit_b || ea <= eb);
-            uint top = w.stack[w.sp - 1];
-            w.stack[w.sp] = a_first ? cb : ca;
+            uint top;
+            if (WALK_REGS > 0u) {
+                top = w.regs[0];
+                walk_regs_update(both, !(hit_a || hit_b), a_first ? cb : ca);
+            } else {
+                top = w.stack[w.sp - 1];
+                w.stack[w.sp] = a_first ? cb : ca;
+                // The stack cannot overflow: the builder's trees are at most BVH_MAX_DEPTH
+                // levels deep, which src/bvh.c checks against GN_WALK_STACK at compile time.
+                w.sp = both ? w.sp + 1 : (hit_a || hit_b) ? w.sp : max(w.sp - 1, 1);
+            }
             w.node = (hit_a || hit_b) ? (a_first ? ca : cb) : top;
-            // The stack cannot overflow: the builder's trees are at most BVH_MAX_DEPTH levels
-            // deep, which src/bvh.c checks against GN_WALK_STACK at compile time.
-            w.sp = both ? w.sp + 1 : (hit_a || hit_b) ? w.sp : max(w.sp - 1, 1);
         }
         // An inner node here: the budget (or llvmpipe's loop cap) ended the loop above early.
         w.hit.truncated = (w.node & GN_BVH_LEAF) == 0u;
@@ -237,7 +269,9 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
             }
         }
         bool found = any_hit && w.hit.tri != GN_INVALID; // any hit: the walk is over
-        uint top = w.stack[w.sp - 1]; // read by every lane, as above
+        uint top = WALK_REGS > 0u ? w.regs[0] : w.stack[w.sp - 1]; // read by every lane, as above
+        if (WALK_REGS > 0u)
+            walk_regs_update(false, leaf, 0u);
         if (leaf) {
             w.node = found ? GN_INVALID : top;
             w.sp = max(w.sp - 1, 1);

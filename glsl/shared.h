@@ -58,6 +58,11 @@ typedef uint32_t uint;
 /* Entries of a BVH walk's stack (glsl/bvh.glsl: Walk), a sentinel and a spare included:
  * room for the 63 nodes a tree of the builder's 64 levels (src/bvh.c) can put off. */
 #define GN_WALK_STACK 66
+/* The most stack entries a walk keeps in registers instead (specialization constant 2 of the
+ * kernels that walk, GN_SPEC_WALK_REGS; glsl/bvh.glsl: Walk): trees of up to this many
+ * levels, whose walks put off at most one node per level. */
+#define GN_WALK_REGS_MAX 8
+#define GN_SPEC_WALK_REGS 2u
 #define GN_TILE_X 8u
 #define GN_TILE_Y 8u
 

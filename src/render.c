@@ -631,13 +631,25 @@ static uint32_t kernel_features(const renderer *r, uint32_t mode)
     return mode == GN_MODE_PATH ? r->path_features : GN_FEAT_ALL;
 }
 
+/* The walk's stack in registers for trees of at most GN_WALK_REGS_MAX levels (a walk puts
+ * off at most one node per level), else in memory (0); GONIO_WALK_ARRAY=1 forces memory, so
+ * that tests/regress/path.sh can check that both give the same pixels. */
+static uint32_t walk_regs(const renderer *r)
+{
+    if (getenv("GONIO_WALK_ARRAY") && !strcmp(getenv("GONIO_WALK_ARRAY"), "1"))
+        return 0;
+    return r->tree.depth <= GN_WALK_REGS_MAX ? r->tree.depth : 0;
+}
+
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec)
 {
     spec->values[0] = mode;
     spec->values[1] = kernel_features(r, mode);
-    spec->entries[0] = (VkSpecializationMapEntry){0, 0, sizeof(uint32_t)};
-    spec->entries[1] = (VkSpecializationMapEntry){1, sizeof(uint32_t), sizeof(uint32_t)};
-    spec->info = (VkSpecializationInfo){2, spec->entries, sizeof spec->values, spec->values};
+    spec->values[2] = walk_regs(r);
+    for (uint32_t i = 0; i < 3; i++)
+        spec->entries[i] = (VkSpecializationMapEntry){i, i * (uint32_t)sizeof(uint32_t), sizeof(uint32_t)};
+    assert(spec->entries[2].constantID == GN_SPEC_WALK_REGS);
+    spec->info = (VkSpecializationInfo){3, spec->entries, sizeof spec->values, spec->values};
     return &spec->info;
 }
 

@@ -86,8 +86,8 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
 /* Specialization constants of the render kernels: constant 0 = mode (or a kernel's own
  * variant); constant 1 = the GN_FEAT_* set (the path kernel reads it; others ignore it). */
 typedef struct renderer_spec {
-    uint32_t values[2];
-    VkSpecializationMapEntry entries[2];
+    uint32_t values[3];
+    VkSpecializationMapEntry entries[3];
     VkSpecializationInfo info;
 } renderer_spec;
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec);

@@ -51,6 +51,27 @@ done
 f=${GONIO_ASSETS:-}/asset-generator/Material_MetallicRoughness/Material_MetallicRoughness_01.gltf
 [ -f "$f" ] && same_as_unspecialised "vertex colours (Asset Generator)" "$f" --env 0.5
 
+# The walk keeps its stack in registers for trees of up to GN_WALK_REGS_MAX levels
+# (glsl/bvh.glsl): every pixel must be what the stack in memory gives (GONIO_WALK_ARRAY=1),
+# in the path kernel and the local modes.
+same_as_stack_array() { # NAME SCENE FLAGS...
+    local what=$1 scene=$2; shift 2
+    if "$G" render "$scene" -o "$tmp/reg.exr" --spp 3 --size 24x24 --quiet "$@" 2>"$tmp/spec.err" &&
+        GONIO_WALK_ARRAY=1 "$G" render "$scene" -o "$tmp/arr.exr" --spp 3 --size 24x24 --quiet "$@" \
+            2>>"$tmp/spec.err"; then
+        check_fails "stack in registers = in memory: $what" 0 "$G" diff "$tmp/reg.exr" "$tmp/arr.exr" \
+            --max-error 0
+    else
+        fail "stack in registers = in memory: $what (render failed)"; sed 's/^/    /' "$tmp/spec.err"
+    fi
+}
+d=$("$G" info $C | awk '$1 == "bvh" && $2 == "depth" {print $3}')
+check "the Cornell box's tree is shallow enough for the register stack (depth $d <= 8)" test "$d" -le 8
+same_as_stack_array "Cornell box" $C
+same_as_stack_array "Cornell box, light sampling only" $C --estimator light
+same_as_stack_array "Cornell box, --mode phong" $C --mode phong
+same_as_stack_array "Cornell box, --mode gouraud" $C --mode gouraud
+
 # Ctrl-C: the render stops after the current pass and writes what it has.
 "$G" render $C -o "$tmp/int.exr" --time 60 --size 32x32 --quiet &
 pid=$!

@@ -2,6 +2,7 @@
  * Vulkan device) against the C traversal of the same GnBvhNode layout and against brute
  * force, on random, degenerate, edge-on and deep meshes; and the renderer end to end on a
  * scene with an analytic answer. */
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -26,8 +27,11 @@ typedef struct gpu_hit {
     float steps, unfinished, pad0, pad1;
 } gpu_hit;
 
-/* A Walk of bvh.glsl in std430: Hit (6 words), node, sp, stack. */
-#define WALK_BYTES (4 * (6 + 2 + GN_WALK_STACK))
+/* A Walk of bvh.glsl in std430: Hit (6 words), node, sp, stack, regs. */
+#define WALK_BYTES (4 * (6 + 2 + GN_WALK_STACK + GN_WALK_REGS_MAX))
+
+/* The walk's stack for gpu_trace: 0, the array; K, K registers (trees of <= K levels). */
+static uint32_t walk_regs;
 
 bool test_open_gpu(gpu *g)
 {
@@ -67,7 +71,10 @@ static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any
             {GN_BIND_VCOLOR, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &wbuf},
             {GN_BIND_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &status},
         };
-        gpu_pipeline_desc pd = {.name = "trace_test", .code = spv_trace_test,
+        const VkSpecializationMapEntry entry = {GN_SPEC_WALK_REGS, 0, sizeof(uint32_t)};
+        const VkSpecializationInfo spec = {1, &entry, sizeof walk_regs, &walk_regs};
+        assert(walk_regs == 0 || b->depth <= walk_regs);
+        gpu_pipeline_desc pd = {.name = "trace_test", .code = spv_trace_test, .specialization = &spec,
                                 .code_size = sizeof spv_trace_test, .local_size = {64, 1, 1},
                                 .push_size = sizeof(GnPush), .bindings = bind,
                                 .num_bindings = sizeof bind / sizeof *bind};
@@ -128,7 +135,9 @@ static bool same_t(float a, float b) { return fabsf(a - b) <= 1e-5f * fmaxf(1.0f
 
 /* GPU closest hits equal the C traversal's and brute force's (t within rounding; the same
  * triangle, at the same barycentrics, unless two tie at that t); any-hit agrees on
- * occlusion. */
+ * occlusion. Trees of at most GN_WALK_REGS_MAX levels are walked three ways: with the stack
+ * in memory, in registers, and in registers resumed every two node visits (the registers
+ * saved and restored with the walk). */
 static void compare_mesh(gpu *g, const char *what, const meshgen_mesh *m, const ray *rays,
                          uint32_t n)
 {
@@ -136,33 +145,40 @@ static void compare_mesh(gpu *g, const char *what, const meshgen_mesh *m, const 
     gpu_hit *closest = calloc(n, sizeof *closest), *any = calloc(n, sizeof *any);
     int bad = 0, hits = 0;
     CHECK(bvh_build(&b, m->positions, 3, m->indices, m->num_triangles));
-    gpu_trace(g, &b, rays, n, false, 1u << 30, false, closest);
-    gpu_trace(g, &b, rays, n, true, 1u << 30, false, any);
-    for (uint32_t i = 0; i < n && bad < 5; i++) {
-        uint32_t steps;
-        bvh_hit c = bvh_intersect(&b, rays[i].o, rays[i].d, rays[i].tmin, rays[i].tmax, &steps);
-        bvh_hit bf = bvh_brute_force(m->positions, 3, m->indices, m->num_triangles, rays[i].o,
-                                     rays[i].d, rays[i].tmin, rays[i].tmax);
-        uint32_t gtri = closest[i].tri;
-        bool ok = (gtri == GN_INVALID) == (c.tri == GN_INVALID) &&
-                  (c.tri == GN_INVALID) == (bf.tri == GN_INVALID);
-        if (ok && c.tri != GN_INVALID) {
-            hits++;
-            ok = same_t(closest[i].t, c.t) && same_t(c.t, bf.t) &&
-                 (b.tri_index[gtri] == b.tri_index[c.tri] || same_t(closest[i].t, bf.t));
-            /* the same triangle: the same point on it, in its own corner order */
-            ok = ok && (gtri != c.tri || (fabsf(closest[i].u - c.u) <= 1e-4f &&
-                                          fabsf(closest[i].v - c.v) <= 1e-4f));
-        }
-        ok = ok && ((any[i].tri != GN_INVALID) == (c.tri != GN_INVALID));
-        ok = ok && closest[i].unfinished == 0.0f;
-        if (!ok) {
-            bad++;
-            fprintf(stderr, "  %s ray %u: gpu tri %u t %.9g uv %g %g, C tri %u t %.9g uv %g %g, "
-                    "brute tri %u t %.9g, any %u\n", what, i, gtri, closest[i].t, closest[i].u,
-                    closest[i].v, c.tri, c.t, c.u, c.v, bf.tri, bf.t, any[i].tri);
+    int ways = b.depth <= GN_WALK_REGS_MAX ? 3 : 1;
+    for (int way = 0; way < ways; way++) {
+        uint32_t budget = way == 2 ? 2 : 1u << 30;
+        walk_regs = way > 0 ? b.depth : 0;
+        gpu_trace(g, &b, rays, n, false, budget, way == 2, closest);
+        gpu_trace(g, &b, rays, n, true, budget, way == 2, any);
+        for (uint32_t i = 0; i < n && bad < 5; i++) {
+            uint32_t steps;
+            bvh_hit c = bvh_intersect(&b, rays[i].o, rays[i].d, rays[i].tmin, rays[i].tmax, &steps);
+            bvh_hit bf = bvh_brute_force(m->positions, 3, m->indices, m->num_triangles, rays[i].o,
+                                         rays[i].d, rays[i].tmin, rays[i].tmax);
+            uint32_t gtri = closest[i].tri;
+            bool ok = (gtri == GN_INVALID) == (c.tri == GN_INVALID) &&
+                      (c.tri == GN_INVALID) == (bf.tri == GN_INVALID);
+            if (ok && c.tri != GN_INVALID) {
+                hits++;
+                ok = same_t(closest[i].t, c.t) && same_t(c.t, bf.t) &&
+                     (b.tri_index[gtri] == b.tri_index[c.tri] || same_t(closest[i].t, bf.t));
+                /* the same triangle: the same point on it, in its own corner order */
+                ok = ok && (gtri != c.tri || (fabsf(closest[i].u - c.u) <= 1e-4f &&
+                                              fabsf(closest[i].v - c.v) <= 1e-4f));
+            }
+            ok = ok && ((any[i].tri != GN_INVALID) == (c.tri != GN_INVALID));
+            ok = ok && closest[i].unfinished == 0.0f;
+            if (!ok) {
+                bad++;
+                fprintf(stderr, "  %s (%s) ray %u: gpu tri %u t %.9g uv %g %g, C tri %u t %.9g uv %g %g, "
+                        "brute tri %u t %.9g, any %u\n", what, way == 0 ? "stack array" : way == 1 ?
+                        "stack in registers" : "registers, resumed", i, gtri, closest[i].t,
+                        closest[i].u, closest[i].v, c.tri, c.t, c.u, c.v, bf.tri, bf.t, any[i].tri);
+            }
         }
     }
+    walk_regs = 0;
     CHECKF(bad == 0, "%s: %d rays disagree", what, bad);
     CHECKF(hits > 0, "%s: no ray hit anything: the test would prove nothing", what);
     bvh_destroy(&b);
@@ -198,6 +214,32 @@ void test_gpu_traversal_sphere(void)
     compare_mesh(&g, "sphere", &m, r, 8192);
     meshgen_destroy(&m);
     free(r);
+    gpu_destroy(&g);
+}
+
+/* Trees shallow enough for the walk's stack in registers: a small soup, a coarse sphere and
+ * triangle pairs in every corner order (compare_mesh walks them all three ways). */
+void test_gpu_traversal_shallow(void)
+{
+    gpu g;
+    const float lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c[3] = {0, 0, 0};
+    meshgen_mesh m[3] = {meshgen_random_triangles(40, 3, lo, hi), meshgen_uv_sphere(c, 0.8f, 8, 5),
+                         meshgen_quad_soup(24, 5, lo, hi)};
+    const char *name[3] = {"small soup", "coarse sphere", "pairs"};
+    ray *r = malloc(sizeof *r * 4096);
+    if (!test_open_gpu(&g))
+        return;
+    random_rays(r, 4096, lo, hi);
+    for (int i = 0; i < 3; i++) {
+        bvh b;
+        CHECK(bvh_build(&b, m[i].positions, 3, m[i].indices, m[i].num_triangles));
+        CHECKF(b.depth <= GN_WALK_REGS_MAX, "%s: depth %u, too deep for the register stack", name[i], b.depth);
+        bvh_destroy(&b);
+        compare_mesh(&g, name[i], &m[i], r, 4096);
+        meshgen_destroy(&m[i]);
+    }
+    free(r);
+    CHECK(gpu_validation_message_count() == 0);
     gpu_destroy(&g);
 }
 
