@@ -54,7 +54,7 @@ typedef uint32_t uint;
  * good default for GPUs (64 threads = 2 warps / 1 wavefront). */
 /* The most samples per pixel one dispatch of the path kernel takes (glsl/path.comp;
  * src/render.c: path_samples picks the number for a scene). */
-#define GN_PATH_SAMPLES 16u
+#define GN_PATH_SAMPLES 32u
 /* Entries of a BVH walk's stack (glsl/bvh.glsl: Walk), a sentinel and a spare included:
  * room for the 63 nodes a tree of the builder's 64 levels (src/bvh.c) can put off. */
 #define GN_WALK_STACK 66
