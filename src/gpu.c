@@ -293,6 +293,7 @@ bool gpu_print_devices(void)
     if (!create_instance(&g, &desc))
         return false;
     devs = list_devices(g.instance, &count);
+    pin_loaded_libraries(); /* the drivers just loaded, as gpu_create does */
     printf("%-5s %-40s %-10s %-24s %s\n", "index", "name", "type", "driver", "api");
     for (uint32_t i = 0; i < count; i++) {
         VkPhysicalDeviceDriverProperties drv = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
