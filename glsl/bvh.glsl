@@ -32,11 +32,9 @@ GnBvhNode bvh_node(uint i)
 
 GnTriPair bvh_pair(uint i)
 {
-    int k = int(4u * i);
-    uvec4 t0 = texelFetch(tri_texels, k), t1 = texelFetch(tri_texels, k + 1);
-    uvec4 t2 = texelFetch(tri_texels, k + 2), t3 = texelFetch(tri_texels, k + 3);
-    return GnTriPair(uintBitsToFloat(t0.xyz), t0.w, uintBitsToFloat(t1.xyz), t1.w,
-                     uintBitsToFloat(t2.xyz), t2.w, uintBitsToFloat(t3.xyz), t3.w);
+    uint k = 3u * i;
+    vec4 a = texel_f(tri_texels, k), b = texel_f(tri_texels, k + 1u), c = texel_f(tri_texels, k + 2u);
+    return GnTriPair(a.xyz, vec3(a.w, b.xy), vec3(b.zw, c.x), c.yzw);
 }
 
 struct Hit {
@@ -91,8 +89,9 @@ float diff_of_products(float a, float b, float c, float d)
 // Watertight test of a GnTriPair's triangles A = (p0, p1, p2) and B = (p0, p2, p3):
 // corners relative to the origin, sheared so the ray is +z; the edge functions decide
 // inside-ness exactly consistently on shared edges. Returns the nearer hit in (tmin, tmax)
-// (A on a tie, as src/bvh.c's leaf_hit), with which = 1 for B and the test's barycentrics
-// (of p1, p2 for A; of p2, p3 for B).
+// (A on a tie, as src/bvh.c's leaf_hit), with which = 1 for B and the barycentrics of p1, p2
+// (A) or p2, p3 (B), which are those of the triangle's GnPrim corners. A lone triangle's
+// B = (p0, p2, p2) has Ub = 0 and Vb = -Wb exactly, so det 0: never a hit.
 // Branch-free (llvmpipe runs every side of every branch anyway, and masks each assignment
 // after an early return): one result at the end.
 bool pair_intersect(RayPre r, GnTriPair q, float tmin, float tmax,
@@ -126,21 +125,13 @@ bool pair_intersect(RayPre r, GnTriPair q, float tmin, float tmax,
     float ra = 1.0 / det_a, rb = 1.0 / det_b;
     float ta = (Ua * z0 + Va * z1 + Wa * z2) * ra, tb = (Ub * z0 + Vb * z2 + Wb * z3) * rb;
     bool hit_a = !out_a && det_a != 0.0 && ta > tmin && ta < tmax;
-    bool hit_b = (q.codes & GN_PAIR_HAS_B) != 0u && !out_b && det_b != 0.0 && tb > tmin && tb < tmax;
+    bool hit_b = !out_b && det_b != 0.0 && tb > tmin && tb < tmax;
     bool b_wins = hit_b && (!hit_a || tb < ta);
     t = b_wins ? tb : ta;
     u = b_wins ? Vb * rb : Va * ra;
     v = b_wins ? Wb * rb : Wa * ra;
     which = b_wins ? 1u : 0u;
     return hit_a || hit_b;
-}
-
-// The hit's barycentrics in its triangle's own corner order (GnTriPair's corner codes).
-vec2 pair_decode(uint code, float u, float v)
-{
-    uint c1 = code & 3u, c2 = (code >> 2u) & 3u;
-    float w = 1.0 - u - v;
-    return vec2(c1 == 0u ? w : c1 == 1u ? u : v, c2 == 0u ? w : c2 == 1u ? u : v);
 }
 
 // max and min of numbers that are never NaN here: GLSL's max and min must return the
@@ -264,8 +255,7 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
             float t, u, v;
             uint which;
             if (pair_intersect(r, q, tmin, w.hit.t, t, u, v, which)) {
-                vec2 uv = pair_decode(q.codes >> (4u * which), u, v);
-                w.hit.t = t; w.hit.u = uv.x; w.hit.v = uv.y; w.hit.tri = q.tri + which;
+                w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = 2u * i + which;
             }
         }
         bool found = any_hit && w.hit.tri != GN_INVALID; // any hit: the walk is over

@@ -12,7 +12,7 @@
 // values that steer loops and re-specializes the shader whenever they change, which cost
 // ~18 ms per dispatch of the path kernel (7x the whole render of a 32x32 image).
 layout(std430, binding = GN_BIND_FRAME) readonly buffer FrameBlock { GnFrame frame; };
-// The BVH nodes (GnBvhNode = 4 texels), triangle pairs (GnTriPair = 4), shading triangles
+// The BVH nodes (GnBvhNode = 4 texels), triangle pairs (GnTriPair = 3), shading triangles
 // (GnPrim = 1), vertices (GnVertex = 4), materials (GnMaterial = 12), textures (GnTexture =
 // 1; their RGBA8 images: R32UI) and path.comp's lights (GnEmitter = 1) are read from texel
 // buffers, not storage buffers: llvmpipe fetches a storage buffer with per-lane offsets one

@@ -166,26 +166,21 @@ GN_STRUCT(GnBvhNode) {
  * test (Woop, Benthin & Wald 2013). Triangle A = (p0, p1, p2), triangle B = (p0, p2, p3):
  * B's edge (p0, p2) is A's, so the walk transforms four corners instead of six, computes
  * that edge's function once (negated for B: the very number B's own would be) and fetches
- * four texels for two triangles instead of six; texel fetches are most of what the walk
- * costs on lavapipe (docs/architecture.md). The pairs are consecutive triangles of the
- * index buffer (2k, 2k + 1) that share an edge, as meshes made of quads come
- * (src/bvh.c: pair_of); a triangle without a partner has p3 = p2 and no B.
- *   tri     the BVH-order index (GnPrim order) of A; B is tri + 1
- *   codes   bits 0-3: A's corner code, bits 4-7: B's, bit 8 (GN_PAIR_HAS_B): B exists.
- *           A corner code maps the test's barycentrics back to the triangle's own corner
- *           order (the walk stores p0.. in the order that puts the shared edge at p2-p0):
- *           with the test's weights w = (1-u'-v', u', v') of its corners, the hit's
- *           (u, v) = (w[code & 3], w[code >> 2]): the weights of the triangle's own
- *           second and third corners. */
-#define GN_PAIR_HAS_B 0x100u
+ * three texels for two triangles instead of six; texel fetches are most of what the walk
+ * costs on lavapipe (docs/architecture.md). The pairs are neighbours in the index buffer
+ * that share an edge, wound alike (src/bvh.c: pairs_with_next); a triangle without a
+ * partner has p3 = p2, a B that no ray can hit (its edge functions cancel exactly: det 0).
+ * Pair i holds the BVH-order triangles 2i (A) and 2i + 1 (B; a hole in GnPrim[] and
+ * tri_index for a lone triangle), whose corners are stored rotated: GnPrim lists each
+ * one's vertices in the test's corner order (the same winding), so the walk's barycentrics
+ * (u, v of p1, p2 for A; of p2, p3 for B) need no translation. No padding: 48 bytes, three
+ * RGBA32UI texels. */
 GN_STRUCT(GnTriPair) {
-    vec3 p0; uint tri;
-    vec3 p1; uint codes;
-    vec3 p2; uint pad0;
-    vec3 p3; uint pad1;
-} GN_END(GnTriPair); /* 64 bytes */
+    vec3 p0; vec3 p1; vec3 p2; vec3 p3;
+} GN_END(GnTriPair); /* 48 bytes */
 
-/* Shading data of a triangle, in BVH order (GnTriPair.tri and the walk's hits count in it). */
+/* Shading data of a triangle, in BVH order (2 per GnTriPair; the walk's hits count in it),
+ * corners in the order the walk's test takes them (GnTriPair). */
 GN_STRUCT(GnPrim) {
     uint i0; uint i1; uint i2; uint material;
 } GN_END(GnPrim); /* 16 bytes */
@@ -298,7 +293,7 @@ GN_STRUCT(GnDisplayPush) {
 #include <stddef.h>
 GN_STATIC_ASSERT(sizeof(GnBvhNode) == 64, "GnBvhNode layout");
 GN_STATIC_ASSERT(offsetof(GnBvhNode, b_min) == 32, "GnBvhNode layout");
-GN_STATIC_ASSERT(sizeof(GnTriPair) == 64, "GnTriPair layout");
+GN_STATIC_ASSERT(sizeof(GnTriPair) == 48, "GnTriPair layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");
 GN_STATIC_ASSERT(sizeof(GnVertex) == 64, "GnVertex layout");
 GN_STATIC_ASSERT(sizeof(GnMaterial) == 192, "GnMaterial layout");

@@ -21,10 +21,10 @@
 #include "util.h"
 
 /* Build tunables. The build's primitives are GnTriPairs (a triangle or two). SAH constants
- * C_trav = 1, C_isect = 1 per pair: on lavapipe a GnBvhNode visit and a pair test both cost
- * four texel fetches, which is most of either (with single triangles of three fetches,
- * C_trav = 2 had measured best). Leaves of 2-4 or 1-4 pairs and C_trav 1.5-2 were tried: no
- * better on the Cornell box's paths or the 250k mesh's rays, and slower to build.
+ * C_trav = 1, C_isect = 1 per pair: on lavapipe a GnBvhNode visit costs four texel fetches
+ * and a pair test three, which is most of either (with single triangles, C_trav = 2 had
+ * measured best). Leaves of 2-4 or 1-4 pairs and C_trav 1.3-2 were tried: no better on the
+ * Cornell box's paths or the 250k mesh's rays, and slower to build.
  * (`gonio info` reports the SAH cost with both constants 1, for comparing trees.) */
 #define BVH_SAH_TRAVERSAL 1.0f
 #define BVH_BINS 16      /* per axis; Wald 2007 finds 16 as good as a full sweep */
@@ -308,6 +308,8 @@ typedef struct builder {
     prim *prims;
     GnBvhNode *nodes;
     GnTriPair *pairs;
+    uint32_t *tri_index;
+    uint8_t *tri_rotation;
     uint32_t num_top, num_pending;
     task pending[BVH_SUBTREES];
     uint32_t subtree_size[BVH_SUBTREES];
@@ -342,13 +344,14 @@ static const float *vertex(const builder *bd, uint32_t tri, int k)
 }
 
 /* Triangles t and t + 1 of the index buffer make one GnTriPair when they share exactly one
- * edge (by vertex index; neither repeats an index) and the pair's box is no larger (in
- * surface area) than the two boxes together: the SAH's view, since a pair costs the walk
- * about what one triangle does (four texel fetches) and is entered whenever a ray enters its
- * box. (Without that test, the few folded pairs of the 250k bench mesh made its rays 15%
- * slower.) Only neighbours in the index buffer are paired: meshes built from quads list a
- * quad's two triangles together (Embree's triangle pairing makes the same assumption), so
- * one pass finds them with no search. */
+ * edge (by vertex index; neither repeats an index), are wound alike (so that GnPrim can
+ * list B's corners in the test's order by a rotation, keeping its winding), and the pair's
+ * box is no larger (in surface area) than the two boxes together: the SAH's view, since a
+ * pair costs the walk about what one triangle does (three texel fetches) and is entered
+ * whenever a ray enters its box. (Without that test, the few folded pairs of the 250k bench
+ * mesh made its rays 15% slower.) Only neighbours in the index buffer are paired: meshes
+ * built from quads list a quad's two triangles together (Embree's triangle pairing makes
+ * the same assumption), so one pass finds them with no search. */
 static bool pairs_with_next(const builder *bd, uint32_t t)
 {
     if ((uint64_t)t + 1 >= bd->num_tris)
@@ -360,6 +363,14 @@ static bool pairs_with_next(const builder *bd, uint32_t t)
     for (int k = 0; k < 3; k++)
         shared += (a[k] == b[0]) + (a[k] == b[1]) + (a[k] == b[2]);
     if (shared != 2)
+        return false;
+    /* wound alike: B runs the shared edge the other way (then B's own corner order is a
+     * rotation of the order the pair's test takes, and GnPrim keeps the winding) */
+    bool alike = false;
+    for (int k = 0; k < 3; k++)
+        for (int m = 0; m < 3; m++)
+            alike |= a[k] == b[(m + 1) % 3] && a[(k + 1) % 3] == b[m];
+    if (!alike)
         return false;
     aabb ba = empty_box, bb = empty_box, bu;
     for (int k = 0; k < 3; k++) {
@@ -432,46 +443,41 @@ static void *setup_worker(void *arg)
     return NULL;
 }
 
-/* Writes record `rec`'s corners into q: A rotated so that the shared edge is (p2, p0), B's
- * third corner as p3, and the corner codes (glsl/shared.h). q->tri and q->pad0 hold the
- * original indices of A and B until number_triangles() renumbers them in BVH order. */
-static void write_pair(const builder *bd, uint32_t rec, GnTriPair *q)
+/* Writes record `rec` as pair i: A rotated so that the shared edge is (p2, p0), B's third
+ * corner as p3 (B's own order is then a rotation of (p0, p2, p3)), and the BVH-order
+ * triangles 2i and 2i + 1 with their rotations. */
+static void write_pair(const builder *bd, uint32_t rec, uint32_t i, GnTriPair *q,
+                       uint32_t *tri_index, uint8_t *tri_rotation)
 {
-    uint32_t ta = rec & ~BVH_REC_PAIR, tb = ta + 1;
+    uint32_t ta = rec & ~BVH_REC_PAIR;
     const uint32_t *a = bd->indices + 3 * (size_t)ta, *b = a + 3;
-    uint32_t rot = 0, idx[4], codes;
-    if (rec & BVH_REC_PAIR) {
-        /* the edge (a[k], a[k + 1]) in B: rotate so that it is (p2, p0) */
+    uint32_t rot = 0, rot_b = 0, idx[4];
+    bool pair = (rec & BVH_REC_PAIR) != 0;
+    if (pair) /* the edge (a[k], a[k + 1]) that B has: rotate it to (p2, p0) */
         for (uint32_t k = 0; k < 3; k++) {
             uint32_t x = a[k], y = a[(k + 1) % 3];
-            bool in_b = (x == b[0] || x == b[1] || x == b[2]) && (y == b[0] || y == b[1] || y == b[2]);
-            if (in_b)
+            if ((x == b[0] || x == b[1] || x == b[2]) && (y == b[0] || y == b[1] || y == b[2]))
                 rot = (k + 1) % 3;
         }
-    }
     for (uint32_t k = 0; k < 3; k++)
         idx[k] = a[(rot + k) % 3];
     idx[3] = idx[2];
-    /* A's own corner m is the test's corner (m - rot) mod 3 */
-    codes = (1 + 3 - rot) % 3 | ((2 + 3 - rot) % 3) << 2;
-    if (rec & BVH_REC_PAIR) {
-        uint32_t pos[3];
-        for (int k = 0; k < 3; k++)
+    if (pair)
+        for (uint32_t k = 0; k < 3; k++) {
             if (b[k] != idx[0] && b[k] != idx[2])
                 idx[3] = b[k];
-        for (int k = 0; k < 3; k++) /* B is tested as (p0, p2, p3) */
-            pos[k] = b[k] == idx[0] ? 0 : b[k] == idx[2] ? 1 : 2;
-        codes |= (pos[1] | pos[2] << 2) << 4 | GN_PAIR_HAS_B;
-    }
+            if (b[k] == idx[0]) /* B's own corner k is the test's p0 */
+                rot_b = k;
+        }
     vec3 *p[4] = {&q->p0, &q->p1, &q->p2, &q->p3};
     for (int k = 0; k < 4; k++) {
         const float *x = bd->positions + (size_t)idx[k] * bd->stride;
         *p[k] = (vec3){x[0], x[1], x[2]};
     }
-    q->tri = ta;
-    q->codes = codes;
-    q->pad0 = rec & BVH_REC_PAIR ? tb : GN_INVALID;
-    q->pad1 = 0;
+    tri_index[2 * (size_t)i] = ta;
+    tri_rotation[2 * (size_t)i] = (uint8_t)rot;
+    tri_index[2 * (size_t)i + 1] = pair ? ta + 1 : GN_INVALID;
+    tri_rotation[2 * (size_t)i + 1] = (uint8_t)rot_b;
 }
 
 /* Decides and performs one node, numbering new nodes from *next_node: a leaf goes into its
@@ -498,7 +504,7 @@ static int process(builder *bd, const task *t, task *l, task *r, uint32_t *next_
         }
         set_child(parent, t->slot, &t->box, t->begin, n);
         for (uint32_t i = t->begin; i < t->end; i++)
-            write_pair(bd, bd->rec[bd->prims[i].id], &bd->pairs[i]);
+            write_pair(bd, bd->rec[bd->prims[i].id], i, &bd->pairs[i], bd->tri_index, bd->tri_rotation);
         return 0;
     }
     uint32_t self = (*next_node)++;
@@ -645,22 +651,6 @@ static uint32_t pack_nodes(builder *bd)
     return lay.next;
 }
 
-/* BVH order of the triangles: the pairs' triangles in leaf order, A before B. Replaces the
- * original indices that write_pair left in each pair by the BVH-order index of A. */
-static void number_triangles(bvh *out)
-{
-    uint32_t next = 0;
-    for (uint32_t i = 0; i < out->num_pairs; i++) {
-        GnTriPair *q = &out->pairs[i];
-        out->tri_index[next] = q->tri;
-        q->tri = next++;
-        if (q->codes & GN_PAIR_HAS_B)
-            out->tri_index[next++] = q->pad0;
-        q->pad0 = 0;
-    }
-    assert(next == out->num_tris);
-}
-
 static double box_area(const vec3 *lo, const vec3 *hi)
 {
     double dx = (double)hi->x - lo->x, dy = (double)hi->y - lo->y, dz = (double)hi->z - lo->z;
@@ -741,6 +731,8 @@ bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
     assert((uintptr_t)bd.prims % sizeof(v4f) == 0);
     bd.nodes = util_calloc(BVH_SUBTREES + (size_t)bd.num_recs, sizeof *bd.nodes);
     bd.pairs = util_malloc(bd.num_recs * sizeof *bd.pairs);
+    bd.tri_index = util_malloc(2 * (size_t)bd.num_recs * sizeof *bd.tri_index);
+    bd.tri_rotation = util_malloc(2 * (size_t)bd.num_recs * sizeof *bd.tri_rotation);
 
     task root = {.begin = 0, .end = bd.num_recs, .level = 1, .parent = GN_INVALID,
                  .box = empty_box, .cbox = empty_box};
@@ -756,8 +748,9 @@ bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
     out->pairs = bd.pairs;
     out->num_pairs = bd.num_recs;
     out->num_tris = num_triangles;
-    out->tri_index = util_malloc(num_triangles * sizeof *out->tri_index);
-    number_triangles(out);
+    out->num_slots = 2 * bd.num_recs;
+    out->tri_index = bd.tri_index;
+    out->tri_rotation = bd.tri_rotation;
     free(bd.prims);
     free(bd.rec);
     free(bd.chunk_first);
@@ -771,6 +764,7 @@ void bvh_destroy(bvh *b)
     free(b->nodes);
     free(b->pairs);
     free(b->tri_index);
+    free(b->tri_rotation);
     memset(b, 0, sizeof *b);
 }
 
@@ -889,15 +883,6 @@ static inline bool box_enter(const ray *r, const vec3 *lo, const vec3 *hi, float
     return tn <= minf(tf, tmax);
 }
 
-/* The hit's barycentrics in its triangle's own corner order, from the test's (u', v') and
- * the triangle's corner code (glsl/shared.h, GnTriPair). */
-static void pair_decode(uint32_t code, float *u, float *v)
-{
-    const float w[3] = {1.0f - *u - *v, *u, *v};
-    *u = w[code & 3];
-    *v = w[(code >> 2) & 3];
-}
-
 /* Tests leaf pairs [first, first + count): A = (p0, p1, p2), then B = (p0, p2, p3) against
  * the range A's hit left (as the GPU keeps A on a tie); true when one was hit. */
 static bool leaf_hit(const bvh *b, const ray *r, uint32_t first, uint32_t count, float tmin,
@@ -909,15 +894,13 @@ static bool leaf_hit(const bvh *b, const ray *r, uint32_t first, uint32_t count,
         const float *p0 = &q->p0.x, *p1 = &q->p1.x, *p2 = &q->p2.x, *p3 = &q->p3.x;
         float t, u, v;
         if (tri_hit(r, p0, p1, p2, tmin, hit->t, &t, &u, &v)) {
-            pair_decode(q->codes, &u, &v);
-            *hit = (bvh_hit){t, u, v, q->tri};
+            *hit = (bvh_hit){t, u, v, 2 * i};
             found = true;
             if (any_hit)
                 break;
         }
-        if ((q->codes & GN_PAIR_HAS_B) && tri_hit(r, p0, p2, p3, tmin, hit->t, &t, &u, &v)) {
-            pair_decode(q->codes >> 4, &u, &v);
-            *hit = (bvh_hit){t, u, v, q->tri + 1};
+        if (b->tri_index[2 * i + 1] != GN_INVALID && tri_hit(r, p0, p2, p3, tmin, hit->t, &t, &u, &v)) {
+            *hit = (bvh_hit){t, u, v, 2 * i + 1};
             found = true;
             if (any_hit)
                 break;

@@ -16,8 +16,11 @@ typedef struct bvh {
     uint32_t num_nodes;
     GnTriPair *pairs;       /* the leaves' primitives in leaf order: a triangle or two */
     uint32_t num_pairs;
-    uint32_t *tri_index;    /* BVH-order triangle (GnTriPair.tri, +1 for B) -> original index */
-    uint32_t num_tris;
+    uint32_t num_slots;     /* BVH-order triangles: 2 per pair (A = 2i, B = 2i + 1) */
+    uint32_t *tri_index;    /* BVH-order triangle -> original index; GN_INVALID: no B */
+    uint8_t *tri_rotation;  /* BVH-order triangle -> r: its corner k in the test's order (and
+                               in bvh_hit's barycentrics) is its own corner (r + k) mod 3 */
+    uint32_t num_tris;      /* triangles */
     uint32_t depth;         /* longest root-to-leaf path, in GnBvhNode levels */
     uint32_t max_leaf_size; /* in GnTriPairs */
     float sah_cost;         /* SAH cost with C_trav = 1, C_isect = 1 per GnTriPair, relative
@@ -26,12 +29,13 @@ typedef struct bvh {
 } bvh;
 
 typedef struct bvh_hit {
-    float t, u, v;          /* p = (1-u-v) v0 + u v1 + v v2 */
+    float t, u, v;          /* p = (1-u-v) c0 + u c1 + v c2, c_k: the triangle's own corner
+                               (tri_rotation[tri] + k) mod 3 */
     uint32_t tri;           /* BVH-order triangle (GnPrim order, tri_index), GN_INVALID: miss */
 } bvh_hit;
 
 /* Builds over num_triangles triangles given by positions (xyz floats) and indices (3 per
- * triangle); triangles 2k and 2k + 1 that share an edge (by index) become one GnTriPair. Triangles must have finite vertices (scene_load guarantees it). Returns false
+ * triangle); neighbours in the index buffer that share an edge may become one GnTriPair. Triangles must have finite vertices (scene_load guarantees it). Returns false
  * only when num_triangles == 0. Deterministic: the same input gives the same tree. */
 bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
                const uint32_t *indices, uint32_t num_triangles);

@@ -215,10 +215,12 @@ static uint32_t material_features(const GnMaterial *m)
 static void build_emitters(renderer *r, const GnPrim *prims)
 {
     const scene *sc = r->sc;
-    uint32_t cap = r->tree.num_tris + sc->num_lights + 1, n = 0;
+    uint32_t cap = r->tree.num_slots + sc->num_lights + 1, n = 0;
     r->emitter_table = util_calloc(cap, sizeof *r->emitter_table);
     r->emitter_weight = util_calloc(cap, sizeof *r->emitter_weight);
-    for (uint32_t i = 0; i < r->tree.num_tris; i++) {
+    for (uint32_t i = 0; i < r->tree.num_slots; i++) {
+        if (r->tree.tri_index[i] == GN_INVALID) /* the missing B of a lone triangle */
+            continue;
         const GnMaterial *m = &sc->materials[prims[i].material];
         const vec3 *p0 = &sc->vertices[prims[i].i0].position, *p1 = &sc->vertices[prims[i].i1].position,
                    *p2 = &sc->vertices[prims[i].i2].position;
@@ -269,11 +271,15 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     r->path_samples = path_samples(r);
     r->path_features = r->material_features;
 
-    prims = util_malloc(sizeof *prims * r->tree.num_tris);
-    for (uint32_t i = 0; i < r->tree.num_tris; i++) {
-        uint32_t t = r->tree.tri_index[i];
-        prims[i] = (GnPrim){sc->indices[3 * t], sc->indices[3 * t + 1], sc->indices[3 * t + 2],
-                            sc->tri_material[t]};
+    /* in BVH order, each triangle's corners in the order the walk's test takes them (a
+     * rotation: the winding stays), so the walk's barycentrics apply as they are */
+    prims = util_calloc(r->tree.num_slots, sizeof *prims);
+    for (uint32_t i = 0; i < r->tree.num_slots; i++) {
+        uint32_t t = r->tree.tri_index[i], k = r->tree.tri_rotation[i];
+        if (t == GN_INVALID)
+            continue;
+        prims[i] = (GnPrim){sc->indices[3 * t + k], sc->indices[3 * t + (k + 1) % 3],
+                            sc->indices[3 * t + (k + 2) % 3], sc->tri_material[t]};
     }
 
     image_offset = util_calloc(sc->num_images + 1, sizeof *image_offset);
@@ -302,7 +308,7 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
                       GPU_MEMORY_HOST);
     gpu_buffer_create_texels(g, &r->nodes, r->tree.nodes, sizeof(GnBvhNode) * r->tree.num_nodes);
     gpu_buffer_create_texels(g, &r->tris, r->tree.pairs, sizeof(GnTriPair) * r->tree.num_pairs);
-    gpu_buffer_create_texels(g, &r->prims, prims, sizeof(GnPrim) * r->tree.num_tris);
+    gpu_buffer_create_texels(g, &r->prims, prims, sizeof(GnPrim) * r->tree.num_slots);
     gpu_buffer_create_texels(g, &r->vertices, sc->vertices, sizeof(GnVertex) * sc->num_vertices);
     gpu_buffer_create_texels(g, &r->materials, sc->materials, sizeof(GnMaterial) * sc->num_materials);
     gpu_buffer_create_storage(g, &r->lights, lights, sizeof(GnLight) * r->num_lights);

@@ -133,6 +133,32 @@ static void random_rays(ray *r, uint32_t n, const float lo[3], const float hi[3]
 
 static bool same_t(float a, float b) { return fabsf(a - b) <= 1e-5f * fmaxf(1.0f, fabsf(b)); }
 
+/* Is the GPU's hit point o + t d the point of BVH-order triangle `slot` at its barycentrics
+ * (corner k: the mesh's (tri_rotation + k) mod 3)? Zero-area triangles pass: their hits
+ * are rounding noise of a det that should be 0. */
+static bool on_triangle(const bvh *b, const meshgen_mesh *m, uint32_t slot, const ray *r,
+                        const gpu_hit *h)
+{
+    const float *c[3];
+    float e1[3], e2[3], n[3], ext = 1;
+    for (int k = 0; k < 3; k++)
+        c[k] = m->positions + 3 * m->indices[3 * b->tri_index[slot] + (b->tri_rotation[slot] + k) % 3];
+    for (int a = 0; a < 3; a++)
+        e1[a] = c[1][a] - c[0][a], e2[a] = c[2][a] - c[0][a];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    if (n[0] * n[0] + n[1] * n[1] + n[2] * n[2] < 1e-20f)
+        return true;
+    for (int a = 0; a < 3; a++)
+        ext = fmaxf(ext, fabsf(r->o[a]) + fabsf(h->t * r->d[a]));
+    for (int a = 0; a < 3; a++) {
+        float p = (1 - h->u - h->v) * c[0][a] + h->u * c[1][a] + h->v * c[2][a];
+        if (fabsf(p - (r->o[a] + h->t * r->d[a])) > 1e-4f * ext)
+            return false;
+    }
+    return true;
+}
+
 /* GPU closest hits equal the C traversal's and brute force's (t within rounding; the same
  * triangle, at the same barycentrics, unless two tie at that t); any-hit agrees on
  * occlusion. Trees of at most GN_WALK_REGS_MAX levels are walked three ways: with the stack
@@ -166,6 +192,10 @@ static void compare_mesh(gpu *g, const char *what, const meshgen_mesh *m, const 
                 /* the same triangle: the same point on it, in its own corner order */
                 ok = ok && (gtri != c.tri || (fabsf(closest[i].u - c.u) <= 1e-4f &&
                                               fabsf(closest[i].v - c.v) <= 1e-4f));
+                /* whichever triangle: its corners (in the walk's order) at the GPU's
+                 * barycentrics are the hit point, so a wrong triangle cannot pass as a tie */
+                ok = ok && gtri < b.num_slots && b.tri_index[gtri] != GN_INVALID &&
+                     on_triangle(&b, m, gtri, &rays[i], &closest[i]);
             }
             ok = ok && ((any[i].tri != GN_INVALID) == (c.tri != GN_INVALID));
             ok = ok && closest[i].unfinished == 0.0f;
