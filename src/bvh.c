@@ -305,6 +305,7 @@ typedef struct builder {
     uint32_t num_tris, num_recs, threads;
     uint32_t *rec;         /* record (the build's primitive) -> A's triangle | BVH_REC_PAIR */
     uint32_t *chunk_first; /* setup chunk -> its first record */
+    uint8_t *pair_at;      /* triangle -> 1: it and the next one are a record (count_worker) */
     prim *prims;
     GnBvhNode *nodes;
     GnTriPair *pairs;
@@ -384,7 +385,7 @@ static bool pairs_with_next(const builder *bd, uint32_t t)
     return half_area(&bu) <= half_area(&ba) + half_area(&bb);
 }
 
-/* Setup, BVH_SETUP_CHUNK triangles at a time: first each chunk's record count
+/* Setup, BVH_SETUP_CHUNK triangles at a time: first each chunk's pairs and record count
  * (count_worker), then, from each chunk's first record, the records and their boxes
  * (setup_worker). Within a chunk the pairing is greedy from its first triangle (a pair,
  * else a single), so it depends on the chunk boundaries only, not on the threads. */
@@ -404,8 +405,11 @@ static void *count_worker(void *arg)
     uint32_t begin, end, c;
     while ((c = chunk_range(bd, &begin, &end)) != GN_INVALID) {
         uint32_t n = 0;
-        for (uint32_t t = begin; t < end; n++)
-            t += t + 1 < end && pairs_with_next(bd, t) ? 2 : 1;
+        for (uint32_t t = begin; t < end; n++) {
+            bool pair = t + 1 < end && pairs_with_next(bd, t);
+            bd->pair_at[t] = pair;
+            t += pair ? 2 : 1;
+        }
         bd->chunk_first[c] = n;
     }
     return NULL;
@@ -419,7 +423,7 @@ static void *setup_worker(void *arg)
     while ((c = chunk_range(bd, &begin, &end)) != GN_INVALID) {
         uint32_t r = bd->chunk_first[c];
         for (uint32_t t = begin; t < end; r++) {
-            bool pair = t + 1 < end && pairs_with_next(bd, t);
+            bool pair = bd->pair_at[t];
             prim *p = &bd->prims[r];
             bd->rec[r] = t | (pair ? BVH_REC_PAIR : 0u);
             for (int a = 0; a < 3; a++)
@@ -719,6 +723,7 @@ bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
                                                               : (uint32_t)cpus;
     uint32_t chunks = (uint32_t)(((uint64_t)num_triangles + BVH_SETUP_CHUNK - 1) / BVH_SETUP_CHUNK);
     bd.chunk_first = util_malloc(chunks * sizeof *bd.chunk_first);
+    bd.pair_at = util_malloc(num_triangles);
     atomic_init(&bd.next_work, 0);
     run_workers(&bd, count_worker, w);
     for (uint32_t c = 0; c < chunks; c++) {
@@ -754,6 +759,7 @@ bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
     free(bd.prims);
     free(bd.rec);
     free(bd.chunk_first);
+    free(bd.pair_at);
     measure(out);
     out->build_seconds = util_now() - t0;
     return true;
