@@ -181,7 +181,7 @@ void walk_start(float tmax)
     walk.hit.t = tmax; walk.hit.u = 0.0; walk.hit.v = 0.0; walk.hit.tri = GN_INVALID;
     walk.hit.steps = 0u; walk.hit.truncated = false;
     walk.node = 0u;
-    walk.sp = 1;
+    walk.sp = 1; // (unused with WALK_REGS > 0)
     if (WALK_REGS == 0u)
         walk.stack[0] = GN_INVALID;
     for (uint k = 0u; k < WALK_REGS; k++)
@@ -262,10 +262,10 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
         uint top = WALK_REGS > 0u ? w.regs[0] : w.stack[w.sp - 1]; // read by every lane, as above
         if (WALK_REGS > 0u)
             walk_regs_update(false, leaf, 0u);
-        if (leaf) {
-            w.node = found ? GN_INVALID : top;
+        else if (leaf)
             w.sp = max(w.sp - 1, 1);
-        }
+        if (leaf)
+            w.node = found ? GN_INVALID : top;
     }
     // The loop ends with the walk over, or else because llvmpipe's loop cap stopped it: the
     // state is still whole (the cap ends loops between iterations), so say so and the

@@ -52,9 +52,9 @@ GnVertex vertex_at(uint i)
 void tri_corners(uint i, out vec3 a, out vec3 b, out vec3 c)
 {
     GnPrim pr = prim_at(i);
-    a = texel_f(vertex_texels, 4u * pr.i0).xyz;
-    b = texel_f(vertex_texels, 4u * pr.i1).xyz;
-    c = texel_f(vertex_texels, 4u * pr.i2).xyz;
+    a = vertex_at(pr.i0).position; // (the unused texels of a vertex are never fetched)
+    b = vertex_at(pr.i1).position;
+    c = vertex_at(pr.i2).position;
 }
 
 // Does the scene have vertex colours (glTF COLOR_0)? Without, GnVertex.color is not read.

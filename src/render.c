@@ -645,7 +645,8 @@ static uint32_t kernel_features(const renderer *r, uint32_t mode)
  * that tests/regress/path.sh can check that both give the same pixels. */
 static uint32_t walk_regs(const renderer *r)
 {
-    if (getenv("GONIO_WALK_ARRAY") && !strcmp(getenv("GONIO_WALK_ARRAY"), "1"))
+    const char *array = getenv("GONIO_WALK_ARRAY");
+    if (array && !strcmp(array, "1"))
         return 0;
     return r->tree.depth <= GN_WALK_REGS_MAX ? r->tree.depth : 0;
 }

@@ -17,22 +17,25 @@ check_fails "an unknown BRDF model is a usage error" 1 "$G" render $C -o "$tmp/x
 check "the message names the models" grep -q 'torrance-sparrow' "$tmp/last"
 check_fails "a missing environment map fails" 1 "$G" render $C -o "$tmp/x.exr" --env "$tmp/none.exr" --quiet
 
+# same_pixels WHAT ENV NAME SCENE FLAGS...: a render as it is and one with the environment
+# assignment ENV must give identical pixels; the check is named "WHAT: NAME".
+same_pixels() {
+    local what=$1 env=$2 name=$3 scene=$4; shift 4
+    if "$G" render "$scene" -o "$tmp/one.exr" --spp 3 --size 24x24 --quiet "$@" 2>"$tmp/spec.err" &&
+        env "$env" "$G" render "$scene" -o "$tmp/two.exr" --spp 3 --size 24x24 --quiet "$@" \
+            2>>"$tmp/spec.err"; then
+        check_fails "$what: $name" 0 "$G" diff "$tmp/one.exr" "$tmp/two.exr" --max-error 0
+    else
+        fail "$what: $name (render failed)"; sed 's/^/    /' "$tmp/spec.err"
+    fi
+}
+
 # The path kernel is specialised on what the scene needs (GN_FEAT_* in glsl/shared.h):
 # removing code must not change a single pixel. Each case renders specialised and with
 # every feature (GONIO_ALL_FEATURES) and demands the same image, for every BRDF model, each
 # estimator, the AOVs, both kinds of environment, and sample models with textures, normal
 # maps, glass, punctual lights and vertex colours.
-same_as_unspecialised() { # NAME SCENE FLAGS...
-    local what=$1 scene=$2; shift 2
-    if "$G" render "$scene" -o "$tmp/spec.exr" --spp 3 --size 24x24 --quiet "$@" 2>"$tmp/spec.err" &&
-        GONIO_ALL_FEATURES=1 "$G" render "$scene" -o "$tmp/all.exr" --spp 3 --size 24x24 --quiet "$@" \
-            2>>"$tmp/spec.err"; then
-        check_fails "specialised = unspecialised: $what" 0 "$G" diff "$tmp/spec.exr" "$tmp/all.exr" \
-            --max-error 0
-    else
-        fail "specialised = unspecialised: $what (render failed)"; sed 's/^/    /' "$tmp/spec.err"
-    fi
-}
+same_as_unspecialised() { same_pixels "specialised = unspecialised" GONIO_ALL_FEATURES=1 "$@"; }
 same_as_unspecialised "Cornell box" $C
 for model in lambert mirror phong blinn-phong torrance-sparrow beckmann ggx conductor \
     conductor:alpha=0 dielectric dielectric:alpha=0.3 \
@@ -54,17 +57,7 @@ f=${GONIO_ASSETS:-}/asset-generator/Material_MetallicRoughness/Material_Metallic
 # The walk keeps its stack in registers for trees of up to GN_WALK_REGS_MAX levels
 # (glsl/bvh.glsl): every pixel must be what the stack in memory gives (GONIO_WALK_ARRAY=1),
 # in the path kernel and the local modes.
-same_as_stack_array() { # NAME SCENE FLAGS...
-    local what=$1 scene=$2; shift 2
-    if "$G" render "$scene" -o "$tmp/reg.exr" --spp 3 --size 24x24 --quiet "$@" 2>"$tmp/spec.err" &&
-        GONIO_WALK_ARRAY=1 "$G" render "$scene" -o "$tmp/arr.exr" --spp 3 --size 24x24 --quiet "$@" \
-            2>>"$tmp/spec.err"; then
-        check_fails "stack in registers = in memory: $what" 0 "$G" diff "$tmp/reg.exr" "$tmp/arr.exr" \
-            --max-error 0
-    else
-        fail "stack in registers = in memory: $what (render failed)"; sed 's/^/    /' "$tmp/spec.err"
-    fi
-}
+same_as_stack_array() { same_pixels "stack in registers = in memory" GONIO_WALK_ARRAY=1 "$@"; }
 d=$("$G" info $C | awk '$1 == "bvh" && $2 == "depth" {print $3}')
 check "the Cornell box's tree is shallow enough for the register stack (depth $d <= 8)" test "$d" -le 8
 same_as_stack_array "Cornell box" $C

@@ -71,8 +71,7 @@ static void check_structure(const bvh *b, const meshgen_mesh *m)
     uint32_t n = m->num_triangles;
     uint8_t *seen_tri = calloc(n, 1), *seen_node = calloc(b->num_nodes, 1);
     uint8_t *seen_pair = calloc(b->num_pairs, 1);
-    uint32_t stack[256], level[256], sp = 0, depth = 0, max_leaf = 0, visited = 0, next = 0;
-    (void)next;
+    uint32_t stack[256], level[256], sp = 0, depth = 0, max_leaf = 0, visited = 0, holes = 0;
     int bad_perm = 0, bad_tri = 0, bad_box = 0, bad_order = 0, bad_leaf = 0, bad_pair = 0;
 
     CHECK(b->num_tris == n && b->num_pairs <= n && 2 * b->num_pairs >= n &&
@@ -83,15 +82,15 @@ static void check_structure(const bvh *b, const meshgen_mesh *m)
     for (uint32_t i = 0; i < b->num_slots; i++) {
         uint32_t id = b->tri_index[i];
         if (id == GN_INVALID && (i & 1)) {
-            next++; /* the holes */
+            holes++;
             continue;
         }
         if (id >= n || seen_tri[id]++ || b->tri_rotation[i] > 2)
             bad_perm++;
     }
-    CHECKF(bad_perm == 0 && next == 2 * b->num_pairs - n,
+    CHECKF(bad_perm == 0 && holes == 2 * b->num_pairs - n,
            "%d tri_index entries are not a permutation (%u holes, %u lone triangles)", bad_perm,
-           next, 2 * b->num_pairs - n);
+           holes, 2 * b->num_pairs - n);
     for (uint32_t i = 0; i < b->num_pairs && !bad_perm; i++) {
         const GnTriPair *q = &b->pairs[i];
         const vec3 *tc[2][3] = {{&q->p0, &q->p1, &q->p2}, {&q->p0, &q->p2, &q->p3}};
