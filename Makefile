@@ -17,7 +17,7 @@ ifeq ($(origin CXX),default)
 CXX := g++
 endif
 
-PKGS := vulkan glfw3 OpenEXR tinygltf libpng zlib
+PKGS := vulkan glfw3 OpenEXR tinygltf libpng zlib stb
 WARN := -Wall -Wextra -Wshadow -Werror
 CPPFLAGS += -Isrc -Iglsl -I$(BUILD)/spv -MMD -MP
 CFLAGS += -std=c11 -D_DEFAULT_SOURCE -pthread $(WARN)
@@ -57,7 +57,7 @@ TESTTOOL := $(BUILD)/testtool
 
 # ---- Debian packages -------------------------------------------------------------------
 DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
-	libopenexr-dev libtinygltf-dev libpng-dev zlib1g-dev mesa-vulkan-drivers
+	libopenexr-dev libtinygltf-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers
 # libmagickcore-6.q16-6-extra: ImageMagick's EXR coder (only a recommendation of imagemagick,
 # which --no-install-recommends leaves out); tests/regress/diff.sh writes EXRs with it.
 DEB_TEST := vulkan-validationlayers openexr xvfb xauth imagemagick libmagickcore-6.q16-6-extra \

@@ -22,8 +22,9 @@ void main()
         return;
     uint pixel = px.y * frame.width + px.x;
     if (MODE == 0u) {
-        vec3 o = frame.camera.position;
-        vec3 d = camera_dir(vec2(px) + rand2(pixel, push.sample_index, 0u));
+        vec3 o, d;
+        float tnear;
+        camera_ray(vec2(px) + rand2(pixel, push.sample_index, 0u), o, d, tnear);
         Hit h = bvh_trace(o, d, 0.0, 1e30, false);
         hit_out[pixel] = vec4(h.t, float(h.steps), 0.0, uintBitsToFloat(h.tri));
         if (h.tri == GN_INVALID) {

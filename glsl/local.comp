@@ -42,7 +42,7 @@ vec3 flat_color(Hit h, vec3 d)
                   vertex_at(pr.i2).position) / 3.0;
     Surface s = surface_at(h.tri, 0.0, 1.0 / 3.0, 1.0 / 3.0, center, d);
     return phong_shade(center, s.ng, s.ng, s.uv, s.vcolor, s.material,
-                       normalize(frame.camera.position - center));
+                       camera_view(center));
 }
 
 void main()
@@ -52,9 +52,10 @@ void main()
         return;
     uint pixel = px.y * frame.width + px.x;
     vec2 jitter = push.sample_index == 0u ? vec2(0.5) : rand2(pixel, push.sample_index, 0u);
-    vec3 o = frame.camera.position;
-    vec3 d = camera_dir(vec2(px) + jitter);
-    Hit h = bvh_trace(o, d, frame.camera.znear / dot(d, frame.camera.forward), 1e30, false);
+    vec3 o, d;
+    float tnear;
+    camera_ray(vec2(px) + jitter, o, d, tnear);
+    Hit h = bvh_trace(o, d, tnear, 1e30, false);
 
     vec3 color = vec3(0.0);
     vec3 normal = vec3(0.0), albedo = vec3(0.0);

@@ -69,9 +69,11 @@ Hit trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
 
 // ---- the environment -------------------------------------------------------------------
 // Lat-long mapping: u = atan(d.z, d.x) / 2pi + 1/2, v = acos(d.y) / pi (+Y up, v = 0 at the
-// top row), so dOmega = 2 pi^2 sin(theta) du dv.
+// top row), so dOmega = 2 pi^2 sin(theta) du dv; d is first turned about +Y by minus the
+// map's rotation (env_cos, env_sin), so the map turns by plus it.
 ivec2 env_texel(vec3 d, out float sin_theta)
 {
+    d.xz = vec2(frame.env_cos * d.x + frame.env_sin * d.z, frame.env_cos * d.z - frame.env_sin * d.x);
     float v = acos(clamp(d.y, -1.0, 1.0)) / PI, u = atan(d.z, d.x) / (2.0 * PI) + 0.5;
     sin_theta = sqrt(max(0.0, 1.0 - d.y * d.y));
     return ivec2(min(uint(u * float(frame.env_width)), frame.env_width - 1u),
@@ -136,7 +138,9 @@ vec3 env_sample(vec2 u, out float pdf)
     float fv = (float(y) + clamp((u.x - y0) / max(y1 - y0, 1e-30), 0.0, 1.0)) / float(h);
     float theta = fv * PI, phi = (fu - 0.5) * 2.0 * PI, st = sin(theta);
     pdf = st > 0.0 ? (y1 - y0) * (x1 - x0) * float(w * h) / (2.0 * PI * PI * st) : 0.0;
-    return vec3(st * cos(phi), cos(theta), st * sin(phi));
+    vec2 xz = st * vec2(cos(phi), sin(phi));
+    return vec3(frame.env_cos * xz.x - frame.env_sin * xz.y, cos(theta),
+                frame.env_sin * xz.x + frame.env_cos * xz.y);
 }
 
 // ---- lights ---------------------------------------------------------------------------------
@@ -284,9 +288,7 @@ void path_start()
     sample_now = push.sample_index + taken;
     budget = frame.traversal_budget;
     depth = 0u;
-    o = frame.camera.position;
-    d = camera_dir(vec2(px) + rng(pixel, 0u).xy);
-    tmin = frame.camera.znear / dot(d, frame.camera.forward);
+    camera_ray(vec2(px) + rng(pixel, 0u).xy, o, d, tmin);
     radiance = vec3(0.0);
     beta = vec3(1.0);
     prev_pdf = 0.0;

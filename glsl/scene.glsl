@@ -90,13 +90,29 @@ vec2 rand2(uint pixel, uint sample_index, uint dim2)
 }
 
 // ---- camera ------------------------------------------------------------------------------
-// Ray through image position (px, py) in pixels (y down), see GnCamera.
-vec3 camera_dir(vec2 p)
+// The camera ray through image position p in pixels (y down), see GnCamera: origin o, unit
+// direction d, and the distance along it to the near plane.
+void camera_ray(vec2 p, out vec3 o, out vec3 d, out float tnear)
 {
     GnCamera c = frame.camera;
-    vec2 ndc = vec2(2.0 * p.x / float(frame.width) - 1.0, 1.0 - 2.0 * p.y / float(frame.height));
-    return normalize(c.forward + ndc.x * c.tan_half_fovy * c.aspect * c.right +
-                     ndc.y * c.tan_half_fovy * c.up);
+    vec2 s = vec2(2.0 * p.x / float(frame.width) - 1.0, 1.0 - 2.0 * p.y / float(frame.height));
+    if (c.ortho_half_height > 0.0) {
+        o = c.position + c.ortho_half_height * (s.x * c.aspect * c.right + s.y * c.up);
+        d = c.forward;
+        tnear = c.znear;
+    } else {
+        o = c.position;
+        d = normalize(c.forward + s.x * c.tan_half_fovy * c.aspect * c.right +
+                      s.y * c.tan_half_fovy * c.up);
+        tnear = c.znear / dot(d, c.forward);
+    }
+}
+
+// Unit vector from p toward the viewer.
+vec3 camera_view(vec3 p)
+{
+    return frame.camera.ortho_half_height > 0.0 ? -frame.camera.forward
+                                                : normalize(frame.camera.position - p);
 }
 
 // ---- textures: RGBA8 texels packed in one buffer (lavapipe has no descriptor indexing,

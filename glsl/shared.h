@@ -240,14 +240,18 @@ GN_STRUCT(GnTexture) {
 #define GN_WRAP_MIRROR 2u
 #define GN_TEX_NEAREST 16u
 
-/* Pinhole camera in world space. Pixel (x, y) with y going down maps to the ray
- * forward + (2 (x+jx)/W - 1) tan_half_fovy aspect right + (1 - 2 (y+jy)/H) tan_half_fovy up. */
+/* Camera in world space. Pixel (x, y) with y going down is at s = (2 (x+jx)/W - 1,
+ * 1 - 2 (y+jy)/H) on the image plane. Perspective (ortho_half_height 0): the ray from
+ * position along forward + s.x tan_half_fovy aspect right + s.y tan_half_fovy up.
+ * Orthographic (glTF xmag/ymag): from position + h (s.x aspect right + s.y up) along
+ * forward, h = ortho_half_height (ymag). */
 GN_STRUCT(GnCamera) {
     vec3 position; float tan_half_fovy;
     vec3 right; float aspect;
     vec3 up; float znear;
     vec3 forward; float zfar;
-} GN_END(GnCamera); /* 64 bytes */
+    float ortho_half_height; float pad0; float pad1; float pad2;
+} GN_END(GnCamera); /* 80 bytes */
 
 /* Constant for a whole render (read-only storage buffer, std430). */
 GN_STRUCT(GnFrame) {
@@ -260,7 +264,9 @@ GN_STRUCT(GnFrame) {
     vec3 bounds_max; uint traversal_budget; /* max BVH steps per ray (see DESIGN: loop cap) */
     uint env_width; uint env_height;     /* GN_FRAME_ENV_MAP: the lat-long map's size */
     float env_select; float env_norm;    /* env's selection probability; 1 / mean map weight */
-} GN_END(GnFrame); /* 176 bytes */
+    float env_cos; float env_sin;        /* the map turned by a about +Y (right-handed): cos a, -sin a */
+    uint pad_env0; uint pad_env1;
+} GN_END(GnFrame); /* 208 bytes */
 
 /* Per-dispatch values (push constants). */
 GN_STRUCT(GnPush) {
@@ -302,10 +308,10 @@ GN_STATIC_ASSERT(offsetof(GnMaterial, phong_ambient) == 128, "GnMaterial layout"
 GN_STATIC_ASSERT(sizeof(GnLight) == 64, "GnLight layout");
 GN_STATIC_ASSERT(sizeof(GnEmitter) == 16, "GnEmitter layout");
 GN_STATIC_ASSERT(sizeof(GnTexture) == 16, "GnTexture layout");
-GN_STATIC_ASSERT(sizeof(GnCamera) == 64, "GnCamera layout");
-GN_STATIC_ASSERT(sizeof(GnFrame) == 176, "GnFrame layout");
-GN_STATIC_ASSERT(offsetof(GnFrame, env_width) == 160, "GnFrame layout");
-GN_STATIC_ASSERT(offsetof(GnFrame, ambient) == 96, "GnFrame layout");
+GN_STATIC_ASSERT(sizeof(GnCamera) == 80, "GnCamera layout");
+GN_STATIC_ASSERT(sizeof(GnFrame) == 208, "GnFrame layout");
+GN_STATIC_ASSERT(offsetof(GnFrame, env_width) == 176, "GnFrame layout");
+GN_STATIC_ASSERT(offsetof(GnFrame, ambient) == 112, "GnFrame layout");
 GN_STATIC_ASSERT(sizeof(GnPush) == 16, "GnPush layout");
 GN_STATIC_ASSERT(sizeof(GnDisplayPush) == 32, "GnDisplayPush layout");
 #endif

@@ -27,7 +27,7 @@ void main()
     vec3 n = dot(a.normal, a.normal) > 1e-20 ? normalize(a.normal) : vec3(0.0);
     if (side == 1u)
         n = -n;
-    vec3 v = normalize(frame.camera.position - a.position);
+    vec3 v = camera_view(a.position);
     vec3 vc = vertex_colors() ? a.color.rgb : vec3(1.0);
     vcolor[2u * i + side].rgb = phong_shade(a.position, n, n, vec2(a.u, a.v), vc, material, v);
 }

@@ -363,8 +363,8 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
     }
     brdf_format_setting(desc, sizeof desc, s);
     {
-        const image_attr attrs[] = {{"gonio:brdf", IMAGE_ATTR_STRING, desc, 0, 0},
-                                    {"gonio:spp", IMAGE_ATTR_INT, NULL, spp, 0}};
+        const image_attr attrs[] = {{"gonio:brdf", IMAGE_ATTR_STRING, desc, 0, 0, NULL},
+                                    {"gonio:spp", IMAGE_ATTR_INT, NULL, spp, 0, NULL}};
         ok = image_write_exr(&img, out, attrs, 2);
     }
     if (ok && png)

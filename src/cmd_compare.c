@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "camera.h"
 #include "cli.h"
 #include "draw.h"
 #include "image.h"
@@ -48,7 +49,7 @@ static const char usage[] =
     "  --spp N             path tracer samples per pixel (default 64); the local modes take\n"
     "                      min(N, 16), which only anti-aliases them\n"
     "  --size WxH          image size (default 320 wide, the camera's aspect)\n"
-    "  --camera N          the scene's N-th camera (default 0 when it has one, else framed)\n"
+    CAMERA_OPTIONS_HELP
     "  --device N          Vulkan device index (see gonio devices)\n"
     "  --validate          enable the Vulkan validation layer; any message fails\n"
     "  --quiet             no progress and no table\n";
@@ -57,25 +58,29 @@ typedef struct compare_opts {
     const char *dir;
     uint32_t modes[COMPARE_MAX_MODES];
     int num_modes;
-    int spp, width, height, camera, device;
+    int spp, width, height, device;
     bool size_given, validate, quiet;
+    camera_option camera;   /* the rule of every command (src/camera.h) */
+    scene_camera view;      /* ... resolved for the scene being compared */
 } compare_opts;
 
 /* ---- rendering ---------------------------------------------------------------------------- */
 
-static void default_size(const scene *sc, compare_opts *o)
+/* The camera for sc (the shared rule) and, without --size, the image size it suggests. */
+static bool choose_view(const scene *sc, compare_opts *o)
 {
-    float aspect = 1.0f;
-    if (o->camera < 0 && sc->num_cameras > 0)
-        o->camera = 0;
-    if (o->size_given)
-        return;
-    if (o->camera >= 0 && (uint32_t)o->camera < sc->num_cameras && sc->cameras[o->camera].aspect > 0)
-        aspect = sc->cameras[o->camera].aspect;
-    o->width = 320;
-    o->height = (int)(320.0f / aspect + 0.5f);
-    if (o->height < 1)
-        o->height = 1;
+    float aspect = o->size_given ? (float)o->width / (float)o->height : 1.0f;
+    if (!camera_resolve(&o->camera, sc, aspect, &o->view))
+        return false;
+    if (!o->size_given) {
+        camera_default_size(&o->view, 320, &o->width, &o->height);
+        if (o->width != 320) { /* 320 wide, as before, whatever the aspect */
+            o->height = (int)fmaxf(1.0f, 320.0f * o->height / o->width + 0.5f);
+            o->width = 320;
+        }
+        camera_resolve(&o->camera, sc, (float)o->width / (float)o->height, &o->view);
+    }
+    return true;
 }
 
 static bool render_one(renderer *r, const compare_opts *o, uint32_t mode, image *out)
@@ -83,7 +88,7 @@ static bool render_one(renderer *r, const compare_opts *o, uint32_t mode, image 
     render_stats st;
     render_settings s = {.mode = mode, .width = o->width, .height = o->height,
                          .spp = mode == GN_MODE_PATH || o->spp < COMPARE_LOCAL_SPP ? o->spp : COMPARE_LOCAL_SPP,
-                         .camera = o->camera, .shadows = true, .progress = !o->quiet};
+                         .view = &o->view, .shadows = true, .progress = !o->quiet};
     return renderer_render(r, &s, out, &st);
 }
 
@@ -242,7 +247,7 @@ static bool run_compare(renderer *r, const compare_opts *o)
             modes[n++] = m;
     }
     for (int i = 0; i < n && ok; i++) {
-        image_attr attr = {"gonio:mode", IMAGE_ATTR_STRING, render_mode_name(modes[i]), 0, 0};
+        image_attr attr = {"gonio:mode", IMAGE_ATTR_STRING, render_mode_name(modes[i]), 0, 0, NULL};
         snprintf(name, sizeof name, "%s.exr", render_mode_name(modes[i]));
         join(path, sizeof path, o->dir, name);
         ok = image_write_exr(&imgs[i], path, &attr, 1);
@@ -434,7 +439,11 @@ static bool run_sweep(gpu *g, compare_opts *o, const int *levels, int n)
         unlink(gltf);
         if (!ok)
             break;
-        default_size(&sc, o);
+        if (!choose_view(&sc, o)) {
+            scene_destroy(&sc);
+            ok = false;
+            break;
+        }
         renderer_create(&r, g, &sc);
         rows[i] = (sweep_row){.level = levels[i], .triangles = sc.num_triangles};
         ok = render_one(&r, o, GN_MODE_PHONG, &phong) && render_one(&r, o, GN_MODE_GOURAUD, &gouraud) &&
@@ -517,9 +526,9 @@ static bool make_dir(const char *dir)
 int cmd_compare(int argc, char **argv)
 {
     compare_opts o = {.modes = {GN_MODE_FLAT, GN_MODE_GOURAUD, GN_MODE_PHONG, GN_MODE_PATH},
-                      .num_modes = 4, .spp = 64, .camera = -1, .device = -1};
+                      .num_modes = 4, .spp = 64, .device = -1};
     const char *input = NULL, *sweep = NULL;
-    int levels[COMPARE_MAX_LEVELS], num_levels = 0, rc = 1;
+    int levels[COMPARE_MAX_LEVELS], num_levels = 0, rc = 1, taken;
     long v;
     gpu g = {0};
 
@@ -552,10 +561,9 @@ int cmd_compare(int argc, char **argv)
                 if (!util_parse_size(val, &o.width, &o.height))
                     return cli_usage_error("compare", "--size '%s': expected WxH, e.g. 320x240", val);
                 o.size_given = true;
-            } else if (!strcmp(a, "--camera")) {
-                if (!util_parse_int(val, 0, 1 << 20, &v))
-                    return cli_usage_error("compare", "--camera '%s': expected an index >= 0", val);
-                o.camera = (int)v;
+            } else if ((taken = camera_parse_option(&o.camera, "compare", a, val))) {
+                if (taken == 2)
+                    return 2;
             } else if (!strcmp(a, "--device")) {
                 if (!util_parse_int(val, 0, 64, &v))
                     return cli_usage_error("compare", "--device '%s': expected an index (see gonio devices)", val);
@@ -588,10 +596,8 @@ int cmd_compare(int argc, char **argv)
         scene sc = {0};
         if (!scene_load(&sc, input))
             return 1;
-        default_size(&sc, &o);
-        if (o.camera >= 0 && (uint32_t)o.camera >= sc.num_cameras) {
-            util_error("%s: --camera %d: the scene has %u perspective camera(s)", input, o.camera,
-                       sc.num_cameras);
+        if (!choose_view(&sc, &o)) {
+            /* camera_resolve said why */
         } else if (cli_gpu_create(&g, o.device, o.validate)) {
             renderer r = {0};
             renderer_create(&r, &g, &sc);

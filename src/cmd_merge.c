@@ -124,11 +124,11 @@ int cmd_merge(int argc, char **argv)
     }
     {
         image_attr attrs[] = {
-            {"gonio:spp", IMAGE_ATTR_INT, NULL, (int)total, 0},
-            {"gonio:mode", IMAGE_ATTR_STRING, mode, 0, 0},
-            {"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, seconds},
-            {"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0},
-            {"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0},
+            {"gonio:spp", IMAGE_ATTR_INT, NULL, (int)total, 0, NULL},
+            {"gonio:mode", IMAGE_ATTR_STRING, mode, 0, 0, NULL},
+            {"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, seconds, NULL},
+            {"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL},
+            {"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL},
         };
         if (image_write_exr(&out, out_path, attrs, sizeof attrs / sizeof *attrs))
             rc = 0;

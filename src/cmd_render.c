@@ -1,5 +1,6 @@
 /* cmd_render.c: `gonio render`, `gonio info` and `gonio devices`. */
 #include <errno.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -7,7 +8,9 @@
 #include <strings.h>
 #include <unistd.h>
 
+#include "camera.h"
 #include "cli.h"
+#include "environment.h"
 #include "image.h"
 #include "render.h"
 #include "scene.h"
@@ -22,12 +25,12 @@ static const char render_usage[] =
     "                      normal, albedo, depth, cost\n"
     "  --spp N             samples per pixel (default 16)\n"
     "  --time SECONDS      render for this long instead of --spp\n"
-    "  --size WxH          image size (default 512x512, or the camera's aspect)\n"
-    "  --camera N          the scene's N-th perspective camera (default: frame the scene)\n"
+    "  --size WxH          image size (default 512 on the longer side, the camera's aspect)\n"
+    CAMERA_OPTIONS_HELP
+    "  --scene N           render the file's glTF scene N (default: its default scene)\n"
     "  --seed S            random seed (default 0); renders with different seeds merge\n"
     "  --aov LIST          extra EXR channels: normal,albedo,depth,variance\n"
-    "  --env R,G,B | V     constant environment radiance (default 0: black)\n"
-    "  --env FILE.exr      path: a lat-long HDR environment map (+Y up), importance sampled\n"
+    ENV_OPTIONS_HELP
     "  --max-depth N       path: at most N bounces (default 0: unbounded, roulette ends paths)\n"
     "  --brdf MODEL[:P=V]  path: render every material with a BRDF model (see gonio brdf\n"
     "                      --list), e.g. --brdf torrance-sparrow:exponent=128:specular=0.5\n"
@@ -72,12 +75,16 @@ static bool check_writable(const char *path)
 int cmd_render(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_path = NULL, *png_path = NULL;
-    const char *brdf = NULL, *env_path = NULL;
+    const char *brdf = NULL;
     image env_map = {0};
     render_settings s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .shadows = true,
                          .progress = true, .stop = &stop_requested};
-    bool size_given = false, quiet = false, validate = false;
-    int device = -1;
+    camera_option cam = {0};
+    env_option env = {0};
+    scene_camera view;
+    char camera_text[160], look_at[256], frame_text[320];
+    bool size_given = false, quiet = false, validate = false, studio = false;
+    int device = -1, scene_index = -1, taken;
     float exposure = 0;
     image_tonemap tm = IMAGE_TONEMAP_CLAMP;
     long v;
@@ -102,7 +109,15 @@ int cmd_render(int argc, char **argv)
         } else if (a[0] == '-' && a[1]) {
             if (!(val = cli_value(argc, argv, &i)))
                 return 2;
-            if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            if ((taken = camera_parse_option(&cam, "render", a, val)) ||
+                (taken = env_parse_option(&env, "render", a, val))) {
+                if (taken == 2)
+                    return 2;
+            } else if (!strcmp(a, "--scene")) {
+                if (!util_parse_int(val, 0, 1 << 20, &v))
+                    return cli_usage_error("render", "--scene '%s': expected an index >= 0", val);
+                scene_index = (int)v;
+            } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
                 out_path = val;
             } else if (!strcmp(a, "--png")) {
                 png_path = val;
@@ -125,10 +140,6 @@ int cmd_render(int argc, char **argv)
                 if (!util_parse_size(val, &s.width, &s.height))
                     return cli_usage_error("render", "--size '%s': expected WxH, e.g. 640x480 (1..16384)", val);
                 size_given = true;
-            } else if (!strcmp(a, "--camera")) {
-                if (!util_parse_int(val, 0, 1 << 20, &v))
-                    return cli_usage_error("render", "--camera '%s': expected an index >= 0", val);
-                s.camera = (int)v;
             } else if (!strcmp(a, "--seed")) {
                 if (!util_parse_int(val, 0, 0xffffffffL, &v))
                     return cli_usage_error("render", "--seed '%s': expected an integer 0..4294967295", val);
@@ -143,12 +154,6 @@ int cmd_render(int argc, char **argv)
                         return cli_usage_error("render", "--aov '%s': expected a list of normal, albedo, depth, variance", tok);
                     else
                         s.aov = true;
-            } else if (!strcmp(a, "--env")) {
-                size_t len = strlen(val);
-                if (len > 4 && !strcasecmp(val + len - 4, ".exr"))
-                    env_path = val;
-                else if (!util_parse_rgb(val, s.env))
-                    return cli_usage_error("render", "--env '%s': expected R,G,B, one value >= 0 or FILE.exr", val);
             } else if (!strcmp(a, "--ambient")) {
                 if (!util_parse_rgb(val, s.ambient))
                     return cli_usage_error("render", "--ambient '%s': expected R,G,B or one value >= 0", val);
@@ -192,30 +197,22 @@ int cmd_render(int argc, char **argv)
     if ((out_path && !check_writable(out_path)) || (png_path && !check_writable(png_path)))
         return 1;
 
-    if (!scene_load(&sc, scene_path))
+    if (!scene_load_scene(&sc, scene_path, scene_index))
         return 1;
-    if (!render_material_overrides(&sc, brdf) || (env_path && !image_read_exr(&env_map, env_path))) {
-        scene_destroy(&sc);
-        return 1;
-    }
-    if (env_path)
-        s.env_map = &env_map;
-    if (!size_given) {
-        float aspect = 1.0f;
-        if (s.camera >= 0 && (uint32_t)s.camera < sc.num_cameras && sc.cameras[s.camera].aspect > 0)
-            aspect = sc.cameras[s.camera].aspect;
-        s.width = 512;
-        s.height = (int)(512.0f / aspect + 0.5f);
-        if (s.height < 1)
-            s.height = 1;
-    }
-    if (s.camera >= 0 && (uint32_t)s.camera >= sc.num_cameras) {
-        util_error("%s: --camera %d: the scene has %u perspective camera(s)", scene_path,
-                   s.camera, sc.num_cameras);
+    if (!render_material_overrides(&sc, brdf) || !env_setup(&env, &sc, quiet, &env_map, &s, &studio) ||
+        !camera_resolve(&cam, &sc, size_given ? (float)s.width / (float)s.height : 1.0f, &view)) {
         scene_destroy(&sc);
         image_destroy(&env_map);
         return 1;
     }
+    if (!size_given) {
+        camera_default_size(&view, 512, &s.width, &s.height);
+        camera_resolve(&cam, &sc, (float)s.width / (float)s.height, &view); /* framing: the real aspect */
+    }
+    s.view = &view;
+    camera_describe(&cam, &sc, camera_text, sizeof camera_text);
+    camera_look_at_string(&view, look_at, sizeof look_at);
+    camera_frame_string(&view, frame_text, sizeof frame_text);
     if (!cli_gpu_create(&g, device, validate)) {
         scene_destroy(&sc);
         image_destroy(&env_map);
@@ -226,13 +223,23 @@ int cmd_render(int argc, char **argv)
     renderer_create(&r, &g, &sc);
     if (renderer_render(&r, &s, &img, &st)) {
         char seconds[32];
+        float w2c[16];
+        camera_world_to_camera(&view, w2c);
         image_attr attrs[] = {
-            {"gonio:spp", IMAGE_ATTR_INT, NULL, st.spp, 0},
-            {"gonio:seed", IMAGE_ATTR_INT, NULL, (int)s.seed, 0},
-            {"gonio:mode", IMAGE_ATTR_STRING, render_mode_name(s.mode), 0, 0},
-            {"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, st.seconds},
-            {"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0},
-            {"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0},
+            {"gonio:camera", IMAGE_ATTR_STRING, camera_text, 0, 0, NULL},
+            {"gonio:look-at", IMAGE_ATTR_STRING, look_at, 0, 0, NULL},
+            {"gonio:view", IMAGE_ATTR_STRING, frame_text, 0, 0, NULL},
+            {view.ortho_half_height > 0 ? "gonio:ortho-half-height" : "gonio:fov", IMAGE_ATTR_DOUBLE, NULL, 0,
+             view.ortho_half_height > 0 ? view.ortho_half_height : view.yfov * 180 / M_PI, NULL},
+            {"worldToCamera", IMAGE_ATTR_M44F, NULL, 0, 0, w2c},
+            {"gonio:environment", IMAGE_ATTR_STRING,
+             studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none", 0, 0, NULL},
+            {"gonio:spp", IMAGE_ATTR_INT, NULL, st.spp, 0, NULL},
+            {"gonio:seed", IMAGE_ATTR_INT, NULL, (int)s.seed, 0, NULL},
+            {"gonio:mode", IMAGE_ATTR_STRING, render_mode_name(s.mode), 0, 0, NULL},
+            {"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, st.seconds, NULL},
+            {"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL},
+            {"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL},
         };
         bool ok = true;
         if (stop_requested && !quiet)
@@ -244,8 +251,8 @@ int cmd_render(int argc, char **argv)
         snprintf(seconds, sizeof seconds, "%.2f", st.seconds);
         if (ok && !quiet)
             /* One camera ray per pixel and sample: a whole path in path mode. */
-            fprintf(stderr, "gonio: %s %dx%d, %s, %d spp in %s s (%.2f %s), setup %.2f s\n",
-                    out_path ? out_path : png_path, s.width, s.height, render_mode_name(s.mode),
+            fprintf(stderr, "gonio: %s %dx%d, %s, %s, %d spp in %s s (%.2f %s), setup %.2f s\n",
+                    out_path ? out_path : png_path, s.width, s.height, camera_text, render_mode_name(s.mode),
                     st.spp, seconds, st.seconds > 0 ? (double)st.rays / st.seconds * 1e-6 : 0.0,
                     s.mode == GN_MODE_PATH ? "M paths/s" : "Mrays/s primary", st.setup_seconds);
         rc = ok ? 0 : 1;

@@ -96,6 +96,12 @@ bool image_write_exr(const image *img, const char *path, const image_attr *attrs
         case IMAGE_ATTR_STRING: rv = exr_attr_set_string(ctx, part, attrs[i].name, attrs[i].s); break;
         case IMAGE_ATTR_INT: rv = exr_attr_set_int(ctx, part, attrs[i].name, attrs[i].i); break;
         case IMAGE_ATTR_DOUBLE: rv = exr_attr_set_double(ctx, part, attrs[i].name, attrs[i].d); break;
+        case IMAGE_ATTR_M44F: {
+            exr_attr_m44f_t m;
+            memcpy(m.m, attrs[i].m, sizeof m.m);
+            rv = exr_attr_set_m44f(ctx, part, attrs[i].name, &m);
+            break;
+        }
         }
     }
     if (!rv)
@@ -311,6 +317,23 @@ bool image_exr_attr_string(const char *path, const char *name, char *out, int ca
     ok = a->type == EXR_ATTR_STRING;
     if (ok)
         snprintf(out, (size_t)cap, "%.*s", a->string->length, a->string->str ? a->string->str : "");
+    exr_finish(&ctx);
+    return ok;
+}
+
+bool image_exr_size(const char *path, int *width, int *height)
+{
+    exr_context_t ctx;
+    const exr_attribute_t *a;
+    bool ok;
+    if (!exr_find_attr(path, "dataWindow", &ctx, &a))
+        return false;
+    ok = a->type == EXR_ATTR_BOX2I;
+    if (ok) {
+        *width = a->box2i->max.x - a->box2i->min.x + 1;
+        *height = a->box2i->max.y - a->box2i->min.y + 1;
+        ok = *width > 0 && *height > 0;
+    }
     exr_finish(&ctx);
     return ok;
 }

@@ -15,7 +15,7 @@ typedef struct image {
     float *planes[IMAGE_MAX_CHANNELS];  /* width * height floats each, rows top to bottom */
 } image;
 
-typedef enum image_attr_type { IMAGE_ATTR_STRING, IMAGE_ATTR_INT, IMAGE_ATTR_DOUBLE } image_attr_type;
+typedef enum image_attr_type { IMAGE_ATTR_STRING, IMAGE_ATTR_INT, IMAGE_ATTR_DOUBLE, IMAGE_ATTR_M44F } image_attr_type;
 
 typedef struct image_attr {
     const char *name;   /* e.g. "gonio:spp" */
@@ -23,6 +23,7 @@ typedef struct image_attr {
     const char *s;
     int i;
     double d;
+    const float *m;     /* IMAGE_ATTR_M44F: 16 floats, row by row (OpenEXR's M44f) */
 } image_attr;
 
 /* Allocates zeroed planes for the named channels. */
@@ -44,6 +45,8 @@ bool image_read_exr(image *img, const char *path);
  * string; false if absent. */
 bool image_exr_attr_double(const char *path, const char *name, double *out);
 bool image_exr_attr_string(const char *path, const char *name, char *out, int cap);
+/* The size of an EXR's data window; false if path is not a readable EXR. */
+bool image_exr_size(const char *path, int *width, int *height);
 
 typedef enum image_tonemap { IMAGE_TONEMAP_CLAMP, IMAGE_TONEMAP_ACES, IMAGE_TONEMAP_REINHARD } image_tonemap;
 

@@ -13,7 +13,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "camera.h"
 #include "cli.h"
+#include "environment.h"
 #include "display.h" /* spv_display: glsl/display.comp compiled by the build */
 #include "image.h"
 #include "render.h"
@@ -32,13 +34,13 @@ static const char usage[] =
     "\n"
     "Opens a window and shows the render converging; press H in it for the keys.\n"
     "\n"
-    "  --mode M            path, phong (default), gouraud, flat, normal, albedo, depth, cost\n"
+    "  --mode M            path (default), phong, gouraud, flat, normal, albedo, depth, cost\n"
     "  --spp N             stop accumulating at N samples per pixel (default: never)\n"
     "  --size WxH          initial window size (default 640 wide, the camera's aspect)\n"
-    "  --camera N          start from the scene's N-th camera (default: frame the scene)\n"
+    CAMERA_OPTIONS_HELP
     "  --seed S            random seed (default 0)\n"
     "  --max-depth N       path tracer: maximum path length (default 0: roulette only)\n"
-    "  --env R,G,B | V     constant background radiance (default 0)\n"
+    ENV_OPTIONS_HELP
     "  --no-shadows        local modes: no shadow rays\n"
     "  --exposure E        display scale 2^E (default 0)\n"
     "  --tonemap T         clamp (default), reinhard, aces\n"
@@ -93,6 +95,7 @@ typedef struct preview {
 
     /* Camera: the start camera until the user moves it, then the orbit below. */
     int start_camera;
+    const scene_camera *start_view; /* --look-at or --camera FILE.exr, else NULL */
     bool moved;
     GnCamera cam;
     float target[3], distance, yaw, pitch, radius;
@@ -242,6 +245,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     switch (key) {
     case GLFW_KEY_ESCAPE: p->quit_key = true; break;
     case GLFW_KEY_C:
+        p->s.view = NULL;
         p->s.camera = p->s.camera + 1 < (int)p->sc.num_cameras ? p->s.camera + 1 : -1;
         camera_start(p);
         p->restart = true;
@@ -252,6 +256,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         break;
     case GLFW_KEY_R:
         p->s.camera = p->start_camera;
+        p->s.view = p->start_view;
         camera_start(p);
         p->restart = true;
         break;
@@ -270,12 +275,24 @@ static bool save_accumulated(preview *p)
     char exr[4096], png[4096];
     image img = {0};
     bool ok;
+    /* The view as render's --camera FILE.exr reads it back (src/camera.h). */
+    scene_camera view = {.position = {p->cam.position.x, p->cam.position.y, p->cam.position.z},
+                         .right = {p->cam.right.x, p->cam.right.y, p->cam.right.z},
+                         .forward = {p->cam.forward.x, p->cam.forward.y, p->cam.forward.z},
+                         .up = {p->cam.up.x, p->cam.up.y, p->cam.up.z}};
+    char look_at[256], frame_text[320];
+    camera_look_at_string(&view, look_at, sizeof look_at);
+    camera_frame_string(&view, frame_text, sizeof frame_text);
     image_attr attrs[] = {
-        {"gonio:spp", IMAGE_ATTR_INT, NULL, p->spp, 0},
-        {"gonio:seed", IMAGE_ATTR_INT, NULL, (int)p->s.seed, 0},
-        {"gonio:mode", IMAGE_ATTR_STRING, render_mode_name(p->s.mode), 0, 0},
-        {"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0},
-        {"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0},
+        {"gonio:look-at", IMAGE_ATTR_STRING, look_at, 0, 0, NULL},
+        {"gonio:view", IMAGE_ATTR_STRING, frame_text, 0, 0, NULL},
+        {p->cam.ortho_half_height > 0 ? "gonio:ortho-half-height" : "gonio:fov", IMAGE_ATTR_DOUBLE, NULL, 0,
+         p->cam.ortho_half_height > 0 ? p->cam.ortho_half_height : 2 * atan(p->cam.tan_half_fovy) * 180 / M_PI, NULL},
+        {"gonio:spp", IMAGE_ATTR_INT, NULL, p->spp, 0, NULL},
+        {"gonio:seed", IMAGE_ATTR_INT, NULL, (int)p->s.seed, 0, NULL},
+        {"gonio:mode", IMAGE_ATTR_STRING, render_mode_name(p->s.mode), 0, 0, NULL},
+        {"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL},
+        {"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL},
     };
     if (p->spp == 0)
         return true;
@@ -723,9 +740,15 @@ int cmd_preview(int argc, char **argv)
     int device = -1, width = 640, height = 480, max_frames = 0, frames = 0, last_passes = 0;
     double submit_time = 0, last_frame;
     long v;
+    int taken;
+    camera_option cam = {0};
+    env_option env = {0};
+    image env_map = {0};
+    scene_camera start_view;
+    bool studio;
 
     memset(p, 0, sizeof *p);
-    p->s = (render_settings){.mode = GN_MODE_PHONG, .camera = -1, .shadows = true};
+    p->s = (render_settings){.mode = GN_MODE_PATH, .camera = -1, .shadows = true};
     p->prefix = "gonio-preview";
     p->batch = 1;
     for (int i = 1; i < argc; i++) {
@@ -744,7 +767,11 @@ int cmd_preview(int argc, char **argv)
         } else if (a[0] == '-' && a[1]) {
             if (!(val = cli_value(argc, argv, &i)))
                 return 2;
-            if (!strcmp(a, "--mode")) {
+            if ((taken = camera_parse_option(&cam, "preview", a, val)) ||
+                (taken = env_parse_option(&env, "preview", a, val))) {
+                if (taken == 2)
+                    return 2;
+            } else if (!strcmp(a, "--mode")) {
                 int m = render_mode_from_name(val);
                 if (m < 0)
                     return cli_usage_error("preview", "--mode '%s': expected one of %s", val,
@@ -760,10 +787,6 @@ int cmd_preview(int argc, char **argv)
                 if (!util_parse_size(val, &width, &height))
                     return cli_usage_error("preview", "--size '%s': expected WxH, e.g. 640x480", val);
                 size_given = true;
-            } else if (!strcmp(a, "--camera")) {
-                if (!util_parse_int(val, 0, 1 << 20, &v))
-                    return cli_usage_error("preview", "--camera '%s': expected an index >= 0", val);
-                p->s.camera = (int)v;
             } else if (!strcmp(a, "--seed")) {
                 if (!util_parse_int(val, 0, 0xffffffffL, &v))
                     return cli_usage_error("preview", "--seed '%s': expected an integer 0..4294967295", val);
@@ -772,9 +795,6 @@ int cmd_preview(int argc, char **argv)
                 if (!util_parse_int(val, 0, 1 << 16, &v))
                     return cli_usage_error("preview", "--max-depth '%s': expected an integer >= 0", val);
                 p->s.max_depth = (int)v;
-            } else if (!strcmp(a, "--env")) {
-                if (!util_parse_rgb(val, p->s.env))
-                    return cli_usage_error("preview", "--env '%s': expected R,G,B or one value >= 0", val);
             } else if (!strcmp(a, "--exposure")) {
                 if (!util_parse_float(val, &p->exposure))
                     return cli_usage_error("preview", "--exposure '%s': expected a number", val);
@@ -816,15 +836,19 @@ int cmd_preview(int argc, char **argv)
         glfwTerminate();
         return 1;
     }
-    if (p->s.camera >= 0 && (uint32_t)p->s.camera >= p->sc.num_cameras) {
-        util_error("%s: --camera %d: the scene has %u perspective camera(s)", scene_path,
-                   p->s.camera, p->sc.num_cameras);
+    if (!env_setup(&env, &p->sc, false, &env_map, &p->s, &studio) ||
+        !camera_resolve(&cam, &p->sc, size_given ? (float)width / (float)height : 1.0f, &start_view)) {
+        image_destroy(&env_map);
         scene_destroy(&p->sc);
         glfwTerminate();
         return 1;
     }
-    if (!size_given && p->s.camera >= 0 && p->sc.cameras[p->s.camera].aspect > 0)
-        height = (int)fmaxf(1.0f, 640.0f / p->sc.cameras[p->s.camera].aspect + 0.5f);
+    /* The shared rule (src/camera.h): the file's cameras by index, so that C steps on. */
+    p->s.camera = cam.kind == CAMERA_INDEX ? cam.index : cam.kind == CAMERA_AUTO && p->sc.num_cameras ? 0 : -1;
+    if (cam.kind == CAMERA_LOOK_AT)
+        p->start_view = p->s.view = &start_view;
+    if (!size_given && p->s.camera >= 0 && start_view.aspect > 0)
+        height = (int)fmaxf(1.0f, 640.0f / start_view.aspect + 0.5f);
     p->start_camera = p->s.camera;
 
     if (setup(p, device, validate, width, height)) {
@@ -864,5 +888,6 @@ int cmd_preview(int argc, char **argv)
     ok = teardown(p) && ok;
     glfwTerminate();
     scene_destroy(&p->sc);
+    image_destroy(&env_map);
     return ok ? 0 : 1;
 }

@@ -365,7 +365,9 @@ bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out)
         out->aspect = aspect;
         return true;
     }
-    if (s->camera >= 0) {
+    if (s->view) {
+        c = *s->view;
+    } else if (s->camera >= 0) {
         if ((uint32_t)s->camera >= r->sc->num_cameras) {
             util_error("%s: --camera %d: the scene has %u perspective camera(s)", r->sc->path,
                        s->camera, r->sc->num_cameras);
@@ -380,6 +382,7 @@ bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out)
     out->up = v3(c.up);
     out->forward = v3(c.forward);
     out->tan_half_fovy = tanf(0.5f * c.yfov);
+    out->ortho_half_height = c.ortho_half_height;
     out->aspect = aspect; /* the image's: a camera's own aspect only suggests the size */
     out->znear = c.znear;
     out->zfar = c.zfar;
@@ -602,6 +605,8 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->flags = (s->aov ? GN_FRAME_AOV : 0u) | (s->shadows ? GN_FRAME_SHADOWS : 0u) |
                    (r->sc->vertex_colors ? GN_FRAME_VERTEX_COLOR : 0u);
     frame->env_color = (vec3){s->env[0], s->env[1], s->env[2]};
+    frame->env_cos = (float)cos(s->env_rotation * M_PI / 180);
+    frame->env_sin = (float)-sin(s->env_rotation * M_PI / 180);
     frame->num_nodes = r->tree.num_nodes;
     frame->bounds_min = v3(r->sc->bounds_min);
     frame->bounds_max = v3(r->sc->bounds_max);

@@ -31,7 +31,10 @@ typedef struct render_settings {
     bool progress;          /* progress bar on stderr */
     volatile sig_atomic_t *stop; /* set asynchronously to end after the current pass */
     const GnCamera *camera_override; /* non-NULL: this camera (aspect from the image), not `camera` */
+    const scene_camera *view; /* non-NULL: this camera (aspect from the image), not `camera`
+                               * (camera_resolve, src/camera.h, makes it) */
     const image *env_map;   /* path: lat-long radiance map (R, G, B or Y), replaces env */
+    float env_rotation;     /* path: the map turned about +Y, degrees (right-handed) */
     uint32_t strategy;      /* path: 0 = MIS, GN_FRAME_LIGHT_ONLY or GN_FRAME_BSDF_ONLY */
     bool variance;          /* add variance.R/G/B: the estimated variance of each pixel's mean */
 } render_settings;

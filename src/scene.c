@@ -72,8 +72,13 @@ uint32_t scene_drop_invalid_triangles(scene *s)
 
 void scene_default_camera(const scene *s, float aspect, scene_camera *out)
 {
-    assert(aspect > 0 && isfinite(aspect));
-    const float half_v = 0.5f * (float)(M_PI / 4);
+    scene_frame_camera(s, aspect, (float)(M_PI / 4), out);
+}
+
+void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *out)
+{
+    assert(aspect > 0 && isfinite(aspect) && yfov > 0 && yfov < (float)M_PI);
+    const float half_v = 0.5f * yfov;
     const float half_h = atanf(tanf(half_v) * aspect);
     const float fit = fminf(half_v, half_h);
     float c[3] = {0, 0, 0}, r = 1;
@@ -91,15 +96,23 @@ void scene_default_camera(const scene *s, float aspect, scene_camera *out)
         r = fmaxf(0.5f * sqrtf(d2), floor);
     }
     float dist = r / sinf(fit);
+    /* A raised three-quarter view, as model viewers open a file: glTF models face +Z with +Y
+     * up, so the camera stands in front (+Z), turned toward +X and raised, looking at the
+     * centre with a level horizon. Straight down an axis, a box looks like a flat square. */
+    const float az = (float)(SCENE_FRAME_AZIMUTH * M_PI / 180), el = (float)(SCENE_FRAME_ELEVATION * M_PI / 180);
+    const float dir[3] = {sinf(az) * cosf(el), sinf(el), cosf(az) * cosf(el)};
     memset(out, 0, sizeof *out);
-    strcpy(out->name, "default");
-    out->position[0] = c[0];
-    out->position[1] = c[1];
-    out->position[2] = c[2] + dist;
-    out->right[0] = 1;
-    out->up[1] = 1;
-    out->forward[2] = -1;
-    out->yfov = (float)(M_PI / 4);
+    strcpy(out->name, "framing");
+    for (int k = 0; k < 3; k++) {
+        out->position[k] = c[k] + dist * dir[k];
+        out->forward[k] = -dir[k];
+    }
+    out->right[0] = cosf(az); /* forward x (0, 1, 0), normalised */
+    out->right[2] = -sinf(az);
+    out->up[0] = -sinf(el) * sinf(az); /* right x forward */
+    out->up[1] = cosf(el);
+    out->up[2] = -sinf(el) * cosf(az);
+    out->yfov = yfov;
     out->aspect = aspect;
     out->znear = 0.5f * (dist - r);
     out->zfar = 2.0f * (dist + r);

@@ -16,8 +16,9 @@ typedef struct scene_camera {
     char name[64];
     float position[3];
     float right[3], up[3], forward[3]; /* orthonormal, world space (forward = node -Z) */
-    float yfov;                        /* radians */
-    float aspect;                      /* 0 when the glTF camera gives none */
+    float yfov;                        /* radians (perspective) */
+    float ortho_half_height;           /* > 0: orthographic, half the view's height (ymag) */
+    float aspect;                      /* 0 when the glTF camera gives none (ortho: xmag / ymag) */
     float znear, zfar;                 /* zfar 0 = infinite */
 } scene_camera;
 
@@ -67,7 +68,7 @@ typedef struct scene {
     uint32_t num_textures;
     scene_texture *textures;
 
-    uint32_t num_cameras;       /* perspective cameras only, in node-traversal order */
+    uint32_t num_cameras;       /* in node-traversal order (depth-first, children in order) */
     scene_camera *cameras;
 
     float bounds_min[3], bounds_max[3]; /* of all triangles; min > max when empty */
@@ -89,16 +90,25 @@ typedef struct scene {
  * normals (de-indexed). Triangles with non-finite or absurdly large (|x| > 1e15) vertices
  * are dropped with one warning. A scene without any triangle is an error ("no triangles"). */
 bool scene_load(scene *out, const char *path);
+/* The same for the glTF scene of index scene_index (-1: the file's default scene, else its
+ * first, else every node without a parent); an index the file lacks is an error. */
+bool scene_load_scene(scene *out, const char *path, int scene_index);
 
 /* Frees everything; accepts a zeroed struct. */
 void scene_destroy(scene *s);
 
-/* A camera that frames the whole scene: looking down -Z at the centre of the bounds from
- * a distance at which the bounding sphere fits in the vertical and horizontal field of
- * view (yfov 45 degrees) for the given image aspect (width / height, > 0); znear and zfar
- * enclose the sphere with a factor of 2 to spare. Empty or single-point bounds still give a
- * valid camera (a tiny sphere around the point, or the unit sphere at the origin). */
+/* A camera that frames the whole scene: a raised three-quarter view of the centre of the
+ * bounds (from the +Z side, turned SCENE_FRAME_AZIMUTH degrees toward +X and raised
+ * SCENE_FRAME_ELEVATION degrees, level horizon) from a distance at which the bounding sphere
+ * fits in the vertical and horizontal field of view (yfov 45 degrees) for the given image
+ * aspect (width / height, > 0); znear and zfar enclose the sphere with a factor of 2 to
+ * spare. Empty or single-point bounds still give a valid camera (a tiny sphere around the
+ * point, or the unit sphere at the origin). */
+#define SCENE_FRAME_AZIMUTH 35.0
+#define SCENE_FRAME_ELEVATION 25.0
 void scene_default_camera(const scene *s, float aspect, scene_camera *out);
+/* The same with another vertical field of view (radians, in (0, pi)). */
+void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *out);
 
 /* Recomputes bounds_min/bounds_max from the triangles. */
 void scene_compute_bounds(scene *s);

@@ -64,6 +64,7 @@ struct Ctx {
     std::vector<std::vector<Prim>> meshes;   /* per glTF mesh */
     std::vector<uint32_t> image_map, texture_map; /* glTF index -> scene index or GN_INVALID */
     bool warned_skin = false, warned_targets = false;
+    int scene_index = -1;                    /* the glTF scene to draw; -1: the default one */
 };
 
 void vreport(const Ctx &c, bool error, const char *fmt, va_list ap)
@@ -674,6 +675,8 @@ bool check_nodes_and_scenes(Ctx &c)
         }
     if (m.defaultScene != -1 && !in_range(m.defaultScene, m.scenes.size()))
         return fail(c, "default scene %d does not exist", m.defaultScene);
+    if (c.scene_index >= 0 && !in_range(c.scene_index, m.scenes.size()))
+        return fail(c, "--scene %d: the file has %zu scene(s)", c.scene_index, m.scenes.size());
     for (size_t s = 0; s < m.scenes.size(); s++)
         for (int r : m.scenes[s].nodes)
             if (!in_range(r, nn))
@@ -717,8 +720,20 @@ void check_cameras(Ctx &c)
     for (size_t i = 0; i < c.m.cameras.size(); i++) {
         const auto &cam = c.m.cameras[i];
         std::string what = label("camera", int(i), cam.name);
+        if (cam.type == "orthographic") {
+            const auto &o = cam.orthographic;
+            if (!(std::isfinite(o.xmag) && std::isfinite(o.ymag) && o.xmag != 0 && o.ymag != 0))
+                warn(c, "%s: xmag %g and ymag %g must be finite and non-zero; skipped", what.c_str(), o.xmag, o.ymag);
+            else if (!(o.znear >= 0))
+                warn(c, "%s: znear %g must not be negative; skipped", what.c_str(), o.znear);
+            else if (!(o.zfar > o.znear) || !std::isfinite(o.zfar))
+                warn(c, "%s: zfar %g must be finite and greater than znear %g; skipped", what.c_str(), o.zfar, o.znear);
+            else
+                c.camera_ok[i] = true;
+            continue;
+        }
         if (cam.type != "perspective") {
-            warn(c, "orthographic camera %zu not supported, skipped", i);
+            warn(c, "%s: unknown type '%s'; skipped", what.c_str(), cam.type.substr(0, 32).c_str());
             continue;
         }
         const auto &p = cam.perspective;
@@ -1019,7 +1034,9 @@ bool collect_instances(Ctx &c, std::vector<Instance> &inst, std::vector<Instance
 {
     const auto &m = c.m;
     std::vector<int> roots;
-    if (!m.scenes.empty()) {
+    if (c.scene_index >= 0) {
+        roots = m.scenes[size_t(c.scene_index)].nodes;
+    } else if (!m.scenes.empty()) {
         roots = m.scenes[size_t(m.defaultScene >= 0 ? m.defaultScene : 0)].nodes;
     } else {
         std::vector<bool> child(m.nodes.size(), false);
@@ -1194,6 +1211,15 @@ void bake_cameras(Ctx &c, const std::vector<Instance> &cams, scene *out)
             o.forward[k] = float(f[k]);
             o.up[k] = float(u[k]);
             o.right[k] = float(r[k]);
+        }
+        if (cam.type == "orthographic") {
+            /* A negative magnification would mirror the image; glTF says it should not be. */
+            const auto &om = cam.orthographic;
+            o.ortho_half_height = float(std::fabs(om.ymag));
+            o.aspect = float(std::fabs(om.xmag / om.ymag));
+            o.znear = float(om.znear);
+            o.zfar = float(om.zfar);
+            continue;
         }
         o.yfov = float(cam.perspective.yfov);
         o.aspect = float(cam.perspective.aspectRatio);
@@ -1553,10 +1579,11 @@ bool parse(Ctx &c, uint8_t *data, size_t size)
     return ok;
 }
 
-bool load(scene *out, const char *path)
+bool load(scene *out, const char *path, int scene_index)
 {
     Ctx c;
     c.path = path;
+    c.scene_index = scene_index;
     snprintf(out->path, sizeof out->path, "%s", path);
     size_t size = 0;
     std::unique_ptr<uint8_t, decltype(&free)> data(static_cast<uint8_t *>(util_read_file(path, &size)), &free);
@@ -1603,12 +1630,14 @@ bool load(scene *out, const char *path)
 
 } // namespace
 
-bool scene_load(scene *out, const char *path)
+bool scene_load(scene *out, const char *path) { return scene_load_scene(out, path, -1); }
+
+bool scene_load_scene(scene *out, const char *path, int scene_index)
 {
     bool ok = false;
     memset(out, 0, sizeof *out);
     try {
-        ok = load(out, path);
+        ok = load(out, path, scene_index);
     } catch (const std::bad_alloc &) {
         util_error("%s: out of memory", path);
     } catch (const std::exception &e) {

@@ -51,16 +51,18 @@ ref normal-big normal 200x150
 check "render phong, 1 spp" "$G" render $C --png "$tmp/phong-1.png" --size 160x120 --spp 1 --quiet
 
 # ---- scripted: N frames, then the screenshot ---------------------------------------------
-check "preview 8 frames at 4 spp" "$G" preview $C --size 160x120 --spp 4 --frames 8 \
+"$G" preview $C --size 32x24 --spp 1 --frames 2 --screenshot "$tmp/default.png" 2>"$tmp/default.err"
+check "the preview's default mode is the path tracer" grep -q 'frame(s), path, ' "$tmp/default.err"
+check "preview 8 frames at 4 spp" "$G" preview $C --mode phong --size 160x120 --spp 4 --frames 8 \
     --screenshot "$tmp/shot.png"
 check "screenshot equals gonio render" same_image "$tmp/shot.png" "$tmp/phong.png"
 check "...and the comparison can fail: 1 spp differs" differs "$tmp/shot.png" "$tmp/phong-1.png"
-check "preview with aces and exposure" "$G" preview $C --size 160x120 --spp 4 --frames 8 \
+check "preview with aces and exposure" "$G" preview $C --mode phong --size 160x120 --spp 4 --frames 8 \
     --tonemap aces --exposure 1.5 --screenshot "$tmp/shot-aces.png"
 check "aces screenshot equals gonio render" same_image "$tmp/shot-aces.png" "$tmp/phong-aces.png"
 
 # ---- interactive: X captures while it runs, keys, resize, P, Esc ------------------------
-timeout 120 "$G" preview $C --size 160x120 --spp 4 --frames 2400 --prefix "$tmp/saved" \
+timeout 120 "$G" preview $C --mode phong --size 160x120 --spp 4 --frames 2400 --prefix "$tmp/saved" \
     --screenshot "$tmp/end.png" >"$tmp/pv.out" 2>"$tmp/pv.err" &
 pid=$!
 wid=$(timeout 30 xdotool search --sync --name '^gonio preview')
@@ -96,6 +98,10 @@ check "P names its files" sh -c "for i in \$(seq 100); do grep -q 'wrote .*saved
     '$tmp/pv.out' && exit 0; sleep 0.1; done; exit 1"
 check "P's EXR equals gonio render's" "$G" diff "$tmp/saved-001.exr" "$tmp/normal-big.exr" --max-error 1e-6 --quiet
 check "P's PNG equals gonio render's" same_image "$tmp/saved-001.png" "$tmp/normal-big.png"
+# The saved EXR carries the view: render --camera FILE.exr renders the same view.
+check "render from the view P saved" "$G" render $C --camera "$tmp/saved-001.exr" -o "$tmp/from-view.exr" \
+    --mode normal --size 200x150 --spp 4 --quiet
+check "... gives P's pixels" "$G" diff "$tmp/from-view.exr" "$tmp/saved-001.exr" --max-error 1e-5 --quiet
 check "Esc" xdotool key Escape
 wait $pid
 rc=$?

@@ -6,6 +6,7 @@
  *   testtool scene NAME OUT.gltf       NAME: plane, inside-sphere
  *   testtool ref NAME AOV W H OUT.exr [SHIFT]  AOV: depth, normal; SHIFT: pixels, in x
  *                                      (a deliberately wrong reference, to show a test fails)
+ *   testtool stats IMAGE.exr           coverage, mean luminance, the box of red pixels
  */
 #include <math.h>
 #include <stdio.h>
@@ -170,8 +171,51 @@ static int write_ref(const char *name, const char *aov, int w, int h, const char
     }
 }
 
+/* Statistics of a rendered EXR for the shell tests: pixels covered (A > 0.5), the mean
+ * luminance over them and over the whole image, and the box of the "red" pixels (R > 0.5,
+ * G and B < 0.25; -1s when none): `covered N mean L image-mean L red X0 Y0 X1 Y1`. */
+static int stats(const char *path)
+{
+    image img;
+    if (!image_read_exr(&img, path))
+        return 1;
+    int r = image_channel(&img, "R"), g = image_channel(&img, "G"), b = image_channel(&img, "B"),
+        a = image_channel(&img, "A");
+    if (r < 0 || g < 0 || b < 0 || a < 0) {
+        fprintf(stderr, "testtool: %s has no R, G, B, A\n", path);
+        image_destroy(&img);
+        return 1;
+    }
+    long covered = 0;
+    double sum = 0, all = 0;
+    int box[4] = {-1, -1, -1, -1};
+    for (int y = 0; y < img.height; y++)
+        for (int x = 0; x < img.width; x++) {
+            size_t i = (size_t)y * img.width + x;
+            double R = img.planes[r][i], G = img.planes[g][i], B = img.planes[b][i];
+            double lum = 0.2126 * R + 0.7152 * G + 0.0722 * B;
+            all += lum;
+            if (img.planes[a][i] > 0.5f) {
+                covered++;
+                sum += lum;
+            }
+            if (R > 0.5 && G < 0.25 && B < 0.25) {
+                if (box[0] < 0 || x < box[0]) box[0] = x;
+                if (box[1] < 0 || y < box[1]) box[1] = y;
+                if (x > box[2]) box[2] = x;
+                if (y > box[3]) box[3] = y;
+            }
+        }
+    printf("covered %ld mean %.6g image-mean %.6g red %d %d %d %d\n", covered, covered ? sum / covered : 0.0,
+           all / ((double)img.width * img.height), box[0], box[1], box[2], box[3]);
+    image_destroy(&img);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 3 && !strcmp(argv[1], "stats"))
+        return stats(argv[2]);
     if (argc == 4 && !strcmp(argv[1], "scene"))
         return write_scene(argv[2], argv[3]);
     if ((argc == 7 || argc == 8) && !strcmp(argv[1], "ref"))

@@ -520,8 +520,8 @@ void test_path_merge(void)
     const char *names[] = {"R", "variance.R"};
     char a_path[256], b_path[256], o_path[256];
     image a = {0}, b = {0}, o = {0};
-    image_attr attr_a[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 1, 0}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 1, 0}};
-    image_attr attr_b[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 3, 0}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 2, 0}};
+    image_attr attr_a[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 1, 0, NULL}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 1, 0, NULL}};
+    image_attr attr_b[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 3, 0, NULL}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 2, 0, NULL}};
     tmp_file(a_path, sizeof a_path, "a.exr");
     tmp_file(b_path, sizeof b_path, "b.exr");
     tmp_file(o_path, sizeof o_path, "o.exr");

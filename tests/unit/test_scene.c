@@ -224,6 +224,8 @@ static bool projects_inside(const scene_camera *c, const float p[3])
     return z > c->znear && z < c->zfar && fabsf(x / (z * t * c->aspect)) <= 1 && fabsf(y / (z * t)) <= 1;
 }
 
+static bool orthonormal(const scene_camera *c);
+
 void test_scene_default_camera(void)
 {
     static const float boxes[][6] = {
@@ -238,7 +240,9 @@ void test_scene_default_camera(void)
             scene_camera c;
             scene_default_camera(&s, aspects[a], &c);
             CHECK(near(c.yfov, (float)(M_PI / 4), 1e-6f) && c.aspect == aspects[a]);
-            CHECK(c.forward[2] == -1 && c.up[1] == 1 && c.right[0] == 1);
+            CHECK(orthonormal(&c) && c.right[1] == 0 && c.up[1] > 0.8f);
+            /* Raised and turned: looking down, toward -Z and -X (a three-quarter view). */
+            CHECK(c.forward[1] < -0.3f && c.forward[2] < -0.5f && c.forward[0] < -0.3f);
             for (int corner = 0; corner < 8; corner++) {
                 float p[3];
                 for (int k = 0; k < 3; k++)
@@ -301,7 +305,7 @@ void test_scene_drop_invalid_triangles(void)
  * = index (or position) count / 3 summed over the primitive instances of the default scene;
  * vertices = POSITION counts, 3 per triangle where a primitive has no NORMAL (flat normals);
  * materials = the file's plus one default when a drawn primitive has none. Warnings: the
- * unsupported features visible in the JSON (an orthographic camera; KHR_materials_volume,
+ * unsupported features visible in the JSON (KHR_materials_volume,
  * _iridescence, KHR_xmp; alphaMode MASK/BLEND materials). */
 static const struct {
     const char *path;
@@ -315,8 +319,8 @@ static const struct {
     {"gltf/BoxTextured/glTF-Binary/BoxTextured.glb", 12, 24, 1, 1, 2, 1, 1, 1, 0, 0, 0},
     {"gltf/BoxTextured/glTF-Embedded/BoxTextured.gltf", 12, 24, 1, 1, 2, 1, 1, 1, 0, 0, 0},
     {"gltf/BoxTextured/glTF/BoxTextured.gltf", 12, 24, 1, 1, 2, 1, 1, 1, 0, 0, 0},
-    {"gltf/Cameras/glTF-Embedded/Cameras.gltf", 2, 6, 1, 1, 3, 1, 0, 0, 1, 0, 1},
-    {"gltf/Cameras/glTF/Cameras.gltf", 2, 6, 1, 1, 3, 1, 0, 0, 1, 0, 1},
+    {"gltf/Cameras/glTF-Embedded/Cameras.gltf", 2, 6, 1, 1, 3, 1, 0, 0, 2, 0, 0},
+    {"gltf/Cameras/glTF/Cameras.gltf", 2, 6, 1, 1, 3, 1, 0, 0, 2, 0, 0},
     {"gltf/DamagedHelmet/glTF/DamagedHelmet.gltf", 15452, 14556, 1, 1, 1, 1, 5, 5, 0, 0, 0},
     {"gltf/Duck/glTF-Binary/Duck.glb", 4212, 2399, 1, 1, 3, 1, 1, 1, 1, 0, 0},
     {"gltf/Duck/glTF/Duck.gltf", 4212, 2399, 1, 1, 3, 1, 1, 1, 1, 0, 0},
@@ -535,13 +539,17 @@ void test_scene_cameras(void)
     int w0 = util_warning_count();
     CHECKF(load(&s, asset(path, sizeof path, "gltf/Cameras/glTF/Cameras.gltf")), "%s", load_log);
     /* Camera 0 is perspective (aspect 1, yfov 0.7, znear 0.01, zfar 100) on a node translated
-     * to (0.5, 0.5, 3); camera 1 is orthographic, skipped with a warning. */
-    CHECK(s.num_cameras == 1 && util_warning_count() == w0 + 1 && strstr(load_log, "orthographic camera 1"));
-    if (s.num_cameras == 1) {
+     * to (0.5, 0.5, 3); camera 1 orthographic (xmag = ymag = 1) on a node at the same place. */
+    CHECK(s.num_cameras == 2 && util_warning_count() == w0);
+    if (s.num_cameras == 2) {
         const scene_camera *c = &s.cameras[0];
         CHECK(c->position[0] == 0.5f && c->position[1] == 0.5f && c->position[2] == 3);
         CHECK(c->forward[2] == -1 && c->up[1] == 1 && c->right[0] == 1 && orthonormal(c));
         CHECK(near(c->yfov, 0.7f, 1e-6f) && c->aspect == 1 && near(c->znear, 0.01f, 1e-9f) && c->zfar == 100);
+        CHECK(c->ortho_half_height == 0);
+        c = &s.cameras[1];
+        CHECK(c->position[0] == 0.5f && c->position[1] == 0.5f && c->position[2] == 3 && orthonormal(c));
+        CHECK(c->ortho_half_height == 1 && c->aspect == 1 && near(c->znear, 0.01f, 1e-9f) && c->zfar == 100);
     }
     scene_destroy(&s);
     CHECKF(load(&s, asset(path, sizeof path, "gltf/Duck/glTF/Duck.gltf")), "%s", load_log);

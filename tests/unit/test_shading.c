@@ -81,14 +81,37 @@ typedef struct render_out {
     float *vcolor; /* 8 floats per vertex (front rgb w, back rgb w); NULL unless asked for */
 } render_out;
 
+/* The framing camera's distance and planes, but looking straight down -Z: the tests'
+ * geometry (a highlight below a light, a triangle facing the camera) is laid out for it. */
+static void straight_down_z(const scene *sc, float aspect, scene_camera *c)
+{
+    scene_default_camera(sc, aspect, c);
+    float centre[3], dist = 0;
+    for (int k = 0; k < 3; k++) {
+        centre[k] = 0.5f * (sc->bounds_min[k] + sc->bounds_max[k]);
+        dist += (c->position[k] - centre[k]) * (c->position[k] - centre[k]);
+    }
+    dist = sqrtf(dist);
+    memset(c->right, 0, sizeof c->right);
+    memset(c->up, 0, sizeof c->up);
+    memset(c->forward, 0, sizeof c->forward);
+    c->right[0] = c->up[1] = 1;
+    c->forward[2] = -1;
+    c->position[0] = centre[0];
+    c->position[1] = centre[1];
+    c->position[2] = centre[2] + dist;
+}
+
 /* Renders sc in `mode`, one sample per pixel (sample 0 goes through pixel centres). */
 static bool render_scene(const scene *sc, uint32_t mode, int w, int h, bool want_vcolor,
                          render_out *out)
 {
     const char *env = getenv("GONIO_VALIDATE");
     gpu_desc d = {.device_index = -1, .validate = env && !strcmp(env, "1")};
+    scene_camera view;
+    straight_down_z(sc, (float)w / (float)h, &view);
     render_settings s = {.mode = mode, .width = w, .height = h, .spp = 1, .camera = -1,
-                         .shadows = true};
+                         .shadows = true, .view = &view};
     render_stats st;
     renderer r;
     gpu g;

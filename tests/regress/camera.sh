@@ -1,0 +1,141 @@
+#!/usr/bin/env bash
+# camera.sh: which camera a render uses (the file's first camera in node order, --camera N,
+# frame, --look-at, a view recorded in an EXR), orthographic cameras, --scene, and the
+# header that records the camera. The scene is glTF JSON written here by Python, not by
+# gonio: a white quad, a red square at a known point, three cameras in a node hierarchy.
+. "$(dirname "$0")/../lib.sh"
+G=$GONIO
+command -v python3 >/dev/null || skip_all "python3 is needed to write the test scene"
+S=$tmp/cameras.gltf
+python3 - "$S" <<'PY'
+import base64, json, struct, sys
+def quad(x0, y0, x1, y1, z):
+    return [x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z]
+pos = quad(-5, -5, 5, 5, 0) + quad(-0.5, -0.5, 0.5, 0.5, 0)  # the red square around its node
+nrm = [0, 0, 1] * 8
+idx = [0, 1, 2, 0, 2, 3]
+blob = struct.pack("<24f", *pos) + struct.pack("<24f", *nrm) + struct.pack("<6H", *idx) + b"\0\0"
+views = [(0, 48), (48, 48), (96, 48), (144, 48), (192, 12)]
+doc = {
+    "asset": {"version": "2.0", "generator": "camera.sh"},
+    "buffers": [{"byteLength": len(blob),
+                 "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+    "bufferViews": [{"buffer": 0, "byteOffset": o, "byteLength": n} for o, n in views],
+    "accessors": [
+        {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-5, -5, 0], "max": [5, 5, 0]},
+        {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, -0.5, 0], "max": [0.5, 0.5, 0]},
+        {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC3"},
+        {"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC3"},
+        {"bufferView": 4, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+    "materials": [
+        {"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0}},
+        {"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 1], "metallicFactor": 0}}],
+    "meshes": [
+        {"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 2}, "indices": 4, "material": 0}]},
+        {"primitives": [{"attributes": {"POSITION": 1, "NORMAL": 3}, "indices": 4, "material": 1}]}],
+    "cameras": [
+        {"name": "B", "type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 1, "znear": 0.1}},
+        {"name": "A", "type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 1, "znear": 0.1}},
+        {"name": "C", "type": "orthographic", "orthographic": {"xmag": 2, "ymag": 1, "znear": 0.1, "zfar": 100}}],
+    # Depth-first: node 0 (quad), its child 3 (camera A), node 1 (camera B), node 2 (red
+    # square at (1.3, 0.4)), its child 4 (camera C, 5 above the square).
+    "nodes": [
+        {"mesh": 0, "children": [3]},
+        {"camera": 0, "translation": [0, 0, 5]},
+        {"mesh": 1, "translation": [1.3, 0.4, 0.01], "children": [4]},
+        {"camera": 1, "translation": [1.3, 0.4, 5]},
+        {"camera": 2, "translation": [0, 0, 5]}],
+    "scenes": [{"nodes": [0, 1, 2]}, {"nodes": [1, 2]}],
+    "scene": 0,
+}
+json.dump(doc, open(sys.argv[1], "w"))
+PY
+[ -s "$S" ] || skip_all "could not write the test scene"
+
+stats() { "$TESTTOOL" stats "$1"; }
+centre_is() { # centre_is FILE.exr red|white: the centre pixel's colour (odd sizes)
+    local want=$1 f=$2 box
+    box=$(stats "$f" | awk '{print $8, $9, $10, $11}')
+    read -r x0 y0 x1 y1 <<<"$box"
+    local c=16 inside=0
+    [ "$x0" -ge 0 ] && [ "$x0" -le $c ] && [ "$x1" -ge $c ] && [ "$y0" -le $c ] && [ "$y1" -ge $c ] && inside=1
+    if [ "$want" = red ]; then [ $inside = 1 ]; else [ $inside = 0 ]; fi
+}
+R() { "$G" render "$S" --mode albedo --spp 1 --quiet "$@"; }
+
+# ---- the default: the first camera of the default scene in depth-first node order (A) ----
+check "default camera renders" R -o "$tmp/default.exr" --size 33x33
+check "default camera is A (looks at the red square)" centre_is red "$tmp/default.exr"
+"$G" render "$S" --mode albedo --spp 1 --size 33x33 -o "$tmp/d2.exr" 2>"$tmp/summary.txt"
+check "summary line names the camera" grep -q "camera 0 'A'" "$tmp/summary.txt"
+check "--camera 1 is B" R -o "$tmp/b.exr" --size 33x33 --camera 1
+check "B looks at the white quad" centre_is white "$tmp/b.exr"
+check "--camera=0 is A" R -o "$tmp/a.exr" --size 33x33 --camera 0
+check "A and the default agree" "$G" diff "$tmp/a.exr" "$tmp/default.exr" --max-error 0 --quiet
+check_fails "--camera 3 does not exist" 1 R -o "$tmp/x.exr" --size 33x33 --camera 3
+check "error names the scene and the count" grep -q "cameras.gltf: --camera 3: the scene has 3 camera" "$tmp/last"
+check_fails "--camera bogus is a usage error" 2 R -o "$tmp/x.exr" --camera bogus
+
+# Perspective geometry: A's red box from the pinhole model, computed here.
+check "A at 65x65" R -o "$tmp/a65.exr" --size 65x65
+want=$(python3 -c '
+import math
+H = 65; th = math.tan(0.25); d = 5 - 0.01
+rows = [y for y in range(H) if abs((1 - 2 * (y + 0.5) / H) * th * d) <= 0.5]
+print(rows[0], rows[0], rows[-1], rows[-1])')
+got=$(stats "$tmp/a65.exr" | awk '{print $8, $9, $10, $11}')
+check "perspective: the red square spans the pixels the pinhole model says ($want)" test "$got" = "$want"
+
+# ---- orthographic: xmag 2, ymag 1 -> the 1 x 1 square is a quarter of the width and half
+# of the height, whatever the distance --------------------------------------------------
+check "--camera 2 (orthographic) renders" R -o "$tmp/ortho.exr" --size 64x32 --camera 2
+got=$(stats "$tmp/ortho.exr" | awk '{print $8, $9, $10, $11}')
+check "orthographic: the square covers columns 24-39 and rows 8-23 (got $got)" test "$got" = "24 8 39 23"
+check "orthographic default size follows xmag/ymag" R -o "$tmp/ortho-size.exr" --camera 2
+check "512x256" sh -c "exrheader '$tmp/ortho-size.exr' | grep -q 'dataWindow.*(0 0) - (511 255)'"
+
+# ---- framing, look-at, --fov ----------------------------------------------------------------
+check "--camera frame renders" R -o "$tmp/frame.exr" --size 33x33 --camera frame
+check "the framing view sees both the quad and the square" sh -c \
+    "'$TESTTOOL' stats '$tmp/frame.exr' | awk '{exit !(\$2 > 200 && \$8 >= 0)}'"
+check "--look-at at the square" R -o "$tmp/look.exr" --size 33x33 --look-at 1.3,0.4,3,1.3,0.4,0 --fov 20
+check "look-at centre is red" centre_is red "$tmp/look.exr"
+check "--look-at=... at the origin" R -o "$tmp/look2.exr" --size 33x33 --look-at 0,0,3,0,0,0,0,1,0
+check "look-at origin centre is white" centre_is white "$tmp/look2.exr"
+# --fov 20 at distance 3: tan(10 deg) * 3 = 0.529 half-height, so the 0.5 square nearly fills it.
+got=$(stats "$tmp/look.exr" | awk '{print $9, $11}')
+check "--fov: the square fills rows 1-31 of 33 (got $got)" test "$got" = "1 31"
+check_fails "--look-at with the target at the eye" 2 R -o "$tmp/x.exr" --look-at 1,1,1,1,1,1
+check_fails "--look-at with 5 numbers" 2 R -o "$tmp/x.exr" --look-at 1,1,1,1,1
+check_fails "--fov 0" 2 R -o "$tmp/x.exr" --fov 0
+
+# ---- the header records the camera, and --camera FILE.exr reproduces it ------------------
+exrheader "$tmp/look2.exr" >"$tmp/hdr.txt" 2>&1
+check "header: gonio:camera" grep -q 'gonio:camera (type string): "look-at' "$tmp/hdr.txt"
+check "header: worldToCamera is an m44f" grep -q 'worldToCamera (type m44f)' "$tmp/hdr.txt"
+# Eye (0,0,3) looking down -Z: right +X, up +Y, view +Z in camera space = -Z in the world,
+# so p' = p M with rows (1 0 0 0) (0 1 0 0) (0 0 -1 0) (0 0 3 1).
+m44=$(awk '/worldToCamera/ {f = 1; next} f && n < 4 {gsub(/[()]/, ""); print; n++}' "$tmp/hdr.txt" | tr -s ' \n' ' ')
+check "worldToCamera of an eye at (0,0,3) looking down -Z ($m44)" python3 -c '
+import sys
+got = [float(v) for v in sys.argv[1].split()]
+want = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0, 3, 1]
+sys.exit(not (len(got) == 16 and all(abs(a - b) < 1e-6 for a, b in zip(got, want))))' "$m44"
+check "--camera FILE.exr takes the recorded view" R -o "$tmp/again.exr" --size 33x33 --camera "$tmp/look.exr"
+check "... and gives the same pixels" "$G" diff "$tmp/again.exr" "$tmp/look.exr" --max-error 0 --quiet
+check "--camera FILE.exr of a file camera" R -o "$tmp/again-a.exr" --size 65x65 --camera "$tmp/a65.exr"
+check "... the same pixels as that camera" "$G" diff "$tmp/again-a.exr" "$tmp/a65.exr" --max-error 0 --quiet
+check_fails "--camera of an EXR without a view" 2 R -o "$tmp/x.exr" --camera "$tmp/nonexistent.exr"
+
+# ---- --scene ---------------------------------------------------------------------------
+check "--scene 1 renders" R -o "$tmp/scene1.exr" --size 33x33 --scene 1
+"$G" render "$S" --mode albedo --spp 1 --size 33x33 --scene 1 -o "$tmp/s1.exr" 2>"$tmp/s1.txt"
+check "scene 1's first camera is B" grep -q "camera 0 'B'" "$tmp/s1.txt"
+check "scene 1 has no quad: the centre is background" sh -c \
+    "'$TESTTOOL' stats '$tmp/scene1.exr' | awk '{exit !(\$2 < 33 * 33)}'"
+check_fails "--scene 2 does not exist" 1 R -o "$tmp/x.exr" --scene 2
+check "error names the scene count" grep -q "the file has 2 scene" "$tmp/last"
+
+# ---- the other commands follow the same rule ------------------------------------------------
+check "compare uses the default camera" "$G" compare "$S" -o "$tmp/cmp" --spp 1 --size 33x33 --quiet
+finish
