@@ -28,6 +28,8 @@ static const char render_usage[] =
     "  --size WxH          image size (default 512 on the longer side, the camera's aspect)\n"
     CAMERA_OPTIONS_HELP
     "  --scene N           render the file's glTF scene N (default: its default scene)\n"
+    "  --allow-outside-files  let the scene read files outside its folder (default: only\n"
+    "                      regular files under it)\n"
     "  --seed S            random seed (default 0); renders with different seeds merge\n"
     "  --aov LIST          extra EXR channels: normal,albedo,depth,variance\n"
     ENV_OPTIONS_HELP
@@ -106,6 +108,8 @@ int cmd_render(int argc, char **argv)
             validate = true;
         } else if (!strcmp(a, "--no-shadows")) {
             s.shadows = false;
+        } else if (!strcmp(a, "--allow-outside-files")) {
+            scene_allow_outside_files(true);
         } else if (a[0] == '-' && a[1]) {
             if (!(val = cli_value(argc, argv, &i)))
                 return 2;
@@ -266,7 +270,7 @@ int cmd_render(int argc, char **argv)
     return rc;
 }
 
-static const char info_usage[] = "usage: gonio info SCENE.gltf|.glb\n\n"
+static const char info_usage[] = "usage: gonio info SCENE.gltf|.glb [--allow-outside-files]\n\n"
                                  "Prints the scene's contents and its BVH statistics.\n";
 
 int cmd_info(int argc, char **argv)
@@ -278,6 +282,9 @@ int cmd_info(int argc, char **argv)
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             fputs(info_usage, stdout);
             return 0;
+        } else if (!strcmp(argv[i], "--allow-outside-files")) {
+            scene_allow_outside_files(true);
+            continue;
         } else if (argv[i][0] == '-' && argv[i][1]) {
             return cli_usage_error("info", "unknown option '%s'", argv[i]);
         } else if (path) {

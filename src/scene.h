@@ -93,6 +93,10 @@ bool scene_load(scene *out, const char *path);
 /* The same for the glTF scene of index scene_index (-1: the file's default scene, else its
  * first, else every node without a parent); an index the file lacks is an error. */
 bool scene_load_scene(scene *out, const char *path, int scene_index);
+/* By default a scene reads only regular files under its own folder (URIs resolved, `..`,
+ * percent-escapes and symlinks included; never the working directory): anything else is an
+ * error naming the URI. True lets a scene read any file (--allow-outside-files). */
+void scene_allow_outside_files(bool allow);
 
 /* Frees everything; accepts a zeroed struct. */
 void scene_destroy(scene *s);

@@ -16,6 +16,8 @@
 #include <memory>
 #include <string>
 #include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <vector>
 
 extern "C" {
@@ -65,7 +67,12 @@ struct Ctx {
     std::vector<uint32_t> image_map, texture_map; /* glTF index -> scene index or GN_INVALID */
     bool warned_skin = false, warned_targets = false;
     int scene_index = -1;                    /* the glTF scene to draw; -1: the default one */
+    std::string folder;                      /* realpath of the scene's folder */
+    std::string base_dir;                    /* the folder as tinygltf joins URIs to it */
+    std::vector<std::string> access_errors;  /* files the confined loader refused */
 };
+
+bool allow_outside_files = false; /* scene_allow_outside_files */
 
 void vreport(const Ctx &c, bool error, const char *fmt, va_list ap)
 {
@@ -1545,6 +1552,105 @@ void load_materials(Ctx &c, scene *out)
     }
 }
 
+/* ---- file access ------------------------------------------------------------------------------
+ * tinygltf's own callbacks expand `~` and `$VAR` (wordexp), read any path and fall back to the
+ * working directory; these read only regular files under the scene's folder (after `..`,
+ * percent-decoding and symlinks: tinygltf decodes URIs before it joins them), unless
+ * scene_allow_outside_files. A refused file is an error naming it that says nothing of
+ * whether it exists or how large it is. */
+
+/* The absolute, lexically normalised form of p ("." and ".." resolved, no symlinks). */
+std::string normal_path(const std::string &p)
+{
+    std::string full = p;
+    if (p.empty() || p[0] != '/') {
+        char cwd[4096];
+        if (!getcwd(cwd, sizeof cwd))
+            return std::string();
+        full = std::string(cwd) + "/" + p;
+    }
+    std::vector<std::string> parts;
+    size_t i = 0;
+    while (i <= full.size()) {
+        size_t j = full.find('/', i);
+        if (j == std::string::npos)
+            j = full.size();
+        std::string part = full.substr(i, j - i);
+        if (part == "..") {
+            if (!parts.empty())
+                parts.pop_back();
+        } else if (!part.empty() && part != ".") {
+            parts.push_back(part);
+        }
+        i = j + 1;
+    }
+    std::string out;
+    for (const auto &part : parts)
+        out += "/" + part;
+    return out.empty() ? "/" : out;
+}
+
+bool under(const std::string &path, const std::string &folder)
+{
+    return folder == "/" || (path.size() > folder.size() && path.compare(0, folder.size(), folder) == 0 &&
+                             path[folder.size()] == '/');
+}
+
+bool fs_file_exists(const std::string &path, void *user)
+{
+    Ctx &c = *static_cast<Ctx *>(user);
+    struct stat st;
+    /* tinygltf tries the scene's folder, then the working directory: never the latter. */
+    bool first = c.base_dir.empty() ? path.compare(0, 2, "./") != 0 : path.compare(0, c.base_dir.size(), c.base_dir) == 0;
+    if (!first && !allow_outside_files)
+        return false;
+    if (normal_path(path) == c.folder) {
+        c.access_errors.push_back("'" + path + "' is not a regular file");
+        return false;
+    }
+    if (!allow_outside_files && !under(normal_path(path), c.folder)) {
+        c.access_errors.push_back("'" + path + "' is outside the scene's folder (--allow-outside-files reads it)");
+        return false;
+    }
+    char *real = realpath(path.c_str(), nullptr);
+    if (!real)
+        return false;
+    std::string resolved(real);
+    free(real);
+    if (!allow_outside_files && !under(resolved, c.folder)) {
+        c.access_errors.push_back("'" + path + "' links outside the scene's folder (--allow-outside-files reads it)");
+        return false;
+    }
+    if (stat(resolved.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
+        c.access_errors.push_back("'" + path + "' is not a regular file");
+        return false;
+    }
+    return true;
+}
+
+std::string fs_expand(const std::string &path, void *) { return path; }
+
+bool fs_read(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *)
+{
+    size_t size = 0;
+    void *data = util_read_file(path.c_str(), &size);
+    if (!data) {
+        if (err)
+            *err += "cannot read " + path;
+        return false;
+    }
+    out->assign(static_cast<unsigned char *>(data), static_cast<unsigned char *>(data) + size);
+    free(data);
+    return true;
+}
+
+bool fs_write(std::string *err, const std::string &, const std::vector<unsigned char> &, void *)
+{
+    if (err)
+        *err += "the loader writes no files";
+    return false;
+}
+
 /* ---- scene_load ------------------------------------------------------------------------------- */
 
 bool parse(Ctx &c, uint8_t *data, size_t size)
@@ -1566,13 +1672,29 @@ bool parse(Ctx &c, uint8_t *data, size_t size)
     const char *text = small.empty() ? reinterpret_cast<const char *>(data) : small.c_str();
     unsigned text_len = small.empty() ? unsigned(len) : unsigned(small.size());
     std::string base_dir(c.path, strrchr(c.path, '/') ? size_t(strrchr(c.path, '/') - c.path) : 0);
+    if (strrchr(c.path, '/') == c.path)
+        base_dir = "/";
+    {
+        char *real = realpath(base_dir.empty() ? "." : base_dir.c_str(), nullptr);
+        if (!real)
+            return fail(c, "cannot resolve the scene's folder");
+        c.folder = real;
+        free(real);
+    }
+    c.base_dir = base_dir;
     tinygltf::TinyGLTF loader;
+    tinygltf::FsCallbacks fs = {fs_file_exists, fs_expand, fs_read, fs_write, &c};
+    loader.SetFsCallbacks(fs);
     loader.SetImageLoader(image_callback, &c);
     std::string err, warnings;
     bool ok = glb ? loader.LoadBinaryFromMemory(&c.m, &err, &warnings, data, unsigned(len), base_dir)
                   : loader.LoadASCIIFromString(&c.m, &err, &warnings, text, text_len, base_dir);
     /* tinygltf 2.7 only warns about external images it cannot read, which get their own
      * warning in load_images_and_textures: `warnings` is not repeated. */
+    for (const auto &e : c.access_errors)
+        fail(c, "%s", e.c_str());
+    if (!c.access_errors.empty())
+        return false;
     if (!ok && err.empty())
         return fail(c, "cannot parse glTF");
     report_lines(c, err, !ok);
@@ -1631,6 +1753,8 @@ bool load(scene *out, const char *path, int scene_index)
 } // namespace
 
 bool scene_load(scene *out, const char *path) { return scene_load_scene(out, path, -1); }
+
+void scene_allow_outside_files(bool allow) { allow_outside_files = allow; }
 
 bool scene_load_scene(scene *out, const char *path, int scene_index)
 {

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -151,8 +152,15 @@ void *util_read_file(const char *path, size_t *size)
     FILE *f = fopen(path, "rb");
     char *data;
     long len;
+    struct stat st;
     if (!f) {
         util_error("%s: cannot open: %s", path, strerror(errno));
+        return NULL;
+    }
+    /* A directory opens and seeks on Linux (ftell gives LONG_MAX): only regular files. */
+    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
+        util_error("%s: not a regular file", path);
+        fclose(f);
         return NULL;
     }
     if (fseek(f, 0, SEEK_END) != 0 || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {

@@ -1,0 +1,66 @@
+#!/usr/bin/env bash
+# hostile.sh: inputs that try to make gonio read what it should not or misread what it
+# reads. A scene reads only regular files under its own folder (src/scene.h); errors name
+# the URI and reveal nothing about the file refused. Scenes are glTF JSON written by Python.
+. "$(dirname "$0")/../lib.sh"
+G=$GONIO
+command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
+D=$tmp/scenes
+mkdir -p "$D/a/b" "$tmp/cwd"
+python3 - "$tmp" <<'PY'
+import json, struct, sys
+t = sys.argv[1]
+blob = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+for f in ("secret.bin", "scenes/a/b/tri.bin", "cwd/only-here.bin"):
+    open(f"{t}/{f}", "wb").write(blob)
+open(f"{t}/big-secret.bin", "wb").write(blob * 70)  # 2520 bytes: a size an error must not tell
+def doc(uri, length=36):
+    return {"asset": {"version": "2.0"}, "buffers": [{"uri": uri, "byteLength": length}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                           "min": [0, 0, 0], "max": [1, 1, 0]}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+            "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}
+cases = {"ok": "tri.bin", "up": "../../../secret.bin", "pct": "%2e%2e/%2e%2e/%2e%2e/secret.bin",
+         "abs": f"{t}/secret.bin", "dot": ".", "dotdot": "..", "root": "/", "link": "link.bin",
+         "cwd": "only-here.bin", "size": "../../../big-secret.bin"}
+for name, uri in cases.items():
+    json.dump(doc(uri, 12 if name == "size" else 36), open(f"{t}/scenes/a/b/{name}.gltf", "w"))
+PY
+ln -sf "$tmp/secret.bin" "$D/a/b/link.bin"
+B=$D/a/b
+
+check "a buffer beside the scene loads" "$G" info "$B/ok.gltf"
+for c in up pct abs link; do
+    check_fails "$c: a buffer outside the scene's folder is refused" 1 "$G" info "$B/$c.gltf"
+    check "$c: the error names the scene" grep -q "$c.gltf" "$tmp/last"
+done
+check "the error says why" grep -q "outside the scene's folder" "$tmp/last"
+for c in dot dotdot root; do
+    check_fails "$c: a URI naming a directory is an error" 1 "$G" info "$B/$c.gltf"
+    check "$c: no 'out of memory'" sh -c "! grep -q 'out of memory' '$tmp/last'"
+done
+# tinygltf would fall back to the working directory for a file missing beside the scene.
+check_fails "cwd: a file only in the working directory is not read" 1 sh -c "cd '$tmp/cwd' && '$G' info '$B/cwd.gltf'"
+check_fails "size: a wrong byteLength on an outside file is refused" 1 "$G" info "$B/size.gltf"
+check "... without telling the file's size" sh -c "! grep -q 2520 '$tmp/last'"
+check "--allow-outside-files reads it" "$G" info "$B/up.gltf" --allow-outside-files
+check "render --allow-outside-files too" "$G" render "$B/up.gltf" --allow-outside-files -o "$tmp/up.exr" \
+    --size 8x8 --spp 1 --quiet
+check_fails "render refuses it by default" 1 "$G" render "$B/up.gltf" -o "$tmp/up2.exr" --size 8x8 --spp 1 --quiet
+check "... and writes nothing" test ! -e "$tmp/up2.exr"
+check_fails "a directory as the scene is an error" 1 "$G" info "$tmp"
+check "... naming it, not 'out of memory'" sh -c "grep -q 'not a regular file' '$tmp/last' && ! grep -q 'out of memory' '$tmp/last'"
+
+# A camera aspect ratio from the file suggests the size, within the longer side's 512.
+python3 - "$B/ok.gltf" "$B/thin.gltf" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 0.004, "znear": 0.1}}]
+d["nodes"].append({"camera": 0, "translation": [0.3, 0.3, 3]})
+d["scenes"][0]["nodes"].append(1)
+json.dump(d, open(sys.argv[2], "w"))
+PY
+check "a camera aspect of 0.004 renders" "$G" render "$B/thin.gltf" -o "$tmp/thin.exr" --spp 1 --quiet
+check "... at most 512 pixels on its longer side" sh -c "exrheader '$tmp/thin.exr' | grep -q 'dataWindow.*(0 0) - (1 511)'"
+finish
