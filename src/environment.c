@@ -19,6 +19,9 @@ static bool has_suffix(const char *s, const char *suffix)
     return n >= m && strcasecmp(s + n - m, suffix) == 0;
 }
 
+/* Radiance beyond this overflows the flux products in float (--env 1e38 wrote NaN pixels). */
+#define ENV_MAX 1e9f
+
 int env_parse_option(env_option *e, const char *cmd, const char *opt, const char *val)
 {
     if (!strcmp(opt, "--env")) {
@@ -26,8 +29,9 @@ int env_parse_option(env_option *e, const char *cmd, const char *opt, const char
         e->path = NULL;
         if (has_suffix(val, ".exr") || has_suffix(val, ".hdr"))
             e->path = val;
-        else if (!util_parse_rgb(val, e->color))
-            return cli_usage_error(cmd, "--env '%s': expected R,G,B, one value >= 0, FILE.exr or FILE.hdr", val);
+        else if (!util_parse_rgb(val, e->color) || e->color[0] > ENV_MAX || e->color[1] > ENV_MAX || e->color[2] > ENV_MAX)
+            return cli_usage_error(cmd, "--env '%s': expected R,G,B or one value in [0, %g], FILE.exr or FILE.hdr",
+                                   val, ENV_MAX);
         return 1;
     }
     if (!strcmp(opt, "--env-rotate")) {
@@ -36,8 +40,8 @@ int env_parse_option(env_option *e, const char *cmd, const char *opt, const char
         return 1;
     }
     if (!strcmp(opt, "--env-intensity")) {
-        if (!util_parse_float(val, &e->intensity) || !(e->intensity > 0) || !isfinite(e->intensity))
-            return cli_usage_error(cmd, "--env-intensity '%s': expected a number > 0", val);
+        if (!util_parse_float(val, &e->intensity) || !(e->intensity > 0) || !(e->intensity <= ENV_MAX))
+            return cli_usage_error(cmd, "--env-intensity '%s': expected a number in (0, %g]", val, ENV_MAX);
         return 1;
     }
     return 0;

@@ -34,6 +34,9 @@ const size_t MAX_ZERO_ELEMENTS = size_t(1) << 22; /* per accessor without one (a
 const size_t MAX_SCENE = size_t(1) << 26;    /* vertices or triangles after instancing (3 GiB) */
 const size_t MAX_PIXELS = size_t(1) << 28;   /* per image */
 const int MAX_JSON_DEPTH = 64;               /* tinygltf copies extras/extensions recursively */
+/* Emission and light intensities above this are clamped: products with areas and squared
+ * distances must stay finite in float (1e39 became inf and NaN pixels). */
+const double MAX_RADIANCE = 1e9;
 
 const char *const SUPPORTED_EXTENSIONS[] = {
     "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_materials_specular",
@@ -1259,7 +1262,13 @@ void bake_lights(Ctx &c, const std::vector<Instance> &lights, scene *out)
         double col[3] = {1, 1, 1};
         if (l.color.size() == 3)
             std::copy(l.color.begin(), l.color.end(), col);
-        o.color = vec3{float(col[0] * l.intensity), float(col[1] * l.intensity), float(col[2] * l.intensity)};
+        double intensity = l.intensity;
+        if (intensity > MAX_RADIANCE) {
+            warn(c, "%s: intensity %g is above %g (clamped)", label("KHR_lights_punctual light", node_light(c.m.nodes[size_t(in.node)]), l.name).c_str(),
+                 intensity, MAX_RADIANCE);
+            intensity = MAX_RADIANCE;
+        }
+        o.color = vec3{float(col[0] * intensity), float(col[1] * intensity), float(col[2] * intensity)};
         o.range = o.type == GN_LIGHT_DIRECTIONAL || l.range < 0 ? 0.0f : float(l.range);
         o.inner_cos = o.outer_cos = -1; /* no cone */
         if (o.type == GN_LIGHT_SPOT) {
@@ -1491,7 +1500,7 @@ void convert_material(Ctx &c, int mi, GnMaterial &g, scene_material_extras &x, c
     g.roughness = ranged(c, pbr.roughnessFactor, 0, 1, what, "roughnessFactor");
     float strength = 1;
     if (const tinygltf::Value *e = extension(mat, "KHR_materials_emissive_strength"))
-        strength = ranged(c, ext_number(c, *e, "emissiveStrength", 1, what), 0, INFINITY, what, "emissiveStrength");
+        strength = ranged(c, ext_number(c, *e, "emissiveStrength", 1, what), 0, MAX_RADIANCE, what, "emissiveStrength");
     if (mat.emissiveFactor.size() == 3)
         g.emissive = vec3{ranged(c, mat.emissiveFactor[0], 0, 1, what, "emissiveFactor") * strength,
                           ranged(c, mat.emissiveFactor[1], 0, 1, what, "emissiveFactor") * strength,

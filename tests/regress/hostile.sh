@@ -63,4 +63,24 @@ json.dump(d, open(sys.argv[2], "w"))
 PY
 check "a camera aspect of 0.004 renders" "$G" render "$B/thin.gltf" -o "$tmp/thin.exr" --spp 1 --quiet
 check "... at most 512 pixels on its longer side" sh -c "exrheader '$tmp/thin.exr' | grep -q 'dataWindow.*(0 0) - (1 511)'"
+
+# Huge radiance: clamped or refused, never NaN or Inf pixels.
+check_fails "--env 1e38 is refused" 2 "$G" render "$B/ok.gltf" -o "$tmp/x.exr" --env 1e38 --quiet
+python3 - "$B/ok.gltf" "$B/bright.gltf" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["extensionsUsed"] = ["KHR_lights_punctual", "KHR_materials_emissive_strength"]
+d["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1e39}]}}
+d["materials"] = [{"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e39}}}]
+d["meshes"][0]["primitives"][0]["material"] = 0
+d["nodes"].append({"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0.2, 0.2, 1]})
+d["scenes"][0]["nodes"].append(1)
+json.dump(d, open(sys.argv[2], "w"))
+PY
+for m in path phong; do
+    check "a light and an emitter of 1e39 render ($m)" "$G" render "$B/bright.gltf" -o "$tmp/bright-$m.exr" \
+        --mode $m --size 16x16 --spp 2 --quiet
+    check "... with finite pixels ($m)" sh -c "'$TESTTOOL' stats '$tmp/bright-$m.exr' | grep -q 'nonfinite 0\$'"
+done
+check "the clamp is a warning naming the value" sh -c "'$G' info '$B/bright.gltf' 2>&1 | grep -q 'intensity 1e+39 is above 1e+09 (clamped)'"
 finish

@@ -173,7 +173,8 @@ static int write_ref(const char *name, const char *aov, int w, int h, const char
 
 /* Statistics of a rendered EXR for the shell tests: pixels covered (A > 0.5), the mean
  * luminance over them and over the whole image, and the box of the "red" pixels (R > 0.5,
- * G and B < 0.25; -1s when none): `covered N mean L image-mean L red X0 Y0 X1 Y1`. */
+ * G and B < 0.25; -1s when none), NaN or infinite values: `covered N mean L image-mean L
+ * red X0 Y0 X1 Y1 nonfinite N`. */
 static int stats(const char *path)
 {
     image img;
@@ -186,7 +187,7 @@ static int stats(const char *path)
         image_destroy(&img);
         return 1;
     }
-    long covered = 0;
+    long covered = 0, nonfinite = 0;
     double sum = 0, all = 0;
     int box[4] = {-1, -1, -1, -1};
     for (int y = 0; y < img.height; y++)
@@ -194,6 +195,7 @@ static int stats(const char *path)
             size_t i = (size_t)y * img.width + x;
             double R = img.planes[r][i], G = img.planes[g][i], B = img.planes[b][i];
             double lum = 0.2126 * R + 0.7152 * G + 0.0722 * B;
+            nonfinite += !isfinite(R) + !isfinite(G) + !isfinite(B);
             all += lum;
             if (img.planes[a][i] > 0.5f) {
                 covered++;
@@ -206,8 +208,9 @@ static int stats(const char *path)
                 if (y > box[3]) box[3] = y;
             }
         }
-    printf("covered %ld mean %.6g image-mean %.6g red %d %d %d %d\n", covered, covered ? sum / covered : 0.0,
-           all / ((double)img.width * img.height), box[0], box[1], box[2], box[3]);
+    printf("covered %ld mean %.6g image-mean %.6g red %d %d %d %d nonfinite %ld\n", covered,
+           covered ? sum / covered : 0.0, all / ((double)img.width * img.height), box[0], box[1], box[2], box[3],
+           nonfinite);
     image_destroy(&img);
     return 0;
 }
