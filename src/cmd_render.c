@@ -10,22 +10,33 @@
 #include "cli.h"
 #include "image.h"
 #include "render.h"
+#include "render_output.h"
 #include "scene.h"
 #include "util.h"
 
 static const char render_usage[] =
-    "usage: gonio render SCENE.gltf|.glb -o OUT.exr [options]\n"
+    "usage: gonio render SCENE.gltf|.glb -o OUT.exr|OUT.png [options]\n"
     "\n"
-    "  -o, --output FILE   linear float RGBA OpenEXR (written atomically)\n"
-    "  --png FILE          also write a tonemapped sRGB PNG (alone: PNG only)\n"
+    "  -o, --output FILE   the image, in the format its name says: .exr linear float RGBA\n"
+    "                      OpenEXR with the gonio:* header; .png the PNG --png writes\n"
+    "                      (any other name is a usage error); written atomically\n"
+    "  --png FILE          also write a PNG: tonemapped sRGB; in modes depth, normal and\n"
+    "                      cost a picture of the data: depth grey from white (nearest) to 20%\n"
+    "                      grey (farthest visible), normals 0.5 n + 0.5, cost a viridis heat\n"
+    "                      map up to the image's maximum; the background black\n"
     "  --mode M            path (default: Monte Carlo path tracing), phong, gouraud, flat,\n"
-    "                      normal, albedo, depth, cost\n"
+    "                      normal, albedo, depth, cost (depth: along the camera axis, 0 where\n"
+    "                      nothing is hit, in the EXR as in the depth AOV)\n"
     "  --spp N             samples per pixel (default 16)\n"
     "  --time SECONDS      render for this long instead of --spp\n"
     "  --size WxH          image size (default 512x512, or the camera's aspect)\n"
     "  --camera N          the scene's N-th perspective camera (default: frame the scene)\n"
     "  --seed S            random seed (default 0); renders with different seeds merge\n"
-    "  --aov LIST          extra EXR channels: normal,albedo,depth,variance\n"
+    "  --aov LIST          extra EXR channels, exactly those listed: any of normal (normal.XYZ),\n"
+    "                      albedo (albedo.RGB), depth (depth.Z, 0 on a miss), variance\n"
+    "                      (variance.RGB: of each pixel's mean), comma-separated\n"
+    "  --half              EXR: 16-bit half channels (default 32-bit float)\n"
+    "  --compression C     EXR: none, rle, zips, zip (default), piz, pxr24, b44, b44a\n"
     "  --env R,G,B | V     constant environment radiance (default 0: black)\n"
     "  --env FILE.exr      path: a lat-long HDR environment map (+Y up), importance sampled\n"
     "  --max-depth N       path: at most N bounces (default 0: unbounded, roulette ends paths)\n"
@@ -80,6 +91,8 @@ int cmd_render(int argc, char **argv)
     int device = -1;
     float exposure = 0;
     image_tonemap tm = IMAGE_TONEMAP_CLAMP;
+    image_exr_options exr = IMAGE_EXR_DEFAULTS;
+    const char *exr_option = NULL, *exr_path = NULL, *png_o = NULL; /* -o as EXR or as PNG */
     long v;
     scene sc = {0};
     gpu g = {0};
@@ -99,6 +112,9 @@ int cmd_render(int argc, char **argv)
             validate = true;
         } else if (!strcmp(a, "--no-shadows")) {
             s.shadows = false;
+        } else if (!strcmp(a, "--half")) {
+            exr.half = true;
+            exr_option = "--half";
         } else if (a[0] == '-' && a[1]) {
             if (!(val = cli_value(argc, argv, &i)))
                 return 2;
@@ -136,13 +152,20 @@ int cmd_render(int argc, char **argv)
             } else if (!strcmp(a, "--aov")) {
                 char buf[256], *tok, *save;
                 snprintf(buf, sizeof buf, "%s", val);
-                for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save))
-                    if (!strcmp(tok, "variance"))
-                        s.variance = true;
-                    else if (strcmp(tok, "normal") && strcmp(tok, "albedo") && strcmp(tok, "depth"))
+                s.aov = 0;
+                for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+                    uint32_t bit = render_aov_from_name(tok);
+                    if (!bit)
                         return cli_usage_error("render", "--aov '%s': expected a list of normal, albedo, depth, variance", tok);
-                    else
-                        s.aov = true;
+                    s.aov |= bit;
+                }
+                if (!s.aov)
+                    return cli_usage_error("render", "--aov '%s': expected a list of normal, albedo, depth, variance", val);
+            } else if (!strcmp(a, "--compression")) {
+                if (!image_exr_compression_from_name(val, &exr.compression))
+                    return cli_usage_error("render", "--compression '%s': expected none, rle, zips, zip, piz, "
+                                           "pxr24, b44 or b44a", val);
+                exr_option = "--compression";
             } else if (!strcmp(a, "--env")) {
                 size_t len = strlen(val);
                 if (len > 4 && !strcasecmp(val + len - 4, ".exr"))
@@ -187,6 +210,17 @@ int cmd_render(int argc, char **argv)
         return cli_usage_error("render", "no scene given");
     if (!out_path && !png_path)
         return cli_usage_error("render", "no output given (-o OUT.exr and/or --png OUT.png)");
+    /* The name says the format: -o OUT.png is the tonemapped PNG, as --png is. */
+    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_UNKNOWN)
+        return cli_usage_error("render", "-o '%s': expected a .exr (OpenEXR) or .png name", out_path);
+    if (png_path && image_format_of(png_path) != IMAGE_FORMAT_PNG)
+        return cli_usage_error("render", "--png '%s': expected a .png name", png_path);
+    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_EXR)
+        exr_path = out_path;
+    else
+        png_o = out_path;
+    if (exr_option && !exr_path)
+        return cli_usage_error("render", "%s is for an EXR output (-o OUT.exr)", exr_option);
     util_set_quiet(quiet);
     s.progress = !quiet;
     if ((out_path && !check_writable(out_path)) || (png_path && !check_writable(png_path)))
@@ -226,21 +260,17 @@ int cmd_render(int argc, char **argv)
     renderer_create(&r, &g, &sc);
     if (renderer_render(&r, &s, &img, &st)) {
         char seconds[32];
-        image_attr attrs[] = {
-            {"gonio:spp", IMAGE_ATTR_INT, NULL, st.spp, 0},
-            {"gonio:seed", IMAGE_ATTR_INT, NULL, (int)s.seed, 0},
-            {"gonio:mode", IMAGE_ATTR_STRING, render_mode_name(s.mode), 0, 0},
-            {"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, st.seconds},
-            {"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0},
-            {"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0},
-        };
+        render_header h;
         bool ok = true;
+        render_header_build(&h, &r, &s, &st, brdf);
         if (stop_requested && !quiet)
             util_warn("interrupted: writing the %d spp rendered so far", st.spp);
-        if (out_path)
-            ok = image_write_exr(&img, out_path, attrs, sizeof attrs / sizeof *attrs);
+        if (exr_path)
+            ok = image_write_exr_with(&img, exr_path, h.attrs, h.count, &exr);
+        if (ok && png_o)
+            ok = render_write_png(&img, s.mode, png_o, exposure, tm);
         if (ok && png_path)
-            ok = image_write_png_from(&img, png_path, exposure, tm);
+            ok = render_write_png(&img, s.mode, png_path, exposure, tm);
         snprintf(seconds, sizeof seconds, "%.2f", st.seconds);
         if (ok && !quiet)
             /* One camera ray per pixel and sample: a whole path in path mode. */

@@ -30,7 +30,7 @@ static bool render_file(gpu *g, const char *path, const char *brdf, render_setti
     render_stats st;
     bool ok = scene_load(&sc, path) && render_material_overrides(&sc, brdf);
     s.mode = GN_MODE_PATH;
-    s.variance = true;
+    s.aov |= RENDER_AOV_VARIANCE;
     if (ok) {
         renderer_create(&r, g, &sc);
         ok = renderer_render(&r, &s, out, &st);
@@ -498,7 +498,7 @@ void test_path_determinism(void)
 {
     gpu g = {0};
     image a = {0}, b = {0};
-    render_settings s = {.width = 24, .height = 24, .spp = 8, .camera = 0, .seed = 9, .aov = true};
+    render_settings s = {.width = 24, .height = 24, .spp = 8, .camera = 0, .seed = 9, .aov = RENDER_AOV_GPU};
     if (!test_open_gpu(&g))
         return;
     if (render_file(&g, "scenes/cornell.gltf", NULL, s, &a) &&
