@@ -788,6 +788,8 @@ int cmd_preview(int argc, char **argv)
                     return cli_usage_error("preview", "--frames '%s': expected an integer >= 1", val);
                 max_frames = (int)v;
             } else if (!strcmp(a, "--screenshot")) {
+                if (image_format_of(val) != IMAGE_FORMAT_PNG)
+                    return cli_usage_error("preview", "--screenshot '%s': expected a .png name", val);
                 screenshot = val;
             } else if (!strcmp(a, "--device")) {
                 if (!util_parse_int(val, 0, 64, &v))

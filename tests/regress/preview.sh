@@ -20,6 +20,7 @@ check_fails "no display: exit 1" 1 env -u DISPLAY -u WAYLAND_DISPLAY "$G" previe
 check "no display: the message points to gonio render and xvfb-run" \
     sh -c "grep -q 'gonio render' '$tmp/last' && grep -q xvfb-run '$tmp/last'"
 check_fails "bad --mode" 2 "$G" preview $C --mode bogus
+check_fails "--screenshot needs a .png name" 2 "$G" preview $C --screenshot "$tmp/shot.exr"
 check_fails "no scene" 2 "$G" preview
 check_fails "missing scene" 1 "$G" preview "$tmp/nope.gltf" --frames 1
 check "missing scene: message names the file" grep -q nope.gltf "$tmp/last"
