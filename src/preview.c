@@ -16,6 +16,7 @@
 #include "cli.h"
 #include "display.h" /* spv_display: glsl/display.comp compiled by the build */
 #include "image.h"
+#include "render_output.h"
 #include "render.h"
 #include "scene.h"
 #include "util.h"
@@ -287,7 +288,7 @@ static bool save_accumulated(preview *p)
     }
     renderer_resolve(&p->r, p->spp, false, &img);
     ok = image_write_exr(&img, exr, attrs, sizeof attrs / sizeof *attrs) &&
-         image_write_png_from(&img, png, p->exposure, p->tonemap);
+         render_write_png(&img, p->s.mode, png, p->exposure, p->tonemap); /* as gonio render's */
     if (ok) {
         printf("gonio preview: wrote %s and %s (%s, %d spp)\n", exr, png,
                render_mode_name(p->s.mode), p->spp);
