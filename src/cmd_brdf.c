@@ -20,7 +20,7 @@ static const char usage[] =
     "usage: gonio brdf --list\n"
     "       gonio brdf MODEL [--PARAM VALUE ...] [--theta DEG] -o LOBE.png [--size WxH]\n"
     "       gonio brdf MODEL [--PARAM VALUE ...] --albedo\n"
-    "       gonio brdf MODEL [--PARAM VALUE ...] --sphere -o BALL.exr [--png BALL.png]\n"
+    "       gonio brdf MODEL [--PARAM VALUE ...] --sphere -o BALL.exr|BALL.png [--png BALL.png]\n"
     "                  [--size WxH] [--spp N]\n"
     "\n"
     "  --list          the models, one a line: name, then each parameter=default\n"
@@ -30,7 +30,8 @@ static const char usage[] =
     "  --albedo        print 'theta_deg albedo_r albedo_g albedo_b' for theta = 0, 5, ..., 85, 89:\n"
     "                  the directional albedo (reflected + transmitted fraction) of light from theta\n"
     "  --sphere        render a unit sphere of the material: directional light + constant sky\n"
-    "  -o FILE         the lobe PNG, or the sphere's linear float EXR\n"
+    "  -o FILE         the lobe plot: a .png; the sphere: a .exr (linear float OpenEXR) or\n"
+    "                  a .png (sRGB, clamped); any other name is a usage error\n"
     "  --png FILE      sphere: also a PNG (sRGB, clamped)\n"
     "  --size WxH      image size (lobe default 560x360, 560x560 with transmission; sphere 256x256)\n"
     "  --spp N         sphere: samples per pixel (default 64)\n"
@@ -365,7 +366,8 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
     {
         const image_attr attrs[] = {{"gonio:brdf", IMAGE_ATTR_STRING, desc, 0, 0, NULL},
                                     {"gonio:spp", IMAGE_ATTR_INT, NULL, spp, 0, NULL}};
-        ok = image_write_exr(&img, out, attrs, 2);
+        if (out)
+            ok = image_write_exr(&img, out, attrs, 2);
     }
     if (ok && png)
         ok = image_write_png_from(&img, png, 0, IMAGE_TONEMAP_CLAMP);
@@ -453,6 +455,22 @@ int cmd_brdf(int argc, char **argv)
         return bad_usage("%s", "-o FILE is needed (a PNG for the lobe plot, an EXR for --sphere)");
     if (png && !sphere)
         return bad_usage("%s", "--png is for --sphere");
+    if (albedo && out)
+        return bad_usage("%s", "--albedo prints its table and writes no file: drop -o");
+    /* The name says the format: the plot is drawn as PNG only; the sphere is an EXR or,
+     * with -o BALL.png, the PNG alone. */
+    if (out && !sphere && image_format_of(out) != IMAGE_FORMAT_PNG)
+        return bad_usage("-o '%s': the lobe plot is a PNG: expected a .png name", out);
+    if (out && sphere && image_format_of(out) == IMAGE_FORMAT_UNKNOWN)
+        return bad_usage("-o '%s': expected a .exr (OpenEXR) or .png name", out);
+    if (png && image_format_of(png) != IMAGE_FORMAT_PNG)
+        return bad_usage("--png '%s': expected a .png name", png);
+    if (sphere && image_format_of(out) == IMAGE_FORMAT_PNG) {
+        if (png)
+            return bad_usage("%s", "-o names a PNG already: drop --png");
+        png = out;
+        out = NULL;
+    }
     if (sphere && (w > 4096 || h > 4096))
         return bad_usage("%s", "a sphere image is at most 4096x4096");
     if (!albedo && !sphere && w && (w < 240 || h < 240))

@@ -1,24 +1,42 @@
 /* cmd_merge.c: `gonio merge`: renders of one scene with different seeds -> one image, each
  * pixel the mean of all N = sum n_i samples (sum n_i x_i / N), so the result is the render
  * of N spp. Variance channels combine through the sums of squares they imply:
- * sum x^2 = n (v (n - 1) + m^2) for a file's mean m and variance of the mean v. */
+ * sum x^2 = n (v (n - 1) + m^2) for a file's mean m and variance of the mean v.
+ *
+ * Only samples of one image can be averaged: the inputs' identity attributes
+ * (render_identity_names, written by render) must be equal, their seeds all different and
+ * their sample counts positive integers whose sum fits the header's int. */
+#include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
 #include "image.h"
+#include "render_output.h"
 #include "util.h"
 
 static const char merge_usage[] =
-    "usage: gonio merge A.exr B.exr ... -o OUT.exr\n"
+    "usage: gonio merge A.exr B.exr ... -o OUT.exr [--force] [--half] [--compression C]\n"
     "\n"
     "Combines renders of the same scene and settings made with different --seed values\n"
     "into one, weighted by each file's sample count (its gonio:spp header): the result is\n"
-    "exactly the mean of all the samples, with gonio:spp their total. Every input needs the\n"
-    "same size and channels. variance.R/G/B channels are merged exactly too.\n"
+    "exactly the mean of all the samples, with gonio:spp their total. variance.R/G/B\n"
+    "channels are merged exactly too.\n"
     "\n"
-    "  -o, --output FILE   the merged EXR (written atomically)\n";
+    "The inputs must be one render: the same size and channels, and the same gonio:scene\n"
+    "(a hash of the scene's content), gonio:size, gonio:mode, gonio:camera and options of the\n"
+    "mode (gonio:max-depth, gonio:estimator, gonio:env, gonio:shadows, gonio:ambient); each\n"
+    "gonio:spp a positive integer, their total at most 2147483647. Anything else is an error\n"
+    "naming both files and the field (exit 1, no output). A seed used twice is an error too\n"
+    "(its samples repeat and add nothing) unless --force. The output records every seed in\n"
+    "gonio:seeds, so merged files merge again.\n"
+    "\n"
+    "  -o, --output FILE   the merged OpenEXR (a .exr name; written atomically)\n"
+    "  --force             merge inputs that share a seed\n"
+    "  --half              16-bit half channels (default 32-bit float)\n"
+    "  --compression C     none, rle, zips, zip (default), piz, pxr24, b44, b44a\n";
 
 /* The channel whose mean a variance channel describes ("variance.R" -> "R"), or NULL. */
 static const char *variance_of(const char *name)
@@ -26,46 +44,134 @@ static const char *variance_of(const char *name)
     return strncmp(name, "variance.", 9) == 0 ? name + 9 : NULL;
 }
 
+/* The file's sample count: a finite positive integer no larger than INT32_MAX. */
+static bool read_spp(const char *path, int64_t *out)
+{
+    double v;
+    if (!image_exr_attr_double(path, "gonio:spp", &v)) {
+        util_error("%s: no gonio:spp sample count in the header (not a gonio render?)", path);
+        return false;
+    }
+    if (!(v >= 1 && v <= INT32_MAX && v == floor(v))) {
+        util_error("%s: gonio:spp %g is not a sample count (a positive integer up to %d)", path, v, INT32_MAX);
+        return false;
+    }
+    *out = (int64_t)v;
+    return true;
+}
+
+typedef struct seed_list {
+    uint32_t *seed;
+    int *file;      /* the input each seed came from */
+    int count, cap;
+    bool complete;  /* every input said its seeds */
+} seed_list;
+
+static void add_seed(seed_list *l, uint32_t seed, int file)
+{
+    if (l->count == l->cap) {
+        l->cap = l->cap ? 2 * l->cap : 16;
+        l->seed = util_realloc(l->seed, sizeof *l->seed * (size_t)l->cap);
+        l->file = util_realloc(l->file, sizeof *l->file * (size_t)l->cap);
+    }
+    l->seed[l->count] = seed;
+    l->file[l->count++] = file;
+}
+
+/* A file's seeds: gonio:seeds (a merge's list) or gonio:seed (a render's); false when the
+ * header has neither or a malformed one. */
+static bool read_seeds(const char *path, int file, seed_list *l)
+{
+    char text[4096], *end;
+    double v;
+    if (image_exr_attr_string(path, "gonio:seeds", text, sizeof text)) {
+        for (const char *p = text; *p; p = *end ? end + 1 : end) {
+            unsigned long long x = strtoull(p, &end, 10);
+            if (end == p || (*end && *end != ',') || x > UINT32_MAX)
+                return false;
+            add_seed(l, (uint32_t)x, file);
+        }
+        return true;
+    }
+    if (image_exr_attr_double(path, "gonio:seed", &v) && v >= 0 && v <= UINT32_MAX && v == floor(v)) {
+        add_seed(l, (uint32_t)v, file);
+        return true;
+    }
+    return false;
+}
+
+/* The identity attributes of a and b agree (absent in both counts as equal). */
+static bool same_render(const char *a, const char *b)
+{
+    for (int k = 0; render_identity_names[k]; k++) {
+        char va[512] = "", vb[512] = "";
+        bool ha = image_exr_attr_string(a, render_identity_names[k], va, sizeof va);
+        bool hb = image_exr_attr_string(b, render_identity_names[k], vb, sizeof vb);
+        if (ha != hb || strcmp(va, vb)) {
+            util_error("%s and %s are not one render: %s differs (%s%s%s vs %s%s%s)", a, b,
+                       render_identity_names[k], ha ? "'" : "", ha ? va : "absent", ha ? "'" : "",
+                       hb ? "'" : "", hb ? vb : "absent", hb ? "'" : "");
+            return false;
+        }
+    }
+    return true;
+}
+
 int cmd_merge(int argc, char **argv)
 {
     const char *out_path = NULL, **inputs = util_calloc((size_t)argc, sizeof *inputs);
     int n = 0, rc = 1;
+    bool force = false;
     image *imgs = NULL, out = {0};
-    double *spp = NULL, total = 0, seconds = 0, seed0 = 0;
-    char mode[64] = "";
+    image_exr_options exr = IMAGE_EXR_DEFAULTS;
+    int64_t *spp = NULL, total = 0;
+    double seconds = 0;
+    seed_list seeds = {.complete = true};
+    char *seed_text = NULL;
 
     for (int i = 1; i < argc; i++) {
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+        const char *a = argv[i], *val;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             fputs(merge_usage, stdout);
             free(inputs);
             return 0;
-        } else if (!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output")) {
+        } else if (!strcmp(a, "--force")) {
+            force = true;
+        } else if (!strcmp(a, "--half")) {
+            exr.half = true;
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
             if (!(out_path = cli_value(argc, argv, &i))) {
                 free(inputs);
                 return 2;
             }
-        } else if (argv[i][0] == '-' && argv[i][1]) {
+        } else if (!strcmp(a, "--compression")) {
+            if (!(val = cli_value(argc, argv, &i)) || !image_exr_compression_from_name(val, &exr.compression)) {
+                free(inputs);
+                return val ? cli_usage_error("merge", "--compression '%s': expected none, rle, zips, zip, "
+                                             "piz, pxr24, b44 or b44a", val) : 2;
+            }
+        } else if (a[0] == '-' && a[1]) {
             free(inputs);
-            return cli_usage_error("merge", "unknown option '%s'", argv[i]);
+            return cli_usage_error("merge", "unknown option '%s'", a);
         } else {
-            inputs[n++] = argv[i];
+            inputs[n++] = a;
         }
     }
     if (!out_path || n < 1) {
         free(inputs);
         return cli_usage_error("merge", out_path ? "no input files" : "no output given (-o OUT.exr)");
     }
+    if (image_format_of(out_path) != IMAGE_FORMAT_EXR) {
+        free(inputs);
+        return cli_usage_error("merge", "-o '%s': merge writes OpenEXR: expected a .exr name", out_path);
+    }
 
     imgs = util_calloc((size_t)n, sizeof *imgs);
     spp = util_calloc((size_t)n, sizeof *spp);
     for (int i = 0; i < n; i++) {
-        double s, seed;
-        if (!image_read_exr(&imgs[i], inputs[i]))
+        double s;
+        if (!image_read_exr(&imgs[i], inputs[i]) || !read_spp(inputs[i], &spp[i]))
             goto done;
-        if (!image_exr_attr_double(inputs[i], "gonio:spp", &spp[i]) || !(spp[i] >= 1)) {
-            util_error("%s: no gonio:spp sample count in the header (not a gonio render?)", inputs[i]);
-            goto done;
-        }
         if (imgs[i].width != imgs[0].width || imgs[i].height != imgs[0].height ||
             imgs[i].num_channels != imgs[0].num_channels) {
             util_error("%s: %dx%d with %d channels, but %s is %dx%d with %d", inputs[i],
@@ -78,19 +184,30 @@ int cmd_merge(int argc, char **argv)
                 util_error("%s: has no channel '%s' (which %s has)", inputs[i], imgs[0].names[c], inputs[0]);
                 goto done;
             }
-        if (image_exr_attr_double(inputs[i], "gonio:seed", &seed)) {
-            if (i == 0)
-                seed0 = seed;
-            else if (seed == seed0)
-                util_warn("%s: same seed (%.0f) as %s: its samples repeat, they add no information",
-                          inputs[i], seed, inputs[0]);
-        }
+        if (i > 0 && !same_render(inputs[0], inputs[i]))
+            goto done;
+        if (!read_seeds(inputs[i], i, &seeds))
+            seeds.complete = false;
         if (image_exr_attr_double(inputs[i], "gonio:seconds", &s))
             seconds += s;
-        total += spp[i];
+        total += spp[i]; /* each <= INT32_MAX: int64 cannot overflow for any argc */
+        if (total > INT32_MAX) {
+            util_error("%s: the total sample count reaches %lld, more than the header's int holds (%d)",
+                       inputs[i], (long long)total, INT32_MAX);
+            goto done;
+        }
     }
-    if (!image_exr_attr_string(inputs[0], "gonio:mode", mode, sizeof mode))
-        strcpy(mode, "?");
+    for (int a = 0; a < seeds.count; a++)
+        for (int b = 0; b < a; b++)
+            if (seeds.seed[a] == seeds.seed[b]) {
+                if (!force) {
+                    util_error("%s and %s: both have seed %u: its samples repeat and add no information "
+                               "(--force merges anyway)", inputs[seeds.file[b]], inputs[seeds.file[a]], seeds.seed[a]);
+                    goto done;
+                }
+                util_warn("%s and %s: both have seed %u (merged: --force)", inputs[seeds.file[b]],
+                          inputs[seeds.file[a]], seeds.seed[a]);
+            }
 
     {
         const char *names[IMAGE_MAX_CHANNELS];
@@ -105,32 +222,48 @@ int cmd_merge(int argc, char **argv)
                 double sum = 0, sq = 0;
                 for (int i = 0; i < n; i++) {
                     double x = imgs[i].planes[image_channel(&imgs[i], names[c])][p];
+                    double w = (double)spp[i];
                     if (mc >= 0) { /* back to the sums of x and x^2 of this file */
                         double m = imgs[i].planes[image_channel(&imgs[i], of)][p];
-                        sum += spp[i] * m;
-                        sq += spp[i] * (x * (spp[i] - 1) + m * m);
+                        sum += w * m;
+                        sq += w * (x * (w - 1) + m * m);
                     } else {
-                        sum += spp[i] * x;
+                        sum += w * x;
                     }
                 }
                 if (mc >= 0) {
-                    double m = sum / total, v = total > 1 ? (sq / total - m * m) / (total - 1) : 0;
+                    double N = (double)total, m = sum / N, v = total > 1 ? (sq / N - m * m) / (N - 1) : 0;
                     out.planes[c][p] = v > 0 ? (float)v : 0;
                 } else {
-                    out.planes[c][p] = (float)(sum / total);
+                    out.planes[c][p] = (float)(sum / (double)total);
                 }
             }
         }
     }
     {
-        image_attr attrs[] = {
-            {"gonio:spp", IMAGE_ATTR_INT, NULL, (int)total, 0, NULL},
-            {"gonio:mode", IMAGE_ATTR_STRING, mode, 0, 0, NULL},
-            {"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, seconds, NULL},
-            {"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL},
-            {"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL},
-        };
-        if (image_write_exr(&out, out_path, attrs, sizeof attrs / sizeof *attrs))
+        /* The identity of the first input (all are equal), then the merge's own. */
+        enum { MAX_ID = 16 };
+        image_attr attrs[MAX_ID + 5];
+        char values[MAX_ID][512];
+        int na = 0;
+        for (int k = 0; render_identity_names[k] && k < MAX_ID; k++)
+            if (image_exr_attr_string(inputs[0], render_identity_names[k], values[na], sizeof values[0])) {
+                attrs[na] = (image_attr){render_identity_names[k], IMAGE_ATTR_STRING, values[na], 0, 0, NULL};
+                na++;
+            }
+        attrs[na++] = (image_attr){"gonio:spp", IMAGE_ATTR_INT, NULL, (int)total, 0, NULL};
+        if (seeds.complete) {
+            size_t len = 0;
+            seed_text = util_malloc(12 * (size_t)seeds.count + 1);
+            seed_text[0] = 0;
+            for (int k = 0; k < seeds.count; k++)
+                len += (size_t)sprintf(seed_text + len, "%s%u", k ? "," : "", seeds.seed[k]);
+            attrs[na++] = (image_attr){"gonio:seeds", IMAGE_ATTR_STRING, seed_text, 0, 0, NULL};
+        }
+        attrs[na++] = (image_attr){"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, seconds, NULL};
+        attrs[na++] = (image_attr){"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL};
+        attrs[na++] = (image_attr){"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL};
+        if (image_write_exr_with(&out, out_path, attrs, na, &exr))
             rc = 0;
     }
 done:
@@ -140,5 +273,8 @@ done:
     free(imgs);
     free(spp);
     free(inputs);
+    free(seeds.seed);
+    free(seeds.file);
+    free(seed_text);
     return rc;
 }

@@ -13,16 +13,23 @@
 #include "environment.h"
 #include "image.h"
 #include "render.h"
+#include "render_output.h"
 #include "scene.h"
 #include "util.h"
 
 static const char render_usage[] =
-    "usage: gonio render SCENE.gltf|.glb -o OUT.exr [options]\n"
+    "usage: gonio render SCENE.gltf|.glb -o OUT.exr|OUT.png [options]\n"
     "\n"
-    "  -o, --output FILE   linear float RGBA OpenEXR (written atomically)\n"
-    "  --png FILE          also write a tonemapped sRGB PNG (alone: PNG only)\n"
+    "  -o, --output FILE   the image, in the format its name says: .exr linear float RGBA\n"
+    "                      OpenEXR with the gonio:* header; .png the PNG --png writes\n"
+    "                      (any other name is a usage error); written atomically\n"
+    "  --png FILE          also write a PNG: tonemapped sRGB; in modes depth, normal and\n"
+    "                      cost a picture of the data: depth grey from white (nearest) to 20%\n"
+    "                      grey (farthest visible), normals 0.5 n + 0.5, cost a viridis heat\n"
+    "                      map up to the image's maximum; the background black\n"
     "  --mode M            path (default: Monte Carlo path tracing), phong, gouraud, flat,\n"
-    "                      normal, albedo, depth, cost\n"
+    "                      normal, albedo, depth, cost (depth: along the camera axis, 0 where\n"
+    "                      nothing is hit, in the EXR as in the depth AOV)\n"
     "  --spp N             samples per pixel (default 16)\n"
     "  --time SECONDS      render for this long instead of --spp\n"
     "  --size WxH          image size (default 512 on the longer side, the camera's aspect)\n"
@@ -31,7 +38,11 @@ static const char render_usage[] =
     "  --allow-outside-files  let the scene read files outside its folder (default: only\n"
     "                      regular files under it)\n"
     "  --seed S            random seed (default 0); renders with different seeds merge\n"
-    "  --aov LIST          extra EXR channels: normal,albedo,depth,variance\n"
+    "  --aov LIST          extra EXR channels, exactly those listed: any of normal (normal.XYZ),\n"
+    "                      albedo (albedo.RGB), depth (depth.Z, 0 on a miss), variance\n"
+    "                      (variance.RGB: of each pixel's mean), comma-separated\n"
+    "  --half              EXR: 16-bit half channels (default 32-bit float)\n"
+    "  --compression C     EXR: none, rle, zips, zip (default), piz, pxr24, b44, b44a\n"
     ENV_OPTIONS_HELP
     "  --max-depth N       path: at most N bounces (default 0: unbounded, roulette ends paths)\n"
     "  --brdf MODEL[:P=V]  path: render every material with a BRDF model (see gonio brdf\n"
@@ -84,11 +95,13 @@ int cmd_render(int argc, char **argv)
     camera_option cam = {0};
     env_option env = {0};
     scene_camera view;
-    char camera_text[160], look_at[256], frame_text[320];
+    char camera_text[160];
     bool size_given = false, quiet = false, validate = false, studio = false;
     int device = -1, scene_index = -1, taken;
     float exposure = 0;
     image_tonemap tm = IMAGE_TONEMAP_CLAMP;
+    image_exr_options exr = IMAGE_EXR_DEFAULTS;
+    const char *exr_option = NULL, *exr_path = NULL, *png_o = NULL; /* -o as EXR or as PNG */
     long v;
     scene sc = {0};
     gpu g = {0};
@@ -110,6 +123,9 @@ int cmd_render(int argc, char **argv)
             s.shadows = false;
         } else if (!strcmp(a, "--allow-outside-files")) {
             scene_allow_outside_files(true);
+        } else if (!strcmp(a, "--half")) {
+            exr.half = true;
+            exr_option = "--half";
         } else if (a[0] == '-' && a[1]) {
             if (!(val = cli_value(argc, argv, &i)))
                 return 2;
@@ -151,13 +167,20 @@ int cmd_render(int argc, char **argv)
             } else if (!strcmp(a, "--aov")) {
                 char buf[256], *tok, *save;
                 snprintf(buf, sizeof buf, "%s", val);
-                for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save))
-                    if (!strcmp(tok, "variance"))
-                        s.variance = true;
-                    else if (strcmp(tok, "normal") && strcmp(tok, "albedo") && strcmp(tok, "depth"))
+                s.aov = 0;
+                for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+                    uint32_t bit = render_aov_from_name(tok);
+                    if (!bit)
                         return cli_usage_error("render", "--aov '%s': expected a list of normal, albedo, depth, variance", tok);
-                    else
-                        s.aov = true;
+                    s.aov |= bit;
+                }
+                if (!s.aov)
+                    return cli_usage_error("render", "--aov '%s': expected a list of normal, albedo, depth, variance", val);
+            } else if (!strcmp(a, "--compression")) {
+                if (!image_exr_compression_from_name(val, &exr.compression))
+                    return cli_usage_error("render", "--compression '%s': expected none, rle, zips, zip, piz, "
+                                           "pxr24, b44 or b44a", val);
+                exr_option = "--compression";
             } else if (!strcmp(a, "--ambient")) {
                 if (!util_parse_rgb(val, s.ambient))
                     return cli_usage_error("render", "--ambient '%s': expected R,G,B or one value >= 0", val);
@@ -196,6 +219,17 @@ int cmd_render(int argc, char **argv)
         return cli_usage_error("render", "no scene given");
     if (!out_path && !png_path)
         return cli_usage_error("render", "no output given (-o OUT.exr and/or --png OUT.png)");
+    /* The name says the format: -o OUT.png is the tonemapped PNG, as --png is. */
+    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_UNKNOWN)
+        return cli_usage_error("render", "-o '%s': expected a .exr (OpenEXR) or .png name", out_path);
+    if (png_path && image_format_of(png_path) != IMAGE_FORMAT_PNG)
+        return cli_usage_error("render", "--png '%s': expected a .png name", png_path);
+    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_EXR)
+        exr_path = out_path;
+    else
+        png_o = out_path;
+    if (exr_option && !exr_path)
+        return cli_usage_error("render", "%s is for an EXR output (-o OUT.exr)", exr_option);
     util_set_quiet(quiet);
     s.progress = !quiet;
     if ((out_path && !check_writable(out_path)) || (png_path && !check_writable(png_path)))
@@ -215,8 +249,8 @@ int cmd_render(int argc, char **argv)
     }
     s.view = &view;
     camera_describe(&cam, &sc, camera_text, sizeof camera_text);
-    camera_look_at_string(&view, look_at, sizeof look_at);
-    camera_frame_string(&view, frame_text, sizeof frame_text);
+    s.camera_label = camera_text;
+    s.env_label = studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none";
     if (!cli_gpu_create(&g, device, validate)) {
         scene_destroy(&sc);
         image_destroy(&env_map);
@@ -227,31 +261,17 @@ int cmd_render(int argc, char **argv)
     renderer_create(&r, &g, &sc);
     if (renderer_render(&r, &s, &img, &st)) {
         char seconds[32];
-        float w2c[16];
-        camera_world_to_camera(&view, w2c);
-        image_attr attrs[] = {
-            {"gonio:camera", IMAGE_ATTR_STRING, camera_text, 0, 0, NULL},
-            {"gonio:look-at", IMAGE_ATTR_STRING, look_at, 0, 0, NULL},
-            {"gonio:view", IMAGE_ATTR_STRING, frame_text, 0, 0, NULL},
-            {view.ortho_half_height > 0 ? "gonio:ortho-half-height" : "gonio:fov", IMAGE_ATTR_DOUBLE, NULL, 0,
-             view.ortho_half_height > 0 ? view.ortho_half_height : view.yfov * 180 / M_PI, NULL},
-            {"worldToCamera", IMAGE_ATTR_M44F, NULL, 0, 0, w2c},
-            {"gonio:environment", IMAGE_ATTR_STRING,
-             studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none", 0, 0, NULL},
-            {"gonio:spp", IMAGE_ATTR_INT, NULL, st.spp, 0, NULL},
-            {"gonio:seed", IMAGE_ATTR_INT, NULL, (int)s.seed, 0, NULL},
-            {"gonio:mode", IMAGE_ATTR_STRING, render_mode_name(s.mode), 0, 0, NULL},
-            {"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, st.seconds, NULL},
-            {"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL},
-            {"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL},
-        };
+        render_header h;
         bool ok = true;
+        render_header_build(&h, &r, &s, &st, brdf);
         if (stop_requested && !quiet)
             util_warn("interrupted: writing the %d spp rendered so far", st.spp);
-        if (out_path)
-            ok = image_write_exr(&img, out_path, attrs, sizeof attrs / sizeof *attrs);
+        if (exr_path)
+            ok = image_write_exr_with(&img, exr_path, h.attrs, h.count, &exr);
+        if (ok && png_o)
+            ok = render_write_png(&img, s.mode, png_o, exposure, tm);
         if (ok && png_path)
-            ok = image_write_png_from(&img, png_path, exposure, tm);
+            ok = render_write_png(&img, s.mode, png_path, exposure, tm);
         snprintf(seconds, sizeof seconds, "%.2f", st.seconds);
         if (ok && !quiet)
             /* One camera ray per pixel and sample: a whole path in path mode. */

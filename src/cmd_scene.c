@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 
 #include "cli.h"
 #include "gltf_write.h"
@@ -16,14 +17,15 @@
 #define SCENE_TEAPOT_MAX_LEVEL 256 /* 4.2 M triangles: far past any use */
 
 static const char scene_usage[] =
-    "usage: gonio scene cornell -o FILE.gltf\n"
-    "       gonio scene teapot [--level N] -o FILE.gltf\n"
-    "       gonio teapot [--level N] -o FILE.gltf\n"
+    "usage: gonio scene cornell -o FILE.gltf|FILE.glb\n"
+    "       gonio scene teapot [--level N] -o FILE.gltf|FILE.glb\n"
+    "       gonio teapot [--level N] -o FILE.gltf|FILE.glb\n"
     "\n"
     "Writes one of gonio's own scenes as a self-contained glTF 2.0 file.\n"
     "  cornell             the Cornell box (published measurements, metres, one area light)\n"
     "  teapot              the Utah teapot as in the lecture's OpenGL 1.x example\n"
-    "  -o, --output FILE   the .gltf to write\n"
+    "  -o, --output FILE   the file to write, in the format its name says: .gltf JSON with\n"
+    "                      the buffer embedded, .glb binary glTF (any other name is a usage error)\n"
     "  --level N           teapot: N x N grid cells per Bezier patch, 1..256 (default 8);\n"
     "                      64 N^2 - 8 N triangles\n";
 
@@ -277,6 +279,11 @@ static int run(int argc, char **argv, int first, const char *name)
         return cli_usage_error(argv[0], "unknown scene '%s' (cornell or teapot)", name);
     if (!out)
         return cli_usage_error(argv[0], "missing -o FILE.gltf");
+    {
+        const char *dot = strrchr(out, '.');
+        if (!dot || (strcasecmp(dot, ".gltf") && strcasecmp(dot, ".glb")))
+            return cli_usage_error(argv[0], "-o '%s': expected a .gltf (JSON) or .glb (binary glTF) name", out);
+    }
     return (teapot ? write_teapot(out, (int)level) : write_cornell(out)) ? 0 : 1;
 }
 

@@ -1,6 +1,6 @@
 /* gltf_write.c: glTF 2.0 writer (Khronos glTF 2.0 specification; KHR_lights_punctual and
  * KHR_materials_{emissive_strength,specular,ior,transmission}); the buffer is embedded as
- * base64 (RFC 4648) in a data URI. */
+ * base64 (RFC 4648) in a data URI; .glb goes through tinygltf (gltf_glb.cpp). */
 #include "gltf_write.h"
 
 #include <assert.h>
@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 #include "util.h"
 
@@ -396,13 +397,38 @@ static void write_json(FILE *f, const gltf_write_desc *d, const uint8_t *buf, si
     fputs("\n}\n", f);
 }
 
+/* .glb: the same document, built in memory and handed to tinygltf (gltf_glb.cpp). */
+static bool write_glb(const char *path, const gltf_write_desc *desc, const uint8_t *buf, size_t size)
+{
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    bool ok;
+    if (!f) {
+        util_error("%s: out of memory", path);
+        return false;
+    }
+    write_json(f, desc, buf, size);
+    ok = !ferror(f);
+    ok = fclose(f) == 0 && ok;
+    ok = ok ? gltf_write_glb_from_json(path, text, len) : (util_error("%s: out of memory", path), false);
+    free(text);
+    return ok;
+}
+
 bool gltf_write_file(const char *path, const gltf_write_desc *desc)
 {
     char tmp[4096];
     size_t size = 0;
     uint8_t *buf = make_buffer(desc, &size);
+    const char *dot = strrchr(path, '.');
     FILE *f;
     bool ok;
+    if (dot && !strcasecmp(dot, ".glb")) {
+        ok = write_glb(path, desc, buf, size);
+        free(buf);
+        return ok;
+    }
     f = util_tmp_open(tmp, sizeof tmp, path, "wb");
     if (!f) {
         free(buf);

@@ -1,5 +1,6 @@
-/* gltf_write.h: writes a glTF 2.0 scene as one self-contained .gltf file: JSON with its one
- * buffer embedded as a base64 data URI (glTF 2.0 specification, sections 3.6-3.7 and 5).
+/* gltf_write.h: writes a glTF 2.0 scene as one self-contained file: a .gltf is JSON with its
+ * one buffer embedded as a base64 data URI (glTF 2.0 specification, sections 3.6-3.7 and 5),
+ * a .glb the same document as binary glTF (section 4.4) with the buffer in its BIN chunk.
  *
  * The caller describes the scene with plain arrays (meshes, materials, nodes, cameras,
  * lights); every node is a root of the one scene. Each mesh is one indexed triangle
@@ -10,6 +11,7 @@
 #define GONIO_GLTF_WRITE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 typedef struct gltf_write_mesh {
@@ -89,9 +91,14 @@ typedef struct gltf_write_desc {
     uint32_t num_nodes;
 } gltf_write_desc;
 
-/* Writes desc to path (through a temporary file renamed into place). Preconditions
+/* Writes desc to path, as GLB when its name ends in .glb (any case), else as .gltf JSON
+ * (through a temporary file renamed into place). Preconditions
  * (asserted): indices and node references in range, finite positions. On an I/O failure
  * prints an error naming the file and returns false; no partial file is left behind. */
 bool gltf_write_file(const char *path, const gltf_write_desc *desc);
+
+/* gltf_write_file's GLB step (gltf_glb.cpp): the JSON document of len bytes, buffers as data
+ * URIs, written to path as GLB by tinygltf. False with an error naming path on failure. */
+bool gltf_write_glb_from_json(const char *path, const char *json, size_t len);
 
 #endif

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 /* Corrupt headers may claim any size; refuse what no render of ours would produce rather than
  * let util_malloc stop the program. */
@@ -73,8 +74,48 @@ static void exr_report(const char *path, const char *what, exr_result_t rv)
     util_error("%s: %s: %s", path, what, exr_message[0] ? exr_message : exr_get_default_error_message(rv));
 }
 
+image_format image_format_of(const char *path)
+{
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    if (!dot || (slash && dot < slash))
+        return IMAGE_FORMAT_UNKNOWN;
+    if (!strcasecmp(dot, ".exr"))
+        return IMAGE_FORMAT_EXR;
+    if (!strcasecmp(dot, ".png"))
+        return IMAGE_FORMAT_PNG;
+    return IMAGE_FORMAT_UNKNOWN;
+}
+
+/* Indexed by exr_compression_t. OpenEXR 3.1's C API reads DWAA/DWAB but cannot write them
+ * ("not yet implemented in C"), so they are not offered. */
+static const char *const exr_compression_names[] = {"none", "rle",  "zips", "zip",  "piz",
+                                                    "pxr24", "b44", "b44a", "dwaa", "dwab"};
+#define EXR_WRITABLE_COMPRESSIONS (EXR_COMPRESSION_B44A + 1)
+
+bool image_exr_compression_from_name(const char *name, int *out)
+{
+    for (int i = 0; i < EXR_WRITABLE_COMPRESSIONS; i++)
+        if (!strcasecmp(name, exr_compression_names[i])) {
+            *out = i;
+            return true;
+        }
+    return false;
+}
+
+const char *image_exr_compression_name(int compression)
+{
+    return compression >= 0 && compression < EXR_COMPRESSION_LAST_TYPE ? exr_compression_names[compression] : "?";
+}
+
 bool image_write_exr(const image *img, const char *path, const image_attr *attrs, int num_attrs)
 {
+    return image_write_exr_with(img, path, attrs, num_attrs, NULL);
+}
+
+bool image_write_exr_with(const image *img, const char *path, const image_attr *attrs, int num_attrs,
+                          const image_exr_options *opt)
+{
+    const image_exr_options o = opt ? *opt : IMAGE_EXR_DEFAULTS;
     exr_context_initializer_t init = exr_init();
     exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
     exr_context_t ctx = NULL;
@@ -88,9 +129,12 @@ bool image_write_exr(const image *img, const char *path, const image_attr *attrs
     if (!rv)
         rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
     if (!rv)
-        rv = exr_initialize_required_attr_simple(ctx, part, img->width, img->height, EXR_COMPRESSION_ZIP);
+        rv = exr_initialize_required_attr_simple(ctx, part, img->width, img->height,
+                                                 (exr_compression_t)o.compression);
+    /* The library converts the float planes to half as it encodes. */
     for (int c = 0; !rv && c < img->num_channels; c++)
-        rv = exr_add_channel(ctx, part, img->names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+        rv = exr_add_channel(ctx, part, img->names[c], o.half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT,
+                             EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
     for (int i = 0; !rv && i < num_attrs; i++) {
         switch (attrs[i].type) {
         case IMAGE_ATTR_STRING: rv = exr_attr_set_string(ctx, part, attrs[i].name, attrs[i].s); break;

@@ -32,9 +32,29 @@ void image_destroy(image *img); /* accepts a zeroed struct */
 /* Index of a channel by name, or -1. */
 int image_channel(const image *img, const char *name);
 
-/* Writes every channel as 32-bit float, ZIP compression, with the given header attributes.
- * Written to a temporary file beside path and renamed, so failure leaves no partial file.
- * False (and an error naming the file) on failure. */
+/* The file formats an output name can ask for, by its extension (case-insensitive). */
+typedef enum image_format { IMAGE_FORMAT_UNKNOWN, IMAGE_FORMAT_EXR, IMAGE_FORMAT_PNG } image_format;
+/* ".exr" -> EXR, ".png" -> PNG, anything else (or no extension) -> UNKNOWN. */
+image_format image_format_of(const char *path);
+
+typedef struct image_exr_options {
+    bool half;       /* 16-bit half channels instead of 32-bit float */
+    int compression; /* an exr_compression_t (openexr.h) */
+} image_exr_options;
+#define IMAGE_EXR_DEFAULTS ((image_exr_options){false, 3 /* EXR_COMPRESSION_ZIP */})
+
+/* The compressions OpenEXR's C API can write: none, rle, zips, zip, piz, pxr24, b44, b44a
+ * (pxr24 is lossy for float channels, b44/b44a for half ones and keep float ones whole).
+ * False for any other name. */
+bool image_exr_compression_from_name(const char *name, int *out);
+const char *image_exr_compression_name(int compression);
+/* Writes every channel as 32-bit float (or half, opt->half) with opt->compression (NULL:
+ * IMAGE_EXR_DEFAULTS) and the given header attributes. Written to a temporary file beside
+ * path and renamed, so failure leaves no partial file. False (and an error naming the
+ * file) on failure. */
+bool image_write_exr_with(const image *img, const char *path, const image_attr *attrs, int num_attrs,
+                          const image_exr_options *opt);
+/* The same with IMAGE_EXR_DEFAULTS: float channels, ZIP. */
 bool image_write_exr(const image *img, const char *path, const image_attr *attrs, int num_attrs);
 
 /* Reads a scanline or tiled EXR (half, float or uint channels) into float planes. False

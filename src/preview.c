@@ -18,6 +18,7 @@
 #include "environment.h"
 #include "display.h" /* spv_display: glsl/display.comp compiled by the build */
 #include "image.h"
+#include "render_output.h"
 #include "render.h"
 #include "scene.h"
 #include "util.h"
@@ -304,7 +305,7 @@ static bool save_accumulated(preview *p)
     }
     renderer_resolve(&p->r, p->spp, false, &img);
     ok = image_write_exr(&img, exr, attrs, sizeof attrs / sizeof *attrs) &&
-         image_write_png_from(&img, png, p->exposure, p->tonemap);
+         render_write_png(&img, p->s.mode, png, p->exposure, p->tonemap); /* as gonio render's */
     if (ok) {
         printf("gonio preview: wrote %s and %s (%s, %d spp)\n", exr, png,
                render_mode_name(p->s.mode), p->spp);
@@ -808,6 +809,8 @@ int cmd_preview(int argc, char **argv)
                     return cli_usage_error("preview", "--frames '%s': expected an integer >= 1", val);
                 max_frames = (int)v;
             } else if (!strcmp(a, "--screenshot")) {
+                if (image_format_of(val) != IMAGE_FORMAT_PNG)
+                    return cli_usage_error("preview", "--screenshot '%s': expected a .png name", val);
                 screenshot = val;
             } else if (!strcmp(a, "--device")) {
                 if (!util_parse_int(val, 0, 64, &v))

@@ -573,7 +573,7 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->emitter_power = (float)total;
     frame->env_select = env > 0 ? (float)(env / total) : 0;
     frame->flags |= s->strategy;
-    r->path_features = r->material_features | (s->aov ? GN_FEAT_AOV : 0u) |
+    r->path_features = r->material_features | (s->aov & RENDER_AOV_GPU ? GN_FEAT_AOV : 0u) |
                        (s->strategy ? GN_FEAT_STRATEGY : 0u) | (n > 1 ? GN_FEAT_LIGHT_SEARCH : 0u) |
                        (env > 0 || s->env[0] != 0 || s->env[1] != 0 || s->env[2] != 0 ? GN_FEAT_ENV : 0u) |
                        (s->env_map ? GN_FEAT_ENV | GN_FEAT_ENV_MAP : 0u);
@@ -602,7 +602,7 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->mode = s->mode;
     frame->max_depth = (uint32_t)s->max_depth;
     frame->num_lights = r->num_lights;
-    frame->flags = (s->aov ? GN_FRAME_AOV : 0u) | (s->shadows ? GN_FRAME_SHADOWS : 0u) |
+    frame->flags = (s->aov & RENDER_AOV_GPU ? GN_FRAME_AOV : 0u) | (s->shadows ? GN_FRAME_SHADOWS : 0u) |
                    (r->sc->vertex_colors ? GN_FRAME_VERTEX_COLOR : 0u);
     frame->env_color = (vec3){s->env[0], s->env[1], s->env[2]};
     frame->env_cos = (float)cos(s->env_rotation * M_PI / 180);
@@ -708,25 +708,34 @@ void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, ui
     }
 }
 
-void renderer_resolve(renderer *r, int spp, bool aov, image *out)
+uint32_t render_aov_from_name(const char *name)
 {
-    static const char *const names[] = {"R", "G", "B", "A", "normal.X", "normal.Y",
-                                        "normal.Z", "albedo.R", "albedo.G", "albedo.B",
-                                        "depth.Z"};
+    static const char *const names[] = {"normal", "albedo", "depth", "variance"};
+    for (uint32_t i = 0; i < 4; i++)
+        if (!strcmp(name, names[i]))
+            return 1u << i;
+    return 0;
+}
+
+/* Appends one zeroed channel and returns its plane. */
+static float *add_channel(image *out, const char *name)
+{
+    const size_t pixels = (size_t)out->width * (size_t)out->height;
+    assert(out->num_channels < IMAGE_MAX_CHANNELS);
+    snprintf(out->names[out->num_channels], sizeof out->names[0], "%s", name);
+    return out->planes[out->num_channels++] = util_calloc(pixels, sizeof(float));
+}
+
+/* aov_offset: where the AOV is in each pixel's 12 floats of the aov buffer (GN_BIND_AOV). */
+static void add_gpu_aov(const renderer *r, int spp, const char *const *names, int n, int aov_offset, image *out)
+{
     const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
-    const float *acc = r->accum.mapped, *aovs = r->aov.mapped;
+    const float *aovs = r->aov.mapped;
     float inv = 1.0f / (float)spp;
-    image_create(out, r->width, r->height, aov ? 11 : 4, names);
-    for (VkDeviceSize p = 0; p < pixels; p++) {
-        for (int c = 0; c < 4; c++)
-            out->planes[c][p] = acc[4 * p + c] * inv;
-        if (aov) {
-            for (int c = 0; c < 3; c++) {
-                out->planes[4 + c][p] = aovs[12 * p + c] * inv;
-                out->planes[7 + c][p] = aovs[12 * p + 4 + c] * inv;
-            }
-            out->planes[10][p] = aovs[12 * p + 8] * inv;
-        }
+    for (int c = 0; c < n; c++) {
+        float *plane = add_channel(out, names[c]);
+        for (VkDeviceSize p = 0; p < pixels; p++)
+            plane[p] = aovs[12 * p + (VkDeviceSize)(aov_offset + c)] * inv;
     }
 }
 
@@ -738,14 +747,35 @@ static void add_variance(const renderer *r, int spp, image *out)
     const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
     const float *acc = r->accum.mapped, *sq = r->squares.mapped;
     for (int c = 0; c < 3; c++) {
-        float *plane = util_calloc(pixels, sizeof *plane);
+        float *plane = add_channel(out, names[c]);
         for (VkDeviceSize p = 0; spp > 1 && p < pixels; p++) {
             double m = (double)acc[4 * p + c] / spp, v = ((double)sq[4 * p + c] / spp - m * m) / (spp - 1);
             plane[p] = v > 0 ? (float)v : 0;
         }
-        snprintf(out->names[out->num_channels], sizeof out->names[0], "%s", names[c]);
-        out->planes[out->num_channels++] = plane;
     }
+}
+
+void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out)
+{
+    static const char *const names[] = {"R", "G", "B", "A"};
+    static const char *const normal[] = {"normal.X", "normal.Y", "normal.Z"};
+    static const char *const albedo[] = {"albedo.R", "albedo.G", "albedo.B"};
+    static const char *const depth[] = {"depth.Z"};
+    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
+    const float *acc = r->accum.mapped;
+    float inv = 1.0f / (float)spp;
+    image_create(out, r->width, r->height, 4, names);
+    for (VkDeviceSize p = 0; p < pixels; p++)
+        for (int c = 0; c < 4; c++)
+            out->planes[c][p] = acc[4 * p + c] * inv;
+    if (aov & RENDER_AOV_NORMAL)
+        add_gpu_aov(r, spp, normal, 3, 0, out);
+    if (aov & RENDER_AOV_ALBEDO)
+        add_gpu_aov(r, spp, albedo, 3, 4, out);
+    if (aov & RENDER_AOV_DEPTH)
+        add_gpu_aov(r, spp, depth, 1, 8, out);
+    if (aov & RENDER_AOV_VARIANCE)
+        add_variance(r, spp, out);
 }
 
 bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats)
@@ -815,8 +845,6 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
         util_warn("%s: %u ray(s) needed more BVH steps than the per-ray budget (%u) and may be "
                   "wrong", r->sc->path, stats->truncated, frame.traversal_budget);
     renderer_resolve(r, done, s->aov, out);
-    if (s->variance)
-        add_variance(r, done, out);
     return true;
 }
 

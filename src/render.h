@@ -22,7 +22,7 @@ typedef struct render_settings {
     double time_limit;      /* > 0: stop after this many seconds (at least one pass) */
     uint32_t seed;
     int camera;             /* glTF camera index, -1 = frame the scene */
-    bool aov;               /* add normal, albedo, depth channels */
+    uint32_t aov;           /* RENDER_AOV_* set: the extra channels to add */
     bool shadows;           /* ray-traced shadows in the local modes (default on) */
     int max_depth;          /* path tracer: 0 = unbounded (roulette only) */
     float env[3];           /* constant environment radiance */
@@ -33,11 +33,22 @@ typedef struct render_settings {
     const GnCamera *camera_override; /* non-NULL: this camera (aspect from the image), not `camera` */
     const scene_camera *view; /* non-NULL: this camera (aspect from the image), not `camera`
                                * (camera_resolve, src/camera.h, makes it) */
+    const char *camera_label; /* for headers: which camera, e.g. "camera 0 'Camera'" */
+    const char *env_label;    /* for headers: "studio", a map's path, "constant" */
     const image *env_map;   /* path: lat-long radiance map (R, G, B or Y), replaces env */
     float env_rotation;     /* path: the map turned about +Y, degrees (right-handed) */
     uint32_t strategy;      /* path: 0 = MIS, GN_FRAME_LIGHT_ONLY or GN_FRAME_BSDF_ONLY */
-    bool variance;          /* add variance.R/G/B: the estimated variance of each pixel's mean */
 } render_settings;
+
+/* The AOVs (extra EXR channels) a render can add. Normal, albedo and depth come from one
+ * GPU pass (GN_FRAME_AOV) whichever of them is asked for; none asked costs nothing. */
+#define RENDER_AOV_NORMAL 1u   /* normal.X/Y/Z: world-space shading normal */
+#define RENDER_AOV_ALBEDO 2u   /* albedo.R/G/B: base colour */
+#define RENDER_AOV_DEPTH 4u    /* depth.Z: distance along the camera axis, 0 on a miss */
+#define RENDER_AOV_VARIANCE 8u /* variance.R/G/B: the estimated variance of each pixel's mean */
+#define RENDER_AOV_GPU (RENDER_AOV_NORMAL | RENDER_AOV_ALBEDO | RENDER_AOV_DEPTH)
+/* "normal", "albedo", "depth", "variance" -> RENDER_AOV_*; 0 when unknown. */
+uint32_t render_aov_from_name(const char *name);
 
 typedef struct render_stats {
     int spp;                /* samples per pixel actually taken */
@@ -102,11 +113,13 @@ bool renderer_mode_available(uint32_t mode);
  * renderer_begin first. */
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,
                              uint32_t count);
-/* The accumulated image divided by spp: R, G, B, A and, with aov, the AOV channels. */
-void renderer_resolve(renderer *r, int spp, bool aov, image *out);
+/* The accumulated image divided by spp: R, G, B, A and the AOV channels of the set aov
+ * (RENDER_AOV_*; the GPU ones need a render with them, variance any). */
+void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out);
 
-/* Renders and fills `out` with R, G, B, A (A = coverage) and, with s->aov, the channels
- * normal.X/Y/Z, albedo.R/G/B and depth.Z (depth along the camera axis, 0 on a miss). */
+/* Renders and fills `out` with R, G, B, A (A = coverage) and the channels of the AOVs in
+ * s->aov, in the order normal.X/Y/Z, albedo.R/G/B, depth.Z, variance.R/G/B. Each is the
+ * mean over the pixel's samples, a miss counting 0 (so depth is 0 where nothing is hit). */
 bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats);
 
 /* Applies BRDF-model overrides to the scene's materials (GnMaterial.brdf, brdf_params and

@@ -111,7 +111,7 @@ check_fails "--fov 0" 2 R -o "$tmp/x.exr" --fov 0
 
 # ---- the header records the camera, and --camera FILE.exr reproduces it ------------------
 exrheader "$tmp/look2.exr" >"$tmp/hdr.txt" 2>&1
-check "header: gonio:camera" grep -q 'gonio:camera (type string): "look-at' "$tmp/hdr.txt"
+check "header: gonio:camera-name" grep -q 'gonio:camera-name (type string): "look-at' "$tmp/hdr.txt"
 check "header: worldToCamera is an m44f" grep -q 'worldToCamera (type m44f)' "$tmp/hdr.txt"
 # Eye (0,0,3) looking down -Z: right +X, up +Y, view +Z in camera space = -Z in the world,
 # so p' = p M with rows (1 0 0 0) (0 1 0 0) (0 0 -1 0) (0 0 3 1).

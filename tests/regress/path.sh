@@ -82,4 +82,55 @@ check "merge" "$G" merge "$tmp/a.exr" "$tmp/b.exr" -o "$tmp/m.exr"
 exrheader "$tmp/m.exr" >"$tmp/hdr.txt" 2>&1
 check "merged spp is the sum" grep -q 'gonio:spp (type int): 16' "$tmp/hdr.txt"
 check_fails "merging different sizes fails" 1 "$G" merge "$tmp/a.exr" "$tmp/d.exr" -o "$tmp/x.exr"
+# merge refuses what cannot be one render: exit 1, a message naming both files and the
+# field, no output. Each input below differs from a.exr in one thing only.
+T=scenes/teapot.gltf
+r32() { "$G" render "$@" --spp 4 --size 32x32 --aov variance --quiet; }
+check "other scene" r32 $T -o "$tmp/i-scene.exr" --seed 3
+check "other mode" r32 $C -o "$tmp/i-mode.exr" --seed 3 --mode phong
+check "other camera" r32 $C -o "$tmp/i-camera.exr" --seed 3 --camera 0
+check "other max-depth" r32 $C -o "$tmp/i-max-depth.exr" --seed 3 --max-depth 2
+check "other env" r32 $C -o "$tmp/i-env.exr" --seed 3 --env 0.5
+check "other estimator" r32 $C -o "$tmp/i-estimator.exr" --seed 3 --estimator light
+check "other brdf" r32 $C -o "$tmp/i-brdf.exr" --seed 3 --brdf lambert
+for f in scene mode camera max-depth env estimator brdf; do
+    field=$f; [ $f = brdf ] && field=scene # --brdf changes the materials: another scene
+    check_fails "merge refuses another $f" 1 "$G" merge "$tmp/a.exr" "$tmp/i-$f.exr" -o "$tmp/x.exr"
+    check "... naming both files and gonio:$field" sh -c "grep 'a.exr' '$tmp/last' | grep 'i-$f.exr' | grep -q 'gonio:$field differs'"
+done
+check "no output after a refusal" test ! -e "$tmp/x.exr"
+check "phong: seed 1" "$G" render $C -o "$tmp/p1.exr" --mode phong --spp 2 --size 32x32 --seed 1 --quiet
+check "phong: seed 2, no shadows" "$G" render $C -o "$tmp/p2.exr" --mode phong --spp 2 --size 32x32 --seed 2 --no-shadows --quiet
+check "phong: seed 3, --max-depth (unused by phong)" "$G" render $C -o "$tmp/p3.exr" --mode phong --spp 2 --size 32x32 --seed 3 --max-depth 2 --quiet
+check_fails "merge refuses phong with and without shadows" 1 "$G" merge "$tmp/p1.exr" "$tmp/p2.exr" -o "$tmp/x.exr"
+check "... naming gonio:shadows" grep -q 'gonio:shadows differs' "$tmp/last"
+check "an option the mode ignores does not keep renders apart" "$G" merge "$tmp/p1.exr" "$tmp/p3.exr" -o "$tmp/p13.exr"
+# The same scene from another file (a copy elsewhere, or as .glb) is the same render.
+mkdir -p "$tmp/elsewhere" && cp $C "$tmp/elsewhere/box.gltf"
+check "render a copy of the scene" r32 "$tmp/elsewhere/box.gltf" -o "$tmp/copy.exr" --seed 3
+check "merge takes the copy" "$G" merge "$tmp/a.exr" "$tmp/copy.exr" -o "$tmp/ac.exr"
+# Seeds: a repeated one is an error unless --force; merged files carry their seeds on.
+check "render seed 1 again" r32 $C -o "$tmp/a2.exr" --seed 1
+check_fails "merge refuses a repeated seed" 1 "$G" merge "$tmp/a.exr" "$tmp/a2.exr" -o "$tmp/x.exr"
+check "... naming both files and the seed" sh -c "grep 'a.exr' '$tmp/last' | grep 'a2.exr' | grep -q 'seed 1'"
+check_fails "merge refuses a seed repeated through a merged file" 1 "$G" merge "$tmp/m.exr" "$tmp/a2.exr" -o "$tmp/x.exr"
+check "no output after a seed refusal" test ! -e "$tmp/x.exr"
+check "--force merges a repeated seed" "$G" merge --force "$tmp/a.exr" "$tmp/a2.exr" -o "$tmp/f.exr"
+check "merged seeds recorded" sh -c "exrheader '$tmp/m.exr' | grep -q 'gonio:seeds (type string): \"1,2\"'"
+check "merge a merged file with a new seed" "$G" merge "$tmp/m.exr" "$tmp/copy.exr" -o "$tmp/m2.exr"
+check "... seeds and spp add up" sh -c "exrheader '$tmp/m2.exr' | grep -q 'gonio:seeds (type string): \"1,2,3\"' && exrheader '$tmp/m2.exr' | grep -q 'gonio:spp (type int): 20'"
+# Sample counts: a total past the header's int is refused (exrstdattr rewrites the header).
+check "spp 2^31 - 1 (a)" exrstdattr -int gonio:spp 2147483647 "$tmp/a.exr" "$tmp/big-a.exr"
+check "spp 2^31 - 1 (b)" exrstdattr -int gonio:spp 2147483647 "$tmp/b.exr" "$tmp/big-b.exr"
+check "spp -4" exrstdattr -int gonio:spp -4 "$tmp/a.exr" "$tmp/neg.exr"
+check_fails "merge refuses a total over 2^31 - 1" 1 "$G" merge "$tmp/big-a.exr" "$tmp/big-b.exr" -o "$tmp/x.exr"
+check "... saying so" grep -q 'total sample count' "$tmp/last"
+check_fails "merge refuses spp -4" 1 "$G" merge "$tmp/neg.exr" "$tmp/b.exr" -o "$tmp/x.exr"
+check "... naming the file" grep -q 'neg.exr: gonio:spp -4' "$tmp/last"
+check "no output after an spp refusal" test ! -e "$tmp/x.exr"
+# Output options: .exr only, --half and --compression as for render.
+check_fails "merge -o x.png" 2 "$G" merge "$tmp/a.exr" "$tmp/b.exr" -o "$tmp/x.png"
+check "merge --half --compression piz" "$G" merge "$tmp/a.exr" "$tmp/b.exr" -o "$tmp/mh.exr" --half --compression piz
+check "... half channels, piz" sh -c "exrheader '$tmp/mh.exr' | grep -q 'R, 16-bit floating' && exrheader '$tmp/mh.exr' | grep -q '^compression (type compression): piz'"
+check "... the same image to half precision" "$G" diff "$tmp/mh.exr" "$tmp/m.exr" --max-rel-bias 1e-3 --quiet
 finish

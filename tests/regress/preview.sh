@@ -20,6 +20,7 @@ check_fails "no display: exit 1" 1 env -u DISPLAY -u WAYLAND_DISPLAY "$G" previe
 check "no display: the message points to gonio render and xvfb-run" \
     sh -c "grep -q 'gonio render' '$tmp/last' && grep -q xvfb-run '$tmp/last'"
 check_fails "bad --mode" 2 "$G" preview $C --mode bogus
+check_fails "--screenshot needs a .png name" 2 "$G" preview $C --screenshot "$tmp/shot.exr"
 check_fails "no scene" 2 "$G" preview
 check_fails "missing scene" 1 "$G" preview "$tmp/nope.gltf" --frames 1
 check "missing scene: message names the file" grep -q nope.gltf "$tmp/last"
@@ -46,8 +47,8 @@ ref() { # ref NAME MODE WxH [render options]: the reference render, EXR and PNG
 }
 ref phong phong 160x120
 ref phong-aces phong 160x120 --tonemap aces --exposure 1.5
-ref normal normal 160x120
-ref normal-big normal 200x150
+ref albedo albedo 160x120
+ref albedo-big albedo 200x150
 check "render phong, 1 spp" "$G" render $C --png "$tmp/phong-1.png" --size 160x120 --spp 1 --quiet
 
 # ---- scripted: N frames, then the screenshot ---------------------------------------------
@@ -81,32 +82,32 @@ check "the screen is not blank" test "$(colours "$tmp/root.png")" -gt 50
 check "import the preview window" import -window "$wid" "$tmp/win-phong.png"
 check "the window shows the render" same_image "$tmp/win-phong.png" "$tmp/phong.png"
 check "focus" xdotool windowfocus --sync "$wid"
-check "key 5" xdotool key 5
-check "title: normal" wait_title '^gonio preview: normal \| 160x120 \| 4 spp'
-check "import the window (normal)" import -window "$wid" "$tmp/win-normal.png"
-check "the window shows the normal render" same_image "$tmp/win-normal.png" "$tmp/normal.png"
+check "key 6" xdotool key 6
+check "title: albedo" wait_title '^gonio preview: albedo \| 160x120 \| 4 spp'
+check "import the window (albedo)" import -window "$wid" "$tmp/win-albedo.png"
+check "the window shows the albedo render" same_image "$tmp/win-albedo.png" "$tmp/albedo.png"
 # Mode 1 (path) switches, or says it is not available and stays.
 check "key 1" xdotool key 1
 check "path, or a message" sh -c "for i in \$(seq 300); do xdotool getwindowname $wid | grep -q ': path' \
     && exit 0; grep -q 'path is not available' '$tmp/pv.err' && exit 0; sleep 0.1; done; exit 1"
-check "key 5 again" xdotool key 5
+check "key 6 again" xdotool key 6
 check "hide and show" sh -c "xdotool windowunmap --sync $wid && sleep 0.3 && xdotool windowmap --sync $wid"
 check "resize" xdotool windowsize --sync "$wid" 200 150
-check "title: restarted at the new size" wait_title '^gonio preview: normal \| 200x150 \| 4 spp'
+check "title: restarted at the new size" wait_title '^gonio preview: albedo \| 200x150 \| 4 spp'
 check "key p" xdotool key p
-check "P names its files" sh -c "for i in \$(seq 100); do grep -q 'wrote .*saved-001.exr and .*saved-001.png (normal, 4 spp)' \
+check "P names its files" sh -c "for i in \$(seq 100); do grep -q 'wrote .*saved-001.exr and .*saved-001.png (albedo, 4 spp)' \
     '$tmp/pv.out' && exit 0; sleep 0.1; done; exit 1"
-check "P's EXR equals gonio render's" "$G" diff "$tmp/saved-001.exr" "$tmp/normal-big.exr" --max-error 1e-6 --quiet
-check "P's PNG equals gonio render's" same_image "$tmp/saved-001.png" "$tmp/normal-big.png"
+check "P's EXR equals gonio render's" "$G" diff "$tmp/saved-001.exr" "$tmp/albedo-big.exr" --max-error 1e-6 --quiet
+check "P's PNG equals gonio render's" same_image "$tmp/saved-001.png" "$tmp/albedo-big.png"
 # The saved EXR carries the view: render --camera FILE.exr renders the same view.
 check "render from the view P saved" "$G" render $C --camera "$tmp/saved-001.exr" -o "$tmp/from-view.exr" \
-    --mode normal --size 200x150 --spp 4 --quiet
-check "... gives P's pixels" "$G" diff "$tmp/from-view.exr" "$tmp/saved-001.exr" --max-error 1e-5 --quiet
+    --mode albedo --size 200x150 --spp 4 --quiet
+check "... gives P's pixels" "$G" diff "$tmp/from-view.exr" "$tmp/saved-001.exr" --max-error 1e-6 --quiet
 check "Esc" xdotool key Escape
 wait $pid
 rc=$?
 [ $rc = 0 ] && pass || { fail "preview exit status $rc"; cat "$tmp/pv.err"; }
-check "the quit screenshot shows the last view" same_image "$tmp/end.png" "$tmp/normal-big.png"
+check "the quit screenshot shows the last view" same_image "$tmp/end.png" "$tmp/albedo-big.png"
 check "no validation messages" sh -c "! grep -q validation '$tmp/pv.err'"
 kill $pid 2>/dev/null
 

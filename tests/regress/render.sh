@@ -46,6 +46,110 @@ for want in 'gonio:spp' 'gonio:seed' 'gonio:mode' 'gonio:seconds' 'gonio:command
     check "EXR header has $want" grep -qF -- "$want" "$tmp/hdr.txt"
 done
 check "spp recorded" grep -q 'gonio:spp (type int): 4' "$tmp/hdr.txt"
+
+# ---- the output's format is the one its name says ----------------------------------------
+magic() { head -c 4 "$1" | od -An -tx1 | tr -d ' \n'; } # first 4 bytes, hex
+is_exr() { [ "$(magic "$1")" = 762f3101 ]; }
+is_png() { [ "$(magic "$1")" = 89504e47 ]; }
+check "render -o x.png" "$G" render $C -o "$tmp/o.png" --spp 1 --size 16x16 --quiet
+check "render -o x.png writes a PNG" is_png "$tmp/o.png"
+check "render -o x.exr writes an EXR" is_exr "$tmp/c.exr"
+check "render --png writes a PNG" is_png "$tmp/c.png"
+check "render -o X.EXR" "$G" render $C -o "$tmp/o.EXR" --spp 1 --size 16x16 --quiet
+check "render -o X.EXR writes an EXR" is_exr "$tmp/o.EXR"
+check "render --png alone" "$G" render $C --png "$tmp/o2.png" --spp 1 --size 16x16 --quiet
+check "render -o x.png is the --png PNG" cmp "$tmp/o.png" "$tmp/o2.png"
+for bad in "-o $tmp/bad.jpg" "-o $tmp/bad" "--png $tmp/bad.exr" "-o $tmp/bad.exr --png $tmp/bad.tif"; do
+    check_fails "render $bad: a usage error" 2 "$G" render $C $bad --spp 1 --size 16x16 --quiet
+done
+check "no output for a bad name" sh -c "! ls '$tmp' | grep -q '^bad'"
+check_fails "--half without an EXR output" 2 "$G" render $C --png "$tmp/bad.png" --half --quiet
+check_fails "an unknown --compression" 2 "$G" render $C -o "$tmp/bad.exr" --compression dwaa --quiet
+check_fails "brdf: the lobe plot is no EXR" 2 "$G" brdf lambert -o "$tmp/bad.exr"
+check_fails "brdf --sphere -o x.jpg" 2 "$G" brdf lambert --sphere -o "$tmp/bad.jpg"
+check "brdf --sphere -o x.png" "$G" brdf lambert --sphere -o "$tmp/ball.png" --size 16x16 --spp 2
+check "brdf --sphere -o x.png writes a PNG" is_png "$tmp/ball.png"
+check "brdf --sphere -o x.exr" "$G" brdf lambert --sphere -o "$tmp/ball.exr" --size 16x16 --spp 2
+check "brdf --sphere -o x.exr writes an EXR" is_exr "$tmp/ball.exr"
+check "brdf lobe -o x.png" "$G" brdf lambert -o "$tmp/lobe.png"
+check "brdf lobe writes a PNG" is_png "$tmp/lobe.png"
+check_fails "teapot -o x.obj" 2 "$G" teapot -o "$tmp/bad.obj"
+# .glb is binary glTF (magic, version 2, total length = file size) that info and render read,
+# and the same scene as the .gltf: identical pixels and the same gonio:scene hash.
+le32() { od -An -tu4 -j "$2" -N4 "$1" | tr -d ' '; }
+for sc in teapot cornell; do
+    check "scene $sc -o x.glb" "$G" scene $sc -o "$tmp/$sc.glb"
+    check "scene $sc -o x.gltf" "$G" scene $sc -o "$tmp/$sc.gltf"
+    check "$sc.glb: GLB magic" test "$(magic "$tmp/$sc.glb")" = 676c5446
+    check "$sc.glb: version 2 and its length" test "$(le32 "$tmp/$sc.glb" 4) $(le32 "$tmp/$sc.glb" 8)" = "2 $(stat -c %s "$tmp/$sc.glb")"
+    check "$sc.gltf is JSON" grep -q '"asset"' "$tmp/$sc.gltf"
+    check "info reads $sc.glb" "$G" info "$tmp/$sc.glb"
+    check "render $sc.glb" "$G" render "$tmp/$sc.glb" -o "$tmp/$sc-glb.exr" --mode phong --spp 2 --size 32x32 --quiet
+    check "render $sc.gltf" "$G" render "$tmp/$sc.gltf" -o "$tmp/$sc-gltf.exr" --mode phong --spp 2 --size 32x32 --quiet
+    check "$sc: .glb and .gltf render the same pixels" "$G" diff "$tmp/$sc-glb.exr" "$tmp/$sc-gltf.exr" --max-error 0 --quiet
+    check "$sc: .glb and .gltf are the same gonio:scene" test \
+        "$(exrheader "$tmp/$sc-glb.exr" | grep 'gonio:scene ')" = "$(exrheader "$tmp/$sc-gltf.exr" | grep 'gonio:scene ')"
+done
+
+# ---- --aov writes exactly the AOVs listed ------------------------------------------------
+channels() { exrheader "$1" | sed -n 's/^    \([^,]*\), .*/\1/p' | sort | tr '\n' ' '; }
+for set in normal albedo depth variance depth,normal albedo,variance normal,albedo,depth,variance; do
+    check "--aov $set" "$G" render $C -o "$tmp/aov.exr" --mode phong --spp 2 --size 16x16 --aov $set --quiet
+    want="A B G R"
+    case ,$set, in *,albedo,*) want="$want albedo.B albedo.G albedo.R" ;; esac
+    case ,$set, in *,depth,*) want="$want depth.Z" ;; esac
+    case ,$set, in *,normal,*) want="$want normal.X normal.Y normal.Z" ;; esac
+    case ,$set, in *,variance,*) want="$want variance.B variance.G variance.R" ;; esac
+    want=$(echo $want | tr ' ' '\n' | sort | tr '\n' ' ')
+    check "--aov $set: channels $want" test "$(channels "$tmp/aov.exr")" = "$want"
+done
+check_fails "--aov bogus" 2 "$G" render $C -o "$tmp/bad.exr" --aov normal,bogus --quiet
+# The depth AOV is the depth mode's image: 0 (not +inf) where nothing is hit, in both.
+check "depth AOV of the plane" "$G" render "$tmp/plane.gltf" -o "$tmp/plane-aov.exr" --mode albedo --aov depth --spp 1 --size 96x96 --camera 0 --quiet
+check "pick the plane's depth.Z" "$TESTTOOL" pick "$tmp/plane-aov.exr" depth.Z "$tmp/plane-aov-z.exr"
+check "the depth AOV matches the analytic depth" "$G" diff "$tmp/plane-aov-z.exr" "$tmp/plane-depth-ref.exr" --max-error 1e-4 --quiet
+check "cornell depth mode" "$G" render $C -o "$tmp/dm.exr" --mode depth --spp 1 --size 32x32 --quiet
+check "cornell depth AOV" "$G" render $C -o "$tmp/da.exr" --mode albedo --aov depth --spp 1 --size 32x32 --quiet
+check "pick depth.Z" "$TESTTOOL" pick "$tmp/da.exr" depth.Z "$tmp/dz.exr"
+check "depth mode = depth AOV, background included" "$G" diff "$tmp/dm.exr" "$tmp/dz.exr" --max-error 0 --quiet
+# Pixel (0, 0) of this view is background (coverage 0); the centre is the back wall.
+check "(0, 0) is background" test "$("$TESTTOOL" at "$tmp/dm.exr" A 0 0)" = 0
+check "background depth is 0 in the depth mode" test "$("$TESTTOOL" at "$tmp/dm.exr" R 0 0)" = 0
+check "background depth is 0 in the depth AOV" test "$("$TESTTOOL" at "$tmp/da.exr" depth.Z 0 0)" = 0
+check "the back wall has a depth" sh -c "test \"\$('$TESTTOOL' at '$tmp/da.exr' depth.Z 16 16)\" != 0"
+
+# ---- --half and --compression (read back by exrheader and gonio diff) --------------------
+for comp in none rle zips zip piz pxr24 b44 b44a; do
+    check "--compression $comp" "$G" render $C -o "$tmp/z-$comp.exr" --mode albedo --spp 1 --size 32x32 --compression $comp --quiet
+    case $comp in rle) says=run-length ;; zips) says="zip, individual" ;; zip) says="zip, multi" ;; *) says="$comp\$" ;; esac
+    check "--compression $comp recorded" sh -c "exrheader '$tmp/z-$comp.exr' | grep -q '^compression (type compression): $says'"
+done
+check "zip is the default" sh -c "exrheader '$tmp/c.exr' | grep -q '^compression (type compression): zip, multi'"
+for comp in none rle zips piz; do # lossless: the same floats as zip
+    check "--compression $comp is lossless" "$G" diff "$tmp/z-$comp.exr" "$tmp/z-zip.exr" --max-error 0 --quiet
+done
+check "--half" "$G" render $C -o "$tmp/h.exr" --mode albedo --spp 1 --size 32x32 --half --aov depth --quiet
+check "--half: half channels" sh -c "exrheader '$tmp/h.exr' | grep -q 'depth.Z, 16-bit floating-point'"
+check "--half: no float channel" sh -c "! exrheader '$tmp/h.exr' | grep -q '32-bit floating'"
+# Half keeps 11 significant bits: albedos in [0, 1] within 2^-11.
+check "--half: values within half precision" "$G" diff "$tmp/h.exr" "$tmp/z-zip.exr" --max-error 4.9e-4 --quiet
+check_fails "--half: but not exactly" 1 "$G" diff "$tmp/h.exr" "$tmp/z-zip.exr" --max-error 0 --quiet
+
+# ---- PNGs of depth, normal and cost are pictures of the data -------------------------------
+# The plane fills the view: depth runs from white (nearest) to 20% grey (farthest); normals
+# give 0.5 n + 0.5 exactly; the background of the Cornell box's normal PNG is black.
+px() { convert "$1" -format "%[fx:int(255*p{$2,$3}.r+0.5)],%[fx:int(255*p{$2,$3}.g+0.5)],%[fx:int(255*p{$2,$3}.b+0.5)]" info:; }
+range() { convert "$1" -colorspace gray -format "%[fx:int(255*minima+0.5)] %[fx:int(255*maxima+0.5)]" info:; }
+check "plane depth PNG" "$G" render "$tmp/plane.gltf" --png "$tmp/pd.png" --mode depth --spp 1 --size 96x96 --camera 0 --quiet
+check "depth PNG spans 51..255 (20% grey to white)" test "$(range "$tmp/pd.png")" = "51 255"
+check "depth PNG is the analytic depth, near white" "$TESTTOOL" png depth "$tmp/pd.png" "$tmp/plane-depth-ref.exr"
+check "plane normal PNG" "$G" render "$tmp/plane.gltf" --png "$tmp/pn.png" --mode normal --spp 1 --size 96x96 --camera 0 --quiet
+check "normal PNG is 0.5 n + 0.5 of the analytic normals" "$TESTTOOL" png normal "$tmp/pn.png" "$tmp/plane-normal-ref.exr"
+check "cornell normal PNG" "$G" render $C -o "$tmp/cn.png" --mode normal --spp 1 --size 64x64 --quiet
+check "normal PNG background is black" test "$(px "$tmp/cn.png" 0 0)" = "0,0,0"
+check "cornell cost PNG" "$G" render $C -o "$tmp/cc.png" --mode cost --spp 1 --size 64x64 --quiet
+check "cost PNG is a heat map: not grey" sh -c "test \"\$(convert '$tmp/cc.png' -colorspace HSL -channel G -separate -format '%[fx:maxima>0.3]' info:)\" = 1"
+check "cost PNG reaches the map's top (yellow)" sh -c "convert '$tmp/cc.png' -format '%[fx:maxima.r>0.9]' info: | grep -q 1"
 check "no temporary files left" sh -c "! ls -a '$tmp' | grep -q tmp-"
 for m in normal albedo depth cost phong; do
     check "mode $m renders" "$G" render $C -o "$tmp/m-$m.exr" --mode $m --spp 2 --size 32x32 --quiet

@@ -215,15 +215,120 @@ static int stats(const char *path)
     return 0;
 }
 
+/* Checks a depth or normal PNG of gonio render against the documented mapping applied to
+ * an analytic reference (from `ref`, all pixels covered): depth: 255 (1 - 0.8 t) with
+ * t = (z - zmin) / (zmax - zmin) over the reference's range; normal: 255 (0.5 n + 0.5).
+ * Passes when every channel of every pixel is within one code value. */
+static int check_png(const char *what, const char *png, const char *ref_path)
+{
+    image ref;
+    uint8_t *px;
+    int w, h, bad = 0;
+    double zmin = INFINITY, zmax = -INFINITY;
+    if (!image_read_exr(&ref, ref_path))
+        return 1;
+    if (!image_read_png(png, &px, &w, &h)) {
+        image_destroy(&ref);
+        return 1;
+    }
+    if (w != ref.width || h != ref.height) {
+        fprintf(stderr, "%s: %dx%d, the reference %dx%d\n", png, w, h, ref.width, ref.height);
+        bad = 1;
+    }
+    {
+        /* Channels come back sorted by name (A, B, G, R): look them up. */
+        const float *rgb[3] = {NULL, NULL, NULL};
+        static const char *const names[3] = {"R", "G", "B"};
+        for (int k = 0; k < 3 && !bad; k++) {
+            int c = image_channel(&ref, names[k]);
+            if (c < 0) {
+                fprintf(stderr, "%s: no channel %s\n", ref_path, names[k]);
+                bad = 1;
+            } else {
+                rgb[k] = ref.planes[c];
+            }
+        }
+        for (int i = 0; !bad && i < w * h; i++) {
+            zmin = fmin(zmin, rgb[0][i]);
+            zmax = fmax(zmax, rgb[0][i]);
+        }
+        if (!bad && !strcmp(what, "depth") && !(zmax > zmin)) {
+            fprintf(stderr, "%s: the reference depth is constant\n", ref_path);
+            bad = 1;
+        }
+        for (int i = 0; !bad && i < w * h; i++)
+            for (int k = 0; k < 3; k++) {
+                double want = !strcmp(what, "depth") ? 255 * (1 - 0.8 * (rgb[0][i] - zmin) / (zmax - zmin))
+                                                     : 255 * (0.5 * rgb[k][i] + 0.5);
+                if (!(fabs(px[4 * i + k] - want) <= 1)) {
+                    fprintf(stderr, "%s: pixel %d channel %d is %d, expected %.1f\n", png, i, k, px[4 * i + k], want);
+                    bad = 1;
+                    break;
+                }
+            }
+    }
+    free(px);
+    image_destroy(&ref);
+    return bad;
+}
+
+/* Copies channel `from` of an EXR into a one-channel EXR as "R" (to compare it with gonio diff). */
+static int pick_channel(const char *in, const char *from, const char *out)
+{
+    image a, b;
+    const char *names[] = {"R"};
+    int c;
+    bool ok;
+    if (!image_read_exr(&a, in))
+        return 1;
+    if ((c = image_channel(&a, from)) < 0) {
+        fprintf(stderr, "%s: no channel %s\n", in, from);
+        image_destroy(&a);
+        return 1;
+    }
+    image_create(&b, a.width, a.height, 1, names);
+    memcpy(b.planes[0], a.planes[c], sizeof(float) * (size_t)a.width * (size_t)a.height);
+    ok = image_write_exr(&b, out, NULL, 0);
+    image_destroy(&a);
+    image_destroy(&b);
+    return ok ? 0 : 1;
+}
+
+/* Prints channel `name` of pixel (x, y) with %.9g. */
+static int print_value(const char *in, const char *name, int x, int y)
+{
+    image a;
+    int c;
+    if (!image_read_exr(&a, in))
+        return 1;
+    c = image_channel(&a, name);
+    if (c < 0 || x < 0 || y < 0 || x >= a.width || y >= a.height) {
+        fprintf(stderr, "%s: no channel %s or pixel (%d, %d)\n", in, name, x, y);
+        image_destroy(&a);
+        return 1;
+    }
+    printf("%.9g\n", a.planes[c][(size_t)y * (size_t)a.width + (size_t)x]);
+    image_destroy(&a);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc == 3 && !strcmp(argv[1], "stats"))
         return stats(argv[2]);
+    if (argc == 6 && !strcmp(argv[1], "at"))
+        return print_value(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]));
+    if (argc == 5 && !strcmp(argv[1], "png") && (!strcmp(argv[2], "depth") || !strcmp(argv[2], "normal")))
+        return check_png(argv[2], argv[3], argv[4]);
+    if (argc == 5 && !strcmp(argv[1], "pick"))
+        return pick_channel(argv[2], argv[3], argv[4]);
     if (argc == 4 && !strcmp(argv[1], "scene"))
         return write_scene(argv[2], argv[3]);
     if ((argc == 7 || argc == 8) && !strcmp(argv[1], "ref"))
         return write_ref(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]), argv[6],
                          argc == 8 ? atof(argv[7]) : 0.0);
-    fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n");
+    fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n"
+                    "       testtool png depth|normal PNG REF.exr | testtool pick IN.exr CHANNEL OUT.exr\n"
+                    "       testtool at IN.exr CHANNEL X Y\n");
     return 2;
 }

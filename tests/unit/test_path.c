@@ -30,7 +30,7 @@ static bool render_file(gpu *g, const char *path, const char *brdf, render_setti
     render_stats st;
     bool ok = scene_load(&sc, path) && render_material_overrides(&sc, brdf);
     s.mode = GN_MODE_PATH;
-    s.variance = true;
+    s.aov |= RENDER_AOV_VARIANCE;
     if (ok) {
         renderer_create(&r, g, &sc);
         ok = renderer_render(&r, &s, out, &st);
@@ -498,7 +498,7 @@ void test_path_determinism(void)
 {
     gpu g = {0};
     image a = {0}, b = {0};
-    render_settings s = {.width = 24, .height = 24, .spp = 8, .camera = 0, .seed = 9, .aov = true};
+    render_settings s = {.width = 24, .height = 24, .spp = 8, .camera = 0, .seed = 9, .aov = RENDER_AOV_GPU};
     if (!test_open_gpu(&g))
         return;
     if (render_file(&g, "scenes/cornell.gltf", NULL, s, &a) &&
@@ -548,6 +548,61 @@ void test_path_merge(void)
     image_destroy(&a);
     image_destroy(&b);
     image_destroy(&o);
+    unlink(a_path);
+    unlink(b_path);
+    unlink(o_path);
+}
+
+/* gonio merge refuses sample counts that are not positive integers (whatever type the
+ * header stores them as), a total past the header's int, and a repeated seed (unless
+ * --force); each refusal exits 1 and writes nothing. */
+void test_path_merge_checks(void)
+{
+    const char *names[] = {"R"};
+    static const struct { image_attr_type type; int i; double d; const char *what; } bad[] = {
+        {IMAGE_ATTR_DOUBLE, 0, INFINITY, "inf"},     {IMAGE_ATTR_DOUBLE, 0, 1e300, "1e300"},
+        {IMAGE_ATTR_DOUBLE, 0, 1.5, "1.5"},          {IMAGE_ATTR_DOUBLE, 0, NAN, "nan"},
+        {IMAGE_ATTR_DOUBLE, 0, 4294967296.0, "2^32"}, {IMAGE_ATTR_INT, 0, 0, "0"},
+        {IMAGE_ATTR_INT, -5, 0, "-5"}};
+    char a_path[256], b_path[256], o_path[256];
+    image a = {0};
+    tmp_file(a_path, sizeof a_path, "ca.exr");
+    tmp_file(b_path, sizeof b_path, "cb.exr");
+    tmp_file(o_path, sizeof o_path, "co.exr");
+    image_create(&a, 2, 2, 1, names);
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
+        image_attr attr_a[] = {{"gonio:spp", bad[k].type, NULL, bad[k].i, bad[k].d},
+                               {"gonio:seed", IMAGE_ATTR_INT, NULL, 1, 0, NULL}};
+        image_attr attr_b[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 3, 0, NULL}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 2, 0, NULL}};
+        char *argv[] = {"merge", b_path, a_path, "-o", o_path, NULL};
+        unlink(o_path);
+        CHECK(image_write_exr(&a, a_path, attr_a, 2) && image_write_exr(&a, b_path, attr_b, 2));
+        CHECKF(cmd_merge(5, argv) == 1, "merge took gonio:spp %s", bad[k].what);
+        CHECKF(access(o_path, F_OK) != 0, "merge wrote an output for gonio:spp %s", bad[k].what);
+    }
+    {
+        /* 2^31 - 1 twice: the total wraps in 32 bits. */
+        image_attr attr_a[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, INT32_MAX, 0, NULL}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 1, 0, NULL}};
+        image_attr attr_b[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, INT32_MAX, 0, NULL}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 2, 0, NULL}};
+        char *argv[] = {"merge", a_path, b_path, "-o", o_path, NULL};
+        CHECK(image_write_exr(&a, a_path, attr_a, 2) && image_write_exr(&a, b_path, attr_b, 2));
+        CHECKF(cmd_merge(5, argv) == 1, "merge took a total of 2^32 - 2 samples");
+        CHECK(access(o_path, F_OK) != 0);
+    }
+    {
+        /* Seed 4 in both (once as a merge's list): refused, and merged with --force. */
+        image_attr attr_a[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 2, 0, NULL}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 4, 0, NULL}};
+        image_attr attr_b[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 6, 0, NULL}, {"gonio:seeds", IMAGE_ATTR_STRING, "3,4,5", 0, 0}};
+        char *argv[] = {"merge", a_path, b_path, "-o", o_path, NULL};
+        char *forced[] = {"merge", "--force", a_path, b_path, "-o", o_path, NULL};
+        char seeds[64] = "";
+        CHECK(image_write_exr(&a, a_path, attr_a, 2) && image_write_exr(&a, b_path, attr_b, 2));
+        CHECKF(cmd_merge(5, argv) == 1, "merge took seed 4 twice");
+        CHECK(access(o_path, F_OK) != 0);
+        CHECK(cmd_merge(6, forced) == 0);
+        CHECK(image_exr_attr_string(o_path, "gonio:seeds", seeds, sizeof seeds) && !strcmp(seeds, "4,3,4,5"));
+    }
+    image_destroy(&a);
     unlink(a_path);
     unlink(b_path);
     unlink(o_path);
