@@ -571,7 +571,7 @@ void test_path_merge_checks(void)
     tmp_file(o_path, sizeof o_path, "co.exr");
     image_create(&a, 2, 2, 1, names);
     for (size_t k = 0; k < sizeof bad / sizeof *bad; k++) {
-        image_attr attr_a[] = {{"gonio:spp", bad[k].type, NULL, bad[k].i, bad[k].d},
+        image_attr attr_a[] = {{"gonio:spp", bad[k].type, NULL, bad[k].i, bad[k].d, NULL},
                                {"gonio:seed", IMAGE_ATTR_INT, NULL, 1, 0, NULL}};
         image_attr attr_b[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 3, 0, NULL}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 2, 0, NULL}};
         char *argv[] = {"merge", b_path, a_path, "-o", o_path, NULL};
