@@ -592,7 +592,7 @@ void test_path_merge_checks(void)
     {
         /* Seed 4 in both (once as a merge's list): refused, and merged with --force. */
         image_attr attr_a[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 2, 0, NULL}, {"gonio:seed", IMAGE_ATTR_INT, NULL, 4, 0, NULL}};
-        image_attr attr_b[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 6, 0, NULL}, {"gonio:seeds", IMAGE_ATTR_STRING, "3,4,5", 0, 0}};
+        image_attr attr_b[] = {{"gonio:spp", IMAGE_ATTR_INT, NULL, 6, 0, NULL}, {"gonio:seeds", IMAGE_ATTR_STRING, "3,4,5", 0, 0, NULL}};
         char *argv[] = {"merge", a_path, b_path, "-o", o_path, NULL};
         char *forced[] = {"merge", "--force", a_path, b_path, "-o", o_path, NULL};
         char seeds[64] = "";
