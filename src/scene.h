@@ -90,6 +90,13 @@ typedef struct scene {
  * normals (de-indexed). Triangles with non-finite or absurdly large (|x| > 1e15) vertices
  * are dropped with one warning. A scene without any triangle is an error ("no triangles"). */
 bool scene_load(scene *out, const char *path);
+
+/* Limits of a decoded scene, checked before anything is allocated, with the numbers in the
+ * error: triangles and vertices after instancing (about 300 bytes each through loading and
+ * the BVH build: 5 GB at the limit), and texels of all images together (RGBA8; images with
+ * the same bytes are decoded once and count once). */
+#define SCENE_MAX_TRIANGLES (1u << 24)
+#define SCENE_MAX_TEXELS (1ull << 28)
 /* The same for the glTF scene of index scene_index (-1: the file's default scene, else its
  * first, else every node without a parent); an index the file lacks is an error. */
 bool scene_load_scene(scene *out, const char *path, int scene_index);

@@ -6,6 +6,9 @@
  * Programming and Computer Graphics", 3rd ed., 4.5). No C++ exception escapes into C. */
 #include <tiny_gltf.h>
 
+#include <stb_image.h>
+#include <zlib.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -31,7 +34,9 @@ namespace {
  * (util_malloc would stop the program) and from recursing deeply inside tinygltf. */
 const size_t MAX_ELEMENTS = size_t(1) << 28; /* per accessor backed by a buffer view */
 const size_t MAX_ZERO_ELEMENTS = size_t(1) << 22; /* per accessor without one (all zeros) */
-const size_t MAX_SCENE = size_t(1) << 26;    /* vertices or triangles after instancing (3 GiB) */
+/* The decoded scene (scene.h: SCENE_MAX_*), checked before anything is allocated: a few
+ * hundred bytes of JSON that instance one large accessor many times asked for gigabytes. */
+const size_t MAX_SCENE = SCENE_MAX_TRIANGLES;
 const size_t MAX_PIXELS = size_t(1) << 28;   /* per image */
 const int MAX_JSON_DEPTH = 64;               /* tinygltf copies extras/extensions recursively */
 /* Emission and light intensities above this are clamped: products with areas and squared
@@ -68,6 +73,10 @@ struct Ctx {
     std::vector<bool> camera_ok, light_ok;   /* per glTF camera / light: values usable */
     std::vector<std::vector<Prim>> meshes;   /* per glTF mesh */
     std::vector<uint32_t> image_map, texture_map; /* glTF index -> scene index or GN_INVALID */
+    std::map<std::pair<uint32_t, size_t>, int> decoded; /* (crc32, size) of image bytes -> first image */
+    std::map<int, int> image_alias;          /* image -> the earlier image with the same bytes */
+    uint64_t texels = 0;                     /* of the images decoded so far */
+    std::string limit_error;                 /* a SCENE_MAX_* limit exceeded while decoding */
     bool warned_skin = false, warned_targets = false;
     int scene_index = -1;                    /* the glTF scene to draw; -1: the default one */
     std::string folder;                      /* realpath of the scene's folder */
@@ -226,7 +235,7 @@ bool check_json_text(Ctx &c, const uint8_t *s, size_t n)
 /* Decodes PNG or JPEG, the formats glTF 2.0 allows. Anything else is refused before stb_image
  * sees it: its other decoders are not needed, and the 16-bit PNM path of the stb bundled with
  * tinygltf 2.7 overflows its buffer. On failure returns the reason. */
-std::string decode_image(tinygltf::Image *img, int idx, const unsigned char *bytes, size_t size)
+std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned char *bytes, size_t size)
 {
     static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
     bool is_png = size >= 8 && memcmp(bytes, png, 8) == 0;
@@ -235,6 +244,27 @@ std::string decode_image(tinygltf::Image *img, int idx, const unsigned char *byt
         return "not a PNG or JPEG image";
     if (size > size_t(INT32_MAX))
         return "image data too large";
+    /* The same bytes are decoded once (a file listing one PNG 500 times decoded it 500 times). */
+    std::pair<uint32_t, size_t> key(uint32_t(crc32_z(crc32_z(0, nullptr, 0), bytes, size)), size);
+    auto seen = c.decoded.find(key);
+    if (seen != c.decoded.end()) {
+        c.image_alias[idx] = seen->second;
+        return "";
+    }
+    int w = 0, h = 0, comp = 0;
+    if (!stbi_info_from_memory(bytes, int(size), &w, &h, &comp))
+        return "cannot decode";
+    if (c.texels + uint64_t(w) * uint64_t(h) > SCENE_MAX_TEXELS) {
+        char msg[256];
+        snprintf(msg, sizeof msg, "images too large: %llu texels with image %d (%dx%d), the limit is %llu",
+                 (unsigned long long)(c.texels + uint64_t(w) * uint64_t(h)), idx, w, h,
+                 (unsigned long long)SCENE_MAX_TEXELS);
+        if (c.limit_error.empty())
+            c.limit_error = msg;
+        return msg;
+    }
+    c.texels += uint64_t(w) * uint64_t(h);
+    c.decoded[key] = idx;
     std::string err, warn_text;
     if (!tinygltf::LoadImageData(img, idx, &err, &warn_text, 0, 0, bytes, int(size), nullptr))
         return err.empty() ? "cannot decode" : err;
@@ -250,7 +280,7 @@ bool image_callback(tinygltf::Image *img, const int idx, std::string *, std::str
     Ctx &c = *static_cast<Ctx *>(user);
     if (img->bufferView >= 0)
         return true;
-    std::string why = decode_image(img, idx, bytes, size_t(size));
+    std::string why = decode_image(c, img, idx, bytes, size_t(size));
     if (!why.empty())
         c.image_errors[idx] = why;
     return true;
@@ -1029,9 +1059,19 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
 
 bool load_meshes(Ctx &c)
 {
+    uint64_t nv = 0, nt = 0; /* what the primitives will hold, counted before reading them */
     c.meshes.resize(c.m.meshes.size());
     for (size_t mi = 0; mi < c.m.meshes.size(); mi++)
         for (size_t pi = 0; pi < c.m.meshes[mi].primitives.size(); pi++) {
+            const auto &prim = c.m.meshes[mi].primitives[pi];
+            auto pos = prim.attributes.find("POSITION");
+            uint64_t verts = pos != prim.attributes.end() && in_range(pos->second, c.m.accessors.size())
+                                 ? c.m.accessors[size_t(pos->second)].count : 0;
+            nv += verts;
+            nt += (in_range(prim.indices, c.m.accessors.size()) ? c.m.accessors[size_t(prim.indices)].count : verts) / 3;
+            if (nv > MAX_SCENE || nt > MAX_SCENE)
+                return fail(c, "scene too large: its meshes hold over %llu triangles and %llu vertices; the limit "
+                            "is %zu each", (unsigned long long)nt, (unsigned long long)nv, MAX_SCENE);
             Prim p;
             if (load_primitive(c, int(mi), int(pi), p))
                 c.meshes[mi].push_back(std::move(p));
@@ -1118,9 +1158,10 @@ bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
             nv += p.pos.size() / 3;
             nt += p.idx.size() / 3;
             np++;
-            if (nv > MAX_SCENE || nt > MAX_SCENE)
-                return fail(c, "scene too large (over %zu vertices or triangles after instancing)", MAX_SCENE);
         }
+    if (nv > MAX_SCENE || nt > MAX_SCENE)
+        return fail(c, "scene too large: %llu triangles and %llu vertices after instancing; the limit is %zu each",
+                    (unsigned long long)nt, (unsigned long long)nv, MAX_SCENE);
     out->num_vertices = uint32_t(nv);
     out->num_triangles = uint32_t(nt);
     out->num_meshes = uint32_t(np);
@@ -1287,7 +1328,7 @@ void decode_view_images(Ctx &c)
         if (img.bufferView < 0) /* tinygltf checked that the view exists, check_buffers_and_views that it fits */
             continue;
         const auto &v = c.m.bufferViews[size_t(img.bufferView)];
-        std::string why = decode_image(&img, int(i), view_data(c, img.bufferView, 0), v.byteLength);
+        std::string why = decode_image(c, &img, int(i), view_data(c, img.bufferView, 0), v.byteLength);
         if (!why.empty())
             c.image_errors[int(i)] = why;
     }
@@ -1350,6 +1391,8 @@ void load_images_and_textures(Ctx &c, scene *out)
     c.image_map.assign(m.images.size(), GN_INVALID);
     for (size_t i = 0; i < m.images.size(); i++) {
         const auto &img = m.images[i];
+        if (c.image_alias.count(int(i)))
+            continue; /* below, once its original is in */
         if (c.image_errors.count(int(i)) || !convert_image(img, out->images[out->num_images])) {
             std::string why = c.image_errors.count(int(i)) ? c.image_errors[int(i)] : "file missing or unreadable";
             while (!why.empty() && why.back() == '\n')
@@ -1361,6 +1404,8 @@ void load_images_and_textures(Ctx &c, scene *out)
         c.image_map[i] = out->num_images++;
         std::vector<unsigned char>().swap(c.m.images[i].image); /* keep one copy at a time */
     }
+    for (const auto &alias : c.image_alias)
+        c.image_map[size_t(alias.first)] = c.image_map[size_t(alias.second)];
     out->textures = static_cast<scene_texture *>(util_calloc(m.textures.size(), sizeof(scene_texture)));
     c.texture_map.assign(m.textures.size(), GN_INVALID);
     for (size_t i = 0; i < m.textures.size(); i++) {
@@ -1721,6 +1766,8 @@ bool load(scene *out, const char *path, int scene_index)
     if (!data || !parse(c, data.get(), size))
         return false;
     data.reset();
+    if (!c.limit_error.empty())
+        return fail(c, "%s", c.limit_error.c_str());
     if (!check_asset(c) || !check_buffers_and_views(c))
         return false;
     for (size_t i = 0; i < c.m.accessors.size(); i++)

@@ -64,6 +64,43 @@ PY
 check "a camera aspect of 0.004 renders" "$G" render "$B/thin.gltf" -o "$tmp/thin.exr" --spp 1 --quiet
 check "... at most 512 pixels on its longer side" sh -c "exrheader '$tmp/thin.exr' | grep -q 'dataWindow.*(0 0) - (1 511)'"
 
+# Amplification: a few hundred bytes of JSON must not decode into gigabytes. One accessor of
+# 4,000,000 zero positions (no buffer view) drawn by 13 primitives is 17.3 M triangles, over
+# SCENE_MAX_TRIANGLES (2^24): refused before anything is read, with the numbers.
+python3 - "$B/amplified.gltf" <<'PY'
+import json, sys
+prims = [{"attributes": {"POSITION": 0}} for _ in range(13)]
+d = {"asset": {"version": "2.0"},
+     "accessors": [{"componentType": 5126, "count": 4000000, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0]}],
+     "meshes": [{"primitives": prims}], "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}
+json.dump(d, open(sys.argv[1], "w"))
+PY
+check_fails "a 17 M-triangle amplification is refused" 1 "$G" info "$B/amplified.gltf"
+check "... with the numbers" grep -q "scene too large: .* the limit is 16777216" "$tmp/last"
+# Images: the same bytes are decoded once and count once against SCENE_MAX_TEXELS (2^28).
+# A 16384 x 4096 grey PNG is 67 M texels: listed 8 times it loads, 5 different ones do not.
+python3 - "$B" <<'PY'
+import json, struct, sys, zlib
+def png(path, w, h, value):
+    def chunk(t, data):
+        return struct.pack(">I", len(data)) + t + data + struct.pack(">I", zlib.crc32(t + data) & 0xffffffff)
+    row = b"\0" + bytes([value]) * w
+    raw = zlib.compress(row * h, 6)
+    open(path, "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0)) +
+                           chunk(b"IDAT", raw) + chunk(b"IEND", b""))
+d = json.load(open(sys.argv[1] + "/ok.gltf"))
+for k in range(5):
+    png(f"{sys.argv[1]}/big{k}.png", 16384, 4096, 40 * k)
+same, different = dict(d), dict(d)
+same["images"] = [{"uri": "big0.png"} for _ in range(8)]
+different["images"] = [{"uri": f"big{k}.png"} for k in range(5)]
+json.dump(same, open(sys.argv[1] + "/same-images.gltf", "w"))
+json.dump(different, open(sys.argv[1] + "/many-images.gltf", "w"))
+PY
+check "one 67 M-texel image listed 8 times loads (decoded once)" "$G" info "$B/same-images.gltf"
+check_fails "5 different ones (335 M texels) are refused" 1 "$G" info "$B/many-images.gltf"
+check "... with the numbers" grep -q "images too large: 335544320 texels with image 4 (16384x4096), the limit is 268435456" "$tmp/last"
+
 # Huge radiance: clamped or refused, never NaN or Inf pixels.
 check_fails "--env 1e38 is refused" 2 "$G" render "$B/ok.gltf" -o "$tmp/x.exr" --env 1e38 --quiet
 python3 - "$B/ok.gltf" "$B/bright.gltf" <<'PY'

@@ -88,7 +88,7 @@ T=scenes/teapot.gltf
 r32() { "$G" render "$@" --spp 4 --size 32x32 --aov variance --quiet; }
 check "other scene" r32 $T -o "$tmp/i-scene.exr" --seed 3
 check "other mode" r32 $C -o "$tmp/i-mode.exr" --seed 3 --mode phong
-check "other camera" r32 $C -o "$tmp/i-camera.exr" --seed 3 --camera 0
+check "other camera" r32 $C -o "$tmp/i-camera.exr" --seed 3 --camera frame
 check "other max-depth" r32 $C -o "$tmp/i-max-depth.exr" --seed 3 --max-depth 2
 check "other env" r32 $C -o "$tmp/i-env.exr" --seed 3 --env 0.5
 check "other estimator" r32 $C -o "$tmp/i-estimator.exr" --seed 3 --estimator light
