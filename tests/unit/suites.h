@@ -7,3 +7,4 @@
 #include "suite_brdf.h"
 #include "suite_shading.h"
 #include "suite_path.h"
+#include "suite_tangent.h"
