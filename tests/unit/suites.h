@@ -8,3 +8,4 @@
 #include "suite_shading.h"
 #include "suite_path.h"
 #include "suite_tangent.h"
+#include "suite_normals.h"
