@@ -6,6 +6,11 @@
 // compiles to its own lean kernel.
 #extension GL_GOOGLE_include_directive : require
 
+// Specialised on GN_FEAT_ALPHA only (src/render.c: kernel_features): the rest is always on.
+#define GN_HAS(f) ((FEATURES & (f)) != 0u)
+#include "shared.h"
+layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
+
 #include "phong.glsl"
 
 layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
@@ -54,7 +59,10 @@ void main()
     vec2 jitter = push.sample_index == 0u ? vec2(0.5) : rand2(pixel, push.sample_index, 0u);
     vec3 o = frame.camera.position;
     vec3 d = camera_dir(vec2(px) + jitter);
-    Hit h = bvh_trace(o, d, frame.camera.znear / dot(d, frame.camera.forward), 1e30, false);
+    rng_pixel = pixel;
+    rng_sample = push.sample_index;
+    Hit h = trace_visible(o, d, frame.camera.znear / dot(d, frame.camera.forward), 1e30, false,
+                          frame.traversal_budget, DIM_ALPHA);
 
     vec3 color = vec3(0.0);
     vec3 normal = vec3(0.0), albedo = vec3(0.0);

@@ -255,6 +255,27 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     return s;
 }
 
+// ---- alphaMode: surfaces cut away -----------------------------------------------------------
+// The opacity of triangle tri at barycentrics (u, v): 1 for OPAQUE; MASK: 1 where alpha >=
+// alphaCutoff, else 0; BLEND: alpha. alpha = base colour factor x texture x vertex colour
+// alpha, as glTF defines it.
+float surface_opacity(uint tri, float u, float v)
+{
+    GnPrim pr = prim_at(tri);
+    GnMaterial m = material_at(pr.material);
+    if ((m.flags & (GN_MAT_MASK | GN_MAT_BLEND)) == 0u)
+        return 1.0;
+    GnVertex a = vertex_at(pr.i0), b = vertex_at(pr.i1), c = vertex_at(pr.i2);
+    float w = 1.0 - u - v, alpha = m.base_color.a;
+    if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_base != GN_INVALID)
+        alpha *= texture_sample(m.tex_base, w * vec2(a.u, a.v) + u * vec2(b.u, b.v) + v * vec2(c.u, c.v), false).a;
+    if (vertex_colors())
+        alpha *= w * a.color.a + u * b.color.a + v * c.color.a;
+    if ((m.flags & GN_MAT_MASK) != 0u)
+        return alpha >= m.alpha_cutoff ? 1.0 : 0.0;
+    return clamp(alpha, 0.0, 1.0);
+}
+
 // The pixel of this invocation. lavapipe runs a work group as SIMD groups of 8 consecutive
 // invocations; laid out as 4x2 blocks of the 8x8 tile (not rows of 8), the rays of a SIMD
 // group start closer together and walk more of the same nodes.

@@ -1517,8 +1517,10 @@ void convert_material(Ctx &c, int mi, GnMaterial &g, scene_material_extras &x, c
     g.normal_scale = float(mat.normalTexture.scale);
     g.occlusion_strength = ranged(c, mat.occlusionTexture.strength, 0, 1, what, "occlusionTexture.strength");
     g.alpha_cutoff = ranged(c, mat.alphaCutoff, 0, INFINITY, what, "alphaCutoff");
-    if (mat.alphaMode == "MASK" || mat.alphaMode == "BLEND")
-        warn(c, "%s: alphaMode %s is rendered opaque", what.c_str(), mat.alphaMode.c_str());
+    if (mat.alphaMode == "MASK")
+        g.flags |= GN_MAT_MASK;
+    else if (mat.alphaMode == "BLEND")
+        g.flags |= GN_MAT_BLEND;
     else if (mat.alphaMode != "OPAQUE")
         warn(c, "%s: unknown alphaMode '%s' (rendered opaque)", what.c_str(), mat.alphaMode.substr(0, 64).c_str());
     g.tex_base = texture_slot(c, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, what, "baseColorTexture");

@@ -9,3 +9,4 @@
 #include "suite_path.h"
 #include "suite_tangent.h"
 #include "suite_normals.h"
+#include "suite_alpha.h"
