@@ -175,7 +175,8 @@ vec3 shading_normal_valid(vec3 n, vec3 ng, vec3 wo)
 struct Surface {
     vec3 p;           // world position
     vec3 ng;          // geometric normal, facing the incoming ray
-    vec3 n;           // shading normal (interpolated, normal-mapped), same side as ng
+    vec3 n;           // shading normal (interpolated, normal-mapped, bent by
+                      // shading_normal_valid), same side as ng
     vec2 uv;
     vec3 base;        // linear base colour (factor * texture * vertex colour)
     vec3 vcolor;      // the interpolated vertex colour (1 without COLOR_0)
