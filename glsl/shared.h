@@ -192,7 +192,8 @@ GN_STRUCT(GnPrim) {
 GN_STRUCT(GnVertex) {
     vec3 position; float u;
     vec3 normal; float v;
-    vec4 tangent; /* xyz tangent, w handedness; all zero when the mesh has none */
+    vec4 tangent; /* xyz tangent, w handedness; the loader generates them (MikkTSpace) for
+                     normal maps without TANGENT; else all zero when the mesh has none */
     vec4 color;   /* glTF COLOR_0 (linear RGBA; 1 when the mesh has none), read only when
                      GnFrame.flags has GN_FRAME_VERTEX_COLOR */
 } GN_END(GnVertex); /* 64 bytes */

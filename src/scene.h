@@ -44,7 +44,8 @@ typedef struct scene {
     char path[1024];
 
     uint32_t num_vertices;
-    GnVertex *vertices;         /* world space; normals normalised; tangents zero if absent */
+    GnVertex *vertices;         /* world space; normals normalised; tangents zero if absent
+                                   and not generated (src/tangent.c: for normal maps) */
 
     uint32_t num_triangles;
     uint32_t *indices;          /* 3 per triangle, into vertices */
