@@ -275,11 +275,50 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
 #undef w
 }
 
-// Closest hit (any_hit false) or any hit (true) in (tmin, tmax) within frame's budget.
+// Closest hit (any_hit false) or any hit (true) in (tmin, tmax) within frame's budget, on
+// every surface (see trace_visible for surfaces cut away).
 Hit bvh_trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
 {
     walk_start(tmax);
     bvh_walk(ray_pre(o, d), tmin, any_hit, frame.traversal_budget);
+    return walk.hit;
+}
+
+// ---- rays through surfaces cut away (glTF alphaMode MASK and BLEND) -------------------------
+// The random numbers of the BLEND test are rng_uniform4(rng_pixel, rng_sample, dim + k) for
+// the ray's k-th crossing (glsl/scene.glsl: the dimensions of a sample); the kernel sets the
+// pixel (or vertex) and sample.
+uint rng_pixel = 0u, rng_sample = 0u;
+#define DIM_ALPHA 0x40000000u // the alpha tests' dimensions: DIM_ALPHA + 4096 ray + crossing
+#define DIM_ALPHA_RAY 4096u
+
+// bvh_trace within `budget` node visits in all, on the surfaces not cut away: the walk is
+// left as it is (docs/architecture.md) and, when the hit's material is MASK or BLEND and the
+// surface is cut there (a uniform number >= its opacity), the same ray goes on from just past
+// the hit, without a bounce. Shadow rays then need the nearest hit too: a ray that took any
+// hit and went on past it would skip the surfaces before it. Without GN_FEAT_ALPHA (opaque
+// scenes) this is bvh_trace. A ray that runs out of budget on the way says so (truncated).
+Hit trace_visible(vec3 o, vec3 d, float tmin, float tmax, bool any_hit, uint budget, uint dim)
+{
+    bool alpha = GN_HAS(GN_FEAT_ALPHA) && (frame.flags & GN_FRAME_ALPHA) != 0u;
+    RayPre r = ray_pre(o, d);
+    walk_start(tmax);
+    bvh_walk(r, tmin, any_hit && !alpha, budget);
+    if (GN_HAS(GN_FEAT_ALPHA)) {
+        uint steps = walk.hit.steps, k = 0u;
+        while (alpha && walk.hit.tri != GN_INVALID && !walk.hit.truncated &&
+               rng_uniform4(rng_pixel, rng_sample, dim + (k & (DIM_ALPHA_RAY - 1u)), frame.seed).x >=
+                   surface_opacity(walk.hit.tri, walk.hit.u, walk.hit.v)) {
+            // (t > the hit's own t: the watertight test gives the same t for the same ray and
+            // triangle, so the surface just crossed is not found again)
+            float t = walk.hit.t;
+            walk_start(tmax);
+            bvh_walk(r, t, false, budget - min(steps, budget));
+            steps += walk.hit.steps;
+            k++;
+        }
+        walk.hit.steps = steps;
+    }
     return walk.hit;
 }
 

@@ -6,6 +6,11 @@
 // compiles to its own lean kernel.
 #extension GL_GOOGLE_include_directive : require
 
+// Specialised on GN_FEAT_ALPHA only (src/render.c: kernel_features): the rest is always on.
+#define GN_HAS(f) ((FEATURES & (f)) != 0u)
+#include "shared.h"
+layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
+
 #include "phong.glsl"
 
 layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
@@ -55,7 +60,9 @@ void main()
     vec3 o, d;
     float tnear;
     camera_ray(vec2(px) + jitter, o, d, tnear);
-    Hit h = bvh_trace(o, d, tnear, 1e30, false);
+    rng_pixel = pixel;
+    rng_sample = push.sample_index;
+    Hit h = trace_visible(o, d, tnear, 1e30, false, frame.traversal_budget, DIM_ALPHA);
 
     vec3 color = vec3(0.0);
     vec3 normal = vec3(0.0), albedo = vec3(0.0);

@@ -58,10 +58,10 @@ float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 
 float power_heuristic(float a, float b) { return a * a / (a * a + b * b); }
 
-Hit trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit)
+// dim: the first random dimension of the ray's crossings of BLEND surfaces (trace_visible).
+Hit trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit, uint dim)
 {
-    walk_start(tmax);
-    bvh_walk(ray_pre(o, d), tmin, any_hit, budget);
+    trace_visible(o, d, tmin, tmax, any_hit, budget, dim);
     budget -= min(walk.hit.steps + TRACE_OVERHEAD, budget);
     truncated = truncated || walk.hit.truncated;
     return walk.hit;
@@ -232,6 +232,9 @@ LightSample light_sample(vec3 p, vec3 u)
         float c = abs(dot(ng, s.wi));
         if (c > 0.0 && d2 > 0.0) {
             s.L = tri_emission(e.prim, b1, b2, s.wi, ng);
+            // A BSDF ray finds an emitter of opacity a only a of the time: so does light sampling.
+            if (GN_HAS(GN_FEAT_ALPHA))
+                s.L *= surface_opacity(e.prim, b1, b2);
             s.pdf = e.pdf / e.area * d2 / c;
         }
     }
@@ -286,6 +289,7 @@ bool prev_delta, covered, ended;
 void path_start()
 {
     sample_now = push.sample_index + taken;
+    rng_sample = sample_now;
     budget = frame.traversal_budget;
     depth = 0u;
     camera_ray(vec2(px) + rng(pixel, 0u).xy, o, d, tmin);
@@ -328,6 +332,7 @@ void main()
     if (px.x >= frame.width || px.y >= frame.height)
         return;
     pixel = px.y * frame.width + px.x;
+    rng_pixel = pixel;
     bool light_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_LIGHT_ONLY) != 0u;
     bool bsdf_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_BSDF_ONLY) != 0u;
     truncated = false;
@@ -344,7 +349,7 @@ void main()
         // every later statement again and cost a third of the speed.)
         ended = true;
         do {
-            Hit h = trace(o, d, tmin, 1e30, false);
+            Hit h = trace(o, d, tmin, 1e30, false, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
             tmin = 0.0;
             if (h.truncated)
                 break;
@@ -401,7 +406,8 @@ void main()
                     float w = ls.delta || light_only ? 1.0 : power_heuristic(ls.pdf, pb);
                     vec3 c = beta * f * abs(wi.z) * ls.L * (w / ls.pdf);
                     if (luminance(c) > 0.0) {
-                        Hit sh = trace(offset_origin(s.p, ng, ls.wi), ls.wi, 0.0, ls.dist * (1.0 - 1e-3), true);
+                        Hit sh = trace(offset_origin(s.p, ng, ls.wi), ls.wi, 0.0, ls.dist * (1.0 - 1e-3), true,
+                                       DIM_ALPHA + DIM_ALPHA_RAY * (2u * depth + 1u));
                         if (sh.tri == GN_INVALID && !sh.truncated)
                             radiance += c;
                     }

@@ -36,13 +36,14 @@ vec3 light_incident(GnLight l, vec3 p, out vec3 wi, out float dist)
 }
 
 // ng: the normal to offset the shadow ray's origin along (the side being lit).
-bool shadowed(vec3 p, vec3 ng, vec3 wi, float dist)
+// dim: the first random dimension of its crossings of BLEND surfaces (trace_visible).
+bool shadowed(vec3 p, vec3 ng, vec3 wi, float dist, uint dim)
 {
     if ((frame.flags & GN_FRAME_SHADOWS) == 0u)
         return false;
     // Offset scaled to the position's magnitude, so the ray does not hit its own triangle.
     float eps = 1e-4 * max(1.0, max(abs(p.x), max(abs(p.y), abs(p.z))));
-    Hit h = bvh_trace(p + ng * eps, wi, 0.0, dist * (1.0 - 1e-4), true);
+    Hit h = trace_visible(p + ng * eps, wi, 0.0, dist * (1.0 - 1e-4), true, frame.traversal_budget, dim);
     return h.tri != GN_INVALID;
 }
 
@@ -74,7 +75,7 @@ vec3 phong_shade(vec3 p, vec3 n, vec3 ng, vec2 uv, vec3 vcolor, uint material, v
         float ndl = dot(n, wi);
         if (ndl <= 0.0 || dot(ng, wi) <= 0.0 || dot(E, E) == 0.0)
             continue;
-        if (shadowed(p, ng, wi, dist))
+        if (shadowed(p, ng, wi, dist, DIM_ALPHA + DIM_ALPHA_RAY * (1u + i)))
             continue;
         vec3 r = 2.0 * ndl * n - wi; // the lecture's r(w_i)
         // OpenGL's 0^0 = 1; GLSL leaves pow(0, 0) undefined.

@@ -156,10 +156,43 @@ vec4 texture_sample(uint index, vec2 uv, bool srgb)
 }
 
 // ---- surface data at a hit ---------------------------------------------------------------
+// A shading normal n (unit) such that the mirror reflection of wo (unit, toward the viewer)
+// about it lies above the geometric surface ng (which faces wo): a normal map or normals
+// interpolated near a silhouette can turn n so far that the viewer is below it or its
+// reflection below the surface, which every BSDF then reads as black. As Cycles does
+// (ensure_valid_reflection), n is bent toward ng, in the plane of n and ng, just far enough
+// that the reflection's height above the surface reaches t = min(0.9 (wo.ng), 0.01).
+// With n = (sin a, cos a) in the basis (x, ng) and wo = (ix, iz), the reflection's height is
+// ix sin 2a + iz cos 2a = t: two solutions for 2a, of which the nearer to n's is taken.
+vec3 shading_normal_valid(vec3 n, vec3 ng, vec3 wo)
+{
+    float iz = dot(wo, ng), t = min(0.9 * iz, 0.01);
+    if (2.0 * dot(n, wo) * dot(n, ng) - iz >= t)
+        return n;
+    vec3 x = n - ng * dot(n, ng);
+    float lx = length(x);
+    if (lx < 1e-7)
+        return ng;
+    x /= lx;
+    float ix = dot(wo, x), a2 = ix * ix + iz * iz, r = sqrt(max(a2 - t * t, 0.0));
+    // The two solutions 2a = phi +- acos(t / |wo|), phi = atan(ix, iz), as cos and sin.
+    vec2 hi = vec2(t * iz - ix * r, t * ix + iz * r) / a2;
+    vec2 lo = vec2(t * iz + ix * r, t * ix - iz * r) / a2;
+    // n's own 2a (cos 2a = 2 nz^2 - 1, sin 2a = 2 nx nz) lies beyond the upper one when
+    // sin(2a - phi) > 0: the nearer solution is then the upper one.
+    float nz = dot(n, ng), nx = dot(n, x);
+    vec2 s = 2.0 * nx * nz * iz - (2.0 * nz * nz - 1.0) * ix > 0.0 ? hi : lo;
+    // back from 2a to a: cos a = sqrt((1 + cos 2a) / 2), sin a = sin 2a / (2 cos a)
+    float ca = sqrt(max(0.5 * (1.0 + s.x), 0.0));
+    float sa = ca > 1e-7 ? s.y / (2.0 * ca) : 1.0;
+    return normalize(sa * x + ca * ng);
+}
+
 struct Surface {
     vec3 p;           // world position
     vec3 ng;          // geometric normal, facing the incoming ray
-    vec3 n;           // shading normal (interpolated, normal-mapped), same side as ng
+    vec3 n;           // shading normal (interpolated, normal-mapped, bent by
+                      // shading_normal_valid), same side as ng
     vec2 uv;
     vec3 base;        // linear base colour (factor * texture * vertex colour)
     vec3 vcolor;      // the interpolated vertex colour (1 without COLOR_0)
@@ -187,8 +220,10 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     n = dot(n, n) > 1e-20 ? normalize(n) : ng;
     // Shade the side the ray sees: the geometric normal faces the viewer, and the shading
     // normal is kept on its side (meshes whose winding disagrees with their normals exist).
+    // The normal map bends the normal of the side the mesh's normals are on; the other side
+    // of the sheet gets the opposite of that whole normal (flip below).
     if (!s.front) ng = -ng;
-    if (dot(n, ng) < 0.0) n = -n;
+    bool flip = dot(n, ng) < 0.0;
     s.ng = ng;
     s.uv = w * vec2(a.u, a.v) + u * vec2(b.u, b.v) + v * vec2(c.u, c.v);
 
@@ -218,34 +253,44 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_occlusion != GN_INVALID)
         s.occlusion = 1.0 + m.occlusion_strength * (texture_sample(m.tex_occlusion, s.uv, false).r - 1.0);
     if (GN_HAS(GN_FEAT_NORMAL_MAP) && m.tex_normal != GN_INVALID) {
-        // Tangent frame: the vertex tangents when the mesh has them, else the triangle's
-        // uv gradient (glTF asks for MikkTSpace; per-triangle is its flat approximation).
+        // The vertex tangents: the mesh's TANGENT or the loader's MikkTSpace ones, which
+        // glTF asks for (src/tangent.c); bitangent = cross(normal, tangent) w, toward -v.
         vec4 tg = w * a.tangent + u * b.tangent + v * c.tangent;
-        vec3 tangent;
-        float sign = 1.0;
-        if (dot(tg.xyz, tg.xyz) > 1e-12) {
-            tangent = tg.xyz;
-            sign = tg.w < 0.0 ? -1.0 : 1.0;
-        } else {
-            vec2 d1 = vec2(b.u - a.u, b.v - a.v), d2 = vec2(c.u - a.u, c.v - a.v);
-            float det = d1.x * d2.y - d1.y * d2.x;
-            tangent = abs(det) > 1e-20 ? (e1 * d2.y - e2 * d1.y) / det : vec3(0.0);
-            if (det < 0.0) sign = -1.0;
-        }
-        if (!s.front) tangent = -tangent;
-        tangent = tangent - n * dot(n, tangent);
+        vec3 tangent = tg.xyz - n * dot(n, tg.xyz);
         if (dot(tangent, tangent) > 1e-20) {
             tangent = normalize(tangent);
-            vec3 bitangent = sign * cross(n, tangent);
+            vec3 bitangent = (tg.w < 0.0 ? -1.0 : 1.0) * cross(n, tangent);
             vec3 tn = texture_sample(m.tex_normal, s.uv, false).xyz * 2.0 - 1.0;
-            tn.xy *= m.normal_scale;
+            tn.xy *= m.normal_scale; // glTF: the scale applies to X and Y of the sampled normal
             vec3 nm = tn.x * tangent + tn.y * bitangent + tn.z * n;
             if (dot(nm, nm) > 1e-20)
                 n = normalize(nm);
         }
     }
-    s.n = n;
+    if (flip) n = -n;
+    s.n = shading_normal_valid(n, ng, -d);
     return s;
+}
+
+// ---- alphaMode: surfaces cut away -----------------------------------------------------------
+// The opacity of triangle tri at barycentrics (u, v): 1 for OPAQUE; MASK: 1 where alpha >=
+// alphaCutoff, else 0; BLEND: alpha. alpha = base colour factor x texture x vertex colour
+// alpha, as glTF defines it.
+float surface_opacity(uint tri, float u, float v)
+{
+    GnPrim pr = prim_at(tri);
+    GnMaterial m = material_at(pr.material);
+    if ((m.flags & (GN_MAT_MASK | GN_MAT_BLEND)) == 0u)
+        return 1.0;
+    GnVertex a = vertex_at(pr.i0), b = vertex_at(pr.i1), c = vertex_at(pr.i2);
+    float w = 1.0 - u - v, alpha = m.base_color.a;
+    if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_base != GN_INVALID)
+        alpha *= texture_sample(m.tex_base, w * vec2(a.u, a.v) + u * vec2(b.u, b.v) + v * vec2(c.u, c.v), false).a;
+    if (vertex_colors())
+        alpha *= w * a.color.a + u * b.color.a + v * c.color.a;
+    if ((m.flags & GN_MAT_MASK) != 0u)
+        return alpha >= m.alpha_cutoff ? 1.0 : 0.0;
+    return clamp(alpha, 0.0, 1.0);
 }
 
 // The pixel of this invocation. lavapipe runs a work group as SIMD groups of 8 consecutive

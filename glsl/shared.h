@@ -89,6 +89,8 @@ typedef uint32_t uint;
 /* GnMaterial.flags */
 #define GN_MAT_DOUBLE_SIDED 1u
 #define GN_MAT_UNLIT 2u
+#define GN_MAT_MASK 4u    /* glTF alphaMode MASK: cut away where alpha < alpha_cutoff */
+#define GN_MAT_BLEND 8u   /* glTF alphaMode BLEND: stochastic transparency, opacity alpha */
 
 /* GnFrame.flags */
 #define GN_FRAME_AOV 1u       /* write normal/albedo/depth sums */
@@ -97,6 +99,7 @@ typedef uint32_t uint;
 #define GN_FRAME_BSDF_ONLY 8u  /* path: area lights and the environment only by BSDF sampling */
 #define GN_FRAME_ENV_MAP 16u   /* path: the environment is the map in GN_BIND_ENV */
 #define GN_FRAME_VERTEX_COLOR 32u /* the scene has vertex colours (GnVertex.color) */
+#define GN_FRAME_ALPHA 64u     /* the scene has MASK or BLEND materials (surfaces cut away) */
 
 /* GnEmitter.prim: a triangle (GnPrim index), a punctual light (this bit | GnLight index),
  * or the environment (GN_INVALID). */
@@ -133,10 +136,11 @@ typedef uint32_t uint;
 #define GN_FEAT_STRATEGY (1u << 22)     /* light-only or BSDF-only estimators */
 #define GN_FEAT_AOV (1u << 23)
 #define GN_FEAT_VERTEX_COLOR (1u << 24) /* glTF COLOR_0 */
+#define GN_FEAT_ALPHA (1u << 25)        /* alphaMode MASK or BLEND (glsl/bvh.glsl: trace_visible) */
 #define GN_FEAT_LOBES (GN_FEAT_MIRROR | GN_FEAT_PHONG | GN_FEAT_BLINN | GN_FEAT_TS | \
                        GN_FEAT_BECKMANN | GN_FEAT_GGX)
 #define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
-#define GN_FEAT_ALL 0x01ffffffu
+#define GN_FEAT_ALL 0x03ffffffu
 
 /* ---- BVH: both children's boxes in one 64-byte node (Aila & Laine 2009, "Understanding
  * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only
@@ -188,7 +192,8 @@ GN_STRUCT(GnPrim) {
 GN_STRUCT(GnVertex) {
     vec3 position; float u;
     vec3 normal; float v;
-    vec4 tangent; /* xyz tangent, w handedness; all zero when the mesh has none */
+    vec4 tangent; /* xyz tangent, w handedness; the loader generates them (MikkTSpace) for
+                     normal maps without TANGENT; else all zero when the mesh has none */
     vec4 color;   /* glTF COLOR_0 (linear RGBA; 1 when the mesh has none), read only when
                      GnFrame.flags has GN_FRAME_VERTEX_COLOR */
 } GN_END(GnVertex); /* 64 bytes */

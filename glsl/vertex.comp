@@ -23,6 +23,8 @@ void main()
     if (i >= uint(vcolor.length()) / 2u)
         return;
     GnVertex a = vertex_at(i);
+    rng_pixel = i; // the BLEND test's random numbers in the shadow rays: per vertex
+    rng_sample = side;
     uint material = floatBitsToUint(vcolor[2u * i].w);
     vec3 n = dot(a.normal, a.normal) > 1e-20 ? normalize(a.normal) : vec3(0.0);
     if (side == 1u)

@@ -120,6 +120,10 @@ static void write_material(FILE *f, const gltf_write_material *m)
     }
     if (m->double_sided)
         fputs(",\"doubleSided\":true", f);
+    if (m->alpha_mode)
+        fprintf(f, ",\"alphaMode\":\"%s\"", m->alpha_mode);
+    if (m->alpha_cutoff != 0)
+        fprintf(f, ",\"alphaCutoff\":%.9g", m->alpha_cutoff);
     if (ext) {
         const char *sep = "";
         fputs(",\"extensions\":{", f);

@@ -36,6 +36,8 @@ typedef struct gltf_write_material {
     float ior;                 /* KHR_materials_ior; 0: not written */
     float transmission;        /* KHR_materials_transmission; 0: not written */
     bool double_sided;
+    const char *alpha_mode;    /* "MASK" or "BLEND"; NULL: OPAQUE (not written) */
+    float alpha_cutoff;        /* MASK only; 0: not written (glTF's 0.5) */
     const char *extras;        /* raw JSON object text, e.g. {"gonio":{...}}; NULL: none */
 } gltf_write_material;
 

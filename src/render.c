@@ -151,6 +151,8 @@ static uint32_t material_features(const GnMaterial *m)
         f |= GN_FEAT_NORMAL_MAP | GN_FEAT_TEXTURES;
     if (m->flags & GN_MAT_UNLIT)
         f |= GN_FEAT_UNLIT;
+    if (m->flags & (GN_MAT_MASK | GN_MAT_BLEND))
+        f |= GN_FEAT_ALPHA;
     if (luminance(&m->emissive.x) > 0)
         f |= GN_FEAT_EMISSIVE;
     switch (m->brdf) {
@@ -603,7 +605,8 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->max_depth = (uint32_t)s->max_depth;
     frame->num_lights = r->num_lights;
     frame->flags = (s->aov & RENDER_AOV_GPU ? GN_FRAME_AOV : 0u) | (s->shadows ? GN_FRAME_SHADOWS : 0u) |
-                   (r->sc->vertex_colors ? GN_FRAME_VERTEX_COLOR : 0u);
+                   (r->sc->vertex_colors ? GN_FRAME_VERTEX_COLOR : 0u) |
+                   (r->material_features & GN_FEAT_ALPHA ? GN_FRAME_ALPHA : 0u);
     frame->env_color = (vec3){s->env[0], s->env[1], s->env[2]};
     frame->env_cos = (float)cos(s->env_rotation * M_PI / 180);
     frame->env_sin = (float)-sin(s->env_rotation * M_PI / 180);
@@ -639,10 +642,12 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     return true;
 }
 
-/* The GN_FEAT_* a mode's kernel is built for: only the path kernel is specialised. */
+/* The GN_FEAT_* a mode's kernel is built for: the path kernel is specialised on all of
+ * them, the local kernels only on GN_FEAT_ALPHA (surfaces cut away, glsl/bvh.glsl). */
 static uint32_t kernel_features(const renderer *r, uint32_t mode)
 {
-    return mode == GN_MODE_PATH ? r->path_features : GN_FEAT_ALL;
+    return mode == GN_MODE_PATH ? r->path_features
+                                : (GN_FEAT_ALL & ~GN_FEAT_ALPHA) | (r->material_features & GN_FEAT_ALPHA);
 }
 
 /* The walk's stack in registers for trees of at most GN_WALK_REGS_MAX levels (a walk puts

@@ -45,7 +45,8 @@ typedef struct scene {
     char path[1024];
 
     uint32_t num_vertices;
-    GnVertex *vertices;         /* world space; normals normalised; tangents zero if absent */
+    GnVertex *vertices;         /* world space; normals normalised; tangents zero if absent
+                                   and not generated (src/tangent.c: for normal maps) */
 
     uint32_t num_triangles;
     uint32_t *indices;          /* 3 per triangle, into vertices */
@@ -84,7 +85,7 @@ typedef struct scene {
  * problem and return false with *out zeroed. What can be skipped or repaired safely prints a
  * warning naming the file and the feature: points/lines primitives (strips and fans become
  * triangles), orthographic or invalid cameras, invalid lights, unknown optional extensions,
- * alpha modes (rendered opaque), texCoord != 0 and missing or undecodable images (texture
+ * unknown alpha modes (rendered opaque), texCoord != 0 and missing or undecodable images (texture
  * slot GN_INVALID; PNG and JPEG only), out-of-range material values (clamped), non-unit
  * normals (renormalised), skins, morph targets, COLOR_0. Primitives without NORMAL get flat
  * normals (de-indexed). Triangles with non-finite or absurdly large (|x| > 1e15) vertices

@@ -25,6 +25,7 @@
 
 extern "C" {
 #include "scene.h"
+#include "tangent.h"
 #include "util.h"
 }
 
@@ -964,6 +965,31 @@ void make_flat(Prim &p)
     p = std::move(f);
 }
 
+/* glTF 2.0, "Meshes": a normal texture without TANGENT takes MikkTSpace tangents
+ * (src/tangent.c), which split vertices where handedness or smoothing groups differ. */
+void generate_tangents(Prim &p)
+{
+    uint32_t *remap;
+    float *tan;
+    size_t n = tangent_generate(p.pos.size() / 3, p.pos.data(), p.nrm.data(), p.uv.data(), p.idx.size() / 3,
+                                p.idx.data(), &remap, &tan);
+    auto expand = [&](std::vector<float> &a, size_t k) {
+        if (a.empty())
+            return;
+        std::vector<float> b(n * k);
+        for (size_t v = 0; v < n; v++)
+            std::copy(&a[remap[v] * k], &a[remap[v] * k] + k, &b[v * k]);
+        a = std::move(b);
+    };
+    expand(p.pos, 3);
+    expand(p.nrm, 3);
+    expand(p.uv, 2);
+    expand(p.col, 4);
+    p.tan.assign(tan, tan + n * 4);
+    free(remap);
+    free(tan);
+}
+
 const char *mode_name(int mode)
 {
     static const char *const names[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
@@ -1054,6 +1080,10 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
         read_colors(c, what, col, out);
     if (out.nrm.empty())
         make_flat(out);
+    const tinygltf::Material *mat = p.material >= 0 && size_t(p.material) < c.m.materials.size()
+                                        ? &c.m.materials[size_t(p.material)] : nullptr;
+    if (out.tan.empty() && !out.uv.empty() && mat && mat->normalTexture.index >= 0)
+        generate_tangents(out);
     return true;
 }
 
@@ -1574,8 +1604,10 @@ void convert_material(Ctx &c, int mi, GnMaterial &g, scene_material_extras &x, c
     g.normal_scale = float(mat.normalTexture.scale);
     g.occlusion_strength = ranged(c, mat.occlusionTexture.strength, 0, 1, what, "occlusionTexture.strength");
     g.alpha_cutoff = ranged(c, mat.alphaCutoff, 0, INFINITY, what, "alphaCutoff");
-    if (mat.alphaMode == "MASK" || mat.alphaMode == "BLEND")
-        warn(c, "%s: alphaMode %s is rendered opaque", what.c_str(), mat.alphaMode.c_str());
+    if (mat.alphaMode == "MASK")
+        g.flags |= GN_MAT_MASK;
+    else if (mat.alphaMode == "BLEND")
+        g.flags |= GN_MAT_BLEND;
     else if (mat.alphaMode != "OPAQUE")
         warn(c, "%s: unknown alphaMode '%s' (rendered opaque)", what.c_str(), mat.alphaMode.substr(0, 64).c_str());
     g.tex_base = texture_slot(c, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, what, "baseColorTexture");

@@ -7,3 +7,6 @@
 #include "suite_brdf.h"
 #include "suite_shading.h"
 #include "suite_path.h"
+#include "suite_tangent.h"
+#include "suite_normals.h"
+#include "suite_alpha.h"
