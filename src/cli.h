@@ -25,6 +25,14 @@ int cmd_preview(int argc, char **argv);
  * error naming the option; cli_usage_error prints "gonio CMD: MESSAGE" and the hint to use
  * --help. */
 const char *cli_value(int argc, char **argv, int *i);
+/* cli_value for an option the command's usage text lists with a value (see cli.c); any
+ * other option is reported as unknown, so a mistyped one never takes the next argument. */
+const char *cli_option_value(int argc, char **argv, int *i, const char *usage);
+bool cli_usage_lists_value(const char *usage, const char *opt);
+/* argv with every "--name=value" (after the command name) split into "--name" "value", so
+ * each command's parser sees one form. Returns the new argc and sets *out (allocated, kept
+ * until exit), or -1 after a usage error (a flag given a value). */
+int cli_split_equals(int argc, char **argv, char ***out);
 int cli_usage_error(const char *cmd, const char *fmt, ...);
 /* The Vulkan device for a command: --device, --validate (or GONIO_VALIDATE=1 in the
  * environment). */

@@ -212,7 +212,7 @@ int cmd_bench(int argc, char **argv)
         } else if (!strcmp(a, "--paths")) {
             paths = true;
         } else if (a[0] == '-' && a[1]) {
-            if (!(val = cli_value(argc, argv, &i)))
+            if (!(val = cli_option_value(argc, argv, &i, bench_usage)))
                 return 2;
             if (!strcmp(a, "--generate")) {
                 if (!util_parse_int(val, 1, 50000000, &generate))

@@ -100,7 +100,7 @@ int cmd_render(int argc, char **argv)
         } else if (!strcmp(a, "--no-shadows")) {
             s.shadows = false;
         } else if (a[0] == '-' && a[1]) {
-            if (!(val = cli_value(argc, argv, &i)))
+            if (!(val = cli_option_value(argc, argv, &i, render_usage)))
                 return 2;
             if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
                 out_path = val;
@@ -317,6 +317,7 @@ int cmd_devices(int argc, char **argv)
         return 0;
     }
     if (argc > 1)
-        return cli_usage_error("devices", "unexpected argument '%s'", argv[1]);
+        return cli_usage_error("devices", argv[1][0] == '-' ? "unknown option '%s'" : "unexpected argument '%s'",
+                               argv[1]);
     return gpu_print_devices() ? 0 : 1;
 }

@@ -742,7 +742,7 @@ int cmd_preview(int argc, char **argv)
         } else if (!strcmp(a, "--no-shadows")) {
             p->s.shadows = false;
         } else if (a[0] == '-' && a[1]) {
-            if (!(val = cli_value(argc, argv, &i)))
+            if (!(val = cli_option_value(argc, argv, &i, usage)))
                 return 2;
             if (!strcmp(a, "--mode")) {
                 int m = render_mode_from_name(val);
