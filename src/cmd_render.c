@@ -40,12 +40,33 @@ static const char render_usage[] =
     "  --validate          enable the Vulkan validation layer; any message fails the render\n"
     "  --quiet             no progress bar and no summary line\n";
 
-static volatile sig_atomic_t stop_requested;
+static volatile sig_atomic_t stop_requested; /* the signal that asked, 0 = none */
+static bool signal_quiet;
 
+/* The first SIGINT or SIGTERM ends the render after the current pass (what it has is
+ * written, and the exit status is 128 + the signal); a second one ends the program at once,
+ * removing the temporary file of a write under way. Only async-signal-safe calls here. */
 static void on_signal(int sig)
 {
-    (void)sig;
-    stop_requested = 1;
+    static const char msg[] = "\ngonio: stopping after this pass (interrupt again to quit now)\n";
+    if (stop_requested) {
+        util_remove_pending_tmp();
+        _exit(128 + sig);
+    }
+    stop_requested = sig;
+    if (!signal_quiet && write(2, msg, sizeof msg - 1) < 0)
+        return;
+}
+
+static void catch_signals(bool quiet)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    signal_quiet = quiet;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
 }
 
 /* Fails early when the directory of an output file cannot be written, rather than after a
@@ -221,8 +242,7 @@ int cmd_render(int argc, char **argv)
         image_destroy(&env_map);
         return 1;
     }
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
+    catch_signals(quiet);
     renderer_create(&r, &g, &sc);
     if (renderer_render(&r, &s, &img, &st)) {
         char seconds[32];
@@ -248,7 +268,7 @@ int cmd_render(int argc, char **argv)
                     out_path ? out_path : png_path, s.width, s.height, render_mode_name(s.mode),
                     st.spp, seconds, st.seconds > 0 ? (double)st.rays / st.seconds * 1e-6 : 0.0,
                     s.mode == GN_MODE_PATH ? "M paths/s" : "Mrays/s primary", st.setup_seconds);
-        rc = ok ? 0 : 1;
+        rc = !ok ? 1 : stop_requested ? 128 + stop_requested : 0;
     }
     image_destroy(&img);
     image_destroy(&env_map);

@@ -43,5 +43,81 @@ for c in "render $C -o $tmp/x.exr" "preview $C" "info $C" devices "compare $C -o
             grep -q "unknown option '*--frobnicate" "$tmp/last"
     done
 done
+# ---- progress ---------------------------------------------------------------------------
+# Not a terminal (a log): plain lines, none before a second has passed, then one a tenth;
+# with --time the percentage is the time's (each line's within 1 of 100 elapsed / limit).
+"$G" render $C -o "$tmp/p.exr" --size 32x32 --time 2 2>"$tmp/p.err"
+check "log: no carriage returns" sh -c "! grep -q \$(printf '\r') '$tmp/p.err'"
+grep -E '^gonio: +[0-9]+%  [0-9]+ spp  [0-9.]+ spp/s  [0-9.]+ M paths/s  [0-9.]+ s  ' "$tmp/p.err" >"$tmp/p.lines"
+n=$(wc -l <"$tmp/p.lines")
+check "log: 3 to 11 progress lines (got $n)" test "$n" -ge 3 -a "$n" -le 11
+check "log: each line has an ETA, the last says done" sh -c \
+    "head -n -1 '$tmp/p.lines' | grep -vq 'ETA' && exit 1; tail -n 1 '$tmp/p.lines' | grep -q '100%.* done$'"
+# elapsed() in awk: the seconds before "ETA" or "done" (printed to 0.1 s: 2.5% of 2 s).
+E='function elapsed() { match($0, /[0-9.]+ s  (ETA|done)/); return substr($0, RSTART) + 0 }'
+check "log: --time progress is the time's" awk "$E"'{ p = $2 + 0; e = 50 * elapsed();
+    if ($NF != "done" && (p > e + 4 || p < e - 4)) { print "line: " $0; bad = 1 } } END { exit bad }' "$tmp/p.lines"
+check "log: no line before a second" awk "$E"'{ if (elapsed() < 0.95 && $NF != "done") bad = 1 } END { exit bad }' "$tmp/p.lines"
+"$G" render $C -o "$tmp/p.exr" --size 32x32 --mode phong --spp 4000 2>"$tmp/p2.err"
+check "log: --spp progress counts spp" grep -Eq '^gonio: +[0-9]+%  [0-9]+/4000 spp .* Mrays/s .* ETA [0-9.]+ s$' "$tmp/p2.err"
+"$G" render $C -o "$tmp/p.exr" --size 32x32 --time 1.5 --quiet 2>"$tmp/p3.err"
+check "--quiet: nothing on stderr" test ! -s "$tmp/p3.err"
+if command -v script >/dev/null; then
+    script -qec "'$G' render '$C' -o '$tmp/p.exr' --size 32x32 --spp 64" /dev/null >"$tmp/tty.out" 2>&1
+    check "terminal: a bar redrawn in place with rate and ETA" \
+        grep -Eq "$(printf '\r')"'\[#* *\] +[0-9]+%  [0-9]+/64 spp  [0-9.]+ spp/s  [0-9.]+ M paths/s  [0-9.]+ s  (ETA|done)' "$tmp/tty.out"
+else
+    echo "  note: script(1) is missing: the terminal progress bar is not checked"
+fi
+
+# ---- interrupts ---------------------------------------------------------------------------
+# wait_for FILE PATTERN: until FILE has a line matching PATTERN (at most 60 s).
+wait_for() { for _ in $(seq 600); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
+# SIGINT (or SIGTERM) once: the render ends after its pass, writes what it has, exits 128 + N.
+for sig in INT TERM; do
+    want=$((128 + $(kill -l $sig)))
+    rm -f "$tmp/i.exr"
+    "$G" render $C -o "$tmp/i.exr" --png "$tmp/i.png" --size 32x32 --time 60 2>"$tmp/i.err" &
+    pid=$!
+    wait_for "$tmp/i.err" 'ETA'
+    kill -$sig $pid
+    wait $pid
+    rc=$?
+    check "SIG$sig: exit $want (got $rc)" test $rc = $want
+    check "SIG$sig: the EXR and PNG are written" test -s "$tmp/i.exr" -a -s "$tmp/i.png"
+    spp=$(exrheader "$tmp/i.exr" 2>/dev/null | sed -n 's/.*gonio:spp (type int): //p')
+    check "SIG$sig: its gonio:spp is what was rendered ($spp)" grep -q "writing the $spp spp" "$tmp/i.err"
+    check "SIG$sig: the progress line says interrupted" grep -Eq '^gonio: +[0-9]+% .* interrupted$' "$tmp/i.err"
+    check "SIG$sig: no temporary file left" sh -c "! ls -a '$tmp' | grep -q tmp-"
+done
+# Twice: at once, status 130, no output at all.
+rm -f "$tmp/i.exr"
+"$G" render $C -o "$tmp/i.exr" --size 512x512 --time 60 2>"$tmp/i.err" &
+pid=$!
+wait_for "$tmp/i.err" 'ETA'
+kill -INT $pid
+wait_for "$tmp/i.err" 'stopping after this pass'
+kill -INT $pid
+wait $pid
+check "SIGINT twice: exit 130 (got $?)" test $? = 130
+check "SIGINT twice: no output" test ! -e "$tmp/i.exr"
+# ...and while the image is being written (a large one): the temporary file is removed.
+"$G" render $C -o "$tmp/big.exr" --size 6000x6000 --mode depth --time 60 2>"$tmp/b.err" &
+pid=$!
+wait_for "$tmp/b.err" 'spp'
+kill -INT $pid
+for _ in $(seq 2000); do ls -a "$tmp" | grep -q '\.big\.exr\.tmp-' && break; sleep 0.005; done
+if ls -a "$tmp" | grep -q '\.big\.exr\.tmp-'; then
+    kill -INT $pid
+    wait $pid
+    rc=$?
+    check "SIGINT during the write: exit 130 (got $rc)" test $rc = 130
+    check "SIGINT during the write: no output, no temporary file" \
+        sh -c "! ls -a '$tmp' | grep -q 'big\.exr'"
+else
+    wait $pid
+    echo "  note: the write ended before it could be interrupted: not checked"
+fi
+
 check "no output after usage errors" test ! -e "$tmp/x.exr"
 finish
