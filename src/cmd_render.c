@@ -90,6 +90,41 @@ static bool check_writable(const char *path)
     return true;
 }
 
+/* Options that the chosen mode or outputs do not use: a warning each, never silence. Reads
+ * argv again (values skipped) rather than flags set by the parser, so it sees what was
+ * typed, defaults included. */
+static void warn_inapplicable(int argc, char **argv, const render_settings *s, const char *png_path)
+{
+    static const struct {
+        const char *opt;
+        int when; /* 0: path mode only; 1: local modes only; 2: with a PNG only; 3: not with
+                   * --time; 4: path and albedo (the model's colour) only */
+    } rules[] = {{"--max-depth", 0}, {"--brdf", 4}, {"--estimator", 0}, {"--ambient", 1},
+                 {"--no-shadows", 1}, {"--exposure", 2}, {"--tonemap", 2}, {"--spp", 3}};
+    const bool path = s->mode == GN_MODE_PATH;
+    for (int i = 1; i < argc; i++) {
+        for (size_t k = 0; k < sizeof rules / sizeof *rules; k++) {
+            if (strcmp(argv[i], rules[k].opt))
+                continue;
+            if (rules[k].when == 0 && !path)
+                util_warn("%s applies to --mode path only; ignored with --mode %s", rules[k].opt,
+                          render_mode_name(s->mode));
+            else if (rules[k].when == 1 && path)
+                util_warn("%s applies to the local modes only; ignored with --mode path", rules[k].opt);
+            else if (rules[k].when == 2 && !png_path)
+                util_warn("%s applies to the PNG only; ignored without --png", rules[k].opt);
+            else if (rules[k].when == 4 && !path && s->mode != GN_MODE_ALBEDO)
+                util_warn("%s applies to --mode path (and albedo, its colour) only; ignored with "
+                          "--mode %s", rules[k].opt, render_mode_name(s->mode));
+            else if (rules[k].when == 3 && s->time_limit > 0)
+                util_warn("%s is ignored with --time: the render takes as many samples as fit",
+                          rules[k].opt);
+        }
+        if (cli_usage_lists_value(render_usage, argv[i]))
+            i++;
+    }
+}
+
 int cmd_render(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_path = NULL, *png_path = NULL;
@@ -204,6 +239,7 @@ int cmd_render(int argc, char **argv)
             return cli_usage_error("render", "unexpected argument '%s'", a);
         }
     }
+    warn_inapplicable(argc, argv, &s, png_path);
     if (!scene_path)
         return cli_usage_error("render", "no scene given");
     if (!out_path && !png_path)

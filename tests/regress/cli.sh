@@ -43,6 +43,33 @@ for c in "render $C -o $tmp/x.exr" "preview $C" "info $C" devices "compare $C -o
             grep -q "unknown option '*--frobnicate" "$tmp/last"
     done
 done
+# ---- render: an option the mode or outputs do not use is a warning, not silence --------
+# warns MODE-AND-OPTIONS... -- WARNING: the render succeeds and stderr says WARNING.
+warns() {
+    local args=() want
+    while [ "$1" != -- ]; do args+=("$1"); shift; done
+    want=$2
+    "$G" render $C -o "$tmp/w.exr" --size 8x8 --spp 1 --quiet "${args[@]}" 2>"$tmp/w.err"
+    if [ $? = 0 ] && grep -q "warning: $want" "$tmp/w.err"; then pass
+    else fail "render ${args[*]}: expected a warning '$want', got: $(cat "$tmp/w.err")"; fi
+}
+for o in "--max-depth 3" "--estimator light"; do
+    warns --mode phong $o -- "${o% *} applies to --mode path only; ignored with --mode phong"
+done
+warns --mode flat --brdf lambert -- "--brdf applies to --mode path (and albedo"
+warns --ambient 0.5 -- "--ambient applies to the local modes only"
+warns --no-shadows -- "--no-shadows applies to the local modes only"
+warns --exposure 1 -- "--exposure applies to the PNG only"
+warns --tonemap=aces -- "--tonemap applies to the PNG only"
+warns --time 0.1 --spp 4 -- "--spp is ignored with --time"
+"$G" render $C -o "$tmp/w.exr" --png "$tmp/w.png" --size 8x8 --spp 1 --max-depth 2 --brdf lambert \
+    --estimator bsdf --exposure 1 --tonemap aces --quiet 2>"$tmp/w.err"
+check "options that apply: no warning" test ! -s "$tmp/w.err"
+"$G" render $C -o "$tmp/w.exr" --size 8x8 --spp 1 --mode albedo --brdf lambert --ambient 1 --no-shadows --quiet 2>"$tmp/w.err"
+check "albedo with --brdf, --ambient, --no-shadows: no warning about --brdf" sh -c "! grep -q brdf '$tmp/w.err'"
+"$G" render $C --png "$tmp/--ambient" --size 8x8 --spp 1 --quiet 2>"$tmp/w.err"
+check "a value that looks like an option is not taken for one" test ! -s "$tmp/w.err"
+
 # ---- progress ---------------------------------------------------------------------------
 # Not a terminal (a log): plain lines, none before a second has passed, then one a tenth;
 # with --time the percentage is the time's (each line's within 1 of 100 elapsed / limit).
