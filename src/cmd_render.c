@@ -1,5 +1,6 @@
 /* cmd_render.c: `gonio render`, `gonio info` and `gonio devices`. */
 #include <errno.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -315,8 +316,46 @@ int cmd_render(int argc, char **argv)
     return rc;
 }
 
-static const char info_usage[] = "usage: gonio info SCENE.gltf|.glb\n\n"
-                                 "Prints the scene's contents and its BVH statistics.\n";
+static const char info_usage[] =
+    "usage: gonio info SCENE.gltf|.glb\n\n"
+    "Prints the scene's contents and its BVH statistics: the emissive triangles (the path\n"
+    "tracer's area lights) and the materials that emit, and one line per camera (index, name,\n"
+    "position, forward direction, vertical field of view).\n";
+
+/* The area lights as the path tracer sees them (render.c: build_emitters): triangles of
+ * non-zero area whose material emits and is not unlit; prints the materials by name. */
+static void print_emitters(const scene *sc)
+{
+    uint32_t tris = 0, mats = 0;
+    uint32_t *count = util_calloc(sc->num_materials, sizeof *count);
+    for (uint32_t t = 0; t < sc->num_triangles; t++) {
+        const GnMaterial *m = &sc->materials[sc->tri_material[t]];
+        const float *p[3];
+        double e1[3], e2[3], c[3];
+        if (!(m->emissive.x > 0 || m->emissive.y > 0 || m->emissive.z > 0) || (m->flags & GN_MAT_UNLIT))
+            continue;
+        for (int k = 0; k < 3; k++)
+            p[k] = &sc->vertices[sc->indices[3 * t + k]].position.x;
+        for (int k = 0; k < 3; k++) {
+            e1[k] = p[1][k] - p[0][k];
+            e2[k] = p[2][k] - p[0][k];
+        }
+        c[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        c[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        c[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        if (!(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > 0))
+            continue;
+        tris++;
+        mats += count[sc->tri_material[t]]++ == 0;
+    }
+    printf("emissive       %u triangles in %u material(s)", tris, mats);
+    for (uint32_t m = 0, n = 0; m < sc->num_materials; m++)
+        if (count[m])
+            printf("%s%s (%u)", n++ ? ", " : ": ", sc->material_names[m][0] ? sc->material_names[m] : "(unnamed)",
+                   count[m]);
+    printf("\n");
+    free(count);
+}
 
 int cmd_info(int argc, char **argv)
 {
@@ -348,7 +387,14 @@ int cmd_info(int argc, char **argv)
     printf("materials      %u\n", sc.num_materials);
     printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
     printf("lights         %u\n", sc.num_lights);
+    print_emitters(&sc);
     printf("cameras        %u\n", sc.num_cameras);
+    for (uint32_t i = 0; i < sc.num_cameras; i++) {
+        const scene_camera *c = &sc.cameras[i];
+        printf("camera %-7u \"%s\" position (%g, %g, %g) forward (%g, %g, %g) yfov %.4g deg\n", i,
+               c->name, c->position[0], c->position[1], c->position[2], c->forward[0],
+               c->forward[1], c->forward[2], c->yfov * 180 / M_PI);
+    }
     printf("bounds         (%g, %g, %g) - (%g, %g, %g)\n", sc.bounds_min[0], sc.bounds_min[1],
            sc.bounds_min[2], sc.bounds_max[0], sc.bounds_max[1], sc.bounds_max[2]);
     printf("bvh nodes      %u (%zu bytes each)\n", b.num_nodes, sizeof(GnBvhNode));

@@ -70,6 +70,26 @@ check "albedo with --brdf, --ambient, --no-shadows: no warning about --brdf" sh 
 "$G" render $C --png "$tmp/--ambient" --size 8x8 --spp 1 --quiet 2>"$tmp/w.err"
 check "a value that looks like an option is not taken for one" test ! -s "$tmp/w.err"
 
+# ---- gonio info: emitters and cameras ---------------------------------------------------
+# The Cornell box's light is one quad (src/cmd_scene.c); its camera stands at (0, 0.273,
+# 0.8) looking down -Z with the published 39.3 degrees.
+"$G" info $C >"$tmp/info.txt"
+check "info: the Cornell box's light, 2 triangles" grep -q '^emissive  *2 triangles in 1 material(s): light (2)$' "$tmp/info.txt"
+check "info: its camera, one line" grep -Eq '^camera 0 +"camera" position \(0, 0.273, 0.8\) forward \(0, 0, -1\) yfov 39.3[0-9]* deg$' "$tmp/info.txt"
+A=${GONIO_ASSETS:-}/gltf
+if [ -d "$A/EmissiveStrengthTest" ] && [ -d "$A/Cameras" ]; then
+    # Five cubes (36 indices each), each with its own emissive material; the backdrop emits nothing.
+    "$G" info "$A/EmissiveStrengthTest/glTF/EmissiveStrengthTest.gltf" >"$tmp/info2.txt"
+    check "info: EmissiveStrengthTest, 60 triangles in 5 materials" \
+        grep -q '^emissive  *60 triangles in 5 material(s): Emit4 (12), Emit2 (12), Emit1 (12), Emit8 (12), Emit16 (12)$' "$tmp/info2.txt"
+    # Its node 1: translation (0.5, 0.5, 3), no rotation, yfov 0.7 rad = 40.107 degrees.
+    "$G" info "$A/Cameras/glTF/Cameras.gltf" >"$tmp/info3.txt" 2>/dev/null
+    check "info: Cameras.gltf's perspective camera" \
+        grep -Eq '^camera 0 +".*" position \(0.5, 0.5, 3\) forward \(0, 0, -1\) yfov 40.1[01] deg$' "$tmp/info3.txt"
+else
+    echo "  note: \$GONIO_ASSETS has no EmissiveStrengthTest or Cameras: those info checks skipped"
+fi
+
 # ---- progress ---------------------------------------------------------------------------
 # Not a terminal (a log): plain lines, none before a second has passed, then one a tenth;
 # with --time the percentage is the time's (each line's within 1 of 100 elapsed / limit).
