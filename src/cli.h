@@ -7,6 +7,8 @@
 
 #include "gpu.h"
 
+struct scene;
+
 #define GONIO_VERSION "0.1.0"
 
 int cmd_render(int argc, char **argv);
@@ -20,6 +22,11 @@ int cmd_teapot(int argc, char **argv);
 int cmd_merge(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_preview(int argc, char **argv);
+
+/* One of `gonio scene`'s scenes ("cornell", "teapot") loaded as from its glTF (written to a
+ * temporary directory and removed), so a default scene needs no file in the working
+ * directory. */
+bool cli_load_builtin_scene(struct scene *out, const char *name);
 
 /* Shared option handling. cli_value returns argv[i + 1] (advancing *i) or reports a usage
  * error naming the option; cli_usage_error prints "gonio CMD: MESSAGE" and the hint to use

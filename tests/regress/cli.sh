@@ -90,6 +90,29 @@ else
     echo "  note: \$GONIO_ASSETS has no EmissiveStrengthTest or Cameras: those info checks skipped"
 fi
 
+# ---- every command from any directory: no path into the source tree ----------------------
+mkdir -p "$tmp/elsewhere"
+cd "$tmp/elsewhere" && {
+    check "bench without a scene, elsewhere" "$G" bench --size 16x16 --seconds 0.05
+    cp "$tmp/out" bench.txt
+    check "... is the built-in Cornell box (32 triangles)" sh -c \
+        "grep -q '^scene  *cornell (built in)' bench.txt && grep -q '^triangles  *32$' bench.txt"
+    check "bench --paths without a scene, elsewhere" "$G" bench --paths --size 16x16 --seconds 0.1 --reference 16x16:8
+    check "scene cornell, elsewhere" "$G" scene cornell -o c.gltf
+    check "... the same file as scenes/cornell.gltf" cmp c.gltf "$C"
+    check "teapot, elsewhere" "$G" teapot --level 1 -o t.gltf
+    check "render, elsewhere" "$G" render c.gltf -o r.exr --png r.png --size 16x16 --spp 2 --quiet
+    check "render another seed, elsewhere" "$G" render c.gltf -o r2.exr --size 16x16 --spp 2 --seed 1 --quiet
+    check "merge, elsewhere" "$G" merge r.exr r2.exr -o m.exr
+    check "diff, elsewhere" "$G" diff r.exr m.exr --quiet
+    check "info, elsewhere" "$G" info t.gltf
+    check "devices, elsewhere" "$G" devices
+    check "brdf --sphere, elsewhere" "$G" brdf lambert --sphere -o b.exr --size 16x16 --spp 1
+    check "compare, elsewhere" "$G" compare c.gltf -o cmp --size 16x16 --spp 1 --modes flat,phong --quiet
+    check "compare --sweep, elsewhere" "$G" compare --sweep 1,2 teapot -o sweep --size 16x16 --quiet
+    cd - >/dev/null
+}
+
 # ---- progress ---------------------------------------------------------------------------
 # Not a terminal (a log): plain lines, none before a second has passed, then one a tenth;
 # with --time the percentage is the time's (each line's within 1 of 100 elapsed / limit).
