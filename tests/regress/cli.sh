@@ -113,6 +113,38 @@ cd "$tmp/elsewhere" && {
     cd - >/dev/null
 }
 
+# ---- make install: the program, its man page, its bash completion ----------------------
+inst=$tmp/inst
+if command -v help2man >/dev/null && command -v man >/dev/null; then
+    check "make install DESTDIR= PREFIX=/usr" make -s install DESTDIR="$inst" PREFIX=/usr config="${CONFIG:-release}"
+    check "installed: bin/gonio runs" "$inst/usr/bin/gonio" --version
+    MANWIDTH=100 man -l "$inst/usr/share/man/man1/gonio.1" >"$tmp/man.txt" 2>"$tmp/man.err"
+    check "man -l renders the page" test -s "$tmp/man.txt"
+    check "man: no roff warnings" test ! -s "$tmp/man.err"
+    for want in "^NAME" "gonio - a physically based renderer" "^COMMANDS" "usage: gonio render SCENE" \
+        "--max-depth N" "gonio teapot .--level N" "^EXIT STATUS" "130 after"; do
+        check "man page has '$want'" grep -q -- "$want" "$tmp/man.txt"
+    done
+    comp=$inst/usr/share/bash-completion/completions/gonio
+    # complete WORDS...: what the installed script offers for the last word.
+    complete_words() {
+        PATH="$inst/usr/bin:$PATH" bash -c '. "$0"; COMP_WORDS=("${@}"); COMP_CWORD=$(($# - 1))
+            _gonio; complete -p gonio >/dev/null || exit 1; [ ${#COMPREPLY[@]} = 0 ] || printf "%s\n" "${COMPREPLY[@]}" | sort -u | tr "\n" " "' "$comp" "$@"
+    }
+    check "completion: gonio re -> render" test "$(complete_words gonio re)" = "render "
+    check "completion: gonio render --mo -> --mode" test "$(complete_words gonio render --mo)" = "--mode "
+    check "completion: --mode p -> path phong" test "$(complete_words gonio render c.gltf --mode p)" = "path phong "
+    check "completion: gonio bench --p -> --paths" test "$(complete_words gonio bench --p)" = "--paths "
+    check "completion: a BRDF model's parameters" test "$(complete_words gonio brdf phong --ex)" = "--exponent "
+    check "completion: no guess after --spp" test -z "$(complete_words gonio render c.gltf --spp '')"
+    mkdir -p "$tmp/files" && touch "$tmp/files/a.exr" "$tmp/files/b.png" "$tmp/files/c.gltf" "$tmp/files/d.glb"
+    check "completion: diff offers EXRs" test "$(cd "$tmp/files" && complete_words gonio diff '')" = "a.exr "
+    check "completion: render offers glTF files" test "$(cd "$tmp/files" && complete_words gonio render '')" = "c.gltf d.glb "
+    check "completion: --png offers PNGs" test "$(cd "$tmp/files" && complete_words gonio render c.gltf --png '')" = "b.png "
+else
+    echo "  note: help2man or man is missing (make test-deps installs them): make install not checked"
+fi
+
 # ---- progress ---------------------------------------------------------------------------
 # Not a terminal (a log): plain lines, none before a second has passed, then one a tenth;
 # with --time the percentage is the time's (each line's within 1 of 100 elapsed / limit).
