@@ -39,7 +39,14 @@ static const char render_usage[] =
     "  --tonemap T         PNG only: clamp (default), reinhard, aces\n"
     "  --device N          Vulkan device index (see gonio devices)\n"
     "  --validate          enable the Vulkan validation layer; any message fails the render\n"
-    "  --quiet             no progress bar and no summary line\n";
+    "  --quiet             no progress and no summary line\n"
+    "\n"
+    "An option the mode or outputs do not use (--max-depth with phong, --ambient with path,\n"
+    "--exposure without --png) is a warning. Progress goes to stderr: a bar on a terminal;\n"
+    "in a log, a line at each tenth once a second has passed (by time with --time).\n"
+    "Exit status: 0 ok, 1 bad input or failed render, 2 bad usage; 128 + N after signal N\n"
+    "(130: Ctrl-C, 143: SIGTERM): the render stopped after its pass and wrote what it had.\n"
+    "A second signal quits at once and leaves no output.\n";
 
 static volatile sig_atomic_t stop_requested; /* the signal that asked, 0 = none */
 static bool signal_quiet;

@@ -31,7 +31,8 @@ static void usage(FILE *f)
                "triangle BVHs and shade with the BRDFs of the lecture.\n\ncommands:\n");
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
         fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].summary);
-    fprintf(f, "\n  --version   print the version\n");
+    fprintf(f, "\n  --version   print the version\n"
+               "\nOptions take their value as --opt value or --opt=value.\n");
 }
 
 int main(int argc, char **argv)
