@@ -1,6 +1,6 @@
 # gonio: build, run, test, bench.
 #   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
-#   make run | test | bench | docs-images | clean | install PREFIX=/usr/local
+#   make run | test | bench | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
 # is printed and make stops.
 
@@ -57,16 +57,17 @@ TESTTOOL := $(BUILD)/testtool
 
 # ---- Debian packages -------------------------------------------------------------------
 DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
-	libopenexr-dev libtinygltf-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers
+	libopenexr-dev libtinygltf-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers help2man
+# man-db: tests/regress/cli.sh renders the installed man page with man -l.
 # libmagickcore-6.q16-6-extra: ImageMagick's EXR coder (only a recommendation of imagemagick,
 # which --no-install-recommends leaves out); tests/regress/diff.sh writes EXRs with it.
 DEB_TEST := vulkan-validationlayers openexr xvfb xauth imagemagick libmagickcore-6.q16-6-extra \
-	x11-apps xdotool
+	x11-apps xdotool man-db
 DEPS_CHECK = { command -v glslangValidator && command -v spirv-val && command -v pkg-config \
-	&& pkg-config --exists $(PKGS) && ls /usr/share/vulkan/icd.d/lvp_icd*.json; } >/dev/null 2>&1
+	&& command -v help2man && pkg-config --exists $(PKGS) && ls /usr/share/vulkan/icd.d/lvp_icd*.json; } >/dev/null 2>&1
 TEST_DEPS_CHECK = { ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json \
 	&& command -v exrheader && command -v xvfb-run && command -v xauth && command -v import \
-	&& command -v xwd && command -v xdotool \
+	&& command -v xwd && command -v xdotool && command -v man \
 	&& convert -list format | grep -q 'EXR.*rw'; } >/dev/null 2>&1
 
 .PHONY: all deps test-deps run test unit regress bench clean install shaders docs-images
@@ -136,9 +137,16 @@ bench: all
 docs-images: all
 	GONIO=$(GONIO) docs/make-images.sh
 
-install: all
-	install -d $(DESTDIR)$(PREFIX)/bin
+# The man page is help2man's reading of every command's --help (docs/make-man.sh).
+$(BUILD)/gonio.1: $(GONIO) docs/make-man.sh
+	GONIO=$(GONIO) docs/make-man.sh $@
+
+install: all $(BUILD)/gonio.1
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/share/man/man1 \
+		$(DESTDIR)$(PREFIX)/share/bash-completion/completions
 	install -m 755 $(GONIO) $(DESTDIR)$(PREFIX)/bin/gonio
+	install -m 644 $(BUILD)/gonio.1 $(DESTDIR)$(PREFIX)/share/man/man1/gonio.1
+	install -m 644 completion/gonio $(DESTDIR)$(PREFIX)/share/bash-completion/completions/gonio
 
 clean:
 	rm -rf build out

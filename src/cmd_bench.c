@@ -22,7 +22,7 @@ static const char bench_usage[] =
     "Prints the BVH build time (best of 3), the time from start to the first finished\n"
     "pixel (load, build, upload, shader compile, one pass), and the throughput of\n"
     "primary (camera) rays and diffuse bounce rays (cosine-distributed from the primary\n"
-    "hits) through the GPU traversal. Default scene: scenes/cornell.gltf.\n"
+    "hits) through the GPU traversal. Default scene: the Cornell box (gonio scene cornell).\n"
     "\n"
     "With --paths, the path tracer instead (--mode path: unbounded depth, MIS): the time to\n"
     "the first finished path pass, paths per second, and the time and spp at which a\n"
@@ -43,7 +43,7 @@ static bool build_scene(scene *sc, const char *path, long generate)
 {
     meshgen_mesh m;
     if (!generate)
-        return scene_load(sc, path);
+        return path ? scene_load(sc, path) : cli_load_builtin_scene(sc, "cornell");
     m = meshgen_bench_mesh((uint32_t)generate);
     scene_from_mesh(sc, "generated", m.num_vertices, m.positions, m.normals, m.num_triangles,
                     m.indices);
@@ -187,7 +187,7 @@ static bool bench_paths(renderer *r, render_settings *s, double t_start, float s
 int cmd_bench(int argc, char **argv)
 {
     const double t_start = util_now();
-    const char *path = "scenes/cornell.gltf";
+    const char *path = NULL; /* the built-in Cornell box */
     long generate = 0, v;
     float seconds = 3, env = 0;
     int device = -1, w = 0, h = 0, ref_w = 128, ref_h = 128, ref_spp = 512;
@@ -212,7 +212,7 @@ int cmd_bench(int argc, char **argv)
         } else if (!strcmp(a, "--paths")) {
             paths = true;
         } else if (a[0] == '-' && a[1]) {
-            if (!(val = cli_value(argc, argv, &i)))
+            if (!(val = cli_option_value(argc, argv, &i, bench_usage)))
                 return 2;
             if (!strcmp(a, "--generate")) {
                 if (!util_parse_int(val, 1, 50000000, &generate))
@@ -254,7 +254,7 @@ int cmd_bench(int argc, char **argv)
         return 1;
     }
     renderer_create(&r, &g, &sc);
-    printf("scene              %s\n", generate ? "generated mesh" : path);
+    printf("scene              %s\n", generate ? "generated mesh" : path ? path : "cornell (built in)");
     printf("device             %s\n", g.props.deviceName);
     printf("triangles          %u\n", sc.num_triangles);
     printf("bvh leaf prims     %u (%u triangle pairs, %u single triangles)\n", r.tree.num_pairs,

@@ -30,7 +30,7 @@ static const char usage[] =
     "  --albedo        print 'theta_deg albedo_r albedo_g albedo_b' for theta = 0, 5, ..., 85, 89:\n"
     "                  the directional albedo (reflected + transmitted fraction) of light from theta\n"
     "  --sphere        render a unit sphere of the material: directional light + constant sky\n"
-    "  -o FILE         the lobe plot: a .png; the sphere: a .exr (linear float OpenEXR) or\n"
+    "  -o, --output FILE  the lobe plot: a .png; the sphere: a .exr (linear float OpenEXR) or\n"
     "                  a .png (sRGB, clamped); any other name is a usage error\n"
     "  --png FILE      sphere: also a PNG (sRGB, clamped)\n"
     "  --size WxH      image size (lobe default 560x360, 560x560 with transmission; sphere 256x256)\n"
@@ -423,6 +423,8 @@ int cmd_brdf(int argc, char **argv)
             return 0;
         } else if (strncmp(a, "--", 2) && strcmp(a, "-o")) {
             return bad_usage("unexpected argument '%s'", a);
+        } else if (!cli_usage_lists_value(usage, a) && !brdf_param_find(m, a + 2)) {
+            return bad_usage("unknown option '%s' (gonio brdf --list: the models' parameters)", a);
         } else if (!(v = cli_value(argc, argv, &i))) {
             return 2;
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {

@@ -44,6 +44,7 @@ static const char usage[] =
     "triangle count) and sweep.png (the plot, log-log).\n"
     "\n"
     "  -o, --output DIR    output directory (created if missing)\n"
+    "  --sweep LEVELS      the teapot at these tessellation levels (see above)\n"
     "  --modes LIST        any of flat,gouraud,phong,path (default all four; phong and path\n"
     "                      are the references); path is skipped when not available\n"
     "  --spp N             path tracer samples per pixel (default 64); the local modes take\n"
@@ -542,7 +543,7 @@ int cmd_compare(int argc, char **argv)
         } else if (!strcmp(a, "--validate")) {
             o.validate = true;
         } else if (a[0] == '-' && a[1]) {
-            if (!(val = cli_value(argc, argv, &i)))
+            if (!(val = cli_option_value(argc, argv, &i, usage)))
                 return 2;
             if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
                 o.dir = val;

@@ -54,14 +54,42 @@ static const char render_usage[] =
     "  --tonemap T         PNG only: clamp (default), reinhard, aces\n"
     "  --device N          Vulkan device index (see gonio devices)\n"
     "  --validate          enable the Vulkan validation layer; any message fails the render\n"
-    "  --quiet             no progress bar and no summary line\n";
+    "  --quiet             no progress and no summary line\n"
+    "\n"
+    "An option the mode or outputs do not use (--max-depth with phong, --ambient with path,\n"
+    "--exposure without --png) is a warning. Progress goes to stderr: a bar on a terminal;\n"
+    "in a log, a line at each tenth once a second has passed (by time with --time).\n"
+    "Exit status: 0 ok, 1 bad input or failed render, 2 bad usage; 128 + N after signal N\n"
+    "(130: Ctrl-C, 143: SIGTERM): the render stopped after its pass and wrote what it had.\n"
+    "A second signal quits at once and leaves no output.\n";
 
-static volatile sig_atomic_t stop_requested;
+static volatile sig_atomic_t stop_requested; /* the signal that asked, 0 = none */
+static bool signal_quiet;
 
+/* The first SIGINT or SIGTERM ends the render after the current pass (what it has is
+ * written, and the exit status is 128 + the signal); a second one ends the program at once,
+ * removing the temporary file of a write under way. Only async-signal-safe calls here. */
 static void on_signal(int sig)
 {
-    (void)sig;
-    stop_requested = 1;
+    static const char msg[] = "\ngonio: stopping after this pass (interrupt again to quit now)\n";
+    if (stop_requested) {
+        util_remove_pending_tmp();
+        _exit(128 + sig);
+    }
+    stop_requested = sig;
+    if (!signal_quiet && write(2, msg, sizeof msg - 1) < 0)
+        return;
+}
+
+static void catch_signals(bool quiet)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    signal_quiet = quiet;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
 }
 
 /* Fails early when the directory of an output file cannot be written, rather than after a
@@ -83,6 +111,41 @@ static bool check_writable(const char *path)
         return false;
     }
     return true;
+}
+
+/* Options that the chosen mode or outputs do not use: a warning each, never silence. Reads
+ * argv again (values skipped) rather than flags set by the parser, so it sees what was
+ * typed, defaults included. */
+static void warn_inapplicable(int argc, char **argv, const render_settings *s, const char *png_path)
+{
+    static const struct {
+        const char *opt;
+        int when; /* 0: path mode only; 1: local modes only; 2: with a PNG only; 3: not with
+                   * --time; 4: path and albedo (the model's colour) only */
+    } rules[] = {{"--max-depth", 0}, {"--brdf", 4}, {"--estimator", 0}, {"--ambient", 1},
+                 {"--no-shadows", 1}, {"--exposure", 2}, {"--tonemap", 2}, {"--spp", 3}};
+    const bool path = s->mode == GN_MODE_PATH;
+    for (int i = 1; i < argc; i++) {
+        for (size_t k = 0; k < sizeof rules / sizeof *rules; k++) {
+            if (strcmp(argv[i], rules[k].opt))
+                continue;
+            if (rules[k].when == 0 && !path)
+                util_warn("%s applies to --mode path only; ignored with --mode %s", rules[k].opt,
+                          render_mode_name(s->mode));
+            else if (rules[k].when == 1 && path)
+                util_warn("%s applies to the local modes only; ignored with --mode path", rules[k].opt);
+            else if (rules[k].when == 2 && !png_path)
+                util_warn("%s applies to the PNG only; ignored without --png", rules[k].opt);
+            else if (rules[k].when == 4 && !path && s->mode != GN_MODE_ALBEDO)
+                util_warn("%s applies to --mode path (and albedo, its colour) only; ignored with "
+                          "--mode %s", rules[k].opt, render_mode_name(s->mode));
+            else if (rules[k].when == 3 && s->time_limit > 0)
+                util_warn("%s is ignored with --time: the render takes as many samples as fit",
+                          rules[k].opt);
+        }
+        if (cli_usage_lists_value(render_usage, argv[i]))
+            i++;
+    }
 }
 
 int cmd_render(int argc, char **argv)
@@ -127,7 +190,7 @@ int cmd_render(int argc, char **argv)
             exr.half = true;
             exr_option = "--half";
         } else if (a[0] == '-' && a[1]) {
-            if (!(val = cli_value(argc, argv, &i)))
+            if (!(val = cli_option_value(argc, argv, &i, render_usage)))
                 return 2;
             if ((taken = camera_parse_option(&cam, "render", a, val)) ||
                 (taken = env_parse_option(&env, "render", a, val))) {
@@ -215,6 +278,7 @@ int cmd_render(int argc, char **argv)
             return cli_usage_error("render", "unexpected argument '%s'", a);
         }
     }
+    warn_inapplicable(argc, argv, &s, png_path);
     if (!scene_path)
         return cli_usage_error("render", "no scene given");
     if (!out_path && !png_path)
@@ -256,8 +320,7 @@ int cmd_render(int argc, char **argv)
         image_destroy(&env_map);
         return 1;
     }
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
+    catch_signals(quiet);
     renderer_create(&r, &g, &sc);
     if (renderer_render(&r, &s, &img, &st)) {
         char seconds[32];
@@ -279,7 +342,7 @@ int cmd_render(int argc, char **argv)
                     out_path ? out_path : png_path, s.width, s.height, camera_text, render_mode_name(s.mode),
                     st.spp, seconds, st.seconds > 0 ? (double)st.rays / st.seconds * 1e-6 : 0.0,
                     s.mode == GN_MODE_PATH ? "M paths/s" : "Mrays/s primary", st.setup_seconds);
-        rc = ok ? 0 : 1;
+        rc = !ok ? 1 : stop_requested ? 128 + stop_requested : 0;
     }
     image_destroy(&img);
     image_destroy(&env_map);
@@ -290,8 +353,47 @@ int cmd_render(int argc, char **argv)
     return rc;
 }
 
-static const char info_usage[] = "usage: gonio info SCENE.gltf|.glb [--allow-outside-files]\n\n"
-                                 "Prints the scene's contents and its BVH statistics.\n";
+static const char info_usage[] =
+    "usage: gonio info SCENE.gltf|.glb [--allow-outside-files]\n\n"
+    "Prints the scene's contents and its BVH statistics: the emissive triangles (the path\n"
+    "tracer's area lights) and the materials that emit, and one line per camera (index, name,\n"
+    "position, forward direction, vertical field of view or orthographic width x height;\n"
+    "the first is the one gonio render uses by default).\n";
+
+/* The area lights as the path tracer sees them (render.c: build_emitters): triangles of
+ * non-zero area whose material emits and is not unlit; prints the materials by name. */
+static void print_emitters(const scene *sc)
+{
+    uint32_t tris = 0, mats = 0;
+    uint32_t *count = util_calloc(sc->num_materials, sizeof *count);
+    for (uint32_t t = 0; t < sc->num_triangles; t++) {
+        const GnMaterial *m = &sc->materials[sc->tri_material[t]];
+        const float *p[3];
+        double e1[3], e2[3], c[3];
+        if (!(m->emissive.x > 0 || m->emissive.y > 0 || m->emissive.z > 0) || (m->flags & GN_MAT_UNLIT))
+            continue;
+        for (int k = 0; k < 3; k++)
+            p[k] = &sc->vertices[sc->indices[3 * t + k]].position.x;
+        for (int k = 0; k < 3; k++) {
+            e1[k] = p[1][k] - p[0][k];
+            e2[k] = p[2][k] - p[0][k];
+        }
+        c[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        c[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        c[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        if (!(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > 0))
+            continue;
+        tris++;
+        mats += count[sc->tri_material[t]]++ == 0;
+    }
+    printf("emissive       %u triangles in %u material(s)", tris, mats);
+    for (uint32_t m = 0, n = 0; m < sc->num_materials; m++)
+        if (count[m])
+            printf("%s%s (%u)", n++ ? ", " : ": ", sc->material_names[m][0] ? sc->material_names[m] : "(unnamed)",
+                   count[m]);
+    printf("\n");
+    free(count);
+}
 
 int cmd_info(int argc, char **argv)
 {
@@ -326,7 +428,17 @@ int cmd_info(int argc, char **argv)
     printf("materials      %u\n", sc.num_materials);
     printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
     printf("lights         %u\n", sc.num_lights);
+    print_emitters(&sc);
     printf("cameras        %u\n", sc.num_cameras);
+    for (uint32_t i = 0; i < sc.num_cameras; i++) {
+        const scene_camera *c = &sc.cameras[i];
+        printf("camera %-7u \"%s\" position (%g, %g, %g) forward (%g, %g, %g) ", i, c->name, c->position[0],
+               c->position[1], c->position[2], c->forward[0], c->forward[1], c->forward[2]);
+        if (c->ortho_half_height > 0)
+            printf("orthographic %g x %g\n", 2 * c->ortho_half_height * c->aspect, 2 * c->ortho_half_height);
+        else
+            printf("yfov %.4g deg\n", c->yfov * 180 / M_PI);
+    }
     printf("bounds         (%g, %g, %g) - (%g, %g, %g)\n", sc.bounds_min[0], sc.bounds_min[1],
            sc.bounds_min[2], sc.bounds_max[0], sc.bounds_max[1], sc.bounds_max[2]);
     printf("bvh nodes      %u (%zu bytes each)\n", b.num_nodes, sizeof(GnBvhNode));
@@ -351,6 +463,7 @@ int cmd_devices(int argc, char **argv)
         return 0;
     }
     if (argc > 1)
-        return cli_usage_error("devices", "unexpected argument '%s'", argv[1]);
+        return cli_usage_error("devices", argv[1][0] == '-' ? "unknown option '%s'" : "unexpected argument '%s'",
+                               argv[1]);
     return gpu_print_devices() ? 0 : 1;
 }

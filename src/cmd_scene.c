@@ -3,13 +3,17 @@
  * measurements (graphics.cornell.edu/online/box/data.html); the teapot scene is the
  * lecture's OpenGL 1.x example (red diffuse, white specular, shininess 128, light from
  * (1,1,1)). */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "gltf_write.h"
+#include "scene.h"
 #include "teapot.h"
 #include "util.h"
 
@@ -299,3 +303,23 @@ int cmd_scene(int argc, char **argv)
 }
 
 int cmd_teapot(int argc, char **argv) { return run(argc, argv, 1, NULL); }
+
+bool cli_load_builtin_scene(scene *out, const char *name)
+{
+    const char *base = getenv("TMPDIR");
+    char dir[4096], path[4200];
+    bool ok;
+    snprintf(dir, sizeof dir, "%s/gonio-XXXXXX", base && *base ? base : "/tmp");
+    if (!mkdtemp(dir)) {
+        util_error("%s: cannot create a temporary directory: %s", dir, strerror(errno));
+        return false;
+    }
+    snprintf(path, sizeof path, "%s/%s.gltf", dir, name);
+    ok = (!strcmp(name, "teapot") ? write_teapot(path, SCENE_TEAPOT_LEVEL) : write_cornell(path)) &&
+         scene_load(out, path);
+    unlink(path);
+    rmdir(dir);
+    if (ok) /* messages name the scene, not a file that is gone */
+        snprintf(out->path, sizeof out->path, "%s (built in)", name);
+    return ok;
+}

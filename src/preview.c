@@ -766,7 +766,7 @@ int cmd_preview(int argc, char **argv)
         } else if (!strcmp(a, "--no-shadows")) {
             p->s.shadows = false;
         } else if (a[0] == '-' && a[1]) {
-            if (!(val = cli_value(argc, argv, &i)))
+            if (!(val = cli_option_value(argc, argv, &i, usage)))
                 return 2;
             if ((taken = camera_parse_option(&cam, "preview", a, val)) ||
                 (taken = env_parse_option(&env, "preview", a, val))) {

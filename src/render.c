@@ -405,12 +405,62 @@ static uint32_t traversal_budget(const gpu *g, uint32_t rays_per_invocation)
     return 60000u / (rays_per_invocation * 19u);
 }
 
-static void progress_bar(int done, int total, double elapsed)
+/* Progress on stderr. On a terminal, a bar redrawn in place; otherwise (a log) plain lines,
+ * one when a render has run for a second and one at each further tenth of the work, so
+ * short renders print none. With a time limit the work is the time, not the spp. */
+typedef struct progress {
+    bool tty;
+    int tenth;      /* plain lines: the last tenth printed, -1 = none yet */
+    double last;    /* terminal: when the bar was last drawn */
+} progress;
+
+static double progress_fraction(const render_settings *s, int done, double elapsed)
 {
-    int width = 40, fill = total ? done * width / total : 0;
-    fprintf(stderr, "\r[%.*s%*s] %d/%d spp  %.1fs", fill,
-            "########################################", width - fill, "", done, total, elapsed);
+    double f = s->time_limit > 0 ? elapsed / s->time_limit : (double)done / s->spp;
+    return f < 1 ? f : 1;
+}
+
+/* One report: the bar or a line; `end` replaces the ETA ("done", "interrupted"). */
+static void progress_show(const render_settings *s, const progress *p, int done, double elapsed,
+                          const char *end)
+{
+    const double pixels = (double)s->width * s->height, rate = elapsed > 0 ? done / elapsed : 0;
+    const double frac = progress_fraction(s, done, elapsed);
+    const int width = 30, fill = (int)(frac * width);
+    char spp[48], eta[48];
+    if (s->time_limit > 0)
+        snprintf(spp, sizeof spp, "%d spp", done);
+    else
+        snprintf(spp, sizeof spp, "%d/%d spp", done, s->spp);
+    if (end)
+        snprintf(eta, sizeof eta, "%s", end);
+    else if (s->time_limit > 0)
+        snprintf(eta, sizeof eta, "ETA %.1f s", s->time_limit > elapsed ? s->time_limit - elapsed : 0);
+    else
+        snprintf(eta, sizeof eta, "ETA %.1f s", rate > 0 ? (s->spp - done) / rate : 0);
+    if (p->tty)
+        fprintf(stderr, "\r[%.*s%*s] ", fill, "##############################", width - fill, "");
+    else
+        fputs("gonio: ", stderr);
+    /* Camera rays per second: whole paths in path mode, as in the summary line. */
+    fprintf(stderr, "%3d%%  %s  %.1f spp/s  %.2f %s  %.1f s  %s%s", (int)(frac * 100), spp, rate,
+            rate * pixels * 1e-6, s->mode == GN_MODE_PATH ? "M paths/s" : "Mrays/s", elapsed, eta,
+            p->tty ? "\x1b[K" : "\n");
     fflush(stderr);
+}
+
+/* After a batch: the bar at most ten times a second, a plain line when one is due. */
+static void progress_update(const render_settings *s, progress *p, int done, double elapsed)
+{
+    double frac = progress_fraction(s, done, elapsed);
+    int tenth = (int)(frac * 10);
+    if (p->tty && elapsed - p->last >= 0.1) {
+        p->last = elapsed;
+        progress_show(s, p, done, elapsed, NULL);
+    } else if (!p->tty && elapsed >= 1 && tenth > p->tenth && frac < 1) {
+        p->tenth = tenth;
+        progress_show(s, p, done, elapsed, NULL);
+    }
 }
 
 uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
@@ -788,10 +838,10 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
     gpu *g = r->g;
     GnFrame frame;
     const VkDeviceSize pixels = (VkDeviceSize)s->width * s->height;
-    double t0, last_progress = 0;
+    double t0;
     int done = 0, batch = 1;
     const int per = s->mode == GN_MODE_PATH ? (int)r->path_samples : 1;
-    bool show_progress = s->progress && isatty(2);
+    progress prog = {.tty = isatty(2), .tenth = -1};
 
     memset(stats, 0, sizeof *stats);
     if (!renderer_mode_available(s->mode)) {
@@ -824,19 +874,20 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
             batch *= 2;
         else if (tb > 0.4 && batch > 1)
             batch /= 2;
-        if (show_progress && util_now() - last_progress > 0.1) {
-            last_progress = util_now();
-            progress_bar(done, s->time_limit > 0 ? done : s->spp, last_progress - t0);
-        }
+        if (s->progress)
+            progress_update(s, &prog, done, util_now() - t0);
         if (s->stop && *s->stop)
             break;
         if (s->time_limit > 0 && util_now() - t0 >= s->time_limit)
             break;
     }
     stats->seconds = util_now() - t0;
-    if (show_progress) {
-        progress_bar(done, done, stats->seconds);
-        fputc('\n', stderr);
+    /* The last state: where an interrupt left it, or done (a log only hears of it when it
+     * heard of the render at all). */
+    if (s->progress && (prog.tty || prog.tenth >= 0)) {
+        progress_show(s, &prog, done, stats->seconds, s->stop && *s->stop ? "interrupted" : "done");
+        if (prog.tty)
+            fputc('\n', stderr);
     }
     stats->spp = done;
     stats->rays = (uint64_t)pixels * (uint64_t)done;

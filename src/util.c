@@ -3,6 +3,7 @@
 #include "util.h"
 
 #include <errno.h>
+#include <signal.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -182,12 +183,28 @@ void *util_read_file(const char *path, size_t *size)
     return data;
 }
 
+/* The temporary file being written, if any, for util_remove_pending_tmp (a signal handler):
+ * one at a time, since every writer commits before the next starts. The flag is cleared
+ * while the name changes and after the rename, so the handler never reads a half-written
+ * name and at worst unlinks a name that no longer exists. */
+static char pending_tmp[4096];
+static volatile sig_atomic_t pending;
+
 void util_tmp_path(char *out, size_t cap, const char *final_path)
 {
     const char *slash = strrchr(final_path, '/');
     int dirlen = slash ? (int)(slash - final_path + 1) : 0;
     snprintf(out, cap, "%.*s.%s.tmp-%ld", dirlen, final_path, slash ? slash + 1 : final_path,
              (long)getpid());
+    pending = 0;
+    snprintf(pending_tmp, sizeof pending_tmp, "%s", out);
+    pending = 1;
+}
+
+void util_remove_pending_tmp(void)
+{
+    if (pending)
+        unlink(pending_tmp);
 }
 
 FILE *util_tmp_open(char *tmp, size_t cap, const char *final_path, const char *mode)
@@ -207,5 +224,6 @@ bool util_commit_file(const char *tmp_path, const char *final_path, bool ok)
     }
     if (!ok)
         unlink(tmp_path);
+    pending = 0;
     return ok;
 }

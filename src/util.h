@@ -53,6 +53,9 @@ void *util_read_file(const char *path, size_t *size);
  * A failed or interrupted write therefore never leaves a half-written output. */
 void util_tmp_path(char *out, size_t cap, const char *final_path);
 bool util_commit_file(const char *tmp_path, const char *final_path, bool ok);
+/* Removes the temporary file of a write under way (async-signal-safe: for a handler that
+ * ends the program at once). */
+void util_remove_pending_tmp(void);
 /* util_tmp_path, then fopen(tmp, mode); NULL with an error naming final_path on failure. */
 FILE *util_tmp_open(char *tmp, size_t cap, const char *final_path, const char *mode);
 

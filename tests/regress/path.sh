@@ -65,13 +65,13 @@ same_as_stack_array "Cornell box, light sampling only" $C --estimator light
 same_as_stack_array "Cornell box, --mode phong" $C --mode phong
 same_as_stack_array "Cornell box, --mode gouraud" $C --mode gouraud
 
-# Ctrl-C: the render stops after the current pass and writes what it has.
+# Ctrl-C: the render stops after the current pass, writes what it has and exits 130.
 "$G" render $C -o "$tmp/int.exr" --time 60 --size 32x32 --quiet &
 pid=$!
 sleep 3
 kill -INT $pid
 wait $pid
-check "an interrupted render exits 0" test $? = 0
+check "an interrupted render exits 130" test $? = 130
 exrheader "$tmp/int.exr" >"$tmp/hdr.txt" 2>&1
 check "the interrupted EXR is readable and has its spp" grep -Eq 'gonio:spp \(type int\): [1-9]' "$tmp/hdr.txt"
 
