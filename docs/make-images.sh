@@ -64,4 +64,16 @@ if [ -d "$assets" ]; then
     sky TransmissionTest path-glass.png --camera 0 --size 320x180 --spp 128
     sky MetalRoughSpheresNoTextures path-metals.png --size 256x256 --spp 64
     sky DamagedHelmet path-helmet.png --size 256x256 --spp 128
+    # Every sample model as a new user renders it: no flags but the size (its own camera or
+    # the framing view, its own lights or the studio environment).
+    tiles=()
+    for d in "$assets"/*/; do
+        m=$(basename "$d")
+        f=$(ls "$d"glTF/*.gltf 2>/dev/null | head -n 1)
+        [ -n "$f" ] || continue
+        "$G" render "$f" --png "$tmp/sample-$m.png" --size 160x160 --spp 64 --quiet
+        tiles+=(-label "$m" "$tmp/sample-$m.png")
+    done
+    montage "${tiles[@]}" -tile 5x -geometry +2+2 -pointsize 11 -background white "$tmp/samples.png"
+    convert "$tmp/samples.png" -quality 85 $img/samples.jpg
 fi

@@ -30,7 +30,7 @@ static const char bench_usage[] =
     "reference's own estimated noise removed) first falls below 0.05 and 0.02 (times count\n"
     "the passes, not the RMSE checks).\n"
     "\n"
-    "  --generate N     a procedural mesh of about N triangles instead of a scene\n"
+    "  --generate N     a procedural mesh of about N triangles (1000..50000000) instead of a scene\n"
     "  --size WxH       rays per pass (default 512x512; --paths: 256x256)\n"
     "  --seconds S      measure each rate for about S seconds (default 3)\n"
     "  --paths          measure the path tracer\n"
@@ -215,8 +215,9 @@ int cmd_bench(int argc, char **argv)
             if (!(val = cli_option_value(argc, argv, &i, bench_usage)))
                 return 2;
             if (!strcmp(a, "--generate")) {
-                if (!util_parse_int(val, 1, 50000000, &generate))
-                    return cli_usage_error("bench", "--generate '%s': expected a triangle count", val);
+                /* meshgen_bench_mesh's 16 spheres and ground need about 1000 triangles. */
+                if (!util_parse_int(val, 1000, 50000000, &generate))
+                    return cli_usage_error("bench", "--generate '%s': expected a triangle count 1000..50000000", val);
             } else if (!strcmp(a, "--size")) {
                 if (!util_parse_size(val, &w, &h))
                     return cli_usage_error("bench", "--size '%s': expected WxH", val);

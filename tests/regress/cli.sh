@@ -15,7 +15,7 @@ check "teapot --level=2 --output=" "$G" teapot --level=2 --output="$tmp/t-eq.glt
 check "teapot --level 2 -o" "$G" teapot --level 2 -o "$tmp/t-sp.gltf"
 check "teapot: both forms, the same file" cmp "$tmp/t-eq.gltf" "$tmp/t-sp.gltf"
 check "scene cornell --output=" "$G" scene cornell --output="$tmp/c.gltf"
-check "merge --output=" "$G" merge "$tmp/sp.exr" "$tmp/eq.exr" --output="$tmp/m.exr"
+check "merge --output=" "$G" merge "$tmp/sp.exr" "$tmp/eq.exr" --force --output="$tmp/m.exr" # one seed twice
 check "merged: 4 spp" sh -c "exrheader '$tmp/m.exr' | grep -q 'gonio:spp (type int): 4'"
 check "bench --generate=N --size= --seconds=" "$G" bench --generate=2000 --size=16x16 --seconds=0.05
 check "brdf MODEL --PARAM=V --theta=" "$G" brdf phong --exponent=8 --theta=45 --output="$tmp/lobe.png" --size=240x240
@@ -67,7 +67,7 @@ warns --time 0.1 --spp 4 -- "--spp is ignored with --time"
 check "options that apply: no warning" test ! -s "$tmp/w.err"
 "$G" render $C -o "$tmp/w.exr" --size 8x8 --spp 1 --mode albedo --brdf lambert --ambient 1 --no-shadows --quiet 2>"$tmp/w.err"
 check "albedo with --brdf, --ambient, --no-shadows: no warning about --brdf" sh -c "! grep -q brdf '$tmp/w.err'"
-"$G" render $C --png "$tmp/--ambient" --size 8x8 --spp 1 --quiet 2>"$tmp/w.err"
+"$G" render $C --png "$tmp/--ambient.png" --size 8x8 --spp 1 --quiet 2>"$tmp/w.err"
 check "a value that looks like an option is not taken for one" test ! -s "$tmp/w.err"
 
 # ---- gonio info: emitters and cameras ---------------------------------------------------

@@ -101,6 +101,10 @@ check "one 67 M-texel image listed 8 times loads (decoded once)" "$G" info "$B/s
 check_fails "5 different ones (335 M texels) are refused" 1 "$G" info "$B/many-images.gltf"
 check "... with the numbers" grep -q "images too large: 335544320 texels with image 4 (16384x4096), the limit is 268435456" "$tmp/last"
 
+# bench --generate below what the generator can build was accepted and then aborted.
+check_fails "bench --generate 999 is a usage error, not an abort" 2 "$G" bench --generate 999
+check "... naming the range" grep -q "1000..50000000" "$tmp/last"
+
 # Huge radiance: clamped or refused, never NaN or Inf pixels.
 check_fails "--env 1e38 is refused" 2 "$G" render "$B/ok.gltf" -o "$tmp/x.exr" --env 1e38 --quiet
 python3 - "$B/ok.gltf" "$B/bright.gltf" <<'PY'
