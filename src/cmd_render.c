@@ -368,19 +368,10 @@ static void print_emitters(const scene *sc)
     uint32_t *count = util_calloc(sc->num_materials, sizeof *count);
     for (uint32_t t = 0; t < sc->num_triangles; t++) {
         const GnMaterial *m = &sc->materials[sc->tri_material[t]];
-        const float *p[3];
-        double e1[3], e2[3], c[3];
+        double c[3];
         if (!(m->emissive.x > 0 || m->emissive.y > 0 || m->emissive.z > 0) || (m->flags & GN_MAT_UNLIT))
             continue;
-        for (int k = 0; k < 3; k++)
-            p[k] = &sc->vertices[sc->indices[3 * t + k]].position.x;
-        for (int k = 0; k < 3; k++) {
-            e1[k] = p[1][k] - p[0][k];
-            e2[k] = p[2][k] - p[0][k];
-        }
-        c[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        c[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        c[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        scene_triangle_cross(sc, t, c);
         if (!(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > 0))
             continue;
         tris++;

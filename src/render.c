@@ -46,18 +46,12 @@ static uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap)
             continue;
         for (uint32_t t = 0; t < sc->num_triangles; t++) {
             const float *p[3];
-            double e1[3], e2[3], cr[3], a;
+            double cr[3], a;
             if (sc->tri_material[t] != m)
                 continue;
             for (int k = 0; k < 3; k++)
                 p[k] = &sc->vertices[sc->indices[3 * t + k]].position.x;
-            for (int k = 0; k < 3; k++) {
-                e1[k] = p[1][k] - p[0][k];
-                e2[k] = p[2][k] - p[0][k];
-            }
-            cr[0] = e1[1] * e2[2] - e1[2] * e2[1];
-            cr[1] = e1[2] * e2[0] - e1[0] * e2[2];
-            cr[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            scene_triangle_cross(sc, t, cr);
             a = 0.5 * sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
             area += a;
             for (int k = 0; k < 3; k++) {

@@ -44,6 +44,21 @@ void scene_compute_bounds(scene *s)
     }
 }
 
+void scene_triangle_cross(const scene *s, uint32_t t, double out[3])
+{
+    const float *p[3];
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; k++)
+        p[k] = &s->vertices[s->indices[3 * t + k]].position.x;
+    for (int k = 0; k < 3; k++) {
+        e1[k] = p[1][k] - p[0][k];
+        e2[k] = p[2][k] - p[0][k];
+    }
+    out[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    out[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    out[2] = e1[0] * e2[1] - e1[1] * e2[0];
+}
+
 static bool position_ok(const vec3 *p)
 {
     return isfinite(p->x) && isfinite(p->y) && isfinite(p->z) && fabsf(p->x) <= 1e15f &&

@@ -122,6 +122,10 @@ void scene_default_camera(const scene *s, float aspect, scene_camera *out);
 /* The same with another vertical field of view (radians, in (0, pi)). */
 void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *out);
 
+/* Triangle t's edge cross product (p1 - p0) x (p2 - p0), in double: twice its area along
+ * its normal. */
+void scene_triangle_cross(const scene *s, uint32_t t, double out[3]);
+
 /* Recomputes bounds_min/bounds_max from the triangles. */
 void scene_compute_bounds(scene *s);
 
