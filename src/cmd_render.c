@@ -8,6 +8,7 @@
 #include <strings.h>
 #include <unistd.h>
 
+#include "brdf.h"
 #include "camera.h"
 #include "cli.h"
 #include "environment.h"
@@ -190,6 +191,8 @@ int cmd_render(int argc, char **argv)
                     return cli_usage_error("render", "--max-depth '%s': expected an integer >= 0", val);
                 s.max_depth = (int)v;
             } else if (!strcmp(a, "--brdf")) {
+                if (!brdf_spec_check(val))
+                    return cli_usage_error("render", "--brdf '%s': see gonio brdf --list", val);
                 brdf = val;
             } else if (!strcmp(a, "--estimator")) {
                 if (!strcmp(val, "mis")) s.strategy = 0;

@@ -78,11 +78,18 @@ void *util_calloc(size_t count, size_t size)
 }
 void *util_realloc(void *ptr, size_t size) { return check_alloc(realloc(ptr, size ? size : 1), size); }
 
+/* strtol and strtod skip leading white space and take a '+': neither is a number as a
+ * user types it on a command line (" 16", "+16"). */
+static bool plain_number_start(const char *s)
+{
+    return s && (*s == '-' || *s == '.' || (*s >= '0' && *s <= '9'));
+}
+
 bool util_parse_int(const char *s, long min, long max, long *out)
 {
     char *end;
     long v;
-    if (!s || !*s)
+    if (!plain_number_start(s))
         return false;
     errno = 0;
     v = strtol(s, &end, 10);
@@ -96,7 +103,8 @@ bool util_parse_float(const char *s, float *out)
 {
     char *end;
     double v;
-    if (!s || !*s)
+    /* strtod also reads hexadecimal ("0x1p4"), not a number as a user writes one. */
+    if (!plain_number_start(s) || strpbrk(s, "xX"))
         return false;
     errno = 0;
     v = strtod(s, &end);

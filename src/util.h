@@ -37,7 +37,8 @@ void *util_malloc(size_t size);
 void *util_calloc(size_t count, size_t size);
 void *util_realloc(void *ptr, size_t size);
 
-/* Strict number parsing: the whole string must be a number in range; false otherwise. */
+/* Strict number parsing: the whole string must be a decimal number in range, as typed: no
+ * leading space, no '+', no hexadecimal; false otherwise. */
 bool util_parse_int(const char *s, long min, long max, long *out);
 bool util_parse_float(const char *s, float *out);
 /* "R,G,B" or one value V (= V,V,V), each finite and >= 0: a colour or a radiance. */

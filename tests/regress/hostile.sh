@@ -83,4 +83,31 @@ for m in path phong; do
     check "... with finite pixels ($m)" sh -c "'$TESTTOOL' stats '$tmp/bright-$m.exr' | grep -q 'nonfinite 0\$'"
 done
 check "the clamp is a warning naming the value" sh -c "'$G' info '$B/bright.gltf' 2>&1 | grep -q 'intensity 1e+39 is above 1e+09 (clamped)'"
+# Command-line values are numbers as typed: no leading space or sign, nothing left over.
+for v in " 16x16" "+16x+16" "16x+16" "16x 16" "0x16" "16x16 "; do
+    check_fails "--size '$v' is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --size "$v" --quiet
+done
+check_fails "--spp +4 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --spp +4 --quiet
+check_fails "--spp ' 4' is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --spp " 4" --quiet
+check_fails "--fov +30 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --fov +30 --quiet
+check_fails "--env ' 1' is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --env " 1" --quiet
+check_fails "--env 0x1p1 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --env 0x1p1 --quiet
+check "--size 16x16 --spp 1 --fov 30 --env 0.5,1,0 still render" "$G" render "$B/ok.gltf" -o "$tmp/v.exr" \
+    --size 16x16 --spp 1 --fov 30 --env 0.5,1,0 --quiet
+for v in "ggx:::" "ggx:" "ggx:alpha=0.3:" ":alpha=0.3" "ggx:=1"; do
+    check_fails "--brdf '$v' is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --brdf "$v" --quiet
+done
+check_fails "--brdf ggx:alpha=5 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --brdf ggx:alpha=5 --quiet
+check "... naming the parameter as it was given" sh -c "grep -q 'parameter alpha=5 is out of range' '$tmp/last' && ! grep -q -- '--alpha' '$tmp/last'"
+check_fails "--brdf ggx:shininess=5 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --brdf ggx:shininess=5 --quiet
+check "... listing the parameters in the spec's form" sh -c "grep -q 'no parameter shininess; it accepts .*alpha=X' '$tmp/last' && ! grep -q -- '--alpha' '$tmp/last'"
+check_fails "--brdf nosuch is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --brdf nosuch --quiet
+check "--brdf ggx:alpha=0.3:diffuse=0.2,0.4,0.6 renders" "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --size 8x8 --spp 1 \
+    --brdf ggx:alpha=0.3:diffuse=0.2,0.4,0.6 --quiet
+check_fails "gonio brdf's own option still says --alpha" 2 "$G" brdf ggx --alpha 5 -o "$tmp/lobe.png"
+check "... (--alpha)" grep -q -- "--alpha 5 is out of range" "$tmp/last"
+# Under the sanitizers a refused device index must not leak (the driver was unloaded
+# before LeakSanitizer could name its allocations).
+check_fails "--device 63 is refused cleanly" 1 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --device 63 --quiet
+check "... naming the devices" grep -q "only .* device(s)" "$tmp/last"
 finish
