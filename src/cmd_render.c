@@ -65,27 +65,6 @@ static void on_signal(int sig)
     stop_requested = 1;
 }
 
-/* Fails early when the directory of an output file cannot be written, rather than after a
- * long render. */
-static bool check_writable(const char *path)
-{
-    char dir[4096];
-    const char *slash = strrchr(path, '/');
-    if (strlen(path) >= sizeof dir)
-        return false;
-    if (slash)
-        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
-    else
-        strcpy(dir, ".");
-    if (!*dir)
-        strcpy(dir, "/");
-    if (access(dir, W_OK) != 0) {
-        util_error("%s: cannot write into '%s': %s", path, dir, strerror(errno));
-        return false;
-    }
-    return true;
-}
-
 int cmd_render(int argc, char **argv)
 {
     const char *scene_path = NULL, *out_path = NULL, *png_path = NULL;
@@ -235,7 +214,7 @@ int cmd_render(int argc, char **argv)
         return cli_usage_error("render", "%s is for an EXR output (-o OUT.exr)", exr_option);
     util_set_quiet(quiet);
     s.progress = !quiet;
-    if ((out_path && !check_writable(out_path)) || (png_path && !check_writable(png_path)))
+    if ((out_path && !util_check_output(out_path)) || (png_path && !util_check_output(png_path)))
         return 1;
 
     if (!scene_load_scene(&sc, scene_path, scene_index))

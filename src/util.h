@@ -51,7 +51,16 @@ void *util_read_file(const char *path, size_t *size);
 
 /* Writing an output file safely: util_tmp_path gives "DIR/.NAME.tmp-PID" beside the
  * destination; util_commit_file renames it into place (or removes it when ok is false).
- * A failed or interrupted write therefore never leaves a half-written output. */
+ * A failed or interrupted write therefore never leaves a half-written output.
+ *
+ * What an output path may be (every command checks with util_check_output before any work,
+ * and util_commit_file checks again): a new name, or a regular file that may be written,
+ * which is replaced and keeps its mode (and owner, where the writer may give it). Refused
+ * with an error naming the path: an empty name, a path too long for its temporary name, a
+ * missing or unwritable folder, a directory, a symbolic link, a device (/dev/null), FIFO or
+ * socket, a read-only file (for root too). util_check_output also removes the temporary
+ * files of this name that a killed gonio left behind (their process no longer exists). */
+bool util_check_output(const char *path);
 void util_tmp_path(char *out, size_t cap, const char *final_path);
 bool util_commit_file(const char *tmp_path, const char *final_path, bool ok);
 /* util_tmp_path, then fopen(tmp, mode); NULL with an error naming final_path on failure. */
