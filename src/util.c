@@ -15,11 +15,13 @@
 #include <time.h>
 #include <unistd.h>
 
-static bool quiet_flag;
+static bool quiet_flag, silent_flag;
 static int warnings;
 
 static void vreport(const char *prefix, const char *fmt, va_list ap)
 {
+    if (silent_flag)
+        return;
     fprintf(stderr, "gonio: %s", prefix);
     vfprintf(stderr, fmt, ap);
     fputc('\n', stderr);
@@ -53,6 +55,7 @@ void util_info(const char *fmt, ...)
 }
 
 void util_set_quiet(bool quiet) { quiet_flag = quiet; }
+void util_set_silent(bool silent) { silent_flag = silent; }
 bool util_quiet(void) { return quiet_flag; }
 int util_warning_count(void) { return warnings; }
 

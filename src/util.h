@@ -25,6 +25,9 @@ void util_warn(const char *fmt, ...) UTIL_PRINTF(1, 2);
 /* Informational line on stderr, silenced by util_set_quiet(true). */
 void util_info(const char *fmt, ...) UTIL_PRINTF(1, 2);
 void util_set_quiet(bool quiet);
+/* No errors or warnings either (warnings still counted): for the fuzz targets only, where
+ * printing them is most of the time spent. */
+void util_set_silent(bool silent);
 bool util_quiet(void);
 /* Number of warnings printed so far (tests and the CLI summary use it). */
 int util_warning_count(void);
