@@ -1,6 +1,7 @@
 # gonio: build, run, test, bench.
 #   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
 #   make run | test | bench | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
+#   make fuzz (libFuzzer targets, clang, in build/fuzz) | fuzz-run [FUZZ_TIME=60]
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
 # is printed and make stops.
 
@@ -31,8 +32,15 @@ OPT := -O0 -g
 else ifeq ($(config),sanitize)
 OPT := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=undefined
 LDFLAGS += -fsanitize=address,undefined
+else ifeq ($(config),fuzz)
+# make fuzz sets this config with CC=clang: libFuzzer's coverage hooks in every object,
+# ASan+UBSan as in sanitize. Not -Werror: clang warns where gcc, the compiler of record, does not.
+OPT := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined,fuzzer-no-link -fno-sanitize-recover=undefined
+LDFLAGS += -fsanitize=address,undefined
+WARN := -Wall -Wextra -Wshadow
+CXXFLAGS := $(filter-out -Werror,$(CXXFLAGS))
 else
-$(error config must be release, debug or sanitize)
+$(error config must be release, debug, sanitize or fuzz)
 endif
 CFLAGS += $(OPT)
 CXXFLAGS += $(OPT)
@@ -70,7 +78,14 @@ TEST_DEPS_CHECK = { ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_valida
 	&& command -v xwd && command -v xdotool && command -v man \
 	&& convert -list format | grep -q 'EXR.*rw'; } >/dev/null 2>&1
 
-.PHONY: all deps test-deps run test unit regress bench clean install shaders docs-images
+# make fuzz only: clang and its libFuzzer runtime (Debian 12's clang is clang-14).
+DEB_FUZZ := clang libclang-rt-14-dev
+FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
+	echo 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n) { return 0; }' | \
+	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
+
+.PHONY: all deps test-deps run test unit regress bench clean install shaders docs-images \
+	fuzz fuzz-deps fuzz-targets fuzz-run
 all: $(GONIO) build/gonio
 
 deps:
@@ -90,6 +105,9 @@ define apt_install
 		echo "  apt-get install $(1)"; exit 1; \
 	fi
 endef
+
+fuzz-deps: deps
+	@if ! $(FUZZ_DEPS_CHECK); then $(call apt_install,$(DEB_FUZZ)); fi
 
 build/gonio: $(GONIO)
 	@ln -sf $(config)/gonio build/gonio
@@ -133,6 +151,19 @@ unit: $(UNIT)
 bench: all
 	@tests/bench.sh $(GONIO)
 
+# libFuzzer targets over scene_load and image_read_exr (tests/fuzz); fuzz-run runs each for
+# FUZZ_TIME seconds from seeds of ../shared/assets and EXRs gonio writes (tests/fuzz/run.sh).
+FUZZ_TARGETS := build/fuzz/fuzz_scene build/fuzz/fuzz_exr
+FUZZ_TIME ?= 60
+fuzz: fuzz-deps
+	@$(MAKE) --no-print-directory config=fuzz CC=clang CXX=clang++ fuzz-targets
+fuzz-targets: $(FUZZ_TARGETS)
+.SECONDARY: $(FUZZ_TARGETS:build/fuzz/%=$(BUILD)/tests/fuzz/%.o)
+build/fuzz/fuzz_%: $(BUILD)/tests/fuzz/fuzz_%.o $(LIB_OBJ) | deps
+	$(CXX) $(LDFLAGS) -fsanitize=fuzzer -o $@ $^ $(PKG_LIBS) -lm
+fuzz-run: fuzz all test-deps
+	@GONIO=$(GONIO) FUZZ_TIME=$(FUZZ_TIME) tests/fuzz/run.sh $(FUZZ_TARGETS)
+
 # The figures of docs/ (docs/make-images.sh lists them).
 docs-images: all
 	GONIO=$(GONIO) docs/make-images.sh
@@ -151,4 +182,5 @@ install: all $(BUILD)/gonio.1
 clean:
 	rm -rf build out
 
--include $(LIB_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(TEST_OBJ:.o=.d) $(TOOL_OBJ:.o=.d) $(wildcard $(BUILD)/spv/*.d)
+-include $(LIB_OBJ:.o=.d) $(MAIN_OBJ:.o=.d) $(TEST_OBJ:.o=.d) $(TOOL_OBJ:.o=.d) $(wildcard $(BUILD)/spv/*.d) \
+	$(wildcard $(BUILD)/tests/fuzz/*.d)

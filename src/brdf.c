@@ -87,14 +87,15 @@ const brdf_param *brdf_param_find(const brdf_model *m, const char *name)
     return NULL;
 }
 
-/* "--a X, --b R,G,B" */
-static void param_list(const brdf_model *m, char *out, size_t cap)
+/* "--a X, --b R,G,B" (options of gonio brdf) or "a=X, b=R,G,B" (a --brdf spec) */
+static void param_list(const brdf_model *m, bool spec, char *out, size_t cap)
 {
     size_t len = 0;
     out[0] = 0;
     for (int i = 0; i < m->num_params && len < cap; i++)
-        len += (size_t)snprintf(out + len, cap - len, "%s--%s %s", i ? ", " : "", m->params[i].name,
-                                m->params[i].count == 3 ? "R,G,B" : "X");
+        len += (size_t)snprintf(out + len, cap - len, "%s%s%s%s", i ? ", " : "", spec ? "" : "--",
+                                m->params[i].name, m->params[i].count == 3 ? (spec ? "=R,G,B" : " R,G,B")
+                                                                           : (spec ? "=X" : " X"));
 }
 
 /* "X" or "R,G,B" -> the number of values (at most 3), 0 when malformed. */
@@ -116,15 +117,18 @@ static int parse_values(const char *text, float v[3])
     }
 }
 
-bool brdf_setting_set(brdf_setting *s, const char *name, const char *value)
+/* Errors name the parameter as the user wrote it: "--alpha" (an option of gonio brdf) or
+ * "parameter alpha" (a PARAM=VALUE of a --brdf spec). */
+static bool setting_set(brdf_setting *s, const char *name, const char *value, bool spec)
 {
     const brdf_param *p = brdf_param_find(s->model, name);
+    const char *pre = spec ? "parameter " : "--";
     float v[3];
     int n;
     if (!p) {
         char list[256];
-        param_list(s->model, list, sizeof list);
-        util_error("BRDF model %s has no parameter --%s; it accepts %s", s->model->name, name, list);
+        param_list(s->model, spec, list, sizeof list);
+        util_error("BRDF model %s has no %s%s; it accepts %s", s->model->name, pre, name, list);
         return false;
     }
     n = parse_values(value, v);
@@ -133,19 +137,73 @@ bool brdf_setting_set(brdf_setting *s, const char *name, const char *value)
         n = 3;
     }
     if (n != p->count) {
-        util_error("BRDF model %s: --%s needs %s, not '%s'", s->model->name, name,
+        util_error("BRDF model %s: %s%s needs %s, not '%s'", s->model->name, pre, name,
                    p->count == 3 ? "a colour R,G,B or one number" : "one number", value);
         return false;
     }
     for (int i = 0; i < n; i++) {
         if (!(v[i] >= p->min && v[i] <= p->max)) {
-            util_error("BRDF model %s: --%s %s is out of range [%g, %g]", s->model->name, name, value,
-                       p->min, p->max);
+            util_error("BRDF model %s: %s%s%s%s is out of range [%g, %g]", s->model->name, pre, name,
+                       spec ? "=" : " ", value, p->min, p->max);
             return false;
         }
     }
     memcpy(&s->v[p->slot], v, sizeof(float) * (size_t)n);
     return true;
+}
+
+bool brdf_setting_set(brdf_setting *s, const char *name, const char *value)
+{
+    return setting_set(s, name, value, false);
+}
+
+/* The spec's text up to the first ':' is the model name. */
+const brdf_model *brdf_spec_model(const char *spec)
+{
+    char name[64];
+    size_t len = strcspn(spec, ":");
+    if (len == 0 || len >= sizeof name) {
+        util_error("--brdf '%s': expected MODEL[:PARAM=VALUE...]", spec);
+        return NULL;
+    }
+    memcpy(name, spec, len);
+    name[len] = 0;
+    return brdf_model_find(name);
+}
+
+bool brdf_spec_apply(brdf_setting *s, const char *spec)
+{
+    const char *c = spec + strcspn(spec, ":");
+    /* Every ':' starts one PARAM=VALUE: "ggx:" and "ggx:::" are mistakes, not defaults. */
+    while (*c == ':') {
+        char kv[128], *eq;
+        size_t len = strcspn(++c, ":");
+        if (len >= sizeof kv) {
+            util_error("--brdf '%s': a PARAM=VALUE is too long", spec);
+            return false;
+        }
+        memcpy(kv, c, len);
+        kv[len] = 0;
+        c += len;
+        if (!(eq = strchr(kv, '=')) || eq == kv) {
+            util_error("--brdf '%s': expected MODEL[:PARAM=VALUE...], not '%s'", spec, kv);
+            return false;
+        }
+        *eq = 0;
+        if (!setting_set(s, kv, eq + 1, true))
+            return false;
+    }
+    return true;
+}
+
+bool brdf_spec_check(const char *spec)
+{
+    const brdf_model *m = brdf_spec_model(spec);
+    brdf_setting st;
+    if (!m)
+        return false;
+    brdf_setting_init(&st, m);
+    return brdf_spec_apply(&st, spec);
 }
 
 bool brdf_setting_two_sided(const brdf_setting *s)

@@ -52,6 +52,13 @@ void brdf_setting_init(brdf_setting *s, const brdf_model *m);
 /* Sets parameter `name` (without "--") from text; false with an error naming the model and
  * listing its parameters (unknown name), or giving the accepted form and range (bad value). */
 bool brdf_setting_set(brdf_setting *s, const char *name, const char *value);
+/* A `--brdf MODEL[:PARAM=VALUE...]` spec (gonio render). brdf_spec_model: its model, NULL
+ * with an error otherwise; brdf_spec_apply: sets its parameters on s (of that model), false
+ * with an error naming the spec or "parameter NAME" (an empty PARAM=VALUE is an error);
+ * brdf_spec_check: both, on a default setting, for checking a command line before work. */
+const brdf_model *brdf_spec_model(const char *spec);
+bool brdf_spec_apply(brdf_setting *s, const char *spec);
+bool brdf_spec_check(const char *spec);
 /* The first parameter named `name`, or NULL. */
 const brdf_param *brdf_param_find(const brdf_model *m, const char *name);
 /* Does the setting transmit (a dielectric interface: light below the surface matters)? */

@@ -477,6 +477,8 @@ int cmd_brdf(int argc, char **argv)
         return bad_usage("%s", "a sphere image is at most 4096x4096");
     if (!albedo && !sphere && w && (w < 240 || h < 240))
         return bad_usage("%s", "a lobe plot needs --size of at least 240x240");
+    if ((out && !util_check_output(out)) || (png && !util_check_output(png)))
+        return 1;
     if (!cli_gpu_create(&g, device, validate))
         return 1;
     if (sphere) {

@@ -165,6 +165,10 @@ int cmd_merge(int argc, char **argv)
         free(inputs);
         return cli_usage_error("merge", "-o '%s': merge writes OpenEXR: expected a .exr name", out_path);
     }
+    if (!util_check_output(out_path)) {
+        free(inputs);
+        return 1;
+    }
 
     imgs = util_calloc((size_t)n, sizeof *imgs);
     spp = util_calloc((size_t)n, sizeof *spp);

@@ -8,6 +8,7 @@
 #include <strings.h>
 #include <unistd.h>
 
+#include "brdf.h"
 #include "camera.h"
 #include "cli.h"
 #include "environment.h"
@@ -90,27 +91,6 @@ static void catch_signals(bool quiet)
     signal_quiet = quiet;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
-}
-
-/* Fails early when the directory of an output file cannot be written, rather than after a
- * long render. */
-static bool check_writable(const char *path)
-{
-    char dir[4096];
-    const char *slash = strrchr(path, '/');
-    if (strlen(path) >= sizeof dir)
-        return false;
-    if (slash)
-        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
-    else
-        strcpy(dir, ".");
-    if (!*dir)
-        strcpy(dir, "/");
-    if (access(dir, W_OK) != 0) {
-        util_error("%s: cannot write into '%s': %s", path, dir, strerror(errno));
-        return false;
-    }
-    return true;
 }
 
 /* Options that the chosen mode or outputs do not use: a warning each, never silence. Reads
@@ -253,6 +233,8 @@ int cmd_render(int argc, char **argv)
                     return cli_usage_error("render", "--max-depth '%s': expected an integer >= 0", val);
                 s.max_depth = (int)v;
             } else if (!strcmp(a, "--brdf")) {
+                if (!brdf_spec_check(val))
+                    return cli_usage_error("render", "--brdf '%s': see gonio brdf --list", val);
                 brdf = val;
             } else if (!strcmp(a, "--estimator")) {
                 if (!strcmp(val, "mis")) s.strategy = 0;
@@ -296,7 +278,7 @@ int cmd_render(int argc, char **argv)
         return cli_usage_error("render", "%s is for an EXR output (-o OUT.exr)", exr_option);
     util_set_quiet(quiet);
     s.progress = !quiet;
-    if ((out_path && !check_writable(out_path)) || (png_path && !check_writable(png_path)))
+    if ((out_path && !util_check_output(out_path)) || (png_path && !util_check_output(png_path)))
         return 1;
 
     if (!scene_load_scene(&sc, scene_path, scene_index))

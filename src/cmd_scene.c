@@ -288,6 +288,8 @@ static int run(int argc, char **argv, int first, const char *name)
         if (!dot || (strcasecmp(dot, ".gltf") && strcasecmp(dot, ".glb")))
             return cli_usage_error(argv[0], "-o '%s': expected a .gltf (JSON) or .glb (binary glTF) name", out);
     }
+    if (!util_check_output(out))
+        return 1;
     return (teapot ? write_teapot(out, (int)level) : write_cornell(out)) ? 0 : 1;
 }
 

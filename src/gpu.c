@@ -202,6 +202,8 @@ bool gpu_create(gpu *g, const gpu_desc *desc)
     if (!create_instance(g, desc))
         return false;
     devs = list_devices(g->instance, &count);
+    /* Here, not after the checks below: their error paths destroy the instance too. */
+    pin_loaded_libraries();
     if (count == 0) {
         util_error("no Vulkan device found (Debian: apt-get install mesa-vulkan-drivers)");
         free(devs);
@@ -235,7 +237,6 @@ bool gpu_create(gpu *g, const gpu_desc *desc)
         gpu_destroy(g);
         return false;
     }
-    pin_loaded_libraries();
     g->physical = devs[chosen];
     free(devs);
     g->queue_family = (uint32_t)family;

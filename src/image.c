@@ -107,6 +107,27 @@ const char *image_exr_compression_name(int compression)
     return compression >= 0 && compression < EXR_COMPRESSION_LAST_TYPE ? exr_compression_names[compression] : "?";
 }
 
+/* B44 packs HALF channels only; the rest of a chunk is stored as is, channel by channel, so
+ * a chunk of float channels comes out exactly as large as the data. OpenEXR's rule (its C++
+ * library follows it) is that a chunk that does not shrink is stored uncompressed, and a
+ * reader takes a chunk of the uncompressed size to be uncompressed. The C API of OpenEXR 3.1
+ * (3.2 fixes it) breaks the rule both ways: it writes the B44 form whatever its size and
+ * decodes a full-size B44 chunk as B44. These two shims apply the rule. */
+static _Thread_local exr_result_t (*exr_b44_compress)(exr_encode_pipeline_t *);
+
+static exr_result_t exr_b44_compress_or_store(exr_encode_pipeline_t *enc)
+{
+    exr_result_t rv = exr_b44_compress(enc);
+    /* The compressed buffer holds at least the packed size (the library allocates 110%). */
+    if (!rv && enc->compressed_bytes >= enc->packed_bytes) {
+        memcpy(enc->compressed_buffer, enc->packed_buffer, enc->packed_bytes);
+        enc->compressed_bytes = enc->packed_bytes;
+    }
+    return rv;
+}
+
+static bool exr_is_b44(exr_compression_t c) { return c == EXR_COMPRESSION_B44 || c == EXR_COMPRESSION_B44A; }
+
 bool image_write_exr(const image *img, const char *path, const image_attr *attrs, int num_attrs)
 {
     return image_write_exr_with(img, path, attrs, num_attrs, NULL);
@@ -172,6 +193,10 @@ bool image_write_exr_with(const image *img, const char *path, const image_attr *
             ch->user_data_type = EXR_PIXEL_FLOAT;
         }
         rv = exr_encoding_choose_default_routines(ctx, part, &enc);
+        if (!rv && exr_is_b44((exr_compression_t)o.compression) && enc.compress_fn) {
+            exr_b44_compress = enc.compress_fn;
+            enc.compress_fn = exr_b44_compress_or_store;
+        }
         if (!rv)
             rv = exr_encoding_run(ctx, part, &enc);
     }
@@ -203,7 +228,8 @@ static bool exr_open(exr_context_t *ctx, const char *path)
  * window, straight into the image planes. Always planar: OpenEXR 3.1.5 swaps channels when
  * decoding half data into an interleaved float buffer. */
 static exr_result_t exr_decode_chunk(exr_context_t ctx, exr_decode_pipeline_t *dec, bool *decoding,
-                                     const exr_chunk_info_t *ci, image *img, int x0, int y0)
+                                     const exr_chunk_info_t *ci, exr_compression_t compression,
+                                     image *img, int x0, int y0)
 {
     exr_result_t rv;
     if (x0 < 0 || y0 < 0 || ci->width < 0 || ci->height < 0 || ci->width > img->width - x0 ||
@@ -225,6 +251,10 @@ static exr_result_t exr_decode_chunk(exr_context_t ctx, exr_decode_pipeline_t *d
         ch->user_data_type = EXR_PIXEL_FLOAT;
     }
     rv = exr_decoding_choose_default_routines(ctx, 0, dec);
+    /* A B44 chunk of the uncompressed size is stored uncompressed (see exr_b44_compress); the
+     * library has already placed it in the unpacked buffer. */
+    if (!rv && exr_is_b44(compression) && ci->packed_size == ci->unpacked_size)
+        dec->decompress_fn = NULL;
     return rv ? rv : exr_decoding_run(ctx, 0, dec);
 }
 
@@ -276,14 +306,16 @@ bool image_read_exr(image *img, const char *path)
     exr_context_t ctx;
     exr_attr_box2i_t dw;
     exr_storage_t storage;
+    exr_compression_t compression;
     bool decoding = false;
     exr_result_t rv = EXR_ERR_SUCCESS;
 
     memset(img, 0, sizeof *img);
     if (!exr_open(&ctx, path))
         return false;
-    if (!exr_prepare(ctx, path, img, &dw, &storage)) {
+    if (!exr_prepare(ctx, path, img, &dw, &storage) || exr_get_compression(ctx, 0, &compression)) {
         exr_finish(&ctx);
+        image_destroy(img);
         return false;
     }
     if (storage == EXR_STORAGE_SCANLINE) {
@@ -293,7 +325,7 @@ bool image_read_exr(image *img, const char *path)
             exr_chunk_info_t ci;
             rv = exr_read_scanline_chunk_info(ctx, 0, (int)y, &ci);
             if (!rv)
-                rv = exr_decode_chunk(ctx, &dec, &decoding, &ci, img, 0, ci.start_y - dw.min.y);
+                rv = exr_decode_chunk(ctx, &dec, &decoding, &ci, compression, img, 0, ci.start_y - dw.min.y);
         }
     } else {
         /* Level 0 of a tiled (or mip/rip-mapped) file is the full-resolution image. */
@@ -306,7 +338,7 @@ bool image_read_exr(image *img, const char *path)
                 exr_chunk_info_t ci;
                 rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &ci);
                 if (!rv)
-                    rv = exr_decode_chunk(ctx, &dec, &decoding, &ci, img, tx * (int)tw, ty * (int)th);
+                    rv = exr_decode_chunk(ctx, &dec, &decoding, &ci, compression, img, tx * (int)tw, ty * (int)th);
             }
         }
     }

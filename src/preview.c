@@ -303,6 +303,8 @@ static bool save_accumulated(preview *p)
         if (access(exr, F_OK) != 0 && access(png, F_OK) != 0)
             break;
     }
+    if (!util_check_output(exr) || !util_check_output(png))
+        return false;
     renderer_resolve(&p->r, p->spp, false, &img);
     ok = image_write_exr(&img, exr, attrs, sizeof attrs / sizeof *attrs) &&
          render_write_png(&img, p->s.mode, png, p->exposure, p->tonemap); /* as gonio render's */
@@ -827,6 +829,8 @@ int cmd_preview(int argc, char **argv)
     }
     if (!scene_path)
         return cli_usage_error("preview", "no scene given");
+    if (screenshot && !util_check_output(screenshot))
+        return 1;
 
     glfwSetErrorCallback(glfw_error);
     if (!glfwInit()) {

@@ -933,33 +933,17 @@ static void setting_from_material(brdf_setting *st, const brdf_model *model, con
 
 bool render_material_overrides(scene *sc, const char *brdf)
 {
-    char spec[256], *name, *save;
     const brdf_model *global = NULL;
-    if (brdf) {
-        snprintf(spec, sizeof spec, "%s", brdf);
-        name = strtok_r(spec, ":", &save);
-        if (!name || !(global = brdf_model_find(name)))
-            return false;
-    }
+    if (brdf && !(global = brdf_spec_model(brdf)))
+        return false;
     for (uint32_t i = 0; i < sc->num_materials; i++) {
         GnMaterial *m = &sc->materials[i];
         const scene_material_extras *x = &sc->material_extras[i];
         brdf_setting st;
         if (global) {
-            char *kv, *rest = NULL;
-            snprintf(spec, sizeof spec, "%s", brdf);
-            strtok_r(spec, ":", &rest);
             setting_from_material(&st, global, m);
-            for (kv = strtok_r(NULL, ":", &rest); kv; kv = strtok_r(NULL, ":", &rest)) {
-                char *eq = strchr(kv, '=');
-                if (!eq) {
-                    util_error("--brdf '%s': expected MODEL[:PARAM=VALUE...], not '%s'", brdf, kv);
-                    return false;
-                }
-                *eq = 0;
-                if (!brdf_setting_set(&st, kv, eq + 1))
-                    return false;
-            }
+            if (!brdf_spec_apply(&st, brdf))
+                return false;
         } else if (x->brdf[0]) {
             const brdf_model *model = brdf_model_find(x->brdf);
             if (!model) {

@@ -2,9 +2,12 @@
 #define _POSIX_C_SOURCE 200809L
 #include "util.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <signal.h>
+#include <limits.h>
 #include <math.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -13,11 +16,13 @@
 #include <time.h>
 #include <unistd.h>
 
-static bool quiet_flag;
+static bool quiet_flag, silent_flag;
 static int warnings;
 
 static void vreport(const char *prefix, const char *fmt, va_list ap)
 {
+    if (silent_flag)
+        return;
     fprintf(stderr, "gonio: %s", prefix);
     vfprintf(stderr, fmt, ap);
     fputc('\n', stderr);
@@ -51,6 +56,7 @@ void util_info(const char *fmt, ...)
 }
 
 void util_set_quiet(bool quiet) { quiet_flag = quiet; }
+void util_set_silent(bool silent) { silent_flag = silent; }
 bool util_quiet(void) { return quiet_flag; }
 int util_warning_count(void) { return warnings; }
 
@@ -79,11 +85,18 @@ void *util_calloc(size_t count, size_t size)
 }
 void *util_realloc(void *ptr, size_t size) { return check_alloc(realloc(ptr, size ? size : 1), size); }
 
+/* strtol and strtod skip leading white space and take a '+': neither is a number as a
+ * user types it on a command line (" 16", "+16"). */
+static bool plain_number_start(const char *s)
+{
+    return s && (*s == '-' || *s == '.' || (*s >= '0' && *s <= '9'));
+}
+
 bool util_parse_int(const char *s, long min, long max, long *out)
 {
     char *end;
     long v;
-    if (!s || !*s)
+    if (!plain_number_start(s))
         return false;
     errno = 0;
     v = strtol(s, &end, 10);
@@ -97,7 +110,8 @@ bool util_parse_float(const char *s, float *out)
 {
     char *end;
     double v;
-    if (!s || !*s)
+    /* strtod also reads hexadecimal ("0x1p4"), not a number as a user writes one. */
+    if (!plain_number_start(s) || strpbrk(s, "xX"))
         return false;
     errno = 0;
     v = strtod(s, &end);
@@ -189,13 +203,17 @@ void *util_read_file(const char *path, size_t *size)
  * name and at worst unlinks a name that no longer exists. */
 static char pending_tmp[4096];
 static volatile sig_atomic_t pending;
+/* The temporary name: "DIR/.NAME.tmp-PID". */
+#define TMP_PREFIX "."
+#define TMP_INFIX ".tmp-"
+#define TMP_EXTRA (sizeof TMP_PREFIX + sizeof TMP_INFIX + 10)
 
 void util_tmp_path(char *out, size_t cap, const char *final_path)
 {
     const char *slash = strrchr(final_path, '/');
     int dirlen = slash ? (int)(slash - final_path + 1) : 0;
-    snprintf(out, cap, "%.*s.%s.tmp-%ld", dirlen, final_path, slash ? slash + 1 : final_path,
-             (long)getpid());
+    snprintf(out, cap, "%.*s" TMP_PREFIX "%s" TMP_INFIX "%ld", dirlen, final_path,
+             slash ? slash + 1 : final_path, (long)getpid());
     pending = 0;
     snprintf(pending_tmp, sizeof pending_tmp, "%s", out);
     pending = 1;
@@ -205,6 +223,105 @@ void util_remove_pending_tmp(void)
 {
     if (pending)
         unlink(pending_tmp);
+}
+
+/* Removes "DIR/.NAME.tmp-PID" files left by a gonio that was killed (SIGKILL, power loss)
+ * while writing NAME: only regular files, and only of processes that no longer exist. */
+static void remove_stale_tmp(const char *dir, const char *name)
+{
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    size_t len = strlen(name);
+    if (!d)
+        return;
+    while ((e = readdir(d))) {
+        const char *n = e->d_name, *pid_text = n + 1 + len + strlen(TMP_INFIX);
+        char path[PATH_MAX];
+        struct stat st;
+        long pid;
+        if (n[0] != '.' || strncmp(n + 1, name, len) || strncmp(n + 1 + len, TMP_INFIX, strlen(TMP_INFIX)) ||
+            !util_parse_int(pid_text, 1, LONG_MAX, &pid) || pid == (long)getpid())
+            continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH)
+            continue;
+        if (snprintf(path, sizeof path, "%s/%s", dir, n) < (int)sizeof path && lstat(path, &st) == 0 &&
+            S_ISREG(st.st_mode) && unlink(path) == 0)
+            util_info("%s: removed a stale temporary file of process %ld", path, pid);
+    }
+    closedir(d);
+}
+
+/* What may be replaced at an output path: nothing, or a regular file that may be written.
+ * A symbolic link, a device, a FIFO or a directory is refused: renaming over it would
+ * replace the link or the device node itself, not write through it. A read-only file is
+ * refused even for root, as the shell's > would refuse it for anyone else. */
+static bool replaceable(const char *path, struct stat *st, bool *exists)
+{
+    *exists = false;
+    if (lstat(path, st) != 0) {
+        if (errno == ENOENT)
+            return true;
+        util_error("%s: cannot write: %s", path, strerror(errno));
+        return false;
+    }
+    *exists = true;
+    if (S_ISLNK(st->st_mode))
+        util_error("%s: is a symbolic link; gonio replaces only regular files (name the target instead)", path);
+    else if (S_ISDIR(st->st_mode))
+        util_error("%s: is a directory; expected a file name", path);
+    else if (!S_ISREG(st->st_mode))
+        util_error("%s: is not a regular file (a device, FIFO or socket); gonio writes only regular files", path);
+    else if ((st->st_mode & 0222) == 0 || access(path, W_OK) != 0)
+        util_error("%s: is read-only; gonio does not replace it", path);
+    else
+        return true;
+    return false;
+}
+
+bool util_check_output(const char *path)
+{
+    char dir[PATH_MAX];
+    const char *slash, *name;
+    struct stat st;
+    bool exists;
+    if (!path || !*path) {
+        util_error("'': an output needs a file name");
+        return false;
+    }
+    if (strlen(path) + TMP_EXTRA >= PATH_MAX) {
+        util_error("%.40s...: output path of %zu characters is too long (at most %zu)", path, strlen(path),
+                   (size_t)PATH_MAX - TMP_EXTRA - 1);
+        return false;
+    }
+    slash = strrchr(path, '/');
+    name = slash ? slash + 1 : path;
+    if (!*name || !strcmp(name, ".") || !strcmp(name, "..")) {
+        util_error("%s: is a directory; expected a file name", path);
+        return false;
+    }
+    if (strlen(name) + TMP_EXTRA > NAME_MAX) {
+        util_error("%s: file name of %zu characters is too long (at most %zu)", path, strlen(name),
+                   (size_t)NAME_MAX - TMP_EXTRA);
+        return false;
+    }
+    if (slash)
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    else
+        strcpy(dir, ".");
+    if (!*dir)
+        strcpy(dir, "/");
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
+        util_error("%s: folder '%s' does not exist", path, dir);
+        return false;
+    }
+    if (access(dir, W_OK) != 0) {
+        util_error("%s: cannot write into '%s': %s", path, dir, strerror(errno));
+        return false;
+    }
+    if (!replaceable(path, &st, &exists))
+        return false;
+    remove_stale_tmp(dir, name);
+    return true;
 }
 
 FILE *util_tmp_open(char *tmp, size_t cap, const char *final_path, const char *mode)
@@ -218,6 +335,21 @@ FILE *util_tmp_open(char *tmp, size_t cap, const char *final_path, const char *m
 
 bool util_commit_file(const char *tmp_path, const char *final_path, bool ok)
 {
+    struct stat st;
+    bool exists;
+    /* Checked again here: the path may have changed since util_check_output, and not every
+     * writer's caller checks. */
+    if (ok && !replaceable(final_path, &st, &exists))
+        ok = false;
+    /* A replaced file keeps its permissions (and its owner, where we may give it). */
+    if (ok && exists) {
+        if (chmod(tmp_path, st.st_mode & 07777) != 0) {
+            util_error("%s: cannot write: %s", final_path, strerror(errno));
+            ok = false;
+        } else if ((st.st_uid != geteuid() || st.st_gid != getegid()) && chown(tmp_path, st.st_uid, st.st_gid) != 0) {
+            /* Not ours to give away: the new file is the writer's, as with any rename. */
+        }
+    }
     if (ok && rename(tmp_path, final_path) != 0) {
         util_error("%s: cannot write: %s", final_path, strerror(errno));
         ok = false;

@@ -2,6 +2,7 @@
 # hostile.sh: inputs that try to make gonio read what it should not or misread what it
 # reads. A scene reads only regular files under its own folder (src/scene.h); errors name
 # the URI and reveal nothing about the file refused. Scenes are glTF JSON written by Python.
+# Also: command-line values parsed strictly, and what an output path may be (src/util.h).
 . "$(dirname "$0")/../lib.sh"
 G=$GONIO
 command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
@@ -124,4 +125,90 @@ for m in path phong; do
     check "... with finite pixels ($m)" sh -c "'$TESTTOOL' stats '$tmp/bright-$m.exr' | grep -q 'nonfinite 0\$'"
 done
 check "the clamp is a warning naming the value" sh -c "'$G' info '$B/bright.gltf' 2>&1 | grep -q 'intensity 1e+39 is above 1e+09 (clamped)'"
+# Command-line values are numbers as typed: no leading space or sign, nothing left over.
+for v in " 16x16" "+16x+16" "16x+16" "16x 16" "0x16" "16x16 "; do
+    check_fails "--size '$v' is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --size "$v" --quiet
+done
+check_fails "--spp +4 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --spp +4 --quiet
+check_fails "--spp ' 4' is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --spp " 4" --quiet
+check_fails "--fov +30 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --fov +30 --quiet
+check_fails "--env ' 1' is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --env " 1" --quiet
+check_fails "--env 0x1p1 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --env 0x1p1 --quiet
+check "--size 16x16 --spp 1 --fov 30 --env 0.5,1,0 still render" "$G" render "$B/ok.gltf" -o "$tmp/v.exr" \
+    --size 16x16 --spp 1 --fov 30 --env 0.5,1,0 --quiet
+for v in "ggx:::" "ggx:" "ggx:alpha=0.3:" ":alpha=0.3" "ggx:=1"; do
+    check_fails "--brdf '$v' is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --brdf "$v" --quiet
+done
+check_fails "--brdf ggx:alpha=5 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --brdf ggx:alpha=5 --quiet
+check "... naming the parameter as it was given" sh -c "grep -q 'parameter alpha=5 is out of range' '$tmp/last' && ! grep -q -- '--alpha' '$tmp/last'"
+check_fails "--brdf ggx:shininess=5 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --brdf ggx:shininess=5 --quiet
+check "... listing the parameters in the spec's form" sh -c "grep -q 'no parameter shininess; it accepts .*alpha=X' '$tmp/last' && ! grep -q -- '--alpha' '$tmp/last'"
+check_fails "--brdf nosuch is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --brdf nosuch --quiet
+check "--brdf ggx:alpha=0.3:diffuse=0.2,0.4,0.6 renders" "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --size 8x8 --spp 1 \
+    --brdf ggx:alpha=0.3:diffuse=0.2,0.4,0.6 --quiet
+check_fails "gonio brdf's own option still says --alpha" 2 "$G" brdf ggx --alpha 5 -o "$tmp/lobe.png"
+check "... (--alpha)" grep -q -- "--alpha 5 is out of range" "$tmp/last"
+# Under the sanitizers a refused device index must not leak (the driver was unloaded
+# before LeakSanitizer could name its allocations).
+check_fails "--device 63 is refused cleanly" 1 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --device 63 --quiet
+check "... naming the devices" grep -q "only .* device(s)" "$tmp/last"
+# ---- Outputs: a new name or a writable regular file, nothing else (src/util.h) ------------
+O=$tmp/outputs
+mkdir -p "$O"
+R="--size 8x8 --spp 1 --quiet"
+echo secret > "$O/target.exr"
+ln -s target.exr "$O/link.exr"
+mkfifo "$O/fifo.exr"
+mkdir "$O/dir.exr" "$O/dir.png" "$O/dir.gltf"
+check_fails "-o a symbolic link is refused" 1 "$G" render "$B/ok.gltf" -o "$O/link.exr" $R
+check "... saying so" grep -q "link.exr: is a symbolic link" "$tmp/last"
+check "... and the link and its target stay" sh -c "test -L '$O/link.exr' && grep -q secret '$O/target.exr'"
+check_fails "-o a FIFO (a special file) is refused" 1 "$G" render "$B/ok.gltf" -o "$O/fifo.exr" $R
+check "... saying so" grep -q "fifo.exr: is not a regular file" "$tmp/last"
+check "... and it stays a FIFO" test -p "$O/fifo.exr"
+check_fails "-o a directory is refused" 1 "$G" render "$B/ok.gltf" -o "$O/dir.exr" $R
+check "... saying so" grep -q "dir.exr: is a directory" "$tmp/last"
+check_fails "--png a directory too" 1 "$G" render "$B/ok.gltf" -o "$O/new.exr" --png "$O/dir.png" $R
+check "... before writing -o" test ! -e "$O/new.exr"
+check_fails "-o in a missing folder is refused" 1 "$G" render "$B/ok.gltf" -o "$O/none/x.exr" $R
+check "... naming it" grep -q "none/x.exr: folder '.*none' does not exist" "$tmp/last"
+long=$O/$(printf 'd%.0s' $(seq 200))/$(printf 'd%.0s' $(seq 200))
+long=$long$long$long$long$long$long$long$long$long$long$long.exr
+check_fails "-o longer than PATH_MAX is refused" 1 "$G" render "$B/ok.gltf" -o "$long" $R
+check "... with a message" grep -q "output path of [0-9]* characters is too long" "$tmp/last"
+check_fails "-o with a 250-character name is refused (its temporary name would not fit)" 1 \
+    "$G" render "$B/ok.gltf" -o "$O/$(printf 'n%.0s' $(seq 246)).exr" $R
+check "... with a message" grep -q "file name of 250 characters is too long" "$tmp/last"
+echo keep > "$O/ro.exr"
+chmod 444 "$O/ro.exr"
+check_fails "-o a read-only file is refused (for root too)" 1 "$G" render "$B/ok.gltf" -o "$O/ro.exr" $R
+check "... saying so, and it stays" sh -c "grep -q 'ro.exr: is read-only' '$tmp/last' && grep -q keep '$O/ro.exr'"
+echo old > "$O/mode.exr"
+chmod 640 "$O/mode.exr"
+check "-o an existing file replaces it" "$G" render "$B/ok.gltf" -o "$O/mode.exr" $R
+check "... keeping its mode" test "$(stat -c %a "$O/mode.exr")" = 640
+if [ "$(id -u)" = 0 ] && id nobody >/dev/null 2>&1; then
+    chown nobody "$O/mode.exr"
+    check "... and its owner (root writing)" sh -c "'$G' render '$B/ok.gltf' -o '$O/mode.exr' $R && test \"\$(stat -c %U '$O/mode.exr')\" = nobody"
+fi
+# A gonio killed while writing leaves .NAME.tmp-PID: the next write of NAME removes it when
+# that process is gone, and leaves other names and live processes' files alone.
+dead=$(sh -c 'echo $$')
+echo half > "$O/.out.exr.tmp-$dead"
+echo live > "$O/.out.exr.tmp-$$"
+echo other > "$O/.other.exr.tmp-$dead"
+check "a stale temporary file is cleaned up" "$G" render "$B/ok.gltf" -o "$O/out.exr" $R
+check "... the dead process's one is gone" test ! -e "$O/.out.exr.tmp-$dead"
+check "... a live process's and another name's stay" test -e "$O/.out.exr.tmp-$$" -a -e "$O/.other.exr.tmp-$dead"
+# Every command that writes checks the same way, before any work.
+"$G" render "$B/ok.gltf" -o "$O/a.exr" $R --seed 1 && "$G" render "$B/ok.gltf" -o "$O/b.exr" $R --seed 2
+check_fails "merge -o a symbolic link is refused" 1 "$G" merge "$O/a.exr" "$O/b.exr" -o "$O/link.exr"
+check "... saying so" grep -q "link.exr: is a symbolic link" "$tmp/last"
+ln -s target.gltf "$O/link.gltf"
+ln -s target.png "$O/link.png"
+check_fails "scene -o a symbolic link is refused" 1 "$G" scene cornell -o "$O/link.gltf"
+check_fails "teapot -o a directory is refused" 1 "$G" teapot -o "$O/dir.gltf"
+check_fails "brdf -o a symbolic link is refused" 1 "$G" brdf ggx --theta 30 -o "$O/link.png"
+check "... saying so" grep -q "link.png: is a symbolic link" "$tmp/last"
+check "... and no target was written" test ! -e "$O/target.gltf" -a ! -e "$O/target.png"
 finish

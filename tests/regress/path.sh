@@ -13,7 +13,7 @@ check "--max-depth, --brdf and the variance AOV" "$G" render $C -o "$tmp/v.exr" 
     --max-depth 3 --brdf torrance-sparrow:exponent=128 --aov variance,albedo --quiet
 exrheader "$tmp/v.exr" >"$tmp/hdr.txt" 2>&1
 check "variance channels written" grep -q 'variance.R,' "$tmp/hdr.txt"
-check_fails "an unknown BRDF model is a usage error" 1 "$G" render $C -o "$tmp/x.exr" --brdf nosuch --quiet
+check_fails "an unknown BRDF model is a usage error" 2 "$G" render $C -o "$tmp/x.exr" --brdf nosuch --quiet
 check "the message names the models" grep -q 'torrance-sparrow' "$tmp/last"
 check_fails "a missing environment map fails" 1 "$G" render $C -o "$tmp/x.exr" --env "$tmp/none.exr" --quiet
 
@@ -88,7 +88,7 @@ T=scenes/teapot.gltf
 r32() { "$G" render "$@" --spp 4 --size 32x32 --aov variance --quiet; }
 check "other scene" r32 $T -o "$tmp/i-scene.exr" --seed 3
 check "other mode" r32 $C -o "$tmp/i-mode.exr" --seed 3 --mode phong
-check "other camera" r32 $C -o "$tmp/i-camera.exr" --seed 3 --camera frame
+check "other camera" r32 $C -o "$tmp/i-camera.exr" --seed 3 --camera frame # 0 is the default
 check "other max-depth" r32 $C -o "$tmp/i-max-depth.exr" --seed 3 --max-depth 2
 check "other env" r32 $C -o "$tmp/i-env.exr" --seed 3 --env 0.5
 check "other estimator" r32 $C -o "$tmp/i-estimator.exr" --seed 3 --estimator light

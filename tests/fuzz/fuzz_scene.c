@@ -1,0 +1,15 @@
+/* fuzz_scene.c: libFuzzer target over scene_load (glTF JSON and GLB, detected by content).
+ * Any input must give a scene or false with an error, never a crash, a sanitizer report,
+ * a leak or a hang. */
+#include "fuzz_common.h"
+#include "scene.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    scene sc;
+    util_set_quiet(true);
+    util_set_silent(true); /* the loader's warnings and errors: most of the time otherwise */
+    if (scene_load(&sc, fuzz_write_input("in.gltf", data, size)))
+        scene_destroy(&sc);
+    return 0;
+}

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# run.sh TARGET...: a bounded libFuzzer run of each target (make fuzz-run): FUZZ_TIME seconds
+# each (default 60), seeded in place from $GONIO_ASSETS (sample models, glTF-Validator's
+# invalid files) and from EXRs that $GONIO writes here, every compression, scanline and
+# tiled. New inputs and crash files go to a temporary folder, kept and named on a crash:
+# minimise one (TARGET -minimize_crash=1 FILE), fix the bug, and add the small file to
+# tests/fuzz/regress (tests/regress/fuzz.sh replays them in make test).
+set -u
+root=$(cd "$(dirname "$0")/../.." && pwd)
+cd "$root"
+GONIO=$(realpath "${GONIO:-build/release/gonio}")
+A=${GONIO_ASSETS:-$root/../shared/assets}
+T=${FUZZ_TIME:-60}
+tmp=$(mktemp -d)
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:quarantine_size_mb=16"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+export VK_ICD_FILENAMES=${VK_ICD_FILENAMES:-$(ls /usr/share/vulkan/icd.d/lvp_icd*.json | head -n 1)}
+
+# Seeds are symbolic links to the files where they are (libFuzzer follows them).
+mkdir -p "$tmp/seed-scene" "$tmp/seed-exr"
+n=0
+link() { ln -s "$(realpath "$2")" "$1/$n-$(basename "$2")"; n=$((n + 1)); }
+for f in scenes/*.gltf; do link "$tmp/seed-scene" "$f"; done
+if [ -d "$A" ]; then
+    while IFS= read -r f; do link "$tmp/seed-scene" "$f"; done < <(
+        find "$A/gltf" "$A/invalid-gltf" "$A/asset-generator" \( -name '*.gltf' -size -64k \) -o \( -name '*.glb' -size -256k \) 2>/dev/null)
+else
+    echo "note: $A is absent: the scene fuzzer starts from scenes/ only"
+fi
+for c in none rle zips zip piz pxr24 b44 b44a; do
+    "$GONIO" render scenes/cornell.gltf -o "$tmp/seed-exr/$c.exr" --size 19x13 --spp 1 --quiet --compression $c --aov normal,depth
+    "$GONIO" render scenes/cornell.gltf -o "$tmp/seed-exr/$c-half.exr" --size 19x13 --spp 1 --quiet --compression $c --half
+    if command -v exrmaketiled >/dev/null; then
+        exrmaketiled -z $c -t 8 8 "$tmp/seed-exr/$c-half.exr" "$tmp/seed-exr/$c-tiled.exr" >/dev/null 2>&1 # no zips: tiles are zip
+    fi
+done
+echo "seeds: $(ls "$tmp/seed-scene" | wc -l) scenes, $(ls "$tmp/seed-exr" | wc -l) EXRs"
+
+failed=0
+for f in "$@"; do
+    t=$(basename "$f")
+    case $t in *scene*) seeds=$tmp/seed-scene; len=65536 ;; *) seeds=$tmp/seed-exr; len=16384 ;; esac
+    mkdir -p "$tmp/corpus-$t"
+    "$f" "$tmp/corpus-$t" "$seeds" -max_total_time="$T" -max_len=$len -timeout=10 -rss_limit_mb=2048 \
+        -artifact_prefix="$tmp/crash-$t-" -print_final_stats=1 >"$tmp/$t.log" 2>&1
+    rc=$?
+    execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$tmp/$t.log")
+    secs=$(sed -n 's/^stat::.*time.*: *//p' "$tmp/$t.log" | head -n 1)
+    crashes=$(ls "$tmp" | grep -c "^crash-$t-")
+    echo "$t: ${execs:-?} executions in ${T} s, corpus $(ls "$tmp/corpus-$t" | wc -l) new inputs, $crashes crash file(s), exit $rc"
+    if [ "$rc" != 0 ] || [ "$crashes" != 0 ]; then
+        failed=1
+        grep -m 1 -A 12 "ERROR\|runtime error\|deadly signal" "$tmp/$t.log"
+        ls "$tmp"/crash-"$t"-* 2>/dev/null
+    fi
+done
+if [ "$failed" = 0 ]; then
+    rm -rf "$tmp"
+else
+    echo "fuzz: FAILED; logs and crash inputs kept in $tmp"
+fi
+exit $failed
