@@ -38,6 +38,12 @@ static const char render_usage[] =
     "  --allow-outside-files  let the scene read files outside its folder (default: only\n"
     "                      regular files under it)\n"
     "  --seed S            random seed (default 0); renders with different seeds merge\n"
+    "  --frame N           the scene's glTF animations at frame N / --fps (all play at once:\n"
+    "                      node translation, rotation, scale; meshes, cameras, lights)\n"
+    "  --fps F             frames per second for --frame and --frames (default 24)\n"
+    "  --at SECONDS        the animations at this time\n"
+    "  --frames A-B        render frames A to B, one file each: -o and --png are patterns\n"
+    "                      with one %d (e.g. out/frame_%04d.exr); stops at the first failure\n"
     "  --crop X0,Y0,X1,Y1  render only pixels [X0, X1) x [Y0, Y1) of the image, each as the\n"
     "                      whole render has it, bit for bit: an EXR whose data window is the\n"
     "                      region of the full display window (gonio merge assembles tiles);\n"
@@ -71,6 +77,68 @@ static volatile sig_atomic_t stop_requested;
 static void on_signal(int sig)
 {
     stop_requested = sig; /* SIGTERM (pre-emption) also makes the output resumable */
+}
+
+/* A file-name pattern with exactly one %d, %Nd or %0Nd and no other '%'. */
+static bool frame_pattern(const char *p)
+{
+    const char *c = strchr(p, '%');
+    if (!c)
+        return false;
+    c++;
+    while (*c >= '0' && *c <= '9')
+        c++;
+    return *c == 'd' && !strchr(c, '%');
+}
+
+/* --frames A-B: cmd_render once per frame, --frame N in place of --frames and the output
+ * patterns filled in. */
+static int render_frames(int argc, char **argv, int at)
+{
+    long a, b;
+    char *dash, range[64], **args = util_calloc((size_t)argc + 1, sizeof *args);
+    char frame[16], names[2][4096];
+    int rc = 0;
+    snprintf(range, sizeof range, "%s", argv[at + 1]);
+    dash = strchr(range + 1, '-');
+    if (dash)
+        *dash = 0;
+    if (!dash || !util_parse_int(range, 0, 1 << 24, &a) || !util_parse_int(dash + 1, 0, 1 << 24, &b) || b < a) {
+        free(args);
+        return cli_usage_error("render", "--frames '%s': expected A-B, frames 0 <= A <= B", argv[at + 1]);
+    }
+    for (int i = 1; i < argc; i++)
+        if ((!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output") || !strcmp(argv[i], "--png")) && i + 1 < argc &&
+            !frame_pattern(argv[i + 1])) {
+            free(args);
+            return cli_usage_error("render", "%s '%s': with --frames, a pattern with one %%d (e.g. frame_%%04d.exr)",
+                                   argv[i], argv[i + 1]);
+        } else if (!strcmp(argv[i], "--frame") || !strcmp(argv[i], "--at")) {
+            free(args);
+            return cli_usage_error("render", "--frames and %s exclude each other", argv[i]);
+        }
+    for (long f = a; f <= b && rc == 0 && !stop_requested; f++) {
+        int nout = 0;
+        snprintf(frame, sizeof frame, "%ld", f);
+        for (int i = 0; i < argc; i++) {
+            args[i] = argv[i];
+            if (i == at)
+                args[i] = "--frame";
+            else if (i == at + 1)
+                args[i] = frame;
+            else if (i > 0 && (!strcmp(argv[i - 1], "-o") || !strcmp(argv[i - 1], "--output") ||
+                               !strcmp(argv[i - 1], "--png")) && nout < 2) {
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+                snprintf(names[nout], sizeof names[0], argv[i], (int)f); /* checked: frame_pattern */
+#pragma GCC diagnostic pop
+                args[i] = names[nout++];
+            }
+        }
+        rc = cmd_render(argc, args);
+    }
+    free(args);
+    return rc;
 }
 
 /* --crop X0,Y0,X1,Y1: pixels, or fractions when any value has a '.'. */
@@ -213,6 +281,9 @@ int cmd_render(int argc, char **argv)
     char camera_text[160];
     bool size_given = false, quiet = false, validate = false, studio = false, resumable = false;
     crop_option crop = {0};
+    int frame = -1;      /* --frame */
+    float fps = 24;
+    double at = -1;      /* --at, or the frame's time */
     const char *crop_text = NULL, *resume_path = NULL;
     image prev = {0};
     int device = -1, scene_index = -1, taken;
@@ -228,6 +299,9 @@ int cmd_render(int argc, char **argv)
     render_stats st;
     int rc = 1;
 
+    for (int i = 1; i + 1 < argc; i++)
+        if (!strcmp(argv[i], "--frames"))
+            return render_frames(argc, argv, i);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *val;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -284,6 +358,18 @@ int cmd_render(int argc, char **argv)
                 if (!util_parse_int(val, 0, 0xffffffffL, &v))
                     return cli_usage_error("render", "--seed '%s': expected an integer 0..4294967295", val);
                 s.seed = (uint32_t)v;
+            } else if (!strcmp(a, "--frame")) {
+                if (!util_parse_int(val, 0, 1 << 24, &v))
+                    return cli_usage_error("render", "--frame '%s': expected a frame number >= 0", val);
+                frame = (int)v;
+            } else if (!strcmp(a, "--fps")) {
+                if (!util_parse_float(val, &fps) || !(fps > 0 && fps <= 1e6f))
+                    return cli_usage_error("render", "--fps '%s': expected frames per second > 0", val);
+            } else if (!strcmp(a, "--at")) {
+                float t;
+                if (!util_parse_float(val, &t) || !(t >= 0 && t <= 1e9f))
+                    return cli_usage_error("render", "--at '%s': expected seconds >= 0", val);
+                at = t;
             } else if (!strcmp(a, "--crop")) {
                 if (!parse_crop(val, &crop))
                     return cli_usage_error("render", "--crop '%s': expected X0,Y0,X1,Y1 in pixels (integers) "
@@ -367,6 +453,11 @@ int cmd_render(int argc, char **argv)
     if ((out_path && !check_writable(out_path)) || (png_path && !check_writable(png_path)))
         return 1;
 
+    if (frame >= 0 && at >= 0)
+        return cli_usage_error("render", "--frame and --at exclude each other");
+    if (frame >= 0)
+        at = frame / (double)fps;
+    scene_animation_time(at);
     if (!scene_load_scene(&sc, scene_path, scene_index))
         return 1;
     if (!render_material_overrides(&sc, brdf) || !env_setup(&env, &sc, quiet, &env_map, &s, &studio) ||
@@ -402,6 +493,11 @@ int cmd_render(int argc, char **argv)
         bool ok = true;
         int region[4];
         render_header_build(&h, &r, &s, &st, brdf);
+        if (at >= 0 && h.count + 2 <= RENDER_HEADER_MAX) { /* the animation's time, and frame */
+            h.attrs[h.count++] = (image_attr){"gonio:time", IMAGE_ATTR_DOUBLE, NULL, 0, at, NULL};
+            if (frame >= 0)
+                h.attrs[h.count++] = (image_attr){"gonio:frame", IMAGE_ATTR_INT, NULL, frame, 0, NULL};
+        }
         if (stop_requested && !quiet)
             util_warn("interrupted: writing the %d spp rendered so far%s", st.spp,
                       stop_requested == SIGTERM && exr_path ? " (resumable: --resume)" : "");

@@ -115,4 +115,77 @@ else
     fail "SIGTERM left no output (exit $st)"
 fi
 
+# ---- animation -----------------------------------------------------------------------------
+# anim FILE NODE INTERP TIMES VALUES: a red 0.4 x 0.4 square (node 0, at the origin) seen by
+# an orthographic camera (node 1, at z = 5, xmag 2, ymag 1), one animation whose sampler
+# (INTERP, key TIMES, output VALUES: x of a VEC3 each, y = 0, z = 0 or the camera's 5)
+# drives NODE's translation. Written here, buffer and all (perl packs the floats).
+anim() {
+    local file=$1 node=$2 interp=$3 times=$4 values=$5 nt nv z=0 b64
+    [ "$node" = 1 ] && z=5
+    nt=$(echo $times | wc -w)
+    nv=$(echo $values | wc -w)
+    b64=$(perl -e '
+        my ($z, $t, $v) = @ARGV;
+        my @t = split " ", $t; my @v = map { ($_, 0, $z) } split " ", $v;
+        print pack("f<12 S<6 x4 f<* f<*", -0.2,-0.2,0, 0.2,-0.2,0, 0.2,0.2,0, -0.2,0.2,0,
+                   0,1,2, 0,2,3, @t, @v);' "$z" "$times" "$values" | base64 -w0)
+    cat >"$file" <<EOF
+{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+ "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}],
+ "cameras": [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 1, "znear": 0.1, "zfar": 100}}],
+ "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 1]}, "doubleSided": true}],
+ "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+ "buffers": [{"byteLength": $((64 + 4 * nt + 12 * nv)), "uri": "data:application/octet-stream;base64,$b64"}],
+ "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48},
+                 {"buffer": 0, "byteOffset": 48, "byteLength": 12},
+                 {"buffer": 0, "byteOffset": 64, "byteLength": $((4 * nt))},
+                 {"buffer": 0, "byteOffset": $((64 + 4 * nt)), "byteLength": $((12 * nv))}],
+ "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
+                "min": [-0.2, -0.2, 0], "max": [0.2, 0.2, 0]},
+               {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
+               {"bufferView": 2, "componentType": 5126, "count": $nt, "type": "SCALAR"},
+               {"bufferView": 3, "componentType": 5126, "count": $nv, "type": "VEC3"}],
+ "animations": [{"name": "move", "samplers": [{"input": 2, "output": 3, "interpolation": "$interp"}],
+                 "channels": [{"sampler": 0, "target": {"node": $node, "path": "translation"}}]}]}
+EOF
+}
+# at FILE.exr X: the red square's centre in the image is where world x = X maps
+# (200 px over 4 units: pixel 50 X + 100), within a pixel.
+at() {
+    local c
+    c=$("$T" stats "$1" | awk '{ print ($8 + $10 + 1) / 2 }')
+    if awk -v c="$c" -v x="$2" 'BEGIN { w = 50 * x + 100; exit !(c - w < 1 && w - c < 1) }'; then pass
+    else fail "$1: the square is centred at pixel $c, expected $(awk -v x="$2" 'BEGIN { print 50 * x + 100 }') (x = $2)"; fi
+}
+a=(--size 200x100 --mode albedo --spp 1 --quiet)
+anim "$tmp/linear.gltf" 0 LINEAR "0 2" "-1 1"
+check "--frames renders one file a frame" "$G" render "$tmp/linear.gltf" "${a[@]}" --fps 4 --frames 0-8 -o "$tmp/lin_%02d.exr"
+at "$tmp/lin_00.exr" -1     # frame 0, t = 0
+at "$tmp/lin_03.exr" -0.25  # frame 3, t = 0.75: -1 + 2 (0.75 / 2)
+at "$tmp/lin_08.exr" 1      # the last frame, t = 2
+exrheader "$tmp/lin_03.exr" >"$tmp/hl"
+has "$tmp/hl" "gonio:frame (type int): 3"
+has "$tmp/hl" "gonio:time (type double): 0.75"
+at_time() { "$G" render "$1" "${a[@]}" --at "$2" -o "$tmp/at.exr" && at "$tmp/at.exr" "$3"; }
+at_time "$tmp/linear.gltf" 5 1  # after the last key: its value
+anim "$tmp/step.gltf" 0 STEP "0 1 2" "-1 0.5 1"
+at_time "$tmp/step.gltf" 0.99 -1
+at_time "$tmp/step.gltf" 1.5 0.5
+# CUBICSPLINE: keys (in-tangent, value, out-tangent) = (0, -1, 1.5) at t 0 and (2, 1, 0) at
+# t 2; at t = 0.5, u = 0.25, td = 2: the spec's Hermite form, computed here.
+anim "$tmp/cubic.gltf" 0 CUBICSPLINE "0 2" "0 -1 1.5 2 1 0"
+want=$(awk 'BEGIN { u = 0.25; td = 2; u2 = u * u; u3 = u2 * u;
+    print (2*u3 - 3*u2 + 1) * -1 + td * (u3 - 2*u2 + u) * 1.5 + (-2*u3 + 3*u2) * 1 + td * (u3 - u2) * 2 }')
+at_time "$tmp/cubic.gltf" 0.5 "$want"
+# The camera animates: it moves to x = 1 over a second; at 0.5 s the square is 0.5 left.
+anim "$tmp/camera.gltf" 1 LINEAR "0 1" "0 1"
+at_time "$tmp/camera.gltf" 0.5 -0.5
+check_fails "--frames needs a pattern" 2 "$G" render "$tmp/linear.gltf" "${a[@]}" --frames 0-2 -o "$tmp/x.exr"
+check_fails "--frames A-B with B < A" 2 "$G" render "$tmp/linear.gltf" "${a[@]}" --frames 3-2 -o "$tmp/x%d.exr"
+check_fails "--frame and --at" 2 "$G" render "$tmp/linear.gltf" "${a[@]}" --frame 1 --at 2 -o "$tmp/x.exr"
+anim "$tmp/short.gltf" 0 LINEAR "0 2" "-1"
+check_fails "a sampler with too few values is refused" 1 "$G" render "$tmp/short.gltf" "${a[@]}" --at 1 -o "$tmp/x.exr"
+has "$tmp/last" "short.gltf"
+
 finish
