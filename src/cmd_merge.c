@@ -1,4 +1,5 @@
-/* cmd_merge.c: `gonio merge`: renders of one scene with different seeds -> one image, each
+/* cmd_merge.c: `gonio merge`: renders of one scene with different seeds, or tiles of it
+ * (--crop: placed by their EXR data windows) -> one image, each
  * pixel the mean of all N = sum n_i samples (sum n_i x_i / N), so the result is the render
  * of N spp. Variance channels combine through the sums of squares they imply:
  * sum x^2 = n (v (n - 1) + m^2) for a file's mean m and variance of the mean v.
@@ -25,13 +26,18 @@ static const char merge_usage[] =
     "exactly the mean of all the samples, with gonio:spp their total. variance.R/G/B\n"
     "channels are merged exactly too.\n"
     "\n"
-    "The inputs must be one render: the same size and channels, and the same gonio:scene\n"
+    "Inputs rendered with --crop are placed by their EXR data windows: tiles assemble into\n"
+    "the frame (or the region they cover), and at every pixel the inputs covering it are\n"
+    "combined; every pixel must get the same number of samples (no holes, no uneven\n"
+    "overlaps). The sum.* channels of --resumable renders are left out.\n"
+    "\n"
+    "The inputs must be one render: the same frame size and channels, and the same gonio:scene\n"
     "(a hash of the scene's content), gonio:size, gonio:mode, gonio:camera and options of the\n"
     "mode (gonio:max-depth, gonio:estimator, gonio:env, gonio:shadows, gonio:ambient); each\n"
     "gonio:spp a positive integer, their total at most 2147483647. Anything else is an error\n"
-    "naming both files and the field (exit 1, no output). A seed used twice is an error too\n"
-    "(its samples repeat and add nothing) unless --force. The output records every seed in\n"
-    "gonio:seeds, so merged files merge again.\n"
+    "naming both files and the field (exit 1, no output). A seed used twice in inputs that\n"
+    "overlap is an error too (its samples repeat and add nothing) unless --force. The output\n"
+    "records every seed in gonio:seeds, so merged files merge again.\n"
     "\n"
     "  -o, --output FILE   the merged OpenEXR (a .exr name; written atomically)\n"
     "  --force             merge inputs that share a seed\n"
