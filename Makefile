@@ -1,6 +1,6 @@
 # gonio: build, run, test, bench.
 #   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
-#   make run | test | bench | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
+#   make run | test | test-farm | bench | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
 #   make fuzz (libFuzzer targets, clang, in build/fuzz) | fuzz-run [FUZZ_TIME=60]
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
 # is printed and make stops.
@@ -85,7 +85,7 @@ FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
 	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
 
 .PHONY: all deps test-deps run test unit regress bench clean install shaders docs-images \
-	fuzz fuzz-deps fuzz-targets fuzz-run
+	fuzz fuzz-deps fuzz-targets fuzz-run test-farm
 all: $(GONIO) build/gonio
 
 deps:
@@ -144,6 +144,14 @@ run: all
 
 test: all $(UNIT) $(TESTTOOL) test-deps
 	@GONIO=$(GONIO) UNIT=$(UNIT) TESTTOOL=$(TESTTOOL) CONFIG=$(config) tests/run.sh
+
+# A one-node Slurm cluster on localhost runs farm/slurm-tiles.sh (tests/farm/slurm.sh);
+# it skips, saying why, where slurm-wlm and munge cannot be installed or started.
+DEB_FARM := slurm-wlm munge
+FARM_DEPS_CHECK = { command -v slurmctld && command -v slurmd && command -v munged; } >/dev/null 2>&1
+test-farm: all $(TESTTOOL)
+	@if ! $(FARM_DEPS_CHECK); then ( $(call apt_install,$(DEB_FARM)) ) || true; fi
+	@GONIO=$(GONIO) TESTTOOL=$(TESTTOOL) tests/farm/slurm.sh; rc=$$?; [ $$rc = 0 ] || [ $$rc = 77 ]
 
 unit: $(UNIT)
 	$(UNIT) $(T)

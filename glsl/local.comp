@@ -53,8 +53,10 @@ vec3 flat_color(Hit h, vec3 d)
 void main()
 {
     uvec2 px = tile_pixel();
-    if (px.x >= frame.width || px.y >= frame.height)
+    if (px.x >= frame.crop_width || px.y >= frame.crop_height)
         return;
+    uint slot = px.y * frame.crop_width + px.x; // in the region's buffers (GnFrame)
+    px += uvec2(frame.crop_x, frame.crop_y);    // in the whole image
     uint pixel = px.y * frame.width + px.x;
     vec2 jitter = push.sample_index == 0u ? vec2(0.5) : rand2(pixel, push.sample_index, 0u);
     vec3 o, d;
@@ -83,12 +85,12 @@ void main()
         color = lit ? frame.env_color : vec3(0.0);
     }
     if (MODE == GN_MODE_COST) color = vec3(float(h.steps));
-    accum[pixel] += vec4(color, h.tri != GN_INVALID ? 1.0 : 0.0); // w: coverage
+    accum[slot] += vec4(color, h.tri != GN_INVALID ? 1.0 : 0.0); // w: coverage
     if (h.truncated)
         atomicAdd(status[0], 1u);
     if ((frame.flags & GN_FRAME_AOV) != 0u) {
-        aov[3u * pixel + 0u] += vec4(normal, 0.0);
-        aov[3u * pixel + 1u] += vec4(albedo, 0.0);
-        aov[3u * pixel + 2u] += vec4(depth, 0.0, 0.0, 0.0);
+        aov[3u * slot + 0u] += vec4(normal, 0.0);
+        aov[3u * slot + 1u] += vec4(albedo, 0.0);
+        aov[3u * slot + 2u] += vec4(depth, 0.0, 0.0, 0.0);
     }
 }

@@ -329,8 +329,10 @@ uint path_step()
 void main()
 {
     px = tile_pixel();
-    if (px.x >= frame.width || px.y >= frame.height)
+    if (px.x >= frame.crop_width || px.y >= frame.crop_height)
         return;
+    uint slot = px.y * frame.crop_width + px.x; // in the region's buffers
+    px += uvec2(frame.crop_x, frame.crop_y);    // in the whole image
     pixel = px.y * frame.width + px.x;
     rng_pixel = pixel;
     bool light_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_LIGHT_ONLY) != 0u;
@@ -338,9 +340,14 @@ void main()
     truncated = false;
     samples = max(push.pad0, 1u);
     taken = 0u;
-    sum = vec4(0.0);
-    sum_sq = sum_n = sum_a = vec3(0.0);
-    sum_depth = 0.0;
+    // The sums go on from the buffers, one sample at a time in sample order, so a pixel's
+    // sum is the same float whichever dispatches (or runs: --resume) took its samples.
+    bool aov_on = GN_HAS(GN_FEAT_AOV) && (frame.flags & GN_FRAME_AOV) != 0u;
+    sum = accum[slot];
+    sum_sq = squares[slot].rgb;
+    sum_n = aov_on ? aov[3u * slot + 0u].xyz : vec3(0.0);
+    sum_a = aov_on ? aov[3u * slot + 1u].xyz : vec3(0.0);
+    sum_depth = aov_on ? aov[3u * slot + 2u].x : 0.0;
 
     path_start();
     while (true) {
@@ -439,11 +446,11 @@ void main()
     // Fewer samples than asked for: llvmpipe's loop cap ended the loop (the rest count 0).
     if (truncated || taken < samples)
         atomicAdd(status[0], 1u);
-    accum[pixel] += sum;
-    squares[pixel] += vec4(sum_sq, 0.0);
-    if (GN_HAS(GN_FEAT_AOV) && (frame.flags & GN_FRAME_AOV) != 0u) {
-        aov[3u * pixel + 0u] += vec4(sum_n, 0.0);
-        aov[3u * pixel + 1u] += vec4(sum_a, 0.0);
-        aov[3u * pixel + 2u] += vec4(sum_depth, 0.0, 0.0, 0.0);
+    accum[slot] = sum;
+    squares[slot] = vec4(sum_sq, 0.0);
+    if (aov_on) {
+        aov[3u * slot + 0u] = vec4(sum_n, 0.0);
+        aov[3u * slot + 1u] = vec4(sum_a, 0.0);
+        aov[3u * slot + 2u] = vec4(sum_depth, 0.0, 0.0, 0.0);
     }
 }

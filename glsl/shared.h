@@ -258,7 +258,10 @@ GN_STRUCT(GnCamera) {
     float ortho_half_height; float pad0; float pad1; float pad2;
 } GN_END(GnCamera); /* 80 bytes */
 
-/* Constant for a whole render (read-only storage buffer, std430). */
+/* Constant for a whole render (read-only storage buffer, std430). width x height is the
+ * whole image, which the camera maps and whose pixel index feeds the random numbers; the
+ * kernels run over its region (crop_x, crop_y) + crop_width x crop_height, whose pixels
+ * the accumulation buffers hold, so a crop renders exactly the pixels of the whole image. */
 GN_STRUCT(GnFrame) {
     GnCamera camera;
     uint width; uint height; uint seed; uint mode;
@@ -270,8 +273,10 @@ GN_STRUCT(GnFrame) {
     uint env_width; uint env_height;     /* GN_FRAME_ENV_MAP: the lat-long map's size */
     float env_select; float env_norm;    /* env's selection probability; 1 / mean map weight */
     float env_cos; float env_sin;        /* the map turned by a about +Y (right-handed): cos a, -sin a */
-    uint pad_env0; uint pad_env1;
-} GN_END(GnFrame); /* 208 bytes */
+    uint crop_x; uint crop_y;            /* the region's top-left pixel in the whole image */
+    uint crop_width; uint crop_height;   /* the region's size: the dispatch and the buffers */
+    uint pad_crop0; uint pad_crop1;
+} GN_END(GnFrame); /* 224 bytes */
 
 /* Per-dispatch values (push constants). */
 GN_STRUCT(GnPush) {
@@ -314,7 +319,8 @@ GN_STATIC_ASSERT(sizeof(GnLight) == 64, "GnLight layout");
 GN_STATIC_ASSERT(sizeof(GnEmitter) == 16, "GnEmitter layout");
 GN_STATIC_ASSERT(sizeof(GnTexture) == 16, "GnTexture layout");
 GN_STATIC_ASSERT(sizeof(GnCamera) == 80, "GnCamera layout");
-GN_STATIC_ASSERT(sizeof(GnFrame) == 208, "GnFrame layout");
+GN_STATIC_ASSERT(sizeof(GnFrame) == 224, "GnFrame layout");
+GN_STATIC_ASSERT(offsetof(GnFrame, crop_x) == 200, "GnFrame layout");
 GN_STATIC_ASSERT(offsetof(GnFrame, env_width) == 176, "GnFrame layout");
 GN_STATIC_ASSERT(offsetof(GnFrame, ambient) == 112, "GnFrame layout");
 GN_STATIC_ASSERT(sizeof(GnPush) == 16, "GnPush layout");

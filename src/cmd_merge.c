@@ -1,4 +1,5 @@
-/* cmd_merge.c: `gonio merge`: renders of one scene with different seeds -> one image, each
+/* cmd_merge.c: `gonio merge`: renders of one scene with different seeds, or tiles of it
+ * (--crop: placed by their EXR data windows) -> one image, each
  * pixel the mean of all N = sum n_i samples (sum n_i x_i / N), so the result is the render
  * of N spp. Variance channels combine through the sums of squares they imply:
  * sum x^2 = n (v (n - 1) + m^2) for a file's mean m and variance of the mean v.
@@ -25,13 +26,18 @@ static const char merge_usage[] =
     "exactly the mean of all the samples, with gonio:spp their total. variance.R/G/B\n"
     "channels are merged exactly too.\n"
     "\n"
-    "The inputs must be one render: the same size and channels, and the same gonio:scene\n"
+    "Inputs rendered with --crop are placed by their EXR data windows: tiles assemble into\n"
+    "the frame (or the region they cover), and at every pixel the inputs covering it are\n"
+    "combined; every pixel must get the same number of samples (no holes, no uneven\n"
+    "overlaps). The sum.* channels of --resumable renders are left out.\n"
+    "\n"
+    "The inputs must be one render: the same frame size and channels, and the same gonio:scene\n"
     "(a hash of the scene's content), gonio:size, gonio:mode, gonio:camera and options of the\n"
     "mode (gonio:max-depth, gonio:estimator, gonio:env, gonio:shadows, gonio:ambient); each\n"
     "gonio:spp a positive integer, their total at most 2147483647. Anything else is an error\n"
-    "naming both files and the field (exit 1, no output). A seed used twice is an error too\n"
-    "(its samples repeat and add nothing) unless --force. The output records every seed in\n"
-    "gonio:seeds, so merged files merge again.\n"
+    "naming both files and the field (exit 1, no output). A seed used twice in inputs that\n"
+    "overlap is an error too (its samples repeat and add nothing) unless --force. The output\n"
+    "records every seed in gonio:seeds, so merged files merge again.\n"
     "\n"
     "  -o, --output FILE   the merged OpenEXR (a .exr name; written atomically)\n"
     "  --force             merge inputs that share a seed\n"
@@ -42,6 +48,33 @@ static const char merge_usage[] =
 static const char *variance_of(const char *name)
 {
     return strncmp(name, "variance.", 9) == 0 ? name + 9 : NULL;
+}
+
+/* The whole frame a file's pixels are part of (its display window). */
+static int frame_width(const image *img) { return img->full_width ? img->full_width : img->width; }
+static int frame_height(const image *img) { return img->full_width ? img->full_height : img->height; }
+
+/* sum.* and sum2.*: a --resumable render's exact sums, state for --resume, not merged. */
+static bool is_sum(const char *name) { return !strncmp(name, "sum.", 4) || !strncmp(name, "sum2.", 5); }
+
+static int pixel_channels(const image *img)
+{
+    int n = 0;
+    for (int c = 0; c < img->num_channels; c++)
+        n += !is_sum(img->names[c]);
+    return n;
+}
+
+/* Frame pixel (x, y) is in img's data window. */
+static bool inside(const image *img, int x, int y)
+{
+    return x >= img->x0 && y >= img->y0 && x < img->x0 + img->width && y < img->y0 + img->height;
+}
+
+static bool overlap(const image *a, const image *b)
+{
+    return a->x0 < b->x0 + b->width && b->x0 < a->x0 + a->width && a->y0 < b->y0 + b->height &&
+           b->y0 < a->y0 + a->height;
 }
 
 /* The file's sample count: a finite positive integer no larger than INT32_MAX. */
@@ -76,6 +109,23 @@ static void add_seed(seed_list *l, uint32_t seed, int file)
     }
     l->seed[l->count] = seed;
     l->file[l->count++] = file;
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The sorted seeds of the inputs marked in `in`, into out; their count. */
+static int covering_seeds(const seed_list *l, const unsigned char *in, uint32_t *out)
+{
+    int k = 0;
+    for (int i = 0; i < l->count; i++)
+        if (in[l->file[i]])
+            out[k++] = l->seed[i];
+    qsort(out, (size_t)k, sizeof *out, cmp_u32);
+    return k;
 }
 
 /* A file's seeds: gonio:seeds (a merge's list) or gonio:seed (a render's); false when the
@@ -176,15 +226,15 @@ int cmd_merge(int argc, char **argv)
         double s;
         if (!image_read_exr(&imgs[i], inputs[i]) || !read_spp(inputs[i], &spp[i]))
             goto done;
-        if (imgs[i].width != imgs[0].width || imgs[i].height != imgs[0].height ||
-            imgs[i].num_channels != imgs[0].num_channels) {
-            util_error("%s: %dx%d with %d channels, but %s is %dx%d with %d", inputs[i],
-                       imgs[i].width, imgs[i].height, imgs[i].num_channels, inputs[0],
-                       imgs[0].width, imgs[0].height, imgs[0].num_channels);
+        if (frame_width(&imgs[i]) != frame_width(&imgs[0]) || frame_height(&imgs[i]) != frame_height(&imgs[0]) ||
+            pixel_channels(&imgs[i]) != pixel_channels(&imgs[0])) {
+            util_error("%s: a %dx%d frame with %d channels, but %s is %dx%d with %d", inputs[i],
+                       frame_width(&imgs[i]), frame_height(&imgs[i]), pixel_channels(&imgs[i]), inputs[0],
+                       frame_width(&imgs[0]), frame_height(&imgs[0]), pixel_channels(&imgs[0]));
             goto done;
         }
         for (int c = 0; c < imgs[0].num_channels; c++)
-            if (image_channel(&imgs[i], imgs[0].names[c]) < 0) {
+            if (!is_sum(imgs[0].names[c]) && image_channel(&imgs[i], imgs[0].names[c]) < 0) {
                 util_error("%s: has no channel '%s' (which %s has)", inputs[i], imgs[0].names[c], inputs[0]);
                 goto done;
             }
@@ -201,9 +251,10 @@ int cmd_merge(int argc, char **argv)
             goto done;
         }
     }
+    /* A seed may repeat in tiles that do not overlap; in overlapping ones its samples repeat. */
     for (int a = 0; a < seeds.count; a++)
         for (int b = 0; b < a; b++)
-            if (seeds.seed[a] == seeds.seed[b]) {
+            if (seeds.seed[a] == seeds.seed[b] && overlap(&imgs[seeds.file[a]], &imgs[seeds.file[b]])) {
                 if (!force) {
                     util_error("%s and %s: both have seed %u: its samples repeat and add no information "
                                "(--force merges anyway)", inputs[seeds.file[b]], inputs[seeds.file[a]], seeds.seed[a]);
@@ -215,33 +266,105 @@ int cmd_merge(int argc, char **argv)
 
     {
         const char *names[IMAGE_MAX_CHANNELS];
-        const size_t pixels = (size_t)imgs[0].width * imgs[0].height;
+        int nc = 0, box[4] = {INT32_MAX, INT32_MAX, 0, 0}; /* the union of the data windows */
+        int64_t *covered;
+        unsigned char *in = util_calloc((size_t)n, 1), *first_in = util_calloc((size_t)n, 1);
+        unsigned char *last_in = util_calloc((size_t)n, 1);
+        uint32_t *first_seeds = util_calloc((size_t)seeds.count + 1, sizeof *first_seeds);
+        uint32_t *pixel_seeds = util_calloc((size_t)seeds.count + 1, sizeof *pixel_seeds);
+        int first_count = 0;
         for (int c = 0; c < imgs[0].num_channels; c++)
-            names[c] = imgs[0].names[c];
-        image_create(&out, imgs[0].width, imgs[0].height, imgs[0].num_channels, names);
-        for (int c = 0; c < out.num_channels; c++) {
-            const char *of = variance_of(names[c]);
-            int mc = of ? image_channel(&imgs[0], of) : -1;
-            for (size_t p = 0; p < pixels; p++) {
-                double sum = 0, sq = 0;
+            if (!is_sum(imgs[0].names[c]))
+                names[nc++] = imgs[0].names[c];
+        for (int i = 0; i < n; i++) {
+            box[0] = imgs[i].x0 < box[0] ? imgs[i].x0 : box[0];
+            box[1] = imgs[i].y0 < box[1] ? imgs[i].y0 : box[1];
+            box[2] = imgs[i].x0 + imgs[i].width > box[2] ? imgs[i].x0 + imgs[i].width : box[2];
+            box[3] = imgs[i].y0 + imgs[i].height > box[3] ? imgs[i].y0 + imgs[i].height : box[3];
+        }
+        image_create(&out, box[2] - box[0], box[3] - box[1], nc, names);
+        if (out.width != frame_width(&imgs[0]) || out.height != frame_height(&imgs[0])) {
+            out.x0 = box[0];
+            out.y0 = box[1];
+            out.full_width = frame_width(&imgs[0]);
+            out.full_height = frame_height(&imgs[0]);
+        }
+        /* Every pixel must have the same sample count, gonio:spp: each has all the tiles'
+         * samples or the merge would be a patchwork of images of different noise. */
+        covered = util_calloc((size_t)out.width * out.height, sizeof *covered);
+        for (int y = 0; y < out.height; y++)
+            for (int x = 0; x < out.width; x++) {
+                int64_t *cv = &covered[(size_t)y * out.width + x];
                 for (int i = 0; i < n; i++) {
-                    double x = imgs[i].planes[image_channel(&imgs[i], names[c])][p];
-                    double w = (double)spp[i];
-                    if (mc >= 0) { /* back to the sums of x and x^2 of this file */
-                        double m = imgs[i].planes[image_channel(&imgs[i], of)][p];
-                        sum += w * m;
-                        sq += w * (x * (w - 1) + m * m);
-                    } else {
-                        sum += w * x;
-                    }
+                    in[i] = inside(&imgs[i], box[0] + x, box[1] + y);
+                    *cv += in[i] ? spp[i] : 0;
                 }
-                if (mc >= 0) {
-                    double N = (double)total, m = sum / N, v = total > 1 ? (sq / N - m * m) / (N - 1) : 0;
-                    out.planes[c][p] = v > 0 ? (float)v : 0;
-                } else {
-                    out.planes[c][p] = (float)(sum / (double)total);
+                if (x == 0 && y == 0) {
+                    memcpy(first_in, in, (size_t)n);
+                    first_count = covering_seeds(&seeds, in, first_seeds);
+                    memcpy(last_in, in, (size_t)n);
+                } else if (seeds.complete && memcmp(last_in, in, (size_t)n)) {
+                    /* other inputs here (tiles): the same seeds, or no one list for the file */
+                    int k = covering_seeds(&seeds, in, pixel_seeds);
+                    if (k != first_count || memcmp(pixel_seeds, first_seeds, sizeof *pixel_seeds * (size_t)k))
+                        seeds.complete = false;
+                    memcpy(last_in, in, (size_t)n);
+                }
+                if (*cv != covered[0]) {
+                    util_error("%s: pixel (%d, %d) has %lld samples in the inputs, but pixel (%d, %d) %lld: "
+                               "the tiles leave a hole or overlap unevenly", out_path, box[0] + x, box[1] + y,
+                               (long long)*cv, box[0], box[1], (long long)covered[0]);
+                    free(covered);
+                    free(in);
+                    free(first_in);
+                    free(last_in);
+                    free(first_seeds);
+                    free(pixel_seeds);
+                    goto done;
                 }
             }
+        total = covered[0];
+        for (int k = seeds.count - 1; seeds.complete && k >= 0; k--)
+            if (!first_in[seeds.file[k]]) { /* only the seeds of the inputs that cover a pixel */
+                memmove(&seeds.seed[k], &seeds.seed[k + 1], sizeof *seeds.seed * (size_t)(seeds.count - k - 1));
+                memmove(&seeds.file[k], &seeds.file[k + 1], sizeof *seeds.file * (size_t)(seeds.count - k - 1));
+                seeds.count--;
+            }
+        free(covered);
+        free(in);
+        free(first_in);
+        free(last_in);
+        free(first_seeds);
+        free(pixel_seeds);
+        for (int c = 0; c < out.num_channels; c++) {
+            const char *of = variance_of(names[c]);
+            bool var = of && image_channel(&imgs[0], of) >= 0;
+            for (int y = 0; y < out.height; y++)
+                for (int x = 0; x < out.width; x++) {
+                    double sum = 0, sq = 0;
+                    for (int i = 0; i < n; i++) {
+                        int fx = box[0] + x - imgs[i].x0, fy = box[1] + y - imgs[i].y0;
+                        size_t p = (size_t)fy * imgs[i].width + fx;
+                        double w = (double)spp[i], xv;
+                        if (!inside(&imgs[i], box[0] + x, box[1] + y))
+                            continue;
+                        xv = imgs[i].planes[image_channel(&imgs[i], names[c])][p];
+                        if (var) { /* back to the sums of x and x^2 of this file */
+                            double m = imgs[i].planes[image_channel(&imgs[i], of)][p];
+                            sum += w * m;
+                            sq += w * (xv * (w - 1) + m * m);
+                        } else {
+                            sum += w * xv;
+                        }
+                    }
+                    float *o = &out.planes[c][(size_t)y * out.width + x];
+                    if (var) {
+                        double N = (double)total, m = sum / N, v = total > 1 ? (sq / N - m * m) / (N - 1) : 0;
+                        *o = v > 0 ? (float)v : 0;
+                    } else {
+                        *o = (float)(sum / (double)total);
+                    }
+                }
         }
     }
     {

@@ -39,6 +39,22 @@ static const char render_usage[] =
     "  --allow-outside-files  let the scene read files outside its folder (default: only\n"
     "                      regular files under it)\n"
     "  --seed S            random seed (default 0); renders with different seeds merge\n"
+    "  --frame N           the scene's glTF animations at frame N / --fps (all play at once:\n"
+    "                      node translation, rotation, scale; meshes, cameras, lights)\n"
+    "  --fps F             frames per second for --frame and --frames (default 24)\n"
+    "  --at SECONDS        the animations at this time\n"
+    "  --frames A-B        render frames A to B, one file each: -o and --png are patterns\n"
+    "                      with one %d (e.g. out/frame_%04d.exr); stops at the first failure\n"
+    "  --crop X0,Y0,X1,Y1  render only pixels [X0, X1) x [Y0, Y1) of the image, each as the\n"
+    "                      whole render has it, bit for bit: an EXR whose data window is the\n"
+    "                      region of the full display window (gonio merge assembles tiles);\n"
+    "                      values with a '.' are fractions of the size (0,0,0.5,0.5: the\n"
+    "                      top-left quarter; pixel = ceil(fraction x size), as pbrt's)\n"
+    "  --resumable         EXR: also write the exact sums (sum.* channels, 32-bit float)\n"
+    "                      that --resume goes on from; SIGTERM always writes them\n"
+    "  --resume FILE.exr   go on from a --resumable render of the same scene, camera, crop,\n"
+    "                      seed and options (checked): --spp is the total; the result is the\n"
+    "                      render of --spp in one run, bit for bit\n"
     "  --aov LIST          extra EXR channels, exactly those listed: any of normal (normal.XYZ),\n"
     "                      albedo (albedo.RGB), depth (depth.Z, 0 on a miss), variance\n"
     "                      (variance.RGB: of each pixel's mean), comma-separated\n"
@@ -80,6 +96,174 @@ static void on_signal(int sig)
     stop_requested = sig;
     if (!signal_quiet && write(2, msg, sizeof msg - 1) < 0)
         return;
+}
+
+/* A file-name pattern with exactly one %d, %Nd or %0Nd and no other '%'. */
+static bool frame_pattern(const char *p)
+{
+    const char *c = strchr(p, '%');
+    if (!c)
+        return false;
+    c++;
+    while (*c >= '0' && *c <= '9')
+        c++;
+    return *c == 'd' && !strchr(c, '%');
+}
+
+/* --frames A-B: cmd_render once per frame, --frame N in place of --frames and the output
+ * patterns filled in. */
+static int render_frames(int argc, char **argv, int at)
+{
+    long a, b;
+    char *dash, range[64], **args = util_calloc((size_t)argc + 1, sizeof *args);
+    char frame[16], names[2][4096];
+    int rc = 0;
+    snprintf(range, sizeof range, "%s", argv[at + 1]);
+    dash = strchr(range + 1, '-');
+    if (dash)
+        *dash = 0;
+    if (!dash || !util_parse_int(range, 0, 1 << 24, &a) || !util_parse_int(dash + 1, 0, 1 << 24, &b) || b < a) {
+        free(args);
+        return cli_usage_error("render", "--frames '%s': expected A-B, frames 0 <= A <= B", argv[at + 1]);
+    }
+    for (int i = 1; i < argc; i++)
+        if ((!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output") || !strcmp(argv[i], "--png")) && i + 1 < argc &&
+            !frame_pattern(argv[i + 1])) {
+            free(args);
+            return cli_usage_error("render", "%s '%s': with --frames, a pattern with one %%d (e.g. frame_%%04d.exr)",
+                                   argv[i], argv[i + 1]);
+        } else if (!strcmp(argv[i], "--frame") || !strcmp(argv[i], "--at")) {
+            free(args);
+            return cli_usage_error("render", "--frames and %s exclude each other", argv[i]);
+        }
+    for (long f = a; f <= b && rc == 0 && !stop_requested; f++) {
+        int nout = 0;
+        snprintf(frame, sizeof frame, "%ld", f);
+        for (int i = 0; i < argc; i++) {
+            args[i] = argv[i];
+            if (i == at)
+                args[i] = "--frame";
+            else if (i == at + 1)
+                args[i] = frame;
+            else if (i > 0 && (!strcmp(argv[i - 1], "-o") || !strcmp(argv[i - 1], "--output") ||
+                               !strcmp(argv[i - 1], "--png")) && nout < 2) {
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+                snprintf(names[nout], sizeof names[0], argv[i], (int)f); /* checked: frame_pattern */
+#pragma GCC diagnostic pop
+                args[i] = names[nout++];
+            }
+        }
+        rc = cmd_render(argc, args);
+    }
+    free(args);
+    return rc;
+}
+
+/* --crop X0,Y0,X1,Y1: pixels, or fractions when any value has a '.'. */
+typedef struct crop_option {
+    bool given, fractions;
+    double v[4];
+} crop_option;
+
+static bool parse_crop(const char *val, crop_option *c)
+{
+    char buf[128], *tok, *save, *end;
+    int n = 0;
+    snprintf(buf, sizeof buf, "%s", val);
+    c->fractions = strchr(val, '.') != NULL;
+    for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        if (n == 4)
+            return false;
+        c->v[n] = strtod(tok, &end);
+        if (end == tok || *end || !isfinite(c->v[n]) || c->v[n] < 0 ||
+            (!c->fractions && c->v[n] != floor(c->v[n])) || (c->fractions && c->v[n] > 1))
+            return false;
+        n++;
+    }
+    c->given = true;
+    return n == 4;
+}
+
+/* The crop in pixels for the image size; false (usage error) when it is empty or outside. */
+static bool apply_crop(const crop_option *c, render_settings *s, const char *val)
+{
+    int p[4];
+    for (int k = 0; k < 4; k++) {
+        double size = k % 2 ? s->height : s->width;
+        double x = c->fractions ? ceil(c->v[k] * size) : c->v[k];
+        p[k] = x > size ? -1 : (int)x;
+        if (p[k] < 0) {
+            cli_usage_error("render", "--crop '%s': outside the %dx%d image", val, s->width, s->height);
+            return false;
+        }
+    }
+    if (p[0] >= p[2] || p[1] >= p[3]) {
+        cli_usage_error("render", "--crop '%s': an empty region (%d,%d to %d,%d: X0 < X1 and Y0 < Y1 "
+                        "needed)", val, p[0], p[1], p[2], p[3]);
+        return false;
+    }
+    s->crop_x0 = p[0];
+    s->crop_y0 = p[1];
+    s->crop_x1 = p[2];
+    s->crop_y1 = p[3];
+    return true;
+}
+
+/* --resume FILE: the file must be an earlier render of exactly this one (identity, seed,
+ * region) with fewer samples and the sums; loads it into *prev and sets s->resume. */
+static bool check_resume(const char *path, const renderer *r, render_settings *s, const char *brdf, image *prev)
+{
+    render_header h;
+    render_stats st = {0};
+    int region[4];
+    double spp, seed;
+    render_header_build(&h, r, s, &st, brdf);
+    if (!image_read_exr(prev, path))
+        return false;
+    if (!image_exr_attr_double(path, "gonio:spp", &spp) || !(spp >= 1 && spp <= INT32_MAX && spp == floor(spp))) {
+        util_error("%s: no gonio:spp sample count in the header (not a gonio render?)", path);
+        return false;
+    }
+    for (int k = 0; render_identity_names[k]; k++) {
+        char file[512] = "", now[512] = "";
+        bool in_file = image_exr_attr_string(path, render_identity_names[k], file, sizeof file), in_now = false;
+        for (int a = 0; a < h.count; a++)
+            if (!strcmp(h.attrs[a].name, render_identity_names[k])) {
+                snprintf(now, sizeof now, "%s", h.attrs[a].s);
+                in_now = true;
+            }
+        if (in_file != in_now || strcmp(file, now)) {
+            util_error("%s: cannot resume: %s differs (the file's %s%s%s, this render's %s%s%s)", path,
+                       render_identity_names[k], in_file ? "'" : "", in_file ? file : "absent",
+                       in_file ? "'" : "", in_now ? "'" : "", in_now ? now : "absent", in_now ? "'" : "");
+            return false;
+        }
+    }
+    if (!image_exr_attr_double(path, "gonio:seed", &seed) || seed != s->seed) {
+        util_error("%s: cannot resume: its seed is not this render's %u (--seed)", path, s->seed);
+        return false;
+    }
+    render_region(s, region);
+    {
+        bool whole = region[0] == 0 && region[1] == 0 && region[2] == s->width && region[3] == s->height;
+        int fx0 = prev->full_width ? prev->x0 : 0, fy0 = prev->full_width ? prev->y0 : 0;
+        if (fx0 != region[0] || fy0 != region[1] || prev->width != region[2] - region[0] ||
+            prev->height != region[3] - region[1] || (!whole && !prev->full_width)) {
+            util_error("%s: cannot resume: its pixels (%d,%d)+%dx%d are not this render's region "
+                       "(%d,%d)+%dx%d (--crop)", path, fx0, fy0, prev->width, prev->height, region[0],
+                       region[1], region[2] - region[0], region[3] - region[1]);
+            return false;
+        }
+    }
+    if (s->time_limit <= 0 && spp >= s->spp) {
+        util_error("%s: cannot resume: it has %d spp already, and --spp %d is the total wanted", path,
+                   (int)spp, s->spp);
+        return false;
+    }
+    s->resume = prev;
+    s->resume_spp = (int)spp;
+    return true;
 }
 
 static void catch_signals(bool quiet)
@@ -139,7 +323,13 @@ int cmd_render(int argc, char **argv)
     env_option env = {0};
     scene_camera view;
     char camera_text[160];
-    bool size_given = false, quiet = false, validate = false, studio = false;
+    bool size_given = false, quiet = false, validate = false, studio = false, resumable = false;
+    crop_option crop = {0};
+    int frame = -1;      /* --frame */
+    float fps = 24;
+    double at = -1;      /* --at, or the frame's time */
+    const char *crop_text = NULL, *resume_path = NULL;
+    image prev = {0};
     int device = -1, scene_index = -1, taken;
     float exposure = 0;
     image_tonemap tm = IMAGE_TONEMAP_CLAMP;
@@ -153,6 +343,9 @@ int cmd_render(int argc, char **argv)
     render_stats st;
     int rc = 1;
 
+    for (int i = 1; i + 1 < argc; i++)
+        if (!strcmp(argv[i], "--frames"))
+            return render_frames(argc, argv, i);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *val;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
@@ -166,6 +359,8 @@ int cmd_render(int argc, char **argv)
             s.shadows = false;
         } else if (!strcmp(a, "--allow-outside-files")) {
             scene_allow_outside_files(true);
+        } else if (!strcmp(a, "--resumable")) {
+            resumable = true;
         } else if (!strcmp(a, "--half")) {
             exr.half = true;
             exr_option = "--half";
@@ -207,6 +402,25 @@ int cmd_render(int argc, char **argv)
                 if (!util_parse_int(val, 0, 0xffffffffL, &v))
                     return cli_usage_error("render", "--seed '%s': expected an integer 0..4294967295", val);
                 s.seed = (uint32_t)v;
+            } else if (!strcmp(a, "--frame")) {
+                if (!util_parse_int(val, 0, 1 << 24, &v))
+                    return cli_usage_error("render", "--frame '%s': expected a frame number >= 0", val);
+                frame = (int)v;
+            } else if (!strcmp(a, "--fps")) {
+                if (!util_parse_float(val, &fps) || !(fps > 0 && fps <= 1e6f))
+                    return cli_usage_error("render", "--fps '%s': expected frames per second > 0", val);
+            } else if (!strcmp(a, "--at")) {
+                float t;
+                if (!util_parse_float(val, &t) || !(t >= 0 && t <= 1e9f))
+                    return cli_usage_error("render", "--at '%s': expected seconds >= 0", val);
+                at = t;
+            } else if (!strcmp(a, "--crop")) {
+                if (!parse_crop(val, &crop))
+                    return cli_usage_error("render", "--crop '%s': expected X0,Y0,X1,Y1 in pixels (integers) "
+                                           "or fractions 0..1", val);
+                crop_text = val;
+            } else if (!strcmp(a, "--resume")) {
+                resume_path = val;
             } else if (!strcmp(a, "--aov")) {
                 char buf[256], *tok, *save;
                 snprintf(buf, sizeof buf, "%s", val);
@@ -276,11 +490,21 @@ int cmd_render(int argc, char **argv)
         png_o = out_path;
     if (exr_option && !exr_path)
         return cli_usage_error("render", "%s is for an EXR output (-o OUT.exr)", exr_option);
+    if (resumable && !exr_path)
+        return cli_usage_error("render", "--resumable is for an EXR output (-o OUT.exr)");
+    if (resume_path && image_format_of(resume_path) != IMAGE_FORMAT_EXR)
+        return cli_usage_error("render", "--resume '%s': expected a .exr render", resume_path);
+    exr.exact_prefix = "sum"; /* sum.* and sum2.*: the state --resume needs exactly */
     util_set_quiet(quiet);
     s.progress = !quiet;
     if ((out_path && !util_check_output(out_path)) || (png_path && !util_check_output(png_path)))
         return 1;
 
+    if (frame >= 0 && at >= 0)
+        return cli_usage_error("render", "--frame and --at exclude each other");
+    if (frame >= 0)
+        at = frame / (double)fps;
+    scene_animation_time(at);
     if (!scene_load_scene(&sc, scene_path, scene_index))
         return 1;
     if (!render_material_overrides(&sc, brdf) || !env_setup(&env, &sc, quiet, &env_map, &s, &studio) ||
@@ -293,6 +517,11 @@ int cmd_render(int argc, char **argv)
         camera_default_size(&view, 512, &s.width, &s.height);
         camera_resolve(&cam, &sc, (float)s.width / (float)s.height, &view); /* framing: the real aspect */
     }
+    if (crop.given && !apply_crop(&crop, &s, crop_text)) {
+        scene_destroy(&sc);
+        image_destroy(&env_map);
+        return 2;
+    }
     s.view = &view;
     camera_describe(&cam, &sc, camera_text, sizeof camera_text);
     s.camera_label = camera_text;
@@ -304,13 +533,29 @@ int cmd_render(int argc, char **argv)
     }
     catch_signals(quiet);
     renderer_create(&r, &g, &sc);
-    if (renderer_render(&r, &s, &img, &st)) {
+    if ((!resume_path || check_resume(resume_path, &r, &s, brdf, &prev)) && renderer_render(&r, &s, &img, &st)) {
         char seconds[32];
         render_header h;
         bool ok = true;
+        int region[4];
         render_header_build(&h, &r, &s, &st, brdf);
+        if (at >= 0 && h.count + 2 <= RENDER_HEADER_MAX) { /* the animation's time, and frame */
+            h.attrs[h.count++] = (image_attr){"gonio:time", IMAGE_ATTR_DOUBLE, NULL, 0, at, NULL};
+            if (frame >= 0)
+                h.attrs[h.count++] = (image_attr){"gonio:frame", IMAGE_ATTR_INT, NULL, frame, 0, NULL};
+        }
         if (stop_requested && !quiet)
-            util_warn("interrupted: writing the %d spp rendered so far", st.spp);
+            util_warn("interrupted: writing the %d spp rendered so far%s", st.spp,
+                      stop_requested == SIGTERM && exr_path ? " (resumable: --resume)" : "");
+        if (resumable || stop_requested == SIGTERM)
+            renderer_sums(&r, s.aov, &img);
+        render_region(&s, region);
+        if (s.crop_x1 > 0) { /* the region in the whole frame: OpenEXR's data window */
+            img.x0 = region[0];
+            img.y0 = region[1];
+            img.full_width = s.width;
+            img.full_height = s.height;
+        }
         if (exr_path)
             ok = image_write_exr_with(&img, exr_path, h.attrs, h.count, &exr);
         if (ok && png_o)
@@ -327,6 +572,7 @@ int cmd_render(int argc, char **argv)
         rc = !ok ? 1 : stop_requested ? 128 + stop_requested : 0;
     }
     image_destroy(&img);
+    image_destroy(&prev);
     image_destroy(&env_map);
     renderer_destroy(&r);
     if (!cli_gpu_finish(&g))

@@ -149,13 +149,29 @@ bool image_write_exr_with(const image *img, const char *path, const image_attr *
     rv = exr_start_write(&ctx, tmp, EXR_WRITE_FILE_DIRECTLY, &init);
     if (!rv)
         rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
-    if (!rv)
+    if (!rv && img->full_width > 0) {
+        exr_attr_box2i_t display, data;
+        exr_attr_v2f_t center;
+        memset(&center, 0, sizeof center);
+        display.min.x = display.min.y = 0;
+        display.max.x = img->full_width - 1;
+        display.max.y = img->full_height - 1;
+        data.min.x = img->x0;
+        data.min.y = img->y0;
+        data.max.x = img->x0 + img->width - 1;
+        data.max.y = img->y0 + img->height - 1;
+        rv = exr_initialize_required_attr(ctx, part, &display, &data, 1, &center, 1,
+                                          EXR_LINEORDER_INCREASING_Y, (exr_compression_t)o.compression);
+    } else if (!rv) {
         rv = exr_initialize_required_attr_simple(ctx, part, img->width, img->height,
                                                  (exr_compression_t)o.compression);
+    }
     /* The library converts the float planes to half as it encodes. */
-    for (int c = 0; !rv && c < img->num_channels; c++)
-        rv = exr_add_channel(ctx, part, img->names[c], o.half ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT,
+    for (int c = 0; !rv && c < img->num_channels; c++) {
+        bool exact = o.exact_prefix && !strncmp(img->names[c], o.exact_prefix, strlen(o.exact_prefix));
+        rv = exr_add_channel(ctx, part, img->names[c], o.half && !exact ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT,
                              EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
+    }
     for (int i = 0; !rv && i < num_attrs; i++) {
         switch (attrs[i].type) {
         case IMAGE_ATTR_STRING: rv = exr_attr_set_string(ctx, part, attrs[i].name, attrs[i].s); break;
@@ -175,7 +191,7 @@ bool image_write_exr_with(const image *img, const char *path, const image_attr *
         rv = exr_get_scanlines_per_chunk(ctx, part, &lines);
     for (int y = 0; !rv && y < img->height; y += lines) {
         exr_chunk_info_t ci;
-        rv = exr_write_scanline_chunk_info(ctx, part, y, &ci);
+        rv = exr_write_scanline_chunk_info(ctx, part, img->y0 + y, &ci);
         if (!rv)
             rv = encoding ? exr_encoding_update(ctx, part, &ci, &enc) : exr_encoding_initialize(ctx, part, &ci, &enc);
         if (rv)
@@ -297,6 +313,20 @@ static bool exr_prepare(exr_context_t ctx, const char *path, image *img, exr_att
         names[c] = e->name.str;
     }
     image_create(img, (int)w, (int)h, chl->num_channels, names);
+    {
+        exr_attr_box2i_t disp;
+        if (!exr_get_display_window(ctx, 0, &disp) &&
+            (disp.min.x != dw->min.x || disp.min.y != dw->min.y || disp.max.x != dw->max.x ||
+             disp.max.y != dw->max.y)) {
+            long long fw = (long long)disp.max.x - disp.min.x + 1, fh = (long long)disp.max.y - disp.min.y + 1;
+            if (fw >= 1 && fh >= 1 && fw <= IMAGE_MAX_DIM && fh <= IMAGE_MAX_DIM) {
+                img->full_width = (int)fw;
+                img->full_height = (int)fh;
+                img->x0 = (int)((long long)dw->min.x - disp.min.x);
+                img->y0 = (int)((long long)dw->min.y - disp.min.y);
+            }
+        }
+    }
     return true;
 }
 

@@ -6,10 +6,14 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#define IMAGE_MAX_CHANNELS 16
+#define IMAGE_MAX_CHANNELS 32
 
 typedef struct image {
     int width, height;
+    /* Where the pixels are in a larger picture, OpenEXR's data window inside its display
+     * window: the top-left pixel (x0, y0) of a full_width x full_height frame; full_width 0
+     * means the image is the whole frame. */
+    int x0, y0, full_width, full_height;
     int num_channels;
     char names[IMAGE_MAX_CHANNELS][32]; /* EXR channel names, e.g. "R", "G", "B", "A", "normal.X" */
     float *planes[IMAGE_MAX_CHANNELS];  /* width * height floats each, rows top to bottom */
@@ -40,8 +44,9 @@ image_format image_format_of(const char *path);
 typedef struct image_exr_options {
     bool half;       /* 16-bit half channels instead of 32-bit float */
     int compression; /* an exr_compression_t (openexr.h) */
+    const char *exact_prefix; /* channels whose names start with it stay float under half */
 } image_exr_options;
-#define IMAGE_EXR_DEFAULTS ((image_exr_options){false, 3 /* EXR_COMPRESSION_ZIP */})
+#define IMAGE_EXR_DEFAULTS ((image_exr_options){false, 3 /* EXR_COMPRESSION_ZIP */, NULL})
 
 /* The compressions OpenEXR's C API can write: none, rle, zips, zip, piz, pxr24, b44, b44a
  * (pxr24 is lossy for float channels, b44/b44a for half ones and keep float ones whole).
@@ -49,7 +54,8 @@ typedef struct image_exr_options {
 bool image_exr_compression_from_name(const char *name, int *out);
 const char *image_exr_compression_name(int compression);
 /* Writes every channel as 32-bit float (or half, opt->half) with opt->compression (NULL:
- * IMAGE_EXR_DEFAULTS) and the given header attributes. Written to a temporary file beside
+ * IMAGE_EXR_DEFAULTS) and the given header attributes; the data window is the image, at
+ * (x0, y0) of a full_width x full_height display window when full_width > 0. Written to a temporary file beside
  * path and renamed, so failure leaves no partial file. False (and an error naming the
  * file) on failure. */
 bool image_write_exr_with(const image *img, const char *path, const image_attr *attrs, int num_attrs,
@@ -57,7 +63,9 @@ bool image_write_exr_with(const image *img, const char *path, const image_attr *
 /* The same with IMAGE_EXR_DEFAULTS: float channels, ZIP. */
 bool image_write_exr(const image *img, const char *path, const image_attr *attrs, int num_attrs);
 
-/* Reads a scanline or tiled EXR (half, float or uint channels) into float planes. False
+/* Reads a scanline or tiled EXR (half, float or uint channels) into float planes: the data
+ * window's pixels, with x0, y0, full_width, full_height saying where they are in the
+ * display window (full_width 0 when the two are the same). False
  * with an error naming the file on any problem (missing, not EXR, truncated). Attributes
  * of type string/int/float/double can be fetched with image_exr_attr_double/string. */
 bool image_read_exr(image *img, const char *path);

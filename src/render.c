@@ -635,15 +635,38 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
     return true;
 }
 
+void render_region(const render_settings *s, int region[4])
+{
+    if (s->crop_x1 > 0) {
+        region[0] = s->crop_x0;
+        region[1] = s->crop_y0;
+        region[2] = s->crop_x1;
+        region[3] = s->crop_y1;
+    } else {
+        region[0] = region[1] = 0;
+        region[2] = s->width;
+        region[3] = s->height;
+    }
+}
+
 bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
 {
     gpu *g = r->g;
-    const VkDeviceSize pixels = (VkDeviceSize)s->width * s->height;
+    int region[4];
+    render_region(s, region);
+    const int rw = region[2] - region[0], rh = region[3] - region[1];
+    const VkDeviceSize pixels = (VkDeviceSize)rw * rh;
+    assert(rw > 0 && rh > 0 && region[0] >= 0 && region[1] >= 0 && region[2] <= s->width &&
+           region[3] <= s->height);
     memset(frame, 0, sizeof *frame);
     if (!renderer_camera(r, s, &frame->camera))
         return false;
     frame->width = (uint32_t)s->width;
     frame->height = (uint32_t)s->height;
+    frame->crop_x = (uint32_t)region[0];
+    frame->crop_y = (uint32_t)region[1];
+    frame->crop_width = (uint32_t)rw;
+    frame->crop_height = (uint32_t)rh;
     frame->seed = s->seed;
     frame->mode = s->mode;
     frame->max_depth = (uint32_t)s->max_depth;
@@ -663,15 +686,15 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
         return false;
     gpu_buffer_upload(g, &r->frame, frame, sizeof *frame, 0);
 
-    if (r->width != s->width || r->height != s->height) {
+    if (r->width != rw || r->height != rh) {
         gpu_buffer_destroy(g, &r->accum);
         gpu_buffer_destroy(g, &r->aov);
         gpu_buffer_destroy(g, &r->squares);
         gpu_buffer_create(g, &r->squares, 16 * pixels, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
         gpu_buffer_create(g, &r->accum, 16 * pixels, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
         gpu_buffer_create(g, &r->aov, 48 * pixels, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
-        r->width = s->width;
-        r->height = s->height;
+        r->width = rw;
+        r->height = rh;
         /* The cached kernels' descriptor sets name the old buffers. */
         for (uint32_t i = 0; i < GN_MODE_COUNT; i++)
             gpu_pipeline_destroy(g, &r->pipelines[i]);
@@ -827,11 +850,74 @@ void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out)
         add_variance(r, spp, out);
 }
 
+/* The channels of renderer_sums: name, buffer (0 accum, 1 aov, 2 squares), float offset
+ * in a pixel's entry of that buffer, and the AOV bit that needs it (0: always). */
+static const struct sum_channel {
+    const char *name;
+    int buffer, offset;
+    uint32_t aov;
+} sum_channels[] = {
+    {"sum.R", 0, 0, 0}, {"sum.G", 0, 1, 0}, {"sum.B", 0, 2, 0}, {"sum.A", 0, 3, 0},
+    {"sum.normal.X", 1, 0, RENDER_AOV_NORMAL}, {"sum.normal.Y", 1, 1, RENDER_AOV_NORMAL},
+    {"sum.normal.Z", 1, 2, RENDER_AOV_NORMAL}, {"sum.albedo.R", 1, 4, RENDER_AOV_ALBEDO},
+    {"sum.albedo.G", 1, 5, RENDER_AOV_ALBEDO}, {"sum.albedo.B", 1, 6, RENDER_AOV_ALBEDO},
+    {"sum.depth.Z", 1, 8, RENDER_AOV_DEPTH}, {"sum2.R", 2, 0, RENDER_AOV_VARIANCE},
+    {"sum2.G", 2, 1, RENDER_AOV_VARIANCE}, {"sum2.B", 2, 2, RENDER_AOV_VARIANCE},
+};
+
+static float *sum_buffer(const renderer *r, int buffer, int *stride)
+{
+    *stride = buffer == 1 ? 12 : 4;
+    return buffer == 0 ? r->accum.mapped : buffer == 1 ? r->aov.mapped : r->squares.mapped;
+}
+
+void renderer_sums(const renderer *r, uint32_t aov, image *out)
+{
+    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
+    for (size_t k = 0; k < sizeof sum_channels / sizeof *sum_channels; k++) {
+        const struct sum_channel *c = &sum_channels[k];
+        int stride;
+        const float *buf = sum_buffer(r, c->buffer, &stride);
+        float *plane;
+        if (c->aov && !(aov & c->aov))
+            continue;
+        plane = add_channel(out, c->name);
+        for (VkDeviceSize p = 0; p < pixels; p++)
+            plane[p] = buf[(VkDeviceSize)stride * p + (VkDeviceSize)c->offset];
+    }
+}
+
+/* Loads the sums of s->resume into the freshly cleared buffers; false (with an error) when
+ * a channel the render needs is missing or the size differs. */
+static bool load_sums(renderer *r, const render_settings *s)
+{
+    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
+    if (s->resume->width != r->width || s->resume->height != r->height) {
+        util_error("--resume: the file's %dx%d pixels are not the %dx%d region rendered",
+                   s->resume->width, s->resume->height, r->width, r->height);
+        return false;
+    }
+    for (size_t k = 0; k < sizeof sum_channels / sizeof *sum_channels; k++) {
+        const struct sum_channel *c = &sum_channels[k];
+        int stride, ch;
+        float *buf = sum_buffer(r, c->buffer, &stride);
+        if (c->aov && !(s->aov & c->aov))
+            continue;
+        if ((ch = image_channel(s->resume, c->name)) < 0) {
+            util_error("--resume: the file has no channel '%s' (not written with --resumable, or "
+                       "with other --aov)", c->name);
+            return false;
+        }
+        for (VkDeviceSize p = 0; p < pixels; p++)
+            buf[(VkDeviceSize)stride * p + (VkDeviceSize)c->offset] = s->resume->planes[ch][p];
+    }
+    return true;
+}
+
 bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats)
 {
     gpu *g = r->g;
     GnFrame frame;
-    const VkDeviceSize pixels = (VkDeviceSize)s->width * s->height;
     double t0;
     int done = 0, batch = 1;
     const int per = s->mode == GN_MODE_PATH ? (int)r->path_samples : 1;
@@ -844,13 +930,20 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
     }
     if (!renderer_begin(r, s, &frame))
         return false;
+    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
+    if (s->resume) {
+        if (!load_sums(r, s))
+            return false;
+        done = s->resume_spp;
+    }
 
     /* Passes are submitted in batches sized to take 0.1 to 0.4 s each: short enough for a
      * responsive progress bar and an early stop, long enough to hide submission costs and
      * to let the path kernel take several samples per dispatch (renderer_record_samples).
-     * A batch is a whole number of dispatches of `per` samples, so dispatches always start
-     * at multiples of `per`: each pixel's samples are summed in the same groups and order
-     * however long the batches took, and the same command gives the same bits. */
+     * The kernels add each sample to the buffers' sums in sample order (glsl/path.comp), so
+     * the bits do not depend on how the batches and dispatches split the samples: the same
+     * command gives the same bits, and so do a render resumed from its sums (s->resume) and
+     * a crop of it (GnFrame). */
     t0 = util_now();
     while (s->time_limit > 0 || done < s->spp) {
         VkCommandBuffer cmd = gpu_begin(g);
@@ -861,7 +954,7 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
         renderer_record_samples(r, cmd, s->mode, (uint32_t)done, (uint32_t)n);
         gpu_submit_wait(g, cmd);
         done += n;
-        if (done == n)
+        if (done == n + (s->resume ? s->resume_spp : 0))
             stats->first_pass_seconds = util_now() - t0;
         tb = util_now() - tb;
         if (tb < 0.1 && batch < 1024)
@@ -884,7 +977,7 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
             fputc('\n', stderr);
     }
     stats->spp = done;
-    stats->rays = (uint64_t)pixels * (uint64_t)done;
+    stats->rays = (uint64_t)pixels * (uint64_t)(done - (s->resume ? s->resume_spp : 0));
     stats->setup_seconds = r->setup_seconds;
     stats->truncated = ((const uint32_t *)r->status.mapped)[0];
     if (stats->truncated && s->mode == GN_MODE_PATH)

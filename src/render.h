@@ -38,7 +38,18 @@ typedef struct render_settings {
     const image *env_map;   /* path: lat-long radiance map (R, G, B or Y), replaces env */
     float env_rotation;     /* path: the map turned about +Y, degrees (right-handed) */
     uint32_t strategy;      /* path: 0 = MIS, GN_FRAME_LIGHT_ONLY or GN_FRAME_BSDF_ONLY */
+    /* The region rendered: pixels [crop_x0, crop_x1) x [crop_y0, crop_y1) of the
+     * width x height image, each exactly as the whole render has it; crop_x1 = 0: all. */
+    int crop_x0, crop_y0, crop_x1, crop_y1;
+    /* Non-NULL: go on from an earlier render of these settings: its sums (channels
+     * RENDER_SUM_*, as renderer_sums writes them) of resume_spp samples are loaded and the
+     * render takes samples resume_spp to spp - 1, so the result is that of one render of spp. */
+    const image *resume;
+    int resume_spp;
 } render_settings;
+
+/* The region s renders, {x0, y0, x1, y1}. */
+void render_region(const render_settings *s, int region[4]);
 
 /* The AOVs (extra EXR channels) a render can add. Normal, albedo and depth come from one
  * GPU pass (GN_FRAME_AOV) whichever of them is asked for; none asked costs nothing. */
@@ -116,6 +127,10 @@ void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, ui
 /* The accumulated image divided by spp: R, G, B, A and the AOV channels of the set aov
  * (RENDER_AOV_*; the GPU ones need a render with them, variance any). */
 void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out);
+/* Appends the exact accumulation sums to out, the state --resume goes on from: sum.R/G/B/A
+ * always, sum.normal.X/Y/Z, sum.albedo.R/G/B, sum.depth.Z with the GPU AOVs of aov, and
+ * sum2.R/G/B (the squares) with variance. The EXR keeps them as 32-bit floats. */
+void renderer_sums(const renderer *r, uint32_t aov, image *out);
 
 /* Renders and fills `out` with R, G, B, A (A = coverage) and the channels of the AOVs in
  * s->aov, in the order normal.X/Y/Z, albedo.R/G/B, depth.Z, variance.R/G/B. Each is the

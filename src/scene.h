@@ -105,6 +105,12 @@ bool scene_load_scene(scene *out, const char *path, int scene_index);
  * percent-escapes and symlinks included; never the working directory): anything else is an
  * error naming the URI. True lets a scene read any file (--allow-outside-files). */
 void scene_allow_outside_files(bool allow);
+/* Loads that follow see the file's animations at this time in seconds: every animation's
+ * translation, rotation and scale channels (STEP, LINEAR with slerp for rotations,
+ * CUBICSPLINE as glTF 2.0 defines them) replace the nodes' own, so meshes, cameras and
+ * lights move; morph-target weights are not animated (a warning). Negative (the default):
+ * the nodes' own transforms. */
+void scene_animation_time(double seconds);
 
 /* Frees everything; accepts a zeroed struct. */
 void scene_destroy(scene *s);

@@ -619,7 +619,108 @@ bool mat_finite(const Mat &m)
     return true;
 }
 
-bool node_local(Ctx &c, int i, Mat &out)
+/* ---- animation: the channels sampled at one time (glTF 2.0, 3.11 and Appendix C) ------ */
+
+double anim_time = -1; /* scene_animation_time; < 0: the nodes' own transforms */
+
+/* A node's animated properties at anim_time: which of T, R, S a channel set. */
+struct Pose {
+    bool has[3] = {false, false, false};
+    double v[3][4] = {{0, 0, 0, 0}, {0, 0, 0, 1}, {1, 1, 1, 0}}; /* translation, rotation, scale */
+};
+
+/* Sampler `sm` of animation `a` at time t into out (n components): before the first key
+ * its value, after the last the last's; STEP the value of the key at or before t; LINEAR
+ * lerp, or for rotations (quat) slerp along the shorter arc; CUBICSPLINE the Hermite
+ * spline of the keys' values and in/out tangents scaled by the key interval. False (a
+ * warning) when the sampler's accessors do not fit. */
+bool sample_channel(Ctx &c, const tinygltf::Animation &a, int sm, double t, size_t n, bool quat, double *out)
+{
+    const auto &smp = a.samplers[size_t(sm)];
+    if (!in_range(smp.input, c.m.accessors.size()) || !in_range(smp.output, c.m.accessors.size()))
+        return fail(c, "animation '%s': sampler %d's accessors do not exist", a.name.c_str(), sm);
+    std::vector<double> times = read_accessor(c, smp.input), vals = read_accessor(c, smp.output);
+    bool cubic = smp.interpolation == "CUBICSPLINE", step = smp.interpolation == "STEP";
+    size_t keys = times.size(), per = cubic ? 3 : 1;
+    if (keys == 0 || num_comps(c.m.accessors[size_t(smp.input)]) != 1 || vals.size() != keys * per * n)
+        return fail(c, "animation '%s': sampler %d has %zu key times and %zu output values (%zu needed)",
+                    a.name.c_str(), sm, keys, vals.size(), keys * per * n);
+    for (size_t k = 0; k < keys; k++)
+        if (!std::isfinite(times[k]) || (k && times[k] < times[k - 1]))
+            return fail(c, "animation '%s': sampler %d's key times are not finite and increasing", a.name.c_str(), sm);
+    auto value = [&](size_t k, size_t part, size_t j) { return vals[(k * per + part) * n + j]; };
+    size_t k = 0; /* the last key at or before t */
+    while (k + 1 < keys && times[k + 1] <= t)
+        k++;
+    if (t <= times[0] || k + 1 == keys || step) {
+        size_t key = t <= times[0] ? 0 : k;
+        for (size_t j = 0; j < n; j++)
+            out[j] = value(key, cubic ? 1 : 0, j);
+    } else {
+        double td = times[k + 1] - times[k], u = (t - times[k]) / td;
+        if (cubic) {
+            double u2 = u * u, u3 = u2 * u;
+            for (size_t j = 0; j < n; j++)
+                out[j] = (2 * u3 - 3 * u2 + 1) * value(k, 1, j) + td * (u3 - 2 * u2 + u) * value(k, 2, j) +
+                         (-2 * u3 + 3 * u2) * value(k + 1, 1, j) + td * (u3 - u2) * value(k + 1, 0, j);
+        } else if (quat) {
+            double q0[4], q1[4], d = 0;
+            for (size_t j = 0; j < 4; j++) {
+                q0[j] = value(k, 0, j);
+                q1[j] = value(k + 1, 0, j);
+                d += q0[j] * q1[j];
+            }
+            double sign = d < 0 ? -1 : 1, w0 = 1 - u, w1 = u;
+            d = std::fabs(d);
+            if (d < 1 - 1e-9) { /* slerp; nearly equal quaternions lerp */
+                double th = std::acos(std::min(d, 1.0)), st = std::sin(th);
+                w0 = std::sin((1 - u) * th) / st;
+                w1 = std::sin(u * th) / st;
+            }
+            for (size_t j = 0; j < 4; j++)
+                out[j] = w0 * q0[j] + w1 * sign * q1[j];
+        } else {
+            for (size_t j = 0; j < n; j++)
+                out[j] = (1 - u) * value(k, 0, j) + u * value(k + 1, 0, j);
+        }
+    }
+    if (quat) {
+        double len = std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2] + out[3] * out[3]);
+        if (!(len > 1e-12))
+            return fail(c, "animation '%s': sampler %d gives a zero rotation", a.name.c_str(), sm);
+        for (size_t j = 0; j < 4; j++)
+            out[j] /= len;
+    }
+    return true;
+}
+
+/* Every animation's channels sampled at anim_time (all animations play together), per node. */
+bool animate(Ctx &c, std::vector<Pose> &pose)
+{
+    bool warned_weights = false;
+    for (const auto &a : c.m.animations)
+        for (const auto &ch : a.channels) {
+            const int path = ch.target_path == "translation" ? 0 : ch.target_path == "rotation" ? 1
+                           : ch.target_path == "scale" ? 2 : -1;
+            if (!in_range(ch.target_node, pose.size()) || !in_range(ch.sampler, a.samplers.size()))
+                return fail(c, "animation '%s': a channel targets node %d, sampler %d, which do not exist",
+                            a.name.c_str(), ch.target_node, ch.sampler);
+            if (path < 0) {
+                if (!warned_weights)
+                    warn(c, "animation '%s': '%s' channels are not animated (morph targets are not supported)",
+                         a.name.c_str(), ch.target_path.c_str());
+                warned_weights = true;
+                continue;
+            }
+            Pose &p = pose[size_t(ch.target_node)];
+            if (!sample_channel(c, a, ch.sampler, anim_time, path == 1 ? 4 : 3, path == 1, p.v[path]))
+                return false;
+            p.has[path] = true;
+        }
+    return true;
+}
+
+bool node_local(Ctx &c, int i, Mat &out, const Pose *pose = nullptr)
 {
     const auto &n = c.m.nodes[size_t(i)];
     std::string what = label("node", i, n.name);
@@ -634,6 +735,14 @@ bool node_local(Ctx &c, int i, Mat &out)
     std::copy(n.translation.begin(), n.translation.end(), t);
     std::copy(n.rotation.begin(), n.rotation.end(), q);
     std::copy(n.scale.begin(), n.scale.end(), s);
+    if (pose) { /* animated properties replace the node's */
+        if (pose->has[0])
+            std::copy(pose->v[0], pose->v[0] + 3, t);
+        if (pose->has[1])
+            std::copy(pose->v[1], pose->v[1] + 4, q);
+        if (pose->has[2])
+            std::copy(pose->v[2], pose->v[2] + 3, s);
+    }
     double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     if (!(len > 1e-6) || !std::isfinite(len))
         return fail(c, "%s: rotation is not a unit quaternion (length %g)", what.c_str(), len);
@@ -668,11 +777,17 @@ bool check_nodes_and_scenes(Ctx &c)
     const auto &m = c.m;
     size_t nn = m.nodes.size();
     std::vector<int> parent(nn, -1);
+    std::vector<Pose> pose(nn);
     c.local.assign(nn, Mat{});
+    if (anim_time >= 0 && !animate(c, pose))
+        return false;
     for (size_t i = 0; i < nn; i++) {
         const auto &n = m.nodes[i];
         std::string what = label("node", int(i), n.name);
-        node_local(c, int(i), c.local[i]);
+        bool animated = pose[i].has[0] || pose[i].has[1] || pose[i].has[2];
+        if (animated && !n.matrix.empty())
+            warn(c, "%s has a matrix and is animated: the matrix wins (glTF forbids the two)", what.c_str());
+        node_local(c, int(i), c.local[i], animated ? &pose[i] : nullptr);
         if (n.mesh != -1 && !in_range(n.mesh, m.meshes.size()))
             fail(c, "%s refers to mesh %d, which does not exist", what.c_str(), n.mesh);
         if (n.camera != -1 && !in_range(n.camera, m.cameras.size()))
@@ -1841,6 +1956,11 @@ bool load(scene *out, const char *path, int scene_index)
 } // namespace
 
 bool scene_load(scene *out, const char *path) { return scene_load_scene(out, path, -1); }
+
+void scene_animation_time(double seconds)
+{
+    anim_time = seconds;
+}
 
 void scene_allow_outside_files(bool allow) { allow_outside_files = allow; }
 

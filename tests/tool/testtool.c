@@ -7,6 +7,8 @@
  *   testtool ref NAME AOV W H OUT.exr [SHIFT]  AOV: depth, normal; SHIFT: pixels, in x
  *                                      (a deliberately wrong reference, to show a test fails)
  *   testtool stats IMAGE.exr           coverage, mean luminance, the box of red pixels
+ *   testtool same WHOLE.exr PART.exr   every value of PART's channels (but sum.*) equals,
+ *                                      bit for bit, WHOLE's at the same display-window pixel
  */
 #include <math.h>
 #include <stdio.h>
@@ -312,8 +314,56 @@ static int print_value(const char *in, const char *name, int x, int y)
     return 0;
 }
 
+/* PART's pixels sit at (x0, y0) of the display window (image.h); so do WHOLE's. */
+static int same_bits(const char *whole, const char *part)
+{
+    image a, b;
+    long differ = 0, compared = 0;
+    int rc = 1;
+    if (!image_read_exr(&a, whole))
+        return 1;
+    if (!image_read_exr(&b, part)) {
+        image_destroy(&a);
+        return 1;
+    }
+    for (int c = 0; c < b.num_channels; c++) {
+        int ca = image_channel(&a, b.names[c]);
+        if (!strncmp(b.names[c], "sum", 3))
+            continue;
+        if (ca < 0) {
+            fprintf(stderr, "%s: no channel %s (which %s has)\n", whole, b.names[c], part);
+            goto done;
+        }
+        for (int y = 0; y < b.height; y++)
+            for (int x = 0; x < b.width; x++) {
+                int ax = b.x0 + x - a.x0, ay = b.y0 + y - a.y0;
+                const float *vb = &b.planes[c][(size_t)y * b.width + x], *va;
+                if (ax < 0 || ay < 0 || ax >= a.width || ay >= a.height) {
+                    fprintf(stderr, "%s: pixel (%d, %d) is outside %s\n", part, b.x0 + x, b.y0 + y, whole);
+                    goto done;
+                }
+                va = &a.planes[ca][(size_t)ay * a.width + ax];
+                compared++;
+                if (memcmp(va, vb, sizeof *va)) {
+                    if (!differ)
+                        fprintf(stderr, "first difference: %s at (%d, %d): %.9g vs %.9g\n", b.names[c],
+                                b.x0 + x, b.y0 + y, *va, *vb);
+                    differ++;
+                }
+            }
+    }
+    printf("%ld of %ld values differ\n", differ, compared);
+    rc = differ || !compared;
+done:
+    image_destroy(&a);
+    image_destroy(&b);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 4 && !strcmp(argv[1], "same"))
+        return same_bits(argv[2], argv[3]);
     if (argc == 3 && !strcmp(argv[1], "stats"))
         return stats(argv[2]);
     if (argc == 6 && !strcmp(argv[1], "at"))
@@ -329,6 +379,6 @@ int main(int argc, char **argv)
                          argc == 8 ? atof(argv[7]) : 0.0);
     fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n"
                     "       testtool png depth|normal PNG REF.exr | testtool pick IN.exr CHANNEL OUT.exr\n"
-                    "       testtool at IN.exr CHANNEL X Y\n");
+                    "       testtool at IN.exr CHANNEL X Y | testtool same WHOLE.exr PART.exr\n");
     return 2;
 }
