@@ -74,6 +74,8 @@ if [ -d "$assets" ]; then
         "$G" render "$f" --png "$tmp/sample-$m.png" --size 160x160 --spp 64 --quiet
         tiles+=(-label "$m" "$tmp/sample-$m.png")
     done
-    montage "${tiles[@]}" -tile 5x -geometry +2+2 -pointsize 11 -background white "$tmp/samples.png"
+    font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf # fonts-dejavu-core; ImageMagick's default may be absent
+    montage "${tiles[@]}" $( [ -f $font ] && echo -font $font ) -tile 5x -geometry +2+2 -pointsize 11 \
+        -background white "$tmp/samples.png"
     convert "$tmp/samples.png" -quality 85 $img/samples.jpg
 fi

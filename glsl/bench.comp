@@ -25,7 +25,7 @@ void main()
         vec3 o, d;
         float tnear;
         camera_ray(vec2(px) + rand2(pixel, push.sample_index, 0u), o, d, tnear);
-        Hit h = bvh_trace(o, d, 0.0, 1e30, false);
+        Hit h = bvh_trace(o, d, tnear, 1e30, false);
         hit_out[pixel] = vec4(h.t, float(h.steps), 0.0, uintBitsToFloat(h.tri));
         if (h.tri == GN_INVALID) {
             rays[2u * pixel + 1u] = vec4(0.0, 0.0, 1.0, -1.0);

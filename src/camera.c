@@ -16,8 +16,8 @@ static int parse_floats(const char *s, float *out, int min_n, int max_n)
 {
     int n = 0;
     const char *p = s;
+    char *end = NULL;
     while (n < max_n) {
-        char *end;
         float v = strtof(p, &end);
         if (end == p || !isfinite(v))
             return 0;
@@ -28,7 +28,7 @@ static int parse_floats(const char *s, float *out, int min_n, int max_n)
             return 0;
         p = end + 1;
     }
-    return n >= min_n && p[strcspn(p, ",")] == 0 ? n : 0;
+    return n >= min_n && *end == 0 ? n : 0;
 }
 
 static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -68,11 +68,6 @@ static bool look_at_frame(const float eye[3], const float target[3], const float
     return true;
 }
 
-static bool has_suffix(const char *s, const char *suffix)
-{
-    size_t n = strlen(s), m = strlen(suffix);
-    return n >= m && strcasecmp(s + n - m, suffix) == 0;
-}
 
 /* --camera FILE.exr: the view gonio recorded in the file's header (camera_record_attrs). */
 static int camera_from_exr(camera_option *c, const char *cmd, const char *path)
@@ -96,9 +91,11 @@ static int camera_from_exr(camera_option *c, const char *cmd, const char *path)
     c->ortho_half_height = ortho > 0 ? (float)ortho : 0;
     /* The exact frame, when recorded: the look-at form loses the last bits of the view
      * direction (target - eye), which moves some silhouette pixels. */
-    if (image_exr_attr_string(path, "gonio:view", view, sizeof view) && parse_floats(view, c->frame, 12, 12) == 12)
+    if (image_exr_attr_string(path, "gonio:view", view, sizeof view) && parse_floats(view, c->frame, 15, 15) == 15)
         c->exact = true;
-    if (c->fov == 0 && fov > 0)
+    if (!image_exr_size(path, &c->width, &c->height))
+        c->width = c->height = 0;
+    if (c->fov == 0 && fov > 0 && !c->exact) /* gonio:view has the exact yfov */
         c->fov = (float)fov;
     return 1;
 }
@@ -109,9 +106,7 @@ int camera_parse_option(camera_option *c, const char *cmd, const char *opt, cons
     if (!strcmp(opt, "--camera")) {
         if (!strcmp(val, "frame")) {
             c->kind = CAMERA_FRAME;
-        } else if (!strcmp(val, "auto")) {
-            c->kind = CAMERA_AUTO;
-        } else if (has_suffix(val, ".exr")) {
+        } else if (util_has_suffix(val, ".exr")) {
             return camera_from_exr(c, cmd, val);
         } else if (util_parse_int(val, 0, 1 << 20, &v)) {
             c->kind = CAMERA_INDEX;
@@ -190,6 +185,13 @@ bool camera_resolve(const camera_option *c, const scene *sc, float aspect, scene
         float r = sqrtf(r2), d = sqrtf(d2);
         out->znear = c->ortho_half_height > 0 ? 0 : fmaxf(1e-4f * fmaxf(r, d), d - r > 0 ? 0.5f * (d - r) : 1e-3f * r);
         out->zfar = 0;
+        if (c->exact) { /* the recorded planes and field of view */
+            out->znear = c->frame[12];
+            out->zfar = c->frame[13];
+            out->yfov = c->frame[14];
+        }
+        if (c->width > 0 && c->height > 0)
+            out->aspect = (float)c->width / (float)c->height;
         break;
     }
     default:
@@ -254,4 +256,5 @@ void camera_frame_string(const scene_camera *c, char *buf, size_t cap)
     for (int i = 0; i < 4; i++)
         for (int k = 0; k < 3; k++)
             n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, "%s%.9g", n ? "," : "", v[i][k]);
+    snprintf(buf + n, n < cap ? cap - n : 0, ",%.9g,%.9g,%.9g", c->znear, c->zfar, c->yfov);
 }

@@ -27,7 +27,8 @@ typedef struct camera_option {
     float eye[3], target[3], up[3];  /* CAMERA_LOOK_AT */
     float ortho_half_height;         /* CAMERA_LOOK_AT: > 0 orthographic (from an EXR) */
     bool exact;                      /* CAMERA_LOOK_AT from an EXR: `frame` as recorded */
-    float frame[12];                 /* position, right, up, forward */
+    float frame[15];                 /* position, right, up, forward, znear, zfar, yfov */
+    int width, height;               /* from an EXR: its size (the default --size) */
     float fov;                       /* vertical, degrees; 0 = the camera's own (45 else) */
 } camera_option;
 
@@ -65,8 +66,8 @@ void camera_world_to_camera(const scene_camera *c, float m[16]);
 /* The view as the --look-at value that reproduces it ("EX,EY,EZ,TX,TY,TZ,UX,UY,UZ", the
  * target one unit ahead), printed exactly (float round trip). */
 void camera_look_at_string(const scene_camera *c, char *buf, size_t cap);
-/* The camera's frame exactly as --camera FILE.exr reads it back: position, right, up and
- * forward, 12 numbers (the gonio:view header attribute). */
+/* The camera's frame exactly as --camera FILE.exr reads it back: position, right, up,
+ * forward, znear, zfar and yfov (radians), 15 numbers (the gonio:view header attribute). */
 void camera_frame_string(const scene_camera *c, char *buf, size_t cap);
 
 #endif

@@ -14,6 +14,7 @@
 #include "camera.h"
 #include "cli.h"
 #include "draw.h"
+#include "environment.h"
 #include "image.h"
 #include "render.h"
 #include "scene.h"
@@ -597,6 +598,11 @@ int cmd_compare(int argc, char **argv)
         scene sc = {0};
         if (!scene_load(&sc, input))
             return 1;
+        /* The comparison is of shading models under the scene's own lights; gonio render's
+         * studio environment would light the local modes and the path tracer differently. */
+        if (!env_scene_has_light(&sc))
+            util_warn("%s has no lights: compare renders it black (gonio render lights such a scene "
+                      "with its studio environment)", input);
         if (!choose_view(&sc, &o)) {
             /* camera_resolve said why */
         } else if (cli_gpu_create(&g, o.device, o.validate)) {

@@ -133,7 +133,7 @@ static int covering_seeds(const seed_list *l, const unsigned char *in, uint32_t 
 static bool read_seeds(const char *path, int file, seed_list *l)
 {
     char text[4096], *end;
-    double v;
+    uint32_t seed;
     if (image_exr_attr_string(path, "gonio:seeds", text, sizeof text)) {
         for (const char *p = text; *p; p = *end ? end + 1 : end) {
             unsigned long long x = strtoull(p, &end, 10);
@@ -143,8 +143,8 @@ static bool read_seeds(const char *path, int file, seed_list *l)
         }
         return true;
     }
-    if (image_exr_attr_double(path, "gonio:seed", &v) && v >= 0 && v <= UINT32_MAX && v == floor(v)) {
-        add_seed(l, (uint32_t)v, file);
+    if (render_header_seed(path, &seed)) {
+        add_seed(l, seed, file);
         return true;
     }
     return false;

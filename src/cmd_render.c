@@ -27,7 +27,8 @@ static const char render_usage[] =
     "  --png FILE          also write a PNG: tonemapped sRGB; in modes depth, normal and\n"
     "                      cost a picture of the data: depth grey from white (nearest) to 20%\n"
     "                      grey (farthest visible), normals 0.5 n + 0.5, cost a viridis heat\n"
-    "                      map up to the image's maximum; the background black\n"
+    "                      map up to the image's maximum (misses too: they walk the tree);\n"
+    "                      the background of depth and normals black\n"
     "  --mode M            path (default: Monte Carlo path tracing), phong, gouraud, flat,\n"
     "                      normal, albedo, depth, cost (depth: along the camera axis, 0 where\n"
     "                      nothing is hit, in the EXR as in the depth AOV)\n"
@@ -217,7 +218,8 @@ static bool check_resume(const char *path, const renderer *r, render_settings *s
     render_header h;
     render_stats st = {0};
     int region[4];
-    double spp, seed;
+    double spp;
+    uint32_t seed;
     render_header_build(&h, r, s, &st, brdf);
     if (!image_read_exr(prev, path))
         return false;
@@ -240,7 +242,7 @@ static bool check_resume(const char *path, const renderer *r, render_settings *s
             return false;
         }
     }
-    if (!image_exr_attr_double(path, "gonio:seed", &seed) || seed != s->seed) {
+    if (!render_header_seed(path, &seed) || seed != s->seed) {
         util_error("%s: cannot resume: its seed is not this render's %u (--seed)", path, s->seed);
         return false;
     }
@@ -280,15 +282,19 @@ static void catch_signals(bool quiet)
 /* Options that the chosen mode or outputs do not use: a warning each, never silence. Reads
  * argv again (values skipped) rather than flags set by the parser, so it sees what was
  * typed, defaults included. */
-static void warn_inapplicable(int argc, char **argv, const render_settings *s, const char *png_path)
+static void warn_inapplicable(int argc, char **argv, const render_settings *s, const char *png_path,
+                              const char *out_path)
 {
     static const struct {
         const char *opt;
         int when; /* 0: path mode only; 1: local modes only; 2: with a PNG only; 3: not with
-                   * --time; 4: path and albedo (the model's colour) only */
+                   * --time; 4: path and albedo (the model's colour) only; 5: with an EXR only */
     } rules[] = {{"--max-depth", 0}, {"--brdf", 4}, {"--estimator", 0}, {"--ambient", 1},
-                 {"--no-shadows", 1}, {"--exposure", 2}, {"--tonemap", 2}, {"--spp", 3}};
+                 {"--no-shadows", 1}, {"--exposure", 2}, {"--tonemap", 2}, {"--spp", 3},
+                 {"--aov", 5}};
     const bool path = s->mode == GN_MODE_PATH;
+    const bool png = png_path || (out_path && util_has_suffix(out_path, ".png"));
+    const bool exr = out_path && util_has_suffix(out_path, ".exr");
     for (int i = 1; i < argc; i++) {
         for (size_t k = 0; k < sizeof rules / sizeof *rules; k++) {
             if (strcmp(argv[i], rules[k].opt))
@@ -298,8 +304,10 @@ static void warn_inapplicable(int argc, char **argv, const render_settings *s, c
                           render_mode_name(s->mode));
             else if (rules[k].when == 1 && path)
                 util_warn("%s applies to the local modes only; ignored with --mode path", rules[k].opt);
-            else if (rules[k].when == 2 && !png_path)
-                util_warn("%s applies to the PNG only; ignored without --png", rules[k].opt);
+            else if (rules[k].when == 2 && !png)
+                util_warn("%s applies to the PNG only; ignored without a PNG output", rules[k].opt);
+            else if (rules[k].when == 5 && !exr)
+                util_warn("%s applies to the EXR only; ignored without an EXR output", rules[k].opt);
             else if (rules[k].when == 4 && !path && s->mode != GN_MODE_ALBEDO)
                 util_warn("%s applies to --mode path (and albedo, its colour) only; ignored with "
                           "--mode %s", rules[k].opt, render_mode_name(s->mode));
@@ -474,7 +482,7 @@ int cmd_render(int argc, char **argv)
             return cli_usage_error("render", "unexpected argument '%s'", a);
         }
     }
-    warn_inapplicable(argc, argv, &s, png_path);
+    warn_inapplicable(argc, argv, &s, png_path, out_path);
     if (!scene_path)
         return cli_usage_error("render", "no scene given");
     if (!out_path && !png_path)
@@ -514,7 +522,12 @@ int cmd_render(int argc, char **argv)
         return 1;
     }
     if (!size_given) {
-        camera_default_size(&view, 512, &s.width, &s.height);
+        if (cam.width > 0) { /* --camera FILE.exr: that render's size, as its view had it */
+            s.width = cam.width;
+            s.height = cam.height;
+        } else {
+            camera_default_size(&view, 512, &s.width, &s.height);
+        }
         camera_resolve(&cam, &sc, (float)s.width / (float)s.height, &view); /* framing: the real aspect */
     }
     if (crop.given && !apply_crop(&crop, &s, crop_text)) {

@@ -13,11 +13,6 @@
 #include "cli.h"
 #include "util.h"
 
-static bool has_suffix(const char *s, const char *suffix)
-{
-    size_t n = strlen(s), m = strlen(suffix);
-    return n >= m && strcasecmp(s + n - m, suffix) == 0;
-}
 
 /* Radiance beyond this overflows the flux products in float (--env 1e38 wrote NaN pixels). */
 #define ENV_MAX 1e9f
@@ -27,7 +22,7 @@ int env_parse_option(env_option *e, const char *cmd, const char *opt, const char
     if (!strcmp(opt, "--env")) {
         e->given = true;
         e->path = NULL;
-        if (has_suffix(val, ".exr") || has_suffix(val, ".hdr"))
+        if (util_has_suffix(val, ".exr") || util_has_suffix(val, ".hdr"))
             e->path = val;
         else if (!util_parse_rgb(val, e->color) || e->color[0] > ENV_MAX || e->color[1] > ENV_MAX || e->color[2] > ENV_MAX)
             return cli_usage_error(cmd, "--env '%s': expected R,G,B or one value in [0, %g], FILE.exr or FILE.hdr",
@@ -211,7 +206,7 @@ bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_se
             mean[k] = s->env[k] = e->color[k] * scale;
     } else if (e->given || !env_scene_has_light(sc)) {
         if (e->given) {
-            bool ok = has_suffix(e->path, ".hdr") ? environment_read_hdr(map, e->path) : image_read_exr(map, e->path);
+            bool ok = util_has_suffix(e->path, ".hdr") ? environment_read_hdr(map, e->path) : image_read_exr(map, e->path);
             if (!ok)
                 return false;
         } else {
@@ -222,6 +217,10 @@ bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_se
                 /* The local modes see the studio as its key light plus the mean of the rest. */
                 GnLight key;
                 environment_studio_key(&key);
+                /* --env-rotate turns the key with the map (R_Y, as path.comp turns the map). */
+                float ca = cosf(e->rotation * (float)(M_PI / 180)), sa = sinf(e->rotation * (float)(M_PI / 180));
+                vec3 d = key.direction;
+                key.direction = (vec3){ca * d.x + sa * d.z, d.y, -sa * d.x + ca * d.z};
                 sc->lights = util_realloc(sc->lights, (sc->num_lights + 1) * sizeof *sc->lights);
                 sc->lights[sc->num_lights++] = key;
                 studio(map, false);

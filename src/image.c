@@ -102,11 +102,6 @@ bool image_exr_compression_from_name(const char *name, int *out)
     return false;
 }
 
-const char *image_exr_compression_name(int compression)
-{
-    return compression >= 0 && compression < EXR_COMPRESSION_LAST_TYPE ? exr_compression_names[compression] : "?";
-}
-
 /* B44 packs HALF channels only; the rest of a chunk is stored as is, channel by channel, so
  * a chunk of float channels comes out exactly as large as the data. OpenEXR's rule (its C++
  * library follows it) is that a chunk that does not shrink is stored uncompressed, and a

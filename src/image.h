@@ -52,7 +52,6 @@ typedef struct image_exr_options {
  * (pxr24 is lossy for float channels, b44/b44a for half ones and keep float ones whole).
  * False for any other name. */
 bool image_exr_compression_from_name(const char *name, int *out);
-const char *image_exr_compression_name(int compression);
 /* Writes every channel as 32-bit float (or half, opt->half) with opt->compression (NULL:
  * IMAGE_EXR_DEFAULTS) and the given header attributes; the data window is the image, at
  * (x0, y0) of a full_width x full_height display window when full_width > 0. Written to a temporary file beside

@@ -276,25 +276,11 @@ static bool save_accumulated(preview *p)
     char exr[4096], png[4096];
     image img = {0};
     bool ok;
-    /* The view as render's --camera FILE.exr reads it back (src/camera.h). */
-    scene_camera view = {.position = {p->cam.position.x, p->cam.position.y, p->cam.position.z},
-                         .right = {p->cam.right.x, p->cam.right.y, p->cam.right.z},
-                         .forward = {p->cam.forward.x, p->cam.forward.y, p->cam.forward.z},
-                         .up = {p->cam.up.x, p->cam.up.y, p->cam.up.z}};
-    char look_at[256], frame_text[320];
-    camera_look_at_string(&view, look_at, sizeof look_at);
-    camera_frame_string(&view, frame_text, sizeof frame_text);
-    image_attr attrs[] = {
-        {"gonio:look-at", IMAGE_ATTR_STRING, look_at, 0, 0, NULL},
-        {"gonio:view", IMAGE_ATTR_STRING, frame_text, 0, 0, NULL},
-        {p->cam.ortho_half_height > 0 ? "gonio:ortho-half-height" : "gonio:fov", IMAGE_ATTR_DOUBLE, NULL, 0,
-         p->cam.ortho_half_height > 0 ? p->cam.ortho_half_height : 2 * atan(p->cam.tan_half_fovy) * 180 / M_PI, NULL},
-        {"gonio:spp", IMAGE_ATTR_INT, NULL, p->spp, 0, NULL},
-        {"gonio:seed", IMAGE_ATTR_INT, NULL, (int)p->s.seed, 0, NULL},
-        {"gonio:mode", IMAGE_ATTR_STRING, render_mode_name(p->s.mode), 0, 0, NULL},
-        {"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL},
-        {"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL},
-    };
+    /* The header gonio render writes (its identity, so P's files merge with renders, and the
+     * view, so --camera FILE.exr renders it again). */
+    render_header h;
+    render_stats st = {.spp = p->spp};
+    render_header_build(&h, &p->r, &p->s, &st, NULL);
     if (p->spp == 0)
         return true;
     for (int n = 1;; n++) {
@@ -306,7 +292,7 @@ static bool save_accumulated(preview *p)
     if (!util_check_output(exr) || !util_check_output(png))
         return false;
     renderer_resolve(&p->r, p->spp, false, &img);
-    ok = image_write_exr(&img, exr, attrs, sizeof attrs / sizeof *attrs) &&
+    ok = image_write_exr(&img, exr, h.attrs, h.count) &&
          render_write_png(&img, p->s.mode, png, p->exposure, p->tonemap); /* as gonio render's */
     if (ok) {
         printf("gonio preview: wrote %s and %s (%s, %d spp)\n", exr, png,
@@ -852,8 +838,12 @@ int cmd_preview(int argc, char **argv)
     }
     /* The shared rule (src/camera.h): the file's cameras by index, so that C steps on. */
     p->s.camera = cam.kind == CAMERA_INDEX ? cam.index : cam.kind == CAMERA_AUTO && p->sc.num_cameras ? 0 : -1;
-    if (cam.kind == CAMERA_LOOK_AT)
+    if (cam.kind == CAMERA_LOOK_AT || cam.fov > 0) /* --fov: that view, as render has it */
         p->start_view = p->s.view = &start_view;
+    if (!size_given && cam.width > 0) { /* --camera FILE.exr: that render's size */
+        width = cam.width;
+        height = cam.height;
+    }
     if (!size_given && p->s.camera >= 0 && start_view.aspect > 0)
         height = (int)fmaxf(1.0f, 640.0f / start_view.aspect + 0.5f);
     p->start_camera = p->s.camera;

@@ -365,7 +365,7 @@ bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out)
         c = *s->view;
     } else if (s->camera >= 0) {
         if ((uint32_t)s->camera >= r->sc->num_cameras) {
-            util_error("%s: --camera %d: the scene has %u perspective camera(s)", r->sc->path,
+            util_error("%s: --camera %d: the scene has %u camera(s)", r->sc->path,
                        s->camera, r->sc->num_cameras);
             return false;
         }

@@ -107,7 +107,11 @@ void render_header_build(render_header *h, const renderer *r, const render_setti
         scene_camera v = {.position = {cam.position.x, cam.position.y, cam.position.z},
                           .right = {cam.right.x, cam.right.y, cam.right.z},
                           .up = {cam.up.x, cam.up.y, cam.up.z},
-                          .forward = {cam.forward.x, cam.forward.y, cam.forward.z}};
+                          .forward = {cam.forward.x, cam.forward.y, cam.forward.z},
+                          .yfov = 2 * atanf(cam.tan_half_fovy), .ortho_half_height = cam.ortho_half_height,
+                          .znear = cam.znear, .zfar = cam.zfar};
+        if (s->view && !s->camera_override) /* the camera itself: its yfov exactly */
+            v = *s->view;
         if (s->camera_label)
             add_string(h, "gonio:camera-name", "%s", s->camera_label);
         camera_look_at_string(&v, h->text[h->count], sizeof h->text[0]);
@@ -128,6 +132,15 @@ void render_header_build(render_header *h, const renderer *r, const render_setti
     add_attr(h, (image_attr){"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, st->seconds, NULL});
     add_attr(h, (image_attr){"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL});
     add_attr(h, (image_attr){"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL});
+}
+
+bool render_header_seed(const char *path, uint32_t *seed)
+{
+    double v;
+    if (!image_exr_attr_double(path, "gonio:seed", &v) || v != floor(v) || v < INT32_MIN || v > UINT32_MAX)
+        return false;
+    *seed = v < 0 ? (uint32_t)(int32_t)v : (uint32_t)v;
+    return true;
 }
 
 /* ---- PNGs of the data modes --------------------------------------------------------- */

@@ -44,14 +44,19 @@ extern const char *const render_identity_names[];
 void render_header_build(render_header *h, const renderer *r, const render_settings *s,
                          const render_stats *st, const char *brdf);
 
+/* The gonio:seed of an EXR header: an OpenEXR int is signed, so seeds of 2^31 and above are
+ * stored as their two's complement and read back here. False when absent or not an int. */
+bool render_header_seed(const char *path, uint32_t *seed);
+
 /* Writes the PNG of a render of `mode`: the colour modes tonemapped (exposure, tm, sRGB);
  * depth, normal and cost as pictures of the data, written as 8-bit values without a
  * transfer curve:
  *   depth   grey: the nearest visible point white, the farthest 20% grey (linear in
  *           between over the image's visible range), background black
  *   normal  0.5 n + 0.5 per channel (X red, Y green, Z blue), background black
- *   cost    viridis heat map of the BVH steps, 0 to the image's maximum
- * An edge pixel blends with the background by its coverage (A). */
+ *   cost    viridis heat map of the BVH steps, 0 to the image's maximum, every pixel (a ray
+ *           that misses still walks the tree)
+ * In depth and normal, an edge pixel blends with the background by its coverage (A). */
 bool render_write_png(const image *img, uint32_t mode, const char *path, float exposure, image_tonemap tm);
 
 #endif

@@ -1801,15 +1801,19 @@ bool fs_file_exists(const std::string &path, void *user)
 {
     Ctx &c = *static_cast<Ctx *>(user);
     struct stat st;
-    /* tinygltf tries the scene's folder, then the working directory: never the latter. */
-    bool first = c.base_dir.empty() ? path.compare(0, 2, "./") != 0 : path.compare(0, c.base_dir.size(), c.base_dir) == 0;
+    /* tinygltf tries the scene's folder, then the working directory: never the latter (with
+     * a scene in the working directory both are its folder). */
+    bool first = c.base_dir.empty() || path.compare(0, c.base_dir.size(), c.base_dir) == 0;
     if (!first && !allow_outside_files)
         return false;
-    if (normal_path(path) == c.folder) {
+    /* Lexically against the folder as named (a symlinked folder is the scene's folder), then
+     * resolved against the folder resolved. */
+    const std::string lexical = normal_path(path), folder = normal_path(c.base_dir.empty() ? "." : c.base_dir);
+    if (lexical == folder) {
         c.access_errors.push_back("'" + path + "' is not a regular file");
         return false;
     }
-    if (!allow_outside_files && !under(normal_path(path), c.folder)) {
+    if (!allow_outside_files && !under(lexical, folder)) {
         c.access_errors.push_back("'" + path + "' is outside the scene's folder (--allow-outside-files reads it)");
         return false;
     }
@@ -1939,6 +1943,8 @@ bool load(scene *out, const char *path, int scene_index)
     if (!collect_instances(c, inst, cams, lights) || !bake_geometry(c, inst, out))
         return false;
     load_images_and_textures(c, out);
+    if (!c.limit_error.empty()) /* images in buffer views are decoded only now */
+        return fail(c, "%s", c.limit_error.c_str());
     load_materials(c, out);
     bake_cameras(c, cams, out);
     bake_lights(c, lights, out);

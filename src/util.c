@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -207,6 +208,12 @@ static volatile sig_atomic_t pending;
 #define TMP_PREFIX "."
 #define TMP_INFIX ".tmp-"
 #define TMP_EXTRA (sizeof TMP_PREFIX + sizeof TMP_INFIX + 10)
+
+bool util_has_suffix(const char *s, const char *suffix)
+{
+    size_t n = strlen(s), m = strlen(suffix);
+    return n >= m && strcasecmp(s + n - m, suffix) == 0;
+}
 
 void util_tmp_path(char *out, size_t cap, const char *final_path)
 {

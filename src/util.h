@@ -65,6 +65,8 @@ void *util_read_file(const char *path, size_t *size);
  * files of this name that a killed gonio left behind (their process no longer exists). */
 bool util_check_output(const char *path);
 void util_tmp_path(char *out, size_t cap, const char *final_path);
+/* Whether s ends in suffix, ignoring case (file extensions). */
+bool util_has_suffix(const char *s, const char *suffix);
 bool util_commit_file(const char *tmp_path, const char *final_path, bool ok);
 /* Removes the temporary file of a write under way (async-signal-safe: for a handler that
  * ends the program at once). */

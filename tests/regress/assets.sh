@@ -21,8 +21,10 @@ for f in "$A"/asset-generator/*/*.gltf; do files+=("$f"); done
 for f in "${files[@]}"; do
     m=$(basename "$f" | sed 's/\.[^.]*$//')
     out="$tmp/$m.exr"
-    if ! "$G" render "$f" -o "$out" --size 32x32 --spp 4 --quiet >"$tmp/out" 2>&1; then
-        fail "$m renders with default flags (exit $?)"
+    "$G" render "$f" -o "$out" --size 32x32 --spp 4 --quiet >"$tmp/out" 2>&1
+    rc=$?
+    if [ $rc != 0 ]; then
+        fail "$m renders with default flags (exit $rc)"
         sed 's/^/    /' "$tmp/out" | tail -n 5
         continue
     fi

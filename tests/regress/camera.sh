@@ -125,7 +125,17 @@ check "--camera FILE.exr takes the recorded view" R -o "$tmp/again.exr" --size 3
 check "... and gives the same pixels" "$G" diff "$tmp/again.exr" "$tmp/look.exr" --max-error 0 --quiet
 check "--camera FILE.exr of a file camera" R -o "$tmp/again-a.exr" --size 65x65 --camera "$tmp/a65.exr"
 check "... the same pixels as that camera" "$G" diff "$tmp/again-a.exr" "$tmp/a65.exr" --max-error 0 --quiet
-check_fails "--camera of an EXR without a view" 2 R -o "$tmp/x.exr" --camera "$tmp/nonexistent.exr"
+# Without --size, the file's own size (a 64x32 orthographic render), and the same identity,
+# so the two renders are one image to gonio merge.
+check "--camera FILE.exr without --size" R -o "$tmp/again-o.exr" --camera "$tmp/ortho.exr"
+check "... renders the file's 64x32" sh -c "exrheader '$tmp/again-o.exr' | grep -q 'dataWindow.*(0 0) - (63 31)'"
+check "... the same pixels" "$G" diff "$tmp/again-o.exr" "$tmp/ortho.exr" --max-error 0 --quiet
+cam_id() { exrheader "$1" | grep 'gonio:camera (type string)'; }
+check "... and the same gonio:camera identity" test "$(cam_id "$tmp/again-o.exr")" = "$(cam_id "$tmp/ortho.exr")"
+check "an EXR without a view" "$TESTTOOL" ref plane depth 8 8 "$tmp/noview.exr"
+check_fails "--camera of an EXR without a view" 2 R -o "$tmp/x.exr" --camera "$tmp/noview.exr"
+check "... says so" grep -q "not an EXR with a gonio:look-at header" "$tmp/last"
+check_fails "--camera of a missing EXR" 2 R -o "$tmp/x.exr" --camera "$tmp/nonexistent.exr"
 
 # ---- --scene ---------------------------------------------------------------------------
 check "--scene 1 renders" R -o "$tmp/scene1.exr" --size 33x33 --scene 1

@@ -102,6 +102,52 @@ check "one 67 M-texel image listed 8 times loads (decoded once)" "$G" info "$B/s
 check_fails "5 different ones (335 M texels) are refused" 1 "$G" info "$B/many-images.gltf"
 check "... with the numbers" grep -q "images too large: 335544320 texels with image 4 (16384x4096), the limit is 268435456" "$tmp/last"
 
+# A scene opened through a symlinked folder reads its own files; so does a "./" URI of a
+# scene named without a folder.
+ln -sfn "$B" "$tmp/linked"
+check "a scene in a symlinked folder loads its buffer" "$G" info "$tmp/linked/ok.gltf"
+python3 - "$B/ok.gltf" "$B/dotslash.gltf" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["buffers"][0]["uri"] = "./tri.bin"
+json.dump(d, open(sys.argv[2], "w"))
+PY
+check "a ./ URI of a scene named without a folder" sh -c "cd '$B' && '$G' info dotslash.gltf"
+
+# Images in a .glb's buffer views count against SCENE_MAX_TEXELS too.
+python3 - "$B" <<'PY'
+import json, struct, sys
+b = sys.argv[1]
+d = json.load(open(b + "/ok.gltf"))
+blob = open(b + "/tri.bin", "rb").read()
+views = [{"buffer": 0, "byteLength": len(blob)}]
+for k in range(5):
+    png = open(f"{b}/big{k}.png", "rb").read()
+    while len(blob) % 4: blob += b"\0"
+    views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(png)})
+    blob += png
+while len(blob) % 4: blob += b"\0"
+d["buffers"] = [{"byteLength": len(blob)}]
+d["bufferViews"] = views
+d["images"] = [{"bufferView": 1 + k, "mimeType": "image/png"} for k in range(5)]
+js = json.dumps(d).encode()
+while len(js) % 4: js += b" "
+out = struct.pack("<III", 0x46546C67, 2, 12 + 8 + len(js) + 8 + len(blob))
+out += struct.pack("<II", len(js), 0x4E4F534A) + js + struct.pack("<II", len(blob), 0x004E4942) + blob
+open(b + "/many-images.glb", "wb").write(out)
+PY
+check_fails "5 different 67 M-texel images in a .glb are refused" 1 "$G" info "$B/many-images.glb"
+check "... with the numbers" grep -q "images too large: 335544320 texels" "$tmp/last"
+
+# Seeds of 2^31 and above survive the EXR header's signed int: merge still sees a repeat.
+for sd in 3000000000 3000000001; do
+    check "render --seed $sd" "$G" render "$B/ok.gltf" -o "$tmp/seed-$sd.exr" --size 8x8 --spp 1 --seed $sd --quiet
+done
+check "the same seed twice" cp "$tmp/seed-3000000000.exr" "$tmp/seed-again.exr"
+check_fails "merge refuses seed 3000000000 twice" 1 "$G" merge "$tmp/seed-3000000000.exr" "$tmp/seed-again.exr" -o "$tmp/sm.exr"
+check "merge takes 3000000000 and 3000000001" "$G" merge "$tmp/seed-3000000000.exr" "$tmp/seed-3000000001.exr" -o "$tmp/sm.exr"
+check "... and lists them" sh -c "exrheader '$tmp/sm.exr' | grep -q 'gonio:seeds (type string): \"3000000000,3000000001\"'"
+
 # bench --generate below what the generator can build was accepted and then aborted.
 check_fails "bench --generate 999 is a usage error, not an abort" 2 "$G" bench --generate 999
 check "... naming the range" grep -q "1000..50000000" "$tmp/last"
