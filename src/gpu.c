@@ -366,6 +366,15 @@ VkDeviceSize gpu_host_heap(const gpu *g)
     return best;
 }
 
+uint32_t gpu_max_texels(const gpu *g, const char **name)
+{
+    uint64_t n = g->props.limits.maxTexelBufferElements;
+    uint64_t forced = env_limit("GONIO_MAX_TEXELS", n);
+    if (name)
+        *name = forced < n ? "GONIO_MAX_TEXELS" : "maxTexelBufferElements";
+    return (uint32_t)(forced < n ? forced : n);
+}
+
 uint32_t gpu_max_groups(const gpu *g, int axis)
 {
     uint64_t n = g->props.limits.maxComputeWorkGroupCount[axis];

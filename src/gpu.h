@@ -50,8 +50,10 @@ void gpu_destroy(gpu *g); /* accepts a zeroed struct */
  * maxStorageBufferRange, maxMemoryAllocationSize and GONIO_MAX_BUFFER_BYTES; *name (may be
  * NULL) gets the name of the one that binds. gpu_host_heap: the size of the heap that
  * host-visible buffers (GPU_MEMORY_HOST) come from. gpu_max_groups: maxComputeWorkGroupCount
- * of an axis, and GONIO_MAX_WORKGROUPS. */
+ * of an axis, and GONIO_MAX_WORKGROUPS. gpu_max_texels: maxTexelBufferElements, and
+ * GONIO_MAX_TEXELS; *name as for gpu_storage_limit. */
 VkDeviceSize gpu_storage_limit(const gpu *g, const char **name);
+uint32_t gpu_max_texels(const gpu *g, const char **name);
 VkDeviceSize gpu_host_heap(const gpu *g);
 uint32_t gpu_max_groups(const gpu *g, int axis);
 

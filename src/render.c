@@ -249,11 +249,12 @@ static void build_emitters(renderer *r, const GnPrim *prims)
  * the scene, the buffer and the numbers when not. */
 static bool texels_fit(const renderer *r, const char *what, uint64_t count)
 {
-    uint32_t limit = r->g->props.limits.maxTexelBufferElements;
+    const char *name;
+    uint32_t limit = gpu_max_texels(r->g, &name);
     if (count <= limit)
         return true;
     util_error("%s: %s need %llu texels, more than the %u of one texel buffer on this device "
-               "(maxTexelBufferElements)", r->sc->path, what, (unsigned long long)count, limit);
+               "(%s)", r->sc->path, what, (unsigned long long)count, limit, name);
     return false;
 }
 
@@ -269,12 +270,13 @@ static bool scene_fits(renderer *r)
             (uint64_t)sc->images[largest].width * sc->images[largest].height)
             largest = i;
     }
-    if (texels > r->g->props.limits.maxTexelBufferElements) {
+    const char *name;
+    const uint32_t limit = gpu_max_texels(r->g, &name);
+    if (texels > limit) {
         util_error("%s: the %u texture image(s) hold %llu texels (the largest, image %u, is %ux%u), "
-                   "more than the %u of one texel buffer on this device (maxTexelBufferElements)",
-                   sc->path, sc->num_images, (unsigned long long)texels, largest,
-                   sc->images[largest].width, sc->images[largest].height,
-                   r->g->props.limits.maxTexelBufferElements);
+                   "more than the %u of one texel buffer on this device (%s)", sc->path,
+                   sc->num_images, (unsigned long long)texels, largest, sc->images[largest].width,
+                   sc->images[largest].height, limit, name);
         return false;
     }
     /* RGBA32UI texels: 16 bytes each */
@@ -620,10 +622,9 @@ static bool upload_env_map(renderer *r, const image *map)
         free(row);
         return false;
     }
-    if (words > r->g->props.limits.maxTexelBufferElements) {
+    if (words > gpu_max_texels(r->g, NULL)) {
         util_error("--env: the map's %dx%d texels and tables need %zu words, more than the %u "
-                   "of a texel buffer on this device", w, h, words,
-                   r->g->props.limits.maxTexelBufferElements);
+                   "of a texel buffer on this device", w, h, words, gpu_max_texels(r->g, NULL));
         free(row);
         return false;
     }
