@@ -704,6 +704,7 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->env_select = env > 0 ? (float)(env / total) : 0;
     frame->flags |= s->strategy;
     r->path_features = r->material_features | (s->aov & RENDER_AOV_GPU ? GN_FEAT_AOV : 0u) |
+                       (s->aov & RENDER_AOV_VARIANCE ? GN_FEAT_VARIANCE : 0u) |
                        (s->strategy ? GN_FEAT_STRATEGY : 0u) | (n > 1 ? GN_FEAT_LIGHT_SEARCH : 0u) |
                        (env > 0 || s->env[0] != 0 || s->env[1] != 0 || s->env[2] != 0 ? GN_FEAT_ENV : 0u) |
                        (s->env_map ? GN_FEAT_ENV | GN_FEAT_ENV_MAP : 0u);

@@ -61,6 +61,8 @@ GONIO_DEBUG_BUFFERS=1 "$G" render $S --spp 1 --size 64x48 --aov depth -o "$tmp/d
 has "$tmp/depth.log" "buffers for 64x48: accum 49152, aov 147456, squares 16 bytes"
 GONIO_DEBUG_BUFFERS=1 "$G" render $S --spp 2 --size 64x48 --aov variance -o "$tmp/var.exr" 2>"$tmp/var.log"
 has "$tmp/var.log" "buffers for 64x48: accum 49152, aov 16, squares 49152 bytes"
+v=$("$T" at "$tmp/var.exr" variance.R 32 24)
+check "the squares are summed (variance.R at 32,24 is $v)" awk -v v="$v" 'BEGIN { exit !(v > 0) }'
 # Without the squares the colours are the same bits.
 check "render with variance" "$G" render $S --spp 2 --size 64x48 --quiet -o "$tmp/novar.exr"
 "$T" pick "$tmp/var.exr" R "$tmp/var_R.exr" && "$T" pick "$tmp/novar.exr" R "$tmp/novar_R.exr"
