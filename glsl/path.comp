@@ -316,7 +316,8 @@ uint path_step()
     if (any(isnan(radiance)) || any(isinf(radiance)))
         radiance = vec3(0.0);
     sum += vec4(radiance, covered ? 1.0 : 0.0);
-    sum_sq += radiance * radiance;
+    if (GN_HAS(GN_FEAT_VARIANCE))
+        sum_sq += radiance * radiance;
     sum_n += normal;
     sum_a += albedo;
     sum_depth += depth_aov;
@@ -343,8 +344,10 @@ void main()
     // The sums go on from the buffers, one sample at a time in sample order, so a pixel's
     // sum is the same float whichever dispatches (or runs: --resume) took its samples.
     bool aov_on = GN_HAS(GN_FEAT_AOV) && (frame.flags & GN_FRAME_AOV) != 0u;
+    // Without them the aov and squares buffers are 16-byte dummies: never indexed.
+    bool squares_on = GN_HAS(GN_FEAT_VARIANCE) && (frame.flags & GN_FRAME_VARIANCE) != 0u;
     sum = accum[slot];
-    sum_sq = squares[slot].rgb;
+    sum_sq = squares_on ? squares[slot].rgb : vec3(0.0);
     sum_n = aov_on ? aov[3u * slot + 0u].xyz : vec3(0.0);
     sum_a = aov_on ? aov[3u * slot + 1u].xyz : vec3(0.0);
     sum_depth = aov_on ? aov[3u * slot + 2u].x : 0.0;
@@ -447,7 +450,8 @@ void main()
     if (truncated || taken < samples)
         atomicAdd(status[0], 1u);
     accum[slot] = sum;
-    squares[slot] = vec4(sum_sq, 0.0);
+    if (squares_on)
+        squares[slot] = vec4(sum_sq, 0.0);
     if (aov_on) {
         aov[3u * slot + 0u] = vec4(sum_n, 0.0);
         aov[3u * slot + 1u] = vec4(sum_a, 0.0);

@@ -41,7 +41,7 @@ typedef uint32_t uint;
 #define GN_BIND_TEXELS 7u    /* uint[]: RGBA8 texels of every image, packed */
 #define GN_BIND_TEXTURES 8u  /* GnTexture[] */
 #define GN_BIND_ACCUM 9u     /* vec4[] per pixel: sum of radiance samples, w = coverage */
-#define GN_BIND_AOV 10u      /* vec4[3 * pixels]: normal, albedo, depth sums */
+#define GN_BIND_AOV 10u      /* vec4[3 * pixels]: normal, albedo, depth sums (GN_FRAME_AOV; else a dummy) */
 #define GN_BIND_VCOLOR 11u   /* vec4[2] per vertex: Gouraud colours of the front and back side;
                                  the first one's w holds the vertex's material (uint bits) */
 #define GN_BIND_EMITTERS 12u /* GnEmitter[]: emissive triangles for light sampling */
@@ -100,6 +100,7 @@ typedef uint32_t uint;
 #define GN_FRAME_ENV_MAP 16u   /* path: the environment is the map in GN_BIND_ENV */
 #define GN_FRAME_VERTEX_COLOR 32u /* the scene has vertex colours (GnVertex.color) */
 #define GN_FRAME_ALPHA 64u     /* the scene has MASK or BLEND materials (surfaces cut away) */
+#define GN_FRAME_VARIANCE 128u /* path: write the squares' sums (GN_BIND_SQUARES; else a dummy) */
 
 /* GnEmitter.prim: a triangle (GnPrim index), a punctual light (this bit | GnLight index),
  * or the environment (GN_INVALID). */
@@ -137,10 +138,11 @@ typedef uint32_t uint;
 #define GN_FEAT_AOV (1u << 23)
 #define GN_FEAT_VERTEX_COLOR (1u << 24) /* glTF COLOR_0 */
 #define GN_FEAT_ALPHA (1u << 25)        /* alphaMode MASK or BLEND (glsl/bvh.glsl: trace_visible) */
+#define GN_FEAT_VARIANCE (1u << 26)     /* sums of squares (--aov variance) */
 #define GN_FEAT_LOBES (GN_FEAT_MIRROR | GN_FEAT_PHONG | GN_FEAT_BLINN | GN_FEAT_TS | \
                        GN_FEAT_BECKMANN | GN_FEAT_GGX)
 #define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
-#define GN_FEAT_ALL 0x03ffffffu
+#define GN_FEAT_ALL 0x07ffffffu
 
 /* ---- BVH: both children's boxes in one 64-byte node (Aila & Laine 2009, "Understanding
  * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only

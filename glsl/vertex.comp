@@ -8,6 +8,8 @@
 // side (two-sided lighting: open meshes show both). The host stores the vertex's material
 // index in the bits of vcolor[2i].w; this pass writes .rgb only. One dispatch per side
 // (push.pass_flags = 0 or 1) keeps one invocation's shadow rays within the loop budget.
+// The dispatch is 2D when the vertices need more work groups than one axis may have
+// (maxComputeWorkGroupCount[0]: 65,535 on lavapipe, 4.2 M vertices): rows of groups.
 #extension GL_GOOGLE_include_directive : require
 
 #include "phong.glsl"
@@ -19,7 +21,8 @@ layout(push_constant) uniform PushBlock { GnPush push; };
 
 void main()
 {
-    uint i = gl_GlobalInvocationID.x, side = push.pass_flags;
+    uint i = gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x + gl_GlobalInvocationID.x;
+    uint side = push.pass_flags;
     if (i >= uint(vcolor.length()) / 2u)
         return;
     GnVertex a = vertex_at(i);

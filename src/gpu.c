@@ -240,7 +240,15 @@ bool gpu_create(gpu *g, const gpu_desc *desc)
     g->physical = devs[chosen];
     free(devs);
     g->queue_family = (uint32_t)family;
-    vkGetPhysicalDeviceProperties(g->physical, &g->props);
+    {
+        VkPhysicalDeviceMaintenance3Properties m3 = {
+            .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};
+        VkPhysicalDeviceProperties2 p2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2,
+                                          .pNext = &m3};
+        vkGetPhysicalDeviceProperties2(g->physical, &p2);
+        g->props = p2.properties;
+        g->max_allocation = m3.maxMemoryAllocationSize;
+    }
     vkGetPhysicalDeviceMemoryProperties(g->physical, &g->memory);
     g->unified_memory = true;
     for (uint32_t i = 0; i < g->memory.memoryTypeCount; i++) {
@@ -311,6 +319,67 @@ bool gpu_print_devices(void)
     free(devs);
     gpu_destroy(&g);
     return true;
+}
+
+/* ---- limits ------------------------------------------------------------------------ */
+
+/* A positive integer from the environment, or `none` when unset or not a number. */
+static uint64_t env_limit(const char *name, uint64_t none)
+{
+    const char *v = getenv(name);
+    char *end;
+    unsigned long long x;
+    if (!v || !*v)
+        return none;
+    x = strtoull(v, &end, 10);
+    return *end || x == 0 ? none : (uint64_t)x;
+}
+
+VkDeviceSize gpu_storage_limit(const gpu *g, const char **name)
+{
+    VkDeviceSize limit = g->props.limits.maxStorageBufferRange, forced;
+    const char *n = "maxStorageBufferRange";
+    if (g->max_allocation && g->max_allocation < limit) {
+        limit = g->max_allocation;
+        n = "maxMemoryAllocationSize";
+    }
+    forced = env_limit("GONIO_MAX_BUFFER_BYTES", UINT64_MAX);
+    if (forced < limit) {
+        limit = forced;
+        n = "GONIO_MAX_BUFFER_BYTES";
+    }
+    if (name)
+        *name = n;
+    return limit;
+}
+
+VkDeviceSize gpu_host_heap(const gpu *g)
+{
+    const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                                       VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    VkDeviceSize best = 0;
+    for (uint32_t i = 0; i < g->memory.memoryTypeCount; i++) {
+        VkDeviceSize size = g->memory.memoryHeaps[g->memory.memoryTypes[i].heapIndex].size;
+        if ((g->memory.memoryTypes[i].propertyFlags & host) == host && size > best)
+            best = size;
+    }
+    return best;
+}
+
+uint32_t gpu_max_texels(const gpu *g, const char **name)
+{
+    uint64_t n = g->props.limits.maxTexelBufferElements;
+    uint64_t forced = env_limit("GONIO_MAX_TEXELS", n);
+    if (name)
+        *name = forced < n ? "GONIO_MAX_TEXELS" : "maxTexelBufferElements";
+    return (uint32_t)(forced < n ? forced : n);
+}
+
+uint32_t gpu_max_groups(const gpu *g, int axis)
+{
+    uint64_t n = g->props.limits.maxComputeWorkGroupCount[axis];
+    uint64_t forced = env_limit("GONIO_MAX_WORKGROUPS", n);
+    return (uint32_t)(forced < n ? forced : n);
 }
 
 /* ---- memory and buffers ------------------------------------------------------------- */

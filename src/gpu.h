@@ -36,12 +36,26 @@ typedef struct gpu {
     VkPhysicalDeviceMemoryProperties memory;
     bool validate;
     bool unified_memory;                /* one heap that is device-local and host-visible */
+    VkDeviceSize max_allocation;        /* maxMemoryAllocationSize (Vulkan 1.1) */
 } gpu;
 
 /* Creates instance and device; false with an error message when no usable device exists,
  * the index is out of range, or validation was asked for and the layer is missing. */
 bool gpu_create(gpu *g, const gpu_desc *desc);
 void gpu_destroy(gpu *g); /* accepts a zeroed struct */
+
+/* The device's limits as gonio applies them, each lowered (never raised) by an environment
+ * variable so that tests can reach the code past a limit on small inputs:
+ * gpu_storage_limit: the largest storage buffer a kernel may bind, the least of
+ * maxStorageBufferRange, maxMemoryAllocationSize and GONIO_MAX_BUFFER_BYTES; *name (may be
+ * NULL) gets the name of the one that binds. gpu_host_heap: the size of the heap that
+ * host-visible buffers (GPU_MEMORY_HOST) come from. gpu_max_groups: maxComputeWorkGroupCount
+ * of an axis, and GONIO_MAX_WORKGROUPS. gpu_max_texels: maxTexelBufferElements, and
+ * GONIO_MAX_TEXELS; *name as for gpu_storage_limit. */
+VkDeviceSize gpu_storage_limit(const gpu *g, const char **name);
+uint32_t gpu_max_texels(const gpu *g, const char **name);
+VkDeviceSize gpu_host_heap(const gpu *g);
+uint32_t gpu_max_groups(const gpu *g, int axis);
 
 /* Validation messages (warnings and errors) seen since start: the tests require 0. */
 int gpu_validation_message_count(void);

@@ -245,12 +245,56 @@ static void build_emitters(renderer *r, const GnPrim *prims)
     r->num_emitters = n;
 }
 
-void renderer_create(renderer *r, gpu *g, const scene *sc)
+/* Whether `count` texels fit one texel buffer (maxTexelBufferElements); an error naming
+ * the scene, the buffer and the numbers when not. */
+static bool texels_fit(const renderer *r, const char *what, uint64_t count)
+{
+    const char *name;
+    uint32_t limit = gpu_max_texels(r->g, &name);
+    if (count <= limit)
+        return true;
+    util_error("%s: %s need %llu texels, more than the %u of one texel buffer on this device "
+               "(%s)", r->sc->path, what, (unsigned long long)count, limit, name);
+    return false;
+}
+
+/* The scene's buffers against the device's limits, before any is made. */
+static bool scene_fits(renderer *r)
+{
+    const scene *sc = r->sc;
+    uint64_t texels = 1; /* the texel buffer's trailing zero */
+    uint32_t largest = 0;
+    for (uint32_t i = 0; i < sc->num_images; i++) {
+        texels += (uint64_t)sc->images[i].width * sc->images[i].height;
+        if ((uint64_t)sc->images[i].width * sc->images[i].height >
+            (uint64_t)sc->images[largest].width * sc->images[largest].height)
+            largest = i;
+    }
+    const char *name;
+    const uint32_t limit = gpu_max_texels(r->g, &name);
+    if (texels > limit) {
+        util_error("%s: the %u texture image(s) hold %llu texels (the largest, image %u, is %ux%u), "
+                   "more than the %u of one texel buffer on this device (%s)", sc->path,
+                   sc->num_images, (unsigned long long)texels, largest, sc->images[largest].width,
+                   sc->images[largest].height, limit, name);
+        return false;
+    }
+    /* RGBA32UI texels: 16 bytes each */
+    return texels_fit(r, "the BVH nodes", (uint64_t)r->tree.num_nodes * sizeof(GnBvhNode) / 16) &&
+           texels_fit(r, "the BVH triangles", (uint64_t)r->tree.num_pairs * sizeof(GnTriPair) / 16) &&
+           texels_fit(r, "the triangles' shading data", (uint64_t)r->tree.num_slots) &&
+           texels_fit(r, "the vertices", (uint64_t)sc->num_vertices * sizeof(GnVertex) / 16) &&
+           texels_fit(r, "the materials", (uint64_t)sc->num_materials * sizeof(GnMaterial) / 16) &&
+           texels_fit(r, "the texture table", (uint64_t)sc->num_textures + 1) &&
+           texels_fit(r, "the light table", (uint64_t)r->tree.num_slots + sc->num_lights + 1);
+}
+
+bool renderer_create(renderer *r, gpu *g, const scene *sc)
 {
     double t0 = util_now();
     GnPrim *prims;
     GnTexture *tex;
-    uint32_t *texels, total_texels = 0, *image_offset;
+    uint32_t *texels, total_texels = 0, *image_offset; /* the total fits: scene_fits */
     vec4 *vcolor;
     GnLight *lights;
 
@@ -260,6 +304,10 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     bvh_build(&r->tree, &sc->vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc->indices,
               sc->num_triangles);
     assert(r->tree.num_tris < (1u << 27)); /* glsl/bvh.glsl packs leaves' first triangles in 27 bits */
+    if (!scene_fits(r)) {
+        r->failed = true;
+        return false;
+    }
     for (uint32_t i = 0; i < sc->num_materials; i++)
         r->material_features |= material_features(&sc->materials[i]);
     if (sc->vertex_colors)
@@ -316,12 +364,17 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     gpu_buffer_create_texels_as(g, &r->env, NULL, 16, VK_FORMAT_R32_UINT);
     /* Gouraud colours, two sides per vertex; the material of each vertex rides in the bits of
      * the first one's w for glsl/vertex.comp (a vertex belongs to one glTF primitive). */
-    vcolor = util_calloc(2 * (size_t)sc->num_vertices, sizeof *vcolor);
-    for (uint32_t t = 0; t < sc->num_triangles; t++)
-        for (int k = 0; k < 3; k++)
-            memcpy(&vcolor[2 * (size_t)sc->indices[3 * t + k]].w, &sc->tri_material[t], 4);
-    gpu_buffer_create_storage(g, &r->vcolor, vcolor, 2 * sizeof *vcolor * (VkDeviceSize)sc->num_vertices);
-    free(vcolor);
+    r->vcolor_bytes = 2 * sizeof *vcolor * (VkDeviceSize)sc->num_vertices;
+    if (r->vcolor_bytes <= gpu_storage_limit(g, NULL)) {
+        vcolor = util_calloc(2 * (size_t)sc->num_vertices, sizeof *vcolor);
+        for (uint32_t t = 0; t < sc->num_triangles; t++)
+            for (int k = 0; k < 3; k++)
+                memcpy(&vcolor[2 * (size_t)sc->indices[3 * t + k]].w, &sc->tri_material[t], 4);
+        gpu_buffer_create_storage(g, &r->vcolor, vcolor, r->vcolor_bytes);
+        free(vcolor);
+    } else { /* too many vertices for Gouraud here (light_vertices says so); the rest renders */
+        gpu_buffer_create_storage(g, &r->vcolor, NULL, 16);
+    }
     gpu_buffer_create(g, &r->status, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
     free(prims);
     free(image_offset);
@@ -329,6 +382,16 @@ void renderer_create(renderer *r, gpu *g, const scene *sc)
     free(tex);
     free(lights);
     r->setup_seconds = util_now() - t0;
+    return true;
+}
+
+/* The host copies of a render in bands (renderer_render). */
+static void free_bands(renderer *r)
+{
+    free(r->band_accum);
+    free(r->band_aov);
+    free(r->band_squares);
+    r->band_accum = r->band_aov = r->band_squares = NULL;
 }
 
 void renderer_destroy(renderer *r)
@@ -345,6 +408,7 @@ void renderer_destroy(renderer *r)
         gpu_pipeline_destroy(r->g, &r->vertex_pass);
     }
     bvh_destroy(&r->tree);
+    free_bands(r);
     free(r->emitter_table);
     free(r->emitter_weight);
     memset(r, 0, sizeof *r);
@@ -482,10 +546,30 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
 }
 
 /* Gouraud's vertex pass: lights every vertex for the frame just uploaded, one dispatch per
- * side (glsl/vertex.comp). */
-static void light_vertices(renderer *r)
+ * side (glsl/vertex.comp), in rows of work groups when one row would have more than
+ * maxComputeWorkGroupCount[0]. False (with an error) when the device cannot hold them. */
+static bool light_vertices(renderer *r)
 {
     VkCommandBuffer cmd;
+    const uint32_t max_x = gpu_max_groups(r->g, 0), max_y = gpu_max_groups(r->g, 1);
+    const uint32_t groups = (r->sc->num_vertices + 63) / 64;
+    const uint32_t groups_x = groups < max_x ? groups : max_x;
+    const uint32_t groups_y = groups_x ? (groups + groups_x - 1) / groups_x : 0;
+    const char *limit;
+    VkDeviceSize bytes = gpu_storage_limit(r->g, &limit);
+    if (r->vcolor_bytes > bytes) {
+        util_error("%s: --mode gouraud: the %u vertices' colours need %llu bytes, more than one "
+                   "storage buffer may hold on this device (%s: %llu)", r->sc->path,
+                   r->sc->num_vertices, (unsigned long long)r->vcolor_bytes, limit,
+                   (unsigned long long)bytes);
+        return false;
+    }
+    if (groups_y > max_y) {
+        util_error("%s: --mode gouraud: the %u vertices need %u work groups, more than this device "
+                   "dispatches (maxComputeWorkGroupCount %u x %u)", r->sc->path, r->sc->num_vertices,
+                   groups, max_x, max_y);
+        return false;
+    }
     if (!r->vertex_pass.pipeline) {
         gpu_binding b[GN_BIND_COUNT];
         gpu_pipeline_desc pd = {
@@ -497,10 +581,11 @@ static void light_vertices(renderer *r)
     cmd = gpu_begin(r->g);
     for (uint32_t side = 0; side < 2; side++) {
         GnPush push = {0, side, 0, 0};
-        gpu_dispatch(cmd, &r->vertex_pass, &push, r->sc->num_vertices, 1, 1);
+        gpu_dispatch(cmd, &r->vertex_pass, &push, 64 * groups_x, groups_y, 1);
         gpu_barrier(cmd);
     }
     gpu_submit_wait(r->g, cmd);
+    return true;
 }
 
 /* IEEE half from float (truncating; the map's values are finite and >= 0). */
@@ -537,10 +622,9 @@ static bool upload_env_map(renderer *r, const image *map)
         free(row);
         return false;
     }
-    if (words > r->g->props.limits.maxTexelBufferElements) {
+    if (words > gpu_max_texels(r->g, NULL)) {
         util_error("--env: the map's %dx%d texels and tables need %zu words, more than the %u "
-                   "of a texel buffer on this device", w, h, words,
-                   r->g->props.limits.maxTexelBufferElements);
+                   "of a texel buffer on this device", w, h, words, gpu_max_texels(r->g, NULL));
         free(row);
         return false;
     }
@@ -620,6 +704,7 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->env_select = env > 0 ? (float)(env / total) : 0;
     frame->flags |= s->strategy;
     r->path_features = r->material_features | (s->aov & RENDER_AOV_GPU ? GN_FEAT_AOV : 0u) |
+                       (s->aov & RENDER_AOV_VARIANCE ? GN_FEAT_VARIANCE : 0u) |
                        (s->strategy ? GN_FEAT_STRATEGY : 0u) | (n > 1 ? GN_FEAT_LIGHT_SEARCH : 0u) |
                        (env > 0 || s->env[0] != 0 || s->env[1] != 0 || s->env[2] != 0 ? GN_FEAT_ENV : 0u) |
                        (s->env_map ? GN_FEAT_ENV | GN_FEAT_ENV_MAP : 0u);
@@ -649,15 +734,9 @@ void render_region(const render_settings *s, int region[4])
     }
 }
 
-bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
+/* The frame constants of s for the pixels `region` (no upload); false when the camera is bad. */
+static bool frame_setup(renderer *r, const render_settings *s, const int region[4], GnFrame *frame)
 {
-    gpu *g = r->g;
-    int region[4];
-    render_region(s, region);
-    const int rw = region[2] - region[0], rh = region[3] - region[1];
-    const VkDeviceSize pixels = (VkDeviceSize)rw * rh;
-    assert(rw > 0 && rh > 0 && region[0] >= 0 && region[1] >= 0 && region[2] <= s->width &&
-           region[3] <= s->height);
     memset(frame, 0, sizeof *frame);
     if (!renderer_camera(r, s, &frame->camera))
         return false;
@@ -665,13 +744,14 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->height = (uint32_t)s->height;
     frame->crop_x = (uint32_t)region[0];
     frame->crop_y = (uint32_t)region[1];
-    frame->crop_width = (uint32_t)rw;
-    frame->crop_height = (uint32_t)rh;
+    frame->crop_width = (uint32_t)(region[2] - region[0]);
+    frame->crop_height = (uint32_t)(region[3] - region[1]);
     frame->seed = s->seed;
     frame->mode = s->mode;
     frame->max_depth = (uint32_t)s->max_depth;
     frame->num_lights = r->num_lights;
     frame->flags = (s->aov & RENDER_AOV_GPU ? GN_FRAME_AOV : 0u) | (s->shadows ? GN_FRAME_SHADOWS : 0u) |
+                   (s->aov & RENDER_AOV_VARIANCE ? GN_FRAME_VARIANCE : 0u) |
                    (r->sc->vertex_colors ? GN_FRAME_VERTEX_COLOR : 0u) |
                    (r->material_features & GN_FEAT_ALPHA ? GN_FRAME_ALPHA : 0u);
     frame->env_color = (vec3){s->env[0], s->env[1], s->env[2]};
@@ -681,32 +761,127 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->bounds_min = v3(r->sc->bounds_min);
     frame->bounds_max = v3(r->sc->bounds_max);
     frame->ambient = v3(s->ambient_set ? s->ambient : r->sc->ambient);
-    frame->traversal_budget = traversal_budget(g, 1 + (s->shadows ? r->num_lights : 0));
-    if (s->mode == GN_MODE_PATH && !path_begin(r, s, frame))
+    frame->traversal_budget = traversal_budget(r->g, 1 + (s->shadows ? r->num_lights : 0));
+    return s->mode != GN_MODE_PATH || path_begin(r, s, frame);
+}
+
+/* Bytes per pixel of the accumulation buffers a render with the AOVs `aov` writes: accum
+ * always, the GPU AOVs' buffer and the squares only when asked for. */
+static VkDeviceSize aov_pixel_bytes(uint32_t aov) { return aov & RENDER_AOV_GPU ? 48 : 0; }
+static VkDeviceSize squares_pixel_bytes(uint32_t aov) { return aov & RENDER_AOV_VARIANCE ? 16 : 0; }
+
+/* How many rows of a w x h region one set of accumulation buffers holds within the device's
+ * limits: each buffer within gpu_storage_limit, all of them within half the host heap (the
+ * rest for the scene and the image), at most 8 maxComputeWorkGroupCount[1] rows and each row
+ * within maxComputeWorkGroupCount[0] work groups. 0 (with an error naming the limit and the
+ * numbers) when not even one row fits; *why (may be NULL) names what bounds it, else NULL. */
+static int band_rows(const renderer *r, int w, int h, uint32_t aov, char *why, size_t why_size)
+{
+    const char *limit_name;
+    const VkDeviceSize limit = gpu_storage_limit(r->g, &limit_name), heap = gpu_host_heap(r->g) / 2;
+    const VkDeviceSize largest = aov_pixel_bytes(aov) > 16 ? aov_pixel_bytes(aov) : 16;
+    const VkDeviceSize all = 16 + aov_pixel_bytes(aov) + squares_pixel_bytes(aov);
+    const uint32_t groups_x = (uint32_t)(w + GN_TILE_X - 1) / GN_TILE_X;
+    VkDeviceSize rows = limit / (largest * (VkDeviceSize)w);
+    const VkDeviceSize heap_rows = heap / (all * (VkDeviceSize)w);
+    const VkDeviceSize group_rows = (VkDeviceSize)gpu_max_groups(r->g, 1) * GN_TILE_Y;
+    if (why)
+        why[0] = 0;
+    if (groups_x > gpu_max_groups(r->g, 0)) {
+        util_error("%s: a row of %d pixels needs %u work groups, more than the %u this device "
+                   "dispatches (maxComputeWorkGroupCount[0])", r->sc->path, w, groups_x,
+                   gpu_max_groups(r->g, 0));
+        return 0;
+    }
+    if (rows < (VkDeviceSize)h && why)
+        snprintf(why, why_size, "its %llu-byte %s buffer exceeds the device's %s (%llu bytes)",
+                 (unsigned long long)(largest * (VkDeviceSize)w * (VkDeviceSize)h),
+                 largest > 16 ? "AOV" : "accumulation", limit_name, (unsigned long long)limit);
+    if (heap_rows < rows) {
+        rows = heap_rows;
+        if (rows < (VkDeviceSize)h && why)
+            snprintf(why, why_size, "its %llu bytes of accumulation buffers exceed half the "
+                     "device's memory heap (%llu bytes)",
+                     (unsigned long long)(all * (VkDeviceSize)w * (VkDeviceSize)h),
+                     (unsigned long long)heap);
+    }
+    if (group_rows < rows) {
+        rows = group_rows;
+        if (rows < (VkDeviceSize)h && why)
+            snprintf(why, why_size, "its %d rows need more work groups than the device's "
+                     "maxComputeWorkGroupCount[1] (%u)", h, gpu_max_groups(r->g, 1));
+    }
+    if (rows == 0) {
+        util_error("%s: a row of %d pixels needs %llu bytes of accumulation buffers, more than this "
+                   "device allows (%s: %llu bytes; half the memory heap: %llu bytes)", r->sc->path, w,
+                   (unsigned long long)(largest * (VkDeviceSize)w), limit_name,
+                   (unsigned long long)limit, (unsigned long long)heap);
+        return 0;
+    }
+    return rows < (VkDeviceSize)h ? (int)rows : h;
+}
+
+/* (Re)allocates the accumulation buffers for w x h pixels: accum always, the AOV and squares
+ * buffers only when the render writes them (16-byte dummies otherwise: every descriptor
+ * must name a buffer). A buffer is kept while it holds the pixels and is at most twice the
+ * size needed, so the bands of a tiled render share one set. */
+static void size_buffers(renderer *r, int w, int h, uint32_t aov)
+{
+    const VkDeviceSize pixels = (VkDeviceSize)w * h;
+    gpu_buffer *bufs[3] = {&r->accum, &r->aov, &r->squares};
+    const VkDeviceSize need[3] = {16 * pixels, aov_pixel_bytes(aov) ? aov_pixel_bytes(aov) * pixels : 16,
+                                  squares_pixel_bytes(aov) ? squares_pixel_bytes(aov) * pixels : 16};
+    bool changed = false;
+    for (int i = 0; i < 3; i++) {
+        if (bufs[i]->buffer && bufs[i]->size >= need[i] && bufs[i]->size / 2 <= need[i])
+            continue;
+        gpu_buffer_destroy(r->g, bufs[i]);
+        gpu_buffer_create(r->g, bufs[i], need[i], VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+        assert(bufs[i]->mapped); /* resolve, resume and bands read and write them directly */
+        changed = true;
+    }
+    if (changed && getenv("GONIO_DEBUG_BUFFERS")) /* tests/regress/limits.sh */
+        fprintf(stderr, "gonio: debug: buffers for %dx%d: accum %llu, aov %llu, squares %llu bytes\n",
+                w, h, (unsigned long long)r->accum.size, (unsigned long long)r->aov.size,
+                (unsigned long long)r->squares.size);
+    r->width = w;
+    r->height = h;
+    if (changed) { /* the cached kernels' descriptor sets name the old buffers */
+        for (uint32_t i = 0; i < GN_MODE_COUNT; i++)
+            gpu_pipeline_destroy(r->g, &r->pipelines[i]);
+        gpu_pipeline_destroy(r->g, &r->vertex_pass);
+    }
+}
+
+bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
+{
+    gpu *g = r->g;
+    int region[4];
+    render_region(s, region);
+    const int rw = region[2] - region[0], rh = region[3] - region[1];
+    char why[256];
+    assert(rw > 0 && rh > 0 && region[0] >= 0 && region[1] >= 0 && region[2] <= s->width &&
+           region[3] <= s->height);
+    free_bands(r);
+    if (r->failed)
+        return false;
+    int rows = band_rows(r, rw, rh, s->aov, why, sizeof why);
+    if (rows == 0)
+        return false;
+    if (rows < rh) {
+        util_error("%s: %dx%d pixels in one piece: %s (gonio render renders it in bands)",
+                   r->sc->path, rw, rh, why);
+        return false;
+    }
+    if (!frame_setup(r, s, region, frame))
         return false;
     gpu_buffer_upload(g, &r->frame, frame, sizeof *frame, 0);
-
-    if (r->width != rw || r->height != rh) {
-        gpu_buffer_destroy(g, &r->accum);
-        gpu_buffer_destroy(g, &r->aov);
-        gpu_buffer_destroy(g, &r->squares);
-        gpu_buffer_create(g, &r->squares, 16 * pixels, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
-        gpu_buffer_create(g, &r->accum, 16 * pixels, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
-        gpu_buffer_create(g, &r->aov, 48 * pixels, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
-        r->width = rw;
-        r->height = rh;
-        /* The cached kernels' descriptor sets name the old buffers. */
-        for (uint32_t i = 0; i < GN_MODE_COUNT; i++)
-            gpu_pipeline_destroy(g, &r->pipelines[i]);
-        gpu_pipeline_destroy(g, &r->vertex_pass);
-    }
+    size_buffers(r, rw, rh, s->aov);
     gpu_buffer_fill_zero(g, &r->accum);
     gpu_buffer_fill_zero(g, &r->aov);
     gpu_buffer_fill_zero(g, &r->squares);
     gpu_buffer_fill_zero(g, &r->status);
-    if (s->mode == GN_MODE_GOURAUD)
-        light_vertices(r);
-    return true;
+    return s->mode != GN_MODE_GOURAUD || light_vertices(r);
 }
 
 /* The GN_FEAT_* a mode's kernel is built for: the path kernel is specialised on all of
@@ -798,11 +973,25 @@ static float *add_channel(image *out, const char *name)
     return out->planes[out->num_channels++] = util_calloc(pixels, sizeof(float));
 }
 
+/* Where a render's sums are: its buffers, or the host copies of a render in bands. */
+typedef struct sums_at {
+    float *accum, *aov, *squares;
+    int width, height;
+} sums_at;
+
+static sums_at sums_of(const renderer *r)
+{
+    if (r->band_accum)
+        return (sums_at){r->band_accum, r->band_aov, r->band_squares, r->region_width, r->region_height};
+    return (sums_at){r->accum.mapped, r->aov.mapped, r->squares.mapped, r->width, r->height};
+}
+
 /* aov_offset: where the AOV is in each pixel's 12 floats of the aov buffer (GN_BIND_AOV). */
 static void add_gpu_aov(const renderer *r, int spp, const char *const *names, int n, int aov_offset, image *out)
 {
-    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
-    const float *aovs = r->aov.mapped;
+    const sums_at at = sums_of(r);
+    const VkDeviceSize pixels = (VkDeviceSize)at.width * at.height;
+    const float *aovs = at.aov;
     float inv = 1.0f / (float)spp;
     for (int c = 0; c < n; c++) {
         float *plane = add_channel(out, names[c]);
@@ -816,8 +1005,9 @@ static void add_gpu_aov(const renderer *r, int spp, const char *const *names, in
 static void add_variance(const renderer *r, int spp, image *out)
 {
     static const char *const names[] = {"variance.R", "variance.G", "variance.B"};
-    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
-    const float *acc = r->accum.mapped, *sq = r->squares.mapped;
+    const sums_at at = sums_of(r);
+    const VkDeviceSize pixels = (VkDeviceSize)at.width * at.height;
+    const float *acc = at.accum, *sq = at.squares;
     for (int c = 0; c < 3; c++) {
         float *plane = add_channel(out, names[c]);
         for (VkDeviceSize p = 0; spp > 1 && p < pixels; p++) {
@@ -833,10 +1023,11 @@ void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out)
     static const char *const normal[] = {"normal.X", "normal.Y", "normal.Z"};
     static const char *const albedo[] = {"albedo.R", "albedo.G", "albedo.B"};
     static const char *const depth[] = {"depth.Z"};
-    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
-    const float *acc = r->accum.mapped;
+    const sums_at at = sums_of(r);
+    const VkDeviceSize pixels = (VkDeviceSize)at.width * at.height;
+    const float *acc = at.accum;
     float inv = 1.0f / (float)spp;
-    image_create(out, r->width, r->height, 4, names);
+    image_create(out, at.width, at.height, 4, names);
     for (VkDeviceSize p = 0; p < pixels; p++)
         for (int c = 0; c < 4; c++)
             out->planes[c][p] = acc[4 * p + c] * inv;
@@ -867,13 +1058,15 @@ static const struct sum_channel {
 
 static float *sum_buffer(const renderer *r, int buffer, int *stride)
 {
+    const sums_at at = sums_of(r);
     *stride = buffer == 1 ? 12 : 4;
-    return buffer == 0 ? r->accum.mapped : buffer == 1 ? r->aov.mapped : r->squares.mapped;
+    return buffer == 0 ? at.accum : buffer == 1 ? at.aov : at.squares;
 }
 
 void renderer_sums(const renderer *r, uint32_t aov, image *out)
 {
-    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
+    const sums_at at = sums_of(r);
+    const VkDeviceSize pixels = (VkDeviceSize)at.width * at.height;
     for (size_t k = 0; k < sizeof sum_channels / sizeof *sum_channels; k++) {
         const struct sum_channel *c = &sum_channels[k];
         int stride;
@@ -891,10 +1084,11 @@ void renderer_sums(const renderer *r, uint32_t aov, image *out)
  * a channel the render needs is missing or the size differs. */
 static bool load_sums(renderer *r, const render_settings *s)
 {
-    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
-    if (s->resume->width != r->width || s->resume->height != r->height) {
+    const sums_at at = sums_of(r);
+    const VkDeviceSize pixels = (VkDeviceSize)at.width * at.height;
+    if (s->resume->width != at.width || s->resume->height != at.height) {
         util_error("--resume: the file's %dx%d pixels are not the %dx%d region rendered",
-                   s->resume->width, s->resume->height, r->width, r->height);
+                   s->resume->width, s->resume->height, at.width, at.height);
         return false;
     }
     for (size_t k = 0; k < sizeof sum_channels / sizeof *sum_channels; k++) {
@@ -914,49 +1108,121 @@ static bool load_sums(renderer *r, const render_settings *s)
     return true;
 }
 
+/* A render in bands of `rows` rows: the frame and buffers for the first band (the others
+ * share them), and the whole region's sums on the host, zeroed. */
+static bool begin_bands(renderer *r, const render_settings *s, const int region[4], int rows,
+                        GnFrame *frame)
+{
+    const int rw = region[2] - region[0], rh = region[3] - region[1];
+    const size_t pixels = (size_t)rw * (size_t)rh;
+    free_bands(r);
+    if (!frame_setup(r, s, region, frame))
+        return false;
+    size_buffers(r, rw, rows, s->aov);
+    gpu_buffer_fill_zero(r->g, &r->status);
+    r->band_accum = util_calloc(4 * pixels, sizeof(float));
+    if (s->aov & RENDER_AOV_GPU)
+        r->band_aov = util_calloc(12 * pixels, sizeof(float));
+    if (s->aov & RENDER_AOV_VARIANCE)
+        r->band_squares = util_calloc(4 * pixels, sizeof(float));
+    r->region_width = rw;
+    r->region_height = rh;
+    return s->mode != GN_MODE_GOURAUD || light_vertices(r);
+}
+
+/* Band b's frame uploaded and its sums (host) copied into the buffers (load), or the
+ * buffers' sums copied back to the host (!load). */
+static void band_swap(renderer *r, GnFrame *frame, const int region[4], int rows, int b, bool load)
+{
+    const int y0 = b * rows, rh = region[3] - region[1], bh = rh - y0 < rows ? rh - y0 : rows;
+    const size_t first = (size_t)r->region_width * (size_t)y0, n = (size_t)r->region_width * (size_t)bh;
+    struct { float *host; gpu_buffer *buf; size_t floats; } parts[3] = {
+        {r->band_accum, &r->accum, 4}, {r->band_aov, &r->aov, 12}, {r->band_squares, &r->squares, 4}};
+    if (load) {
+        frame->crop_y = (uint32_t)(region[1] + y0);
+        frame->crop_height = (uint32_t)bh;
+        gpu_buffer_upload(r->g, &r->frame, frame, sizeof *frame, 0);
+        r->height = bh; /* the dispatch's rows; the buffers hold `rows` */
+    }
+    for (int i = 0; i < 3; i++) {
+        float *host = parts[i].host ? parts[i].host + parts[i].floats * first : NULL;
+        if (host && load)
+            memcpy(parts[i].buf->mapped, host, parts[i].floats * sizeof(float) * n);
+        else if (host)
+            memcpy(host, parts[i].buf->mapped, parts[i].floats * sizeof(float) * n);
+    }
+}
+
 bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats)
 {
     gpu *g = r->g;
     GnFrame frame;
     double t0;
-    int done = 0, batch = 1;
+    int done = 0, batch = 1, region[4], rows, bands;
     const int per = s->mode == GN_MODE_PATH ? (int)r->path_samples : 1;
     progress prog = {.tty = isatty(2), .tenth = -1};
+    char why[256];
 
     memset(stats, 0, sizeof *stats);
     if (!renderer_mode_available(s->mode)) {
         util_error("--mode %s is not available yet", render_mode_name(s->mode));
         return false;
     }
-    if (!renderer_begin(r, s, &frame))
+    if (r->failed)
         return false;
-    const VkDeviceSize pixels = (VkDeviceSize)r->width * r->height;
+    render_region(s, region);
+    const int rw = region[2] - region[0], rh = region[3] - region[1];
+    const VkDeviceSize pixels = (VkDeviceSize)rw * rh;
+    if ((rows = band_rows(r, rw, rh, s->aov, why, sizeof why)) == 0)
+        return false;
+    bands = (rh + rows - 1) / rows;
+    if (bands > 1) {
+        /* Bands of about equal height, whole 8-row tiles where that stays within the limit. */
+        int even = (rh + bands - 1) / bands, tiled = (even + (int)GN_TILE_Y - 1) / (int)GN_TILE_Y * (int)GN_TILE_Y;
+        rows = tiled <= rows ? tiled : even;
+        bands = (rh + rows - 1) / rows;
+        util_info("%dx%d rendered in %d bands of %d rows: %s", rw, rh, bands, rows, why);
+        if (!begin_bands(r, s, region, rows, &frame))
+            return false;
+    } else if (!renderer_begin(r, s, &frame)) {
+        return false;
+    }
+    stats->bands = bands;
     if (s->resume) {
         if (!load_sums(r, s))
             return false;
         done = s->resume_spp;
     }
 
-    /* Passes are submitted in batches sized to take 0.1 to 0.4 s each: short enough for a
-     * responsive progress bar and an early stop, long enough to hide submission costs and
-     * to let the path kernel take several samples per dispatch (renderer_record_samples).
-     * The kernels add each sample to the buffers' sums in sample order (glsl/path.comp), so
-     * the bits do not depend on how the batches and dispatches split the samples: the same
-     * command gives the same bits, and so do a render resumed from its sums (s->resume) and
-     * a crop of it (GnFrame). */
+    /* Passes are submitted in batches sized to take 0.1 to 0.4 s each (per band): short
+     * enough for a responsive progress bar and an early stop, long enough to hide submission
+     * costs and to let the path kernel take several samples per dispatch
+     * (renderer_record_samples). The kernels add each sample to the buffers' sums in sample
+     * order (glsl/path.comp), so the bits do not depend on how the batches, dispatches and
+     * bands split the samples: the same command gives the same bits, and so do a render
+     * resumed from its sums (s->resume), a crop of it (GnFrame) and one in bands. A batch
+     * goes through every band before the next, so all pixels always have the same samples:
+     * a stop or --time ends the render after a whole round. */
     t0 = util_now();
     while (s->time_limit > 0 || done < s->spp) {
-        VkCommandBuffer cmd = gpu_begin(g);
         double tb = util_now();
         int n = batch * per;
         if (s->time_limit <= 0 && n > s->spp - done)
             n = s->spp - done;
-        renderer_record_samples(r, cmd, s->mode, (uint32_t)done, (uint32_t)n);
-        gpu_submit_wait(g, cmd);
+        for (int b = 0; b < bands; b++) {
+            VkCommandBuffer cmd;
+            if (bands > 1)
+                band_swap(r, &frame, region, rows, b, true);
+            cmd = gpu_begin(g);
+            renderer_record_samples(r, cmd, s->mode, (uint32_t)done, (uint32_t)n);
+            gpu_submit_wait(g, cmd);
+            if (bands > 1)
+                band_swap(r, &frame, region, rows, b, false);
+        }
         done += n;
         if (done == n + (s->resume ? s->resume_spp : 0))
             stats->first_pass_seconds = util_now() - t0;
-        tb = util_now() - tb;
+        tb = (util_now() - tb) / bands;
         if (tb < 0.1 && batch < 1024)
             batch *= 2;
         else if (tb > 0.4 && batch > 1)

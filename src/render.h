@@ -68,6 +68,7 @@ typedef struct render_stats {
     double setup_seconds;   /* BVH build and upload */
     uint64_t rays;          /* camera rays traced (pixels * spp) */
     uint32_t truncated;     /* rays (path: pixel passes) cut short by the traversal budget */
+    int bands;              /* horizontal bands the region was rendered in (1: one piece) */
 } render_stats;
 
 typedef struct renderer {
@@ -92,10 +93,19 @@ typedef struct renderer {
     uint32_t path_features;     /* ... and the current path render (renderer_begin) */
     uint32_t pipeline_features[GN_MODE_COUNT]; /* what each cached kernel was built for */
     uint32_t path_samples;      /* samples per path dispatch (1..GN_PATH_SAMPLES) */
+    bool failed;                /* renderer_create refused the scene: nothing renders */
+    VkDeviceSize vcolor_bytes;  /* Gouraud's colours: more than a storage buffer holds when
+                                 * vcolor is a dummy (then --mode gouraud is refused) */
+    /* A render in bands (renderer_render): the whole region's sums on the host, which
+     * renderer_resolve and renderer_sums read instead of the buffers; NULL otherwise. */
+    float *band_accum, *band_aov, *band_squares;
+    int region_width, region_height;
 } renderer;
 
-/* Builds the BVH and uploads the scene. */
-void renderer_create(renderer *r, gpu *g, const scene *sc);
+/* Builds the BVH and uploads the scene. False (with an error naming the scene, the limit
+ * and the numbers) when the scene's buffers exceed the device's limits; the renderer is then
+ * marked failed, so that renderer_begin and renderer_render return false too. */
+bool renderer_create(renderer *r, gpu *g, const scene *sc);
 void renderer_destroy(renderer *r); /* accepts a zeroed struct */
 
 /* The camera for settings->camera (or the framing one) as the GPU wants it. Returns false
@@ -103,7 +113,9 @@ void renderer_destroy(renderer *r); /* accepts a zeroed struct */
 bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out);
 
 /* Fills and uploads the frame constants for s; (re)allocates and clears the accumulation,
- * AOV and status buffers for s's image size. */
+ * AOV and status buffers for s's region (the AOV and squares buffers only when s->aov asks
+ * for them; 16-byte dummies otherwise). False (with an error) when the region needs more
+ * than one buffer may hold: only renderer_render renders such a region, in bands. */
 bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame);
 /* The descriptor bindings of every render kernel (up to GN_BIND_COUNT entries). */
 uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
@@ -134,7 +146,11 @@ void renderer_sums(const renderer *r, uint32_t aov, image *out);
 
 /* Renders and fills `out` with R, G, B, A (A = coverage) and the channels of the AOVs in
  * s->aov, in the order normal.X/Y/Z, albedo.R/G/B, depth.Z, variance.R/G/B. Each is the
- * mean over the pixel's samples, a miss counting 0 (so depth is 0 where nothing is hit). */
+ * mean over the pixel's samples, a miss counting 0 (so depth is 0 where nothing is hit).
+ * A region whose accumulation buffers exceed the device's limits (gpu_storage_limit, half
+ * the host heap, maxComputeWorkGroupCount[1]) is rendered in horizontal bands, each a crop
+ * with the same bits: every batch of samples goes through all bands in turn (their sums
+ * kept on the host), so --time, a stop and the progress act on whole rounds of bands. */
 bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats);
 
 /* Applies BRDF-model overrides to the scene's materials (GnMaterial.brdf, brdf_params and
