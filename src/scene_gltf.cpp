@@ -1,9 +1,11 @@
-/* scene_gltf.cpp: scene_load, the glTF 2.0 loader. tinygltf parses the JSON/GLB and fetches
- * buffers and images; everything it returns is checked here against the glTF 2.0 specification
- * (references, accessor ranges and formats, values) before one byte is read, in cgltf's order:
- * parse, load buffers, validate, read. Geometry is baked into world space, normals with the
- * cofactor matrix (the inverse transpose up to det, Lengyel, "Mathematics for 3D Game
- * Programming and Computer Graphics", 3rd ed., 4.5). No C++ exception escapes into C. */
+/* scene_gltf.cpp: scene_load, the glTF 2.0 loader. The JSON document is checked first as JSON
+ * (check_document: types, indices, sizes, enums, which tinygltf's conversions lose); then
+ * tinygltf parses the JSON/GLB and fetches buffers and images, and everything it returns is
+ * checked here against the glTF 2.0 specification (references, accessor ranges and formats,
+ * values) before one byte is read, in cgltf's order: parse, load buffers, validate, read.
+ * Geometry is baked into world space, normals with the cofactor matrix (the inverse transpose
+ * up to det, Lengyel, "Mathematics for 3D Game Programming and Computer Graphics", 3rd ed.,
+ * 4.5). No C++ exception escapes into C. */
 #include <tiny_gltf.h>
 
 #include <nlohmann/json.hpp>
@@ -1872,7 +1874,8 @@ struct Doc {
     Ctx &c;
     const Json &root;
     int errors = 0;
-    std::vector<bool> position_bounds_warned; /* per accessor */
+    std::vector<bool> unbounded; /* per accessor: a POSITION without min or max */
+    size_t num_unbounded = 0, first_unbounded = 0;
 
     bool glb;
     Doc(Ctx &ctx, const Json &r, bool is_glb) : c(ctx), root(r), glb(is_glb) {}
@@ -2115,13 +2118,13 @@ void Doc::check_primitive(const Json &pr, const std::string &p)
             int64_t a = index(it.value(), at(ap, it.key().c_str()), "accessors", count_of("accessors"));
             /* The validator's POSITION_ACCESSOR_WITHOUT_BOUNDS is an error, but gonio computes
              * the bounds it needs from the data and never trusts these: refusing would only
-             * lose the scene, so it is a warning (once per accessor). */
-            if (it.key() == "POSITION" && a >= 0 && !position_bounds_warned[size_t(a)]) {
+             * lose the scene, so it is a warning (one for the file, in check). */
+            if (it.key() == "POSITION" && a >= 0 && !unbounded[size_t(a)]) {
                 const Json &acc = root.at("accessors").at(size_t(a));
                 if (acc.is_object() && (!acc.count("min") || !acc.count("max"))) {
-                    warn(c, "accessors[%lld]: a POSITION accessor without min and max (glTF requires them; "
-                            "gonio computes the bounds itself)", (long long)a);
-                    position_bounds_warned[size_t(a)] = true;
+                    unbounded[size_t(a)] = true;
+                    if (!num_unbounded++)
+                        first_unbounded = size_t(a);
                 }
             }
         }
@@ -2230,7 +2233,7 @@ void Doc::check()
             error(at(p, "byteStride"), "%lld is not a multiple of 4", (long long)stride);
         enum_int(v, "target", p, {34962, 34963});
     });
-    position_bounds_warned.assign(count_of("accessors"), false);
+    unbounded.assign(count_of("accessors"), false);
     each(root, "accessors", "", [&](const Json &a, const std::string &p, size_t) { check_accessor(a, p); });
     each(root, "meshes", "", [&](const Json &m, const std::string &p, size_t) {
         if (!array(m, "primitives", p, true))
@@ -2274,11 +2277,12 @@ void Doc::check()
     each(root, "animations", "", [&](const Json &a, const std::string &p, size_t) {
         const Json *samplers = array(a, "samplers", p, true);
         size_t ns = samplers ? samplers->size() : 0;
-        each(a, "samplers", p, [&](const Json &s, const std::string &sp, size_t) {
-            index(s, "input", sp, "accessors", true);
-            index(s, "output", sp, "accessors", true);
-            enum_str(s, "interpolation", sp, {"LINEAR", "STEP", "CUBICSPLINE"});
-        });
+        if (samplers)
+            each(a, "samplers", p, [&](const Json &s, const std::string &sp, size_t) {
+                index(s, "input", sp, "accessors", true);
+                index(s, "output", sp, "accessors", true);
+                enum_str(s, "interpolation", sp, {"LINEAR", "STEP", "CUBICSPLINE"});
+            });
         if (!array(a, "channels", p, true))
             return;
         each(a, "channels", p, [&](const Json &ch, const std::string &cp, size_t) {
@@ -2292,6 +2296,10 @@ void Doc::check()
     });
     if (errors > MAX_DOC_ERRORS)
         util_error("%s: %d more errors in the JSON", c.path, errors - MAX_DOC_ERRORS);
+    if (num_unbounded && !c.failed)
+        warn(c, "accessors[%zu]: a POSITION accessor without min and max%s (glTF requires them; gonio computes "
+                "the bounds itself)", first_unbounded,
+             num_unbounded > 1 ? (", and " + std::to_string(num_unbounded - 1) + " more").c_str() : "");
 }
 
 /* The document checks over the JSON text. Text that is not JSON is left to tinygltf, which
