@@ -1873,11 +1873,11 @@ const int MAX_DOC_ERRORS = 20; /* then only a count: a fuzzed file can have mill
 struct Doc {
     Ctx &c;
     const Json &root;
+    bool glb;
     int errors = 0;
     std::vector<bool> unbounded; /* per accessor: a POSITION without min or max */
     size_t num_unbounded = 0, first_unbounded = 0;
 
-    bool glb;
     Doc(Ctx &ctx, const Json &r, bool is_glb) : c(ctx), root(r), glb(is_glb) {}
 
     void error(const std::string &path, const char *fmt, ...) UTIL_PRINTF(3, 4)
@@ -1900,6 +1900,15 @@ struct Doc {
     }
     static std::string at(const std::string &path, const char *key) { return path.empty() ? key : path + "." + key; }
     static std::string item(const std::string &path, size_t i) { return path + "[" + std::to_string(i) + "]"; }
+    /* A key the file chose (attribute names), fit for a message: short, printable. */
+    static std::string key_of(const std::string &k)
+    {
+        std::string s = k.substr(0, 64);
+        for (char &ch : s)
+            if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f)
+                ch = '?';
+        return s;
+    }
 
     /* Member `key` of object o, nullptr when absent (an error when required). */
     const Json *member(const Json &o, const char *key, const std::string &path, bool required = false)
@@ -2095,7 +2104,7 @@ void Doc::check_accessor(const Json &a, const std::string &p)
     numbers(a, "max", p, 0);
     if (const Json *s = object(a, "sparse", p)) {
         std::string sp = at(p, "sparse");
-        integer(*s, "count", sp, 1, UINT32_MAX, true);
+        integer(*s, "count", sp, 1, INT32_MAX, true); /* tinygltf holds it in an int */
         if (const Json *i = object(*s, "indices", sp, true)) {
             std::string ip = at(sp, "indices");
             index(*i, "bufferView", ip, "bufferViews", true);
@@ -2115,7 +2124,7 @@ void Doc::check_primitive(const Json &pr, const std::string &p)
     if (const Json *attrs = object(pr, "attributes", p, true)) {
         std::string ap = at(p, "attributes");
         for (auto it = attrs->begin(); it != attrs->end(); ++it) {
-            int64_t a = index(it.value(), at(ap, it.key().c_str()), "accessors", count_of("accessors"));
+            int64_t a = index(it.value(), at(ap, key_of(it.key()).c_str()), "accessors", count_of("accessors"));
             /* The validator's POSITION_ACCESSOR_WITHOUT_BOUNDS is an error, but gonio computes
              * the bounds it needs from the data and never trusts these: refusing would only
              * lose the scene, so it is a warning (one for the file, in check). */
@@ -2274,6 +2283,7 @@ void Doc::check()
         index(t, "source", p, "images");
     });
     each(root, "materials", "", [&](const Json &m, const std::string &p, size_t) { check_material(m, p); });
+    each(root, "skins", "", [&](const Json &, const std::string &, size_t) {}); /* only node.skin is read */
     each(root, "animations", "", [&](const Json &a, const std::string &p, size_t) {
         const Json *samplers = array(a, "samplers", p, true);
         size_t ns = samplers ? samplers->size() : 0;

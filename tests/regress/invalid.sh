@@ -188,6 +188,8 @@ mutants = [
      "animations[0].channels[0].sampler: 4294967296 does not exist"),
     ("anim_node", ["animations", 0, "channels", 0, "target", "node"], 1.5, 1, "target.node: 1.5 is not an integer index"),
     ("anim_input", ["animations", 0, "samplers", 0, "input"], -2, 1, "samplers[0].input: -2 is not a valid index"),
+    ("attribute_key", ["meshes", 0, "primitives", 0, "attributes", "TEXCOORD_\n9"], 99, 1,
+     "attributes.TEXCOORD_?9: 99 does not exist"),  # a control character in a message
     ("sparse_view", ["accessors", 4, "sparse", "values", "bufferView"], 2**32 + 4, 1,
      "sparse.values.bufferView: 4294967300 does not exist"),
     # Sizes and offsets: non-negative integers in range.
@@ -205,6 +207,8 @@ mutants = [
     ("count_missing", ["accessors", 1, "count"], DELETE, 1, "accessors[1].count: missing (required)"),
     ("sparse_offset_negative", ["accessors", 4, "sparse", "values", "byteOffset"], -4, 1,
      "sparse.values.byteOffset: -4 is out of range"),
+    ("sparse_count_big", ["accessors", 4, "sparse", "count"], 3000000000, 1,
+     "sparse.count: 3000000000 is out of range (1..2147483647)"),
     ("texcoord_negative", ["materials", 0, "pbrMetallicRoughness", "baseColorTexture", "texCoord"], -1, 1,
      "baseColorTexture.texCoord: -1 is out of range"),
     ("offset_without_view", ["accessors", 3, "bufferView"], DELETE, 1, "accessors[3].byteOffset: requires a bufferView"),
