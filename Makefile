@@ -18,7 +18,7 @@ ifeq ($(origin CXX),default)
 CXX := g++
 endif
 
-PKGS := vulkan glfw3 OpenEXR tinygltf libpng zlib stb
+PKGS := vulkan glfw3 OpenEXR tinygltf nlohmann_json libpng zlib stb
 WARN := -Wall -Wextra -Wshadow -Werror
 CPPFLAGS += -Isrc -Iglsl -I$(BUILD)/spv -MMD -MP
 CFLAGS += -std=c11 -D_DEFAULT_SOURCE -pthread $(WARN)
@@ -64,8 +64,10 @@ UNIT := $(BUILD)/unit_tests
 TESTTOOL := $(BUILD)/testtool
 
 # ---- Debian packages -------------------------------------------------------------------
+# nlohmann-json3-dev: the JSON library tinygltf parses with, which scene_gltf.cpp uses to check
+# the document itself (tinygltf's package does not depend on it).
 DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
-	libopenexr-dev libtinygltf-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers help2man
+	libopenexr-dev libtinygltf-dev nlohmann-json3-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers help2man
 # man-db: tests/regress/cli.sh renders the installed man page with man -l.
 # libmagickcore-6.q16-6-extra: ImageMagick's EXR coder (only a recommendation of imagemagick,
 # which --no-install-recommends leaves out); tests/regress/diff.sh writes EXRs with it.
