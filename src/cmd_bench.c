@@ -196,7 +196,8 @@ int cmd_bench(int argc, char **argv)
     gpu g = {0};
     renderer r = {0};
     gpu_pipeline pipes[2] = {{0}};
-    render_settings s = {.mode = GN_MODE_PHONG, .camera = -1};
+    /* bench.comp writes its rays into the AOV buffer, which is allocated only when asked for. */
+    render_settings s = {.mode = GN_MODE_PHONG, .camera = -1, .aov = RENDER_AOV_GPU};
     GnFrame frame;
     double t_first = 0, t_primary = 0, t_diffuse = 0;
     uint64_t n_primary = 0, n_diffuse = 0;
@@ -272,6 +273,7 @@ int cmd_bench(int argc, char **argv)
     if (paths) {
         bool ok;
         s.mode = GN_MODE_PATH;
+        s.aov = RENDER_AOV_VARIANCE; /* the reference's own noise needs its squares */
         s.env[0] = s.env[1] = s.env[2] = env;
         ok = bench_paths(&r, &s, t_start, seconds, ref_w, ref_h, ref_spp);
         print_build(&sc);
