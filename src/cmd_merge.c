@@ -273,6 +273,7 @@ int cmd_merge(int argc, char **argv)
         uint32_t *first_seeds = util_calloc((size_t)seeds.count + 1, sizeof *first_seeds);
         uint32_t *pixel_seeds = util_calloc((size_t)seeds.count + 1, sizeof *pixel_seeds);
         int first_count = 0;
+        bool hole = false; /* the tiles leave a hole: refused after the scratch arrays are freed */
         for (int c = 0; c < imgs[0].num_channels; c++)
             if (!is_sum(imgs[0].names[c]))
                 names[nc++] = imgs[0].names[c];
@@ -314,13 +315,8 @@ int cmd_merge(int argc, char **argv)
                     util_error("%s: pixel (%d, %d) has %lld samples in the inputs, but pixel (%d, %d) %lld: "
                                "the tiles leave a hole or overlap unevenly", out_path, box[0] + x, box[1] + y,
                                (long long)*cv, box[0], box[1], (long long)covered[0]);
-                    free(covered);
-                    free(in);
-                    free(first_in);
-                    free(last_in);
-                    free(first_seeds);
-                    free(pixel_seeds);
-                    goto done;
+                    hole = true;
+                    goto scratch;
                 }
             }
         total = covered[0];
@@ -330,12 +326,15 @@ int cmd_merge(int argc, char **argv)
                 memmove(&seeds.file[k], &seeds.file[k + 1], sizeof *seeds.file * (size_t)(seeds.count - k - 1));
                 seeds.count--;
             }
+    scratch:
         free(covered);
         free(in);
         free(first_in);
         free(last_in);
         free(first_seeds);
         free(pixel_seeds);
+        if (hole)
+            goto done;
         for (int c = 0; c < out.num_channels; c++) {
             const char *of = variance_of(names[c]);
             bool var = of && image_channel(&imgs[0], of) >= 0;
