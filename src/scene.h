@@ -88,7 +88,7 @@ typedef struct scene {
  * problem and return false with *out zeroed. What can be skipped or repaired safely prints a
  * warning naming the file and the feature: points/lines primitives (strips and fans become
  * triangles), orthographic or invalid cameras, invalid lights, unknown optional extensions,
- * unknown alpha modes (rendered opaque), texCoord != 0 and missing or undecodable images (texture
+ * unknown alpha modes (rendered opaque), texCoord > 1 and missing or undecodable images (texture
  * slot GN_INVALID; PNG and JPEG only), out-of-range material values (clamped), non-unit
  * normals (renormalised), skins, morph targets, COLOR_0. Primitives without NORMAL get flat
  * normals (de-indexed). Triangles with non-finite or absurdly large (|x| > 1e15) vertices
