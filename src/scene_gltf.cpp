@@ -77,6 +77,7 @@ struct Ctx {
     std::vector<std::vector<Prim>> meshes;   /* per glTF mesh */
     std::vector<uint32_t> image_map, texture_map; /* glTF index -> scene index or GN_INVALID */
     scene *textures_out = nullptr;           /* where texture_slot adds transformed textures */
+    size_t textures_room = 0;                /* textures_out->textures' allocated entries */
     std::map<std::pair<uint32_t, size_t>, int> decoded; /* (crc32, size) of image bytes -> first image */
     std::map<int, int> image_alias;          /* image -> the earlier image with the same bytes */
     uint64_t texels = 0;                     /* of the images decoded so far */
@@ -1618,9 +1619,9 @@ void load_images_and_textures(Ctx &c, scene *out)
     }
     for (const auto &alias : c.image_alias)
         c.image_map[size_t(alias.first)] = c.image_map[size_t(alias.second)];
-    /* room for texture_slot's variants too: at most one per texture slot of a material */
-    out->textures = static_cast<scene_texture *>(
-        util_calloc(m.textures.size() + 5 * m.materials.size(), sizeof(scene_texture)));
+    /* room for texture_slot's variants too: one per texture slot of a material at most */
+    c.textures_room = m.textures.size() + 5 * m.materials.size();
+    out->textures = static_cast<scene_texture *>(util_calloc(c.textures_room, sizeof(scene_texture)));
     c.textures_out = out;
     c.texture_map.assign(m.textures.size(), GN_INVALID);
     for (size_t i = 0; i < m.textures.size(); i++) {
@@ -1732,6 +1733,10 @@ template <typename Info> uint32_t texture_slot(Ctx &c, const Info &info, const s
     if (tex_coord == 0 && !transformed)
         return base;
     scene *out = c.textures_out;
+    if (out->num_textures == c.textures_room) { /* a caller beyond one call per slot */
+        c.textures_room *= 2;
+        out->textures = static_cast<scene_texture *>(util_realloc(out->textures, c.textures_room * sizeof(scene_texture)));
+    }
     scene_texture t = out->textures[base];
     t.flags |= tex_coord == 1 ? GN_TEX_UV1 : 0u;
     memcpy(t.transform, xf, sizeof xf);
