@@ -165,7 +165,7 @@ vec3 tri_emission(uint prim, float u, float v, vec3 d, vec3 ng)
     vec3 e = m.emissive;
     if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_emissive != GN_INVALID) {
         GnVertex a = vertex_at(pr.i0), b = vertex_at(pr.i1), c = vertex_at(pr.i2);
-        vec2 uv = (1.0 - u - v) * vec2(a.u, a.v) + u * vec2(b.u, b.v) + v * vec2(c.u, c.v);
+        vec4 uv = (1.0 - u - v) * vertex_uv(a) + u * vertex_uv(b) + v * vertex_uv(c);
         e *= texture_sample(m.tex_emissive, uv, true).rgb;
     }
     return e;

@@ -49,9 +49,9 @@ bool shadowed(vec3 p, vec3 ng, vec3 wi, float dist, uint dim)
 
 // The Phong reflection model at p with shading normal n (unit, or zero: then no light but
 // ambient and emission), geometric normal ng on the same side (light below it is cut off),
-// texture coordinates uv and vertex colour vcolor (1 without), seen from direction v (unit,
+// texture coordinates uv (both sets: vertex_uv) and vertex colour vcolor (1 without), seen from direction v (unit,
 // towards the viewer).
-vec3 phong_shade(vec3 p, vec3 n, vec3 ng, vec2 uv, vec3 vcolor, uint material, vec3 v)
+vec3 phong_shade(vec3 p, vec3 n, vec3 ng, vec4 uv, vec3 vcolor, uint material, vec3 v)
 {
     GnMaterial m = material_at(material);
     // The glTF base-colour texture and vertex colours modulate the classic colours, as they

@@ -42,9 +42,10 @@ GnPrim prim_at(uint i)
 
 GnVertex vertex_at(uint i)
 {
-    vec4 a = texel_f(vertex_texels, 4u * i), b = texel_f(vertex_texels, 4u * i + 1u);
-    return GnVertex(a.xyz, a.w, b.xyz, b.w, texel_f(vertex_texels, 4u * i + 2u),
-                    texel_f(vertex_texels, 4u * i + 3u));
+    vec4 a = texel_f(vertex_texels, 5u * i), b = texel_f(vertex_texels, 5u * i + 1u);
+    vec4 e = texel_f(vertex_texels, 5u * i + 4u);
+    return GnVertex(a.xyz, a.w, b.xyz, b.w, texel_f(vertex_texels, 5u * i + 2u),
+                    texel_f(vertex_texels, 5u * i + 3u), e.x, e.y, e.z, e.w);
 }
 
 // The corners of BVH-order triangle i (the walk's GnTriPairs hold them too, but a pair has
@@ -129,14 +130,26 @@ vec4 srgb_to_linear(vec4 c)
     return vec4(mix(hi, lo, lessThanEqual(c.rgb, vec3(0.04045))), c.a);
 }
 
-// Bilinear (or nearest) lookup; srgb decodes before filtering, as GPUs do.
-vec4 texture_sample(uint index, vec2 uv, bool srgb)
+// Both texture coordinate sets of a vertex: TEXCOORD_0 in xy, TEXCOORD_1 in zw.
+vec4 vertex_uv(GnVertex a) { return vec4(a.u, a.v, a.u1, a.v1); }
+
+// Bilinear (or nearest) lookup of texture `index` at its set of uv (vertex_uv), moved by its
+// KHR_texture_transform; srgb decodes before filtering, as GPUs do. Kernels without
+// GN_FEAT_UV1 or GN_FEAT_TEX_TRANSFORM never fetch what those need.
+vec4 texture_sample(uint index, vec4 uv, bool srgb)
 {
-    uvec4 tt = texelFetch(texture_texels, int(index));
-    GnTexture t = GnTexture(tt.x, tt.y, tt.z, tt.w);
+    uvec4 tt = texelFetch(texture_texels, int(3u * index));
+    GnTexture t;
+    t.offset = tt.x; t.width = tt.y; t.height = tt.z; t.flags = tt.w;
     int w = int(t.width), h = int(t.height);
     uint ws = t.flags & 3u, wt = (t.flags >> 2u) & 3u;
-    vec2 p = uv * vec2(w, h) - 0.5;
+    vec2 st = GN_HAS(GN_FEAT_UV1) && (t.flags & GN_TEX_UV1) != 0u ? uv.zw : uv.xy;
+    if (GN_HAS(GN_FEAT_TEX_TRANSFORM)) {
+        vec3 r0 = texel_f(texture_texels, 3u * index + 1u).xyz;
+        vec3 r1 = texel_f(texture_texels, 3u * index + 2u).xyz;
+        st = vec2(dot(r0, vec3(st, 1.0)), dot(r1, vec3(st, 1.0)));
+    }
+    vec2 p = st * vec2(w, h) - 0.5;
     if ((t.flags & GN_TEX_NEAREST) != 0u) {
         ivec2 q = ivec2(floor(p + 0.5));
         vec4 c = texel_fetch(t, ivec2(tex_wrap(q.x, w, ws), tex_wrap(q.y, h, wt)));
@@ -193,7 +206,7 @@ struct Surface {
     vec3 ng;          // geometric normal, facing the incoming ray
     vec3 n;           // shading normal (interpolated, normal-mapped, bent by
                       // shading_normal_valid), same side as ng
-    vec2 uv;
+    vec4 uv;          // TEXCOORD_0 (xy) and TEXCOORD_1 (zw)
     vec3 base;        // linear base colour (factor * texture * vertex colour)
     vec3 vcolor;      // the interpolated vertex colour (1 without COLOR_0)
     float alpha;
@@ -225,7 +238,7 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     if (!s.front) ng = -ng;
     bool flip = dot(n, ng) < 0.0;
     s.ng = ng;
-    s.uv = w * vec2(a.u, a.v) + u * vec2(b.u, b.v) + v * vec2(c.u, c.v);
+    s.uv = w * vertex_uv(a) + u * vertex_uv(b) + v * vertex_uv(c);
 
     GnMaterial m = material_at(pr.material);
     s.material = pr.material;
@@ -285,7 +298,7 @@ float surface_opacity(uint tri, float u, float v)
     GnVertex a = vertex_at(pr.i0), b = vertex_at(pr.i1), c = vertex_at(pr.i2);
     float w = 1.0 - u - v, alpha = m.base_color.a;
     if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_base != GN_INVALID)
-        alpha *= texture_sample(m.tex_base, w * vec2(a.u, a.v) + u * vec2(b.u, b.v) + v * vec2(c.u, c.v), false).a;
+        alpha *= texture_sample(m.tex_base, w * vertex_uv(a) + u * vertex_uv(b) + v * vertex_uv(c), false).a;
     if (vertex_colors())
         alpha *= w * a.color.a + u * b.color.a + v * c.color.a;
     if ((m.flags & GN_MAT_MASK) != 0u)

@@ -139,10 +139,12 @@ typedef uint32_t uint;
 #define GN_FEAT_VERTEX_COLOR (1u << 24) /* glTF COLOR_0 */
 #define GN_FEAT_ALPHA (1u << 25)        /* alphaMode MASK or BLEND (glsl/bvh.glsl: trace_visible) */
 #define GN_FEAT_VARIANCE (1u << 26)     /* sums of squares (--aov variance) */
+#define GN_FEAT_TEX_TRANSFORM (1u << 27) /* KHR_texture_transform (GnTexture.transform) */
+#define GN_FEAT_UV1 (1u << 28)          /* textures reading TEXCOORD_1 (GN_TEX_UV1) */
 #define GN_FEAT_LOBES (GN_FEAT_MIRROR | GN_FEAT_PHONG | GN_FEAT_BLINN | GN_FEAT_TS | \
                        GN_FEAT_BECKMANN | GN_FEAT_GGX)
 #define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
-#define GN_FEAT_ALL 0x07ffffffu
+#define GN_FEAT_ALL 0x1fffffffu
 
 /* ---- BVH: both children's boxes in one 64-byte node (Aila & Laine 2009, "Understanding
  * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only
@@ -198,7 +200,9 @@ GN_STRUCT(GnVertex) {
                      normal maps without TANGENT; else all zero when the mesh has none */
     vec4 color;   /* glTF COLOR_0 (linear RGBA; 1 when the mesh has none), read only when
                      GnFrame.flags has GN_FRAME_VERTEX_COLOR */
-} GN_END(GnVertex); /* 64 bytes */
+    float u1; float v1; float pad0; float pad1; /* glTF TEXCOORD_1 (0 without), read only by
+                     kernels with GN_FEAT_UV1 */
+} GN_END(GnVertex); /* 80 bytes */
 
 /* glTF metallic-roughness material plus the classic (OpenGL 1.x) Phong parameters used by
  * the local shading modes, and an optional BRDF-model override for the path tracer.
@@ -234,18 +238,27 @@ GN_STRUCT(GnEmitter) {
     uint prim; float area; float cdf; float pdf; /* area: of the triangle, else 0 */
 } GN_END(GnEmitter);
 
-/* An image in the packed texel buffer; RGBA8, rows top to bottom. */
+/* A material's use of an image in the packed texel buffer (RGBA8, rows top to bottom): its
+ * sampler, the texture coordinate set it reads and its KHR_texture_transform. One per
+ * (texture, texCoord, transform) that a material uses, so the material needs no more room.
+ * transform holds the rows of the spec's 3x3 matrix T R S (its last row is 0 0 1):
+ * uv' = (dot(row0.xyz, (u, v, 1)), dot(row1.xyz, (u, v, 1))); identity without the extension,
+ * and read only by kernels with GN_FEAT_TEX_TRANSFORM. */
 GN_STRUCT(GnTexture) {
     uint offset;   /* first texel (uint) in the texel buffer */
     uint width;
     uint height;
-    uint flags;    /* bits 0-1 wrap S, 2-3 wrap T (0 repeat, 1 clamp, 2 mirror), 4 nearest */
-} GN_END(GnTexture);
+    uint flags;    /* bits 0-1 wrap S, 2-3 wrap T (0 repeat, 1 clamp, 2 mirror), 4 nearest,
+                      5 TEXCOORD_1 */
+    vec3 row0; float pad0;
+    vec3 row1; float pad1;
+} GN_END(GnTexture); /* 48 bytes */
 
 #define GN_WRAP_REPEAT 0u
 #define GN_WRAP_CLAMP 1u
 #define GN_WRAP_MIRROR 2u
 #define GN_TEX_NEAREST 16u
+#define GN_TEX_UV1 32u
 
 /* Camera in world space. Pixel (x, y) with y going down is at s = (2 (x+jx)/W - 1,
  * 1 - 2 (y+jy)/H) on the image plane. Perspective (ortho_half_height 0): the ray from
@@ -313,13 +326,15 @@ GN_STATIC_ASSERT(sizeof(GnBvhNode) == 64, "GnBvhNode layout");
 GN_STATIC_ASSERT(offsetof(GnBvhNode, b_min) == 32, "GnBvhNode layout");
 GN_STATIC_ASSERT(sizeof(GnTriPair) == 48, "GnTriPair layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");
-GN_STATIC_ASSERT(sizeof(GnVertex) == 64, "GnVertex layout");
+GN_STATIC_ASSERT(sizeof(GnVertex) == 80, "GnVertex layout");
+GN_STATIC_ASSERT(offsetof(GnVertex, u1) == 64, "GnVertex layout");
 GN_STATIC_ASSERT(sizeof(GnMaterial) == 192, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, brdf_params) == 112, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, phong_ambient) == 128, "GnMaterial layout");
 GN_STATIC_ASSERT(sizeof(GnLight) == 64, "GnLight layout");
 GN_STATIC_ASSERT(sizeof(GnEmitter) == 16, "GnEmitter layout");
-GN_STATIC_ASSERT(sizeof(GnTexture) == 16, "GnTexture layout");
+GN_STATIC_ASSERT(sizeof(GnTexture) == 48, "GnTexture layout");
+GN_STATIC_ASSERT(offsetof(GnTexture, row1) == 32, "GnTexture layout");
 GN_STATIC_ASSERT(sizeof(GnCamera) == 80, "GnCamera layout");
 GN_STATIC_ASSERT(sizeof(GnFrame) == 224, "GnFrame layout");
 GN_STATIC_ASSERT(offsetof(GnFrame, crop_x) == 200, "GnFrame layout");

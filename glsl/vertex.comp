@@ -34,5 +34,5 @@ void main()
         n = -n;
     vec3 v = camera_view(a.position);
     vec3 vc = vertex_colors() ? a.color.rgb : vec3(1.0);
-    vcolor[2u * i + side].rgb = phong_shade(a.position, n, n, vec2(a.u, a.v), vc, material, v);
+    vcolor[2u * i + side].rgb = phong_shade(a.position, n, n, vertex_uv(a), vc, material, v);
 }

@@ -312,6 +312,13 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
         r->material_features |= material_features(&sc->materials[i]);
     if (sc->vertex_colors)
         r->material_features |= GN_FEAT_VERTEX_COLOR;
+    for (uint32_t i = 0; i < sc->num_textures; i++) {
+        const float *t = sc->textures[i].transform;
+        if (t[0] != 1 || t[1] != 0 || t[2] != 0 || t[3] != 0 || t[4] != 1 || t[5] != 0)
+            r->material_features |= GN_FEAT_TEX_TRANSFORM;
+        if (sc->textures[i].flags & GN_TEX_UV1)
+            r->material_features |= GN_FEAT_UV1;
+    }
     r->path_samples = path_samples(r);
     r->path_features = r->material_features;
 
@@ -339,8 +346,9 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
     tex = util_calloc(sc->num_textures + 1, sizeof *tex);
     for (uint32_t i = 0; i < sc->num_textures; i++) {
         const scene_image *im = &sc->images[sc->textures[i].image];
+        const float *t = sc->textures[i].transform;
         tex[i] = (GnTexture){image_offset[sc->textures[i].image], im->width, im->height,
-                             sc->textures[i].flags};
+                             sc->textures[i].flags, {t[0], t[1], t[2]}, 0, {t[3], t[4], t[5]}, 0};
     }
 
     lights = util_calloc(sc->num_lights + 16, sizeof *lights);
@@ -885,11 +893,13 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
 }
 
 /* The GN_FEAT_* a mode's kernel is built for: the path kernel is specialised on all of
- * them, the local kernels only on GN_FEAT_ALPHA (surfaces cut away, glsl/bvh.glsl). */
+ * them, the local kernels only on GN_FEAT_ALPHA (surfaces cut away, glsl/bvh.glsl) and the
+ * texture lookups' GN_FEAT_TEX_TRANSFORM and GN_FEAT_UV1 (glsl/scene.glsl). */
 static uint32_t kernel_features(const renderer *r, uint32_t mode)
 {
+    const uint32_t local = GN_FEAT_ALPHA | GN_FEAT_TEX_TRANSFORM | GN_FEAT_UV1;
     return mode == GN_MODE_PATH ? r->path_features
-                                : (GN_FEAT_ALL & ~GN_FEAT_ALPHA) | (r->material_features & GN_FEAT_ALPHA);
+                                : (GN_FEAT_ALL & ~local) | (r->material_features & local);
 }
 
 /* The walk's stack in registers for trees of at most GN_WALK_REGS_MAX levels (a walk puts

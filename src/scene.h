@@ -27,9 +27,12 @@ typedef struct scene_image {
     uint8_t *rgba8; /* width * height * 4 bytes, rows top to bottom, as stored in the file */
 } scene_image;
 
+/* A material's use of an image (GnTexture): one per glTF texture, plus one per texture
+ * reference with its own texCoord or KHR_texture_transform. */
 typedef struct scene_texture {
     uint32_t image; /* index into images */
-    uint32_t flags; /* GnTexture flags: wrap S/T and GN_TEX_NEAREST */
+    uint32_t flags; /* GnTexture flags: wrap S/T, GN_TEX_NEAREST, GN_TEX_UV1 */
+    float transform[6]; /* the rows of KHR_texture_transform's matrix (GnTexture.row0, row1) */
 } scene_texture;
 
 /* Raw `extras: {"gonio": {...}}` of a material, kept for the integrators that read them. */
@@ -85,7 +88,7 @@ typedef struct scene {
  * problem and return false with *out zeroed. What can be skipped or repaired safely prints a
  * warning naming the file and the feature: points/lines primitives (strips and fans become
  * triangles), orthographic or invalid cameras, invalid lights, unknown optional extensions,
- * unknown alpha modes (rendered opaque), texCoord != 0 and missing or undecodable images (texture
+ * unknown alpha modes (rendered opaque), texCoord > 1 and missing or undecodable images (texture
  * slot GN_INVALID; PNG and JPEG only), out-of-range material values (clamped), non-unit
  * normals (renormalised), skins, morph targets, COLOR_0. Primitives without NORMAL get flat
  * normals (de-indexed). Triangles with non-finite or absurdly large (|x| > 1e15) vertices

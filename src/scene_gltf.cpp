@@ -50,7 +50,8 @@ const double MAX_RADIANCE = 1e9;
 
 const char *const SUPPORTED_EXTENSIONS[] = {
     "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_materials_specular",
-    "KHR_materials_transmission", "KHR_materials_ior",               "KHR_materials_unlit"};
+    "KHR_materials_transmission", "KHR_materials_ior",               "KHR_materials_unlit",
+    "KHR_texture_transform",      "KHR_mesh_quantization"};
 
 using Json = nlohmann::json;
 
@@ -60,6 +61,7 @@ struct Prim {                 /* one triangle primitive of a glTF mesh, in the m
     std::vector<float> pos;   /* 3 per vertex */
     std::vector<float> nrm;   /* 3 per vertex */
     std::vector<float> uv;    /* 2 per vertex, empty without TEXCOORD_0 */
+    std::vector<float> uv1;   /* 2 per vertex, empty without TEXCOORD_1 */
     std::vector<float> tan;   /* 4 per vertex, empty without TANGENT */
     std::vector<float> col;   /* 4 per vertex (RGBA), empty without COLOR_0 */
     std::vector<uint32_t> idx; /* 3 per triangle */
@@ -80,6 +82,8 @@ struct Ctx {
     std::vector<bool> camera_ok, light_ok;   /* per glTF camera / light: values usable */
     std::vector<std::vector<Prim>> meshes;   /* per glTF mesh */
     std::vector<uint32_t> image_map, texture_map; /* glTF index -> scene index or GN_INVALID */
+    scene *textures_out = nullptr;           /* where texture_slot adds transformed textures */
+    size_t textures_room = 0;                /* textures_out->textures' allocated entries */
     std::map<std::pair<uint32_t, size_t>, int> decoded; /* (crc32, size) of image bytes -> first image */
     std::map<int, int> image_alias;          /* image -> the earlier image with the same bytes */
     uint64_t texels = 0;                     /* of the images decoded so far */
@@ -524,32 +528,49 @@ void check_accessor_data(Ctx &c, int i)
     }
 }
 
+/* Component formats of an attribute accessor, as bits. */
+enum : unsigned { F_F = 1, F_I8 = 2, F_I8N = 4, F_U8 = 8, F_U8N = 16, F_I16 = 32, F_I16N = 64, F_U16 = 128, F_U16N = 256 };
+const unsigned F_QUANT_ANY = F_F | F_I8 | F_I8N | F_U8 | F_U8N | F_I16 | F_I16N | F_U16 | F_U16N;
+
 struct Format {
     const char *semantic; /* name, or prefix when it ends in '_' */
     int type, alt_type;   /* allowed accessor types */
-    bool f, u8n, u16n, u8, u16; /* allowed component types */
+    unsigned core, quant; /* allowed component formats: glTF 2.0; with KHR_mesh_quantization */
 };
-/* glTF 2.0, "Meshes": accessor formats allowed per attribute semantic. */
+/* Accessor formats allowed per attribute semantic: glTF 2.0, "Meshes", and those that
+ * KHR_mesh_quantization adds (its README's table; the integer values of a non-normalized
+ * POSITION or TEXCOORD are used as they are, the node's transform scaling them). */
 const Format FORMATS[] = {
-    {"POSITION", TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC3, true, false, false, false, false},
-    {"NORMAL", TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC3, true, false, false, false, false},
-    {"TANGENT", TINYGLTF_TYPE_VEC4, TINYGLTF_TYPE_VEC4, true, false, false, false, false},
-    {"TEXCOORD_", TINYGLTF_TYPE_VEC2, TINYGLTF_TYPE_VEC2, true, true, true, false, false},
-    {"COLOR_", TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4, true, true, true, false, false},
-    {"JOINTS_", TINYGLTF_TYPE_VEC4, TINYGLTF_TYPE_VEC4, false, false, false, true, true},
-    {"WEIGHTS_", TINYGLTF_TYPE_VEC4, TINYGLTF_TYPE_VEC4, true, true, true, false, false},
+    {"POSITION", TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC3, F_F, F_QUANT_ANY},
+    {"NORMAL", TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC3, F_F, F_F | F_I8N | F_I16N},
+    {"TANGENT", TINYGLTF_TYPE_VEC4, TINYGLTF_TYPE_VEC4, F_F, F_F | F_I8N | F_I16N},
+    {"TEXCOORD_", TINYGLTF_TYPE_VEC2, TINYGLTF_TYPE_VEC2, F_F | F_U8N | F_U16N, F_QUANT_ANY},
+    {"COLOR_", TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4, F_F | F_U8N | F_U16N, F_F | F_U8N | F_U16N},
+    {"JOINTS_", TINYGLTF_TYPE_VEC4, TINYGLTF_TYPE_VEC4, F_U8 | F_U16, F_U8 | F_U16},
+    {"WEIGHTS_", TINYGLTF_TYPE_VEC4, TINYGLTF_TYPE_VEC4, F_F | F_U8N | F_U16N, F_F | F_U8N | F_U16N},
 };
 
-bool format_ok(const Format &f, const tinygltf::Accessor &a)
+unsigned format_bit(const tinygltf::Accessor &a)
 {
-    if (a.type != f.type && a.type != f.alt_type)
-        return false;
     switch (a.componentType) {
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return f.f;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return a.normalized ? f.u8n : f.u8;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return a.normalized ? f.u16n : f.u16;
-    default: return false;
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return F_F;
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return a.normalized ? F_I8N : F_I8;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return a.normalized ? F_U8N : F_U8;
+    case TINYGLTF_COMPONENT_TYPE_SHORT: return a.normalized ? F_I16N : F_I16;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return a.normalized ? F_U16N : F_U16;
+    default: return 0;
     }
+}
+
+bool uses_extension(const tinygltf::Model &m, const char *name)
+{
+    for (const auto &e : m.extensionsUsed)
+        if (e == name)
+            return true;
+    for (const auto &e : m.extensionsRequired)
+        if (e == name)
+            return true;
+    return false;
 }
 
 bool check_primitive(Ctx &c, int mi, int pi)
@@ -582,11 +603,16 @@ bool check_primitive(Ctx &c, int mi, int pi)
             return fail(c, "%s: attribute %s has %zu elements, others %zu (all must have the same count)",
                         what.c_str(), name, a.count, count);
         count = a.count;
+        bool quant = uses_extension(m, "KHR_mesh_quantization");
         for (const Format &f : FORMATS) {
             size_t n = strlen(f.semantic);
             bool prefix = f.semantic[n - 1] == '_';
-            if ((prefix ? strncmp(name, f.semantic, n) : strcmp(name, f.semantic)) == 0 && !format_ok(f, a))
-                return fail(c, "%s: accessor %d has a format not allowed for attribute %s", what.c_str(), attr.second, name);
+            if ((prefix ? strncmp(name, f.semantic, n) : strcmp(name, f.semantic)) != 0)
+                continue;
+            unsigned bit = format_bit(a);
+            if ((a.type != f.type && a.type != f.alt_type) || !(bit & (quant ? f.quant : f.core)))
+                return fail(c, "%s: accessor %d has a format not allowed for attribute %s%s", what.c_str(), attr.second,
+                            name, !quant && (bit & f.quant) ? " (it needs KHR_mesh_quantization in extensionsUsed)" : "");
         }
     }
     return true;
@@ -1054,6 +1080,8 @@ void make_flat(Prim &p)
     f.nrm.resize(nt * 9);
     if (!p.uv.empty())
         f.uv.resize(nt * 6);
+    if (!p.uv1.empty())
+        f.uv1.resize(nt * 6);
     if (!p.col.empty())
         f.col.resize(nt * 12);
     f.idx.resize(nt * 3);
@@ -1063,6 +1091,8 @@ void make_flat(Prim &p)
             std::copy(&p.pos[v * 3], &p.pos[v * 3] + 3, &f.pos[o * 3]);
             if (!p.uv.empty())
                 std::copy(&p.uv[v * 2], &p.uv[v * 2] + 2, &f.uv[o * 2]);
+            if (!p.uv1.empty())
+                std::copy(&p.uv1[v * 2], &p.uv1[v * 2] + 2, &f.uv1[o * 2]);
             if (!p.col.empty())
                 std::copy(&p.col[v * 4], &p.col[v * 4] + 4, &f.col[o * 4]);
             f.idx[o] = uint32_t(o);
@@ -1088,11 +1118,11 @@ void make_flat(Prim &p)
 
 /* glTF 2.0, "Meshes": a normal texture without TANGENT takes MikkTSpace tangents
  * (src/tangent.c), which split vertices where handedness or smoothing groups differ. */
-void generate_tangents(Prim &p)
+void generate_tangents(Prim &p, const std::vector<float> &uv)
 {
     uint32_t *remap;
     float *tan;
-    size_t n = tangent_generate(p.pos.size() / 3, p.pos.data(), p.nrm.data(), p.uv.data(), p.idx.size() / 3,
+    size_t n = tangent_generate(p.pos.size() / 3, p.pos.data(), p.nrm.data(), uv.data(), p.idx.size() / 3,
                                 p.idx.data(), &remap, &tan);
     auto expand = [&](std::vector<float> &a, size_t k) {
         if (a.empty())
@@ -1105,6 +1135,7 @@ void generate_tangents(Prim &p)
     expand(p.pos, 3);
     expand(p.nrm, 3);
     expand(p.uv, 2);
+    expand(p.uv1, 2);
     expand(p.col, 4);
     p.tan.assign(tan, tan + n * 4);
     free(remap);
@@ -1131,7 +1162,7 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
         return it == p.attributes.end() ? -1 : it->second;
     };
     int pos = attr("POSITION"), nrm = attr("NORMAL"), tan = attr("TANGENT"), uv = attr("TEXCOORD_0");
-    int col = attr("COLOR_0");
+    int col = attr("COLOR_0"), uv1 = attr("TEXCOORD_1");
     if (pos < 0) {
         warn(c, "%s has no POSITION (skipped)", what.c_str());
         return false;
@@ -1190,12 +1221,15 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
         warn(c, "%s: TANGENT without NORMAL is ignored", what.c_str());
     else if (tan >= 0 && !out.nrm.empty())
         read_tangents(c, what, tan, out);
-    if (uv >= 0) {
-        std::vector<double> d = read_accessor(c, uv);
+    for (int set = 0; set < 2; set++) {
+        int acc = set ? uv1 : uv;
+        if (acc < 0)
+            continue;
+        std::vector<double> d = read_accessor(c, acc);
         if (all_finite(d))
-            out.uv = to_float(d);
+            (set ? out.uv1 : out.uv) = to_float(d);
         else
-            warn(c, "%s: TEXCOORD_0 has non-finite values (ignored)", what.c_str());
+            warn(c, "%s: TEXCOORD_%d has non-finite values (ignored)", what.c_str(), set);
     }
     if (col >= 0)
         read_colors(c, what, col, out);
@@ -1203,8 +1237,18 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
         make_flat(out);
     const tinygltf::Material *mat = p.material >= 0 && size_t(p.material) < c.m.materials.size()
                                         ? &c.m.materials[size_t(p.material)] : nullptr;
-    if (out.tan.empty() && !out.uv.empty() && mat && mat->normalTexture.index >= 0)
-        generate_tangents(out);
+    /* the tangents follow the set the normal texture reads (KHR_texture_transform's texCoord
+     * overrides the reference's) */
+    int nset = mat ? mat->normalTexture.texCoord : 0;
+    if (mat) {
+        auto xf = mat->normalTexture.extensions.find("KHR_texture_transform");
+        if (xf != mat->normalTexture.extensions.end() && xf->second.IsObject() && xf->second.Has("texCoord") &&
+            xf->second.Get("texCoord").IsInt())
+            nset = xf->second.Get("texCoord").GetNumberAsInt();
+    }
+    const std::vector<float> &tuv = nset == 1 ? out.uv1 : out.uv;
+    if (out.tan.empty() && !tuv.empty() && mat && mat->normalTexture.index >= 0)
+        generate_tangents(out, tuv);
     return true;
 }
 
@@ -1357,6 +1401,10 @@ bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
                 if (!p.uv.empty()) {
                     o.u = p.uv[v * 2];
                     o.v = p.uv[v * 2 + 1];
+                }
+                if (!p.uv1.empty()) {
+                    o.u1 = p.uv1[v * 2];
+                    o.v1 = p.uv1[v * 2 + 1];
                 }
                 if (!p.col.empty()) {
                     o.color = vec4{p.col[v * 4], p.col[v * 4 + 1], p.col[v * 4 + 2], p.col[v * 4 + 3]};
@@ -1534,6 +1582,26 @@ uint32_t wrap_mode(Ctx &c, size_t sampler, int mode)
     }
 }
 
+/* GN_TEX_NEAREST or 0 for a sampler's filters. The kernels look a texture up at one point
+ * of its full-resolution image per sample, and the samples of a pixel average what it
+ * covers, which is the minification (no mipmaps are needed for that); so magFilter decides
+ * between nearest and bilinear, and without one, minFilter's filter within a level does. */
+uint32_t filter_mode(Ctx &c, size_t sampler, int mag, int min)
+{
+    if (mag != -1 && mag != TINYGLTF_TEXTURE_FILTER_NEAREST && mag != TINYGLTF_TEXTURE_FILTER_LINEAR) {
+        warn(c, "sampler %zu: invalid magFilter %d (using LINEAR)", sampler, mag);
+        mag = TINYGLTF_TEXTURE_FILTER_LINEAR;
+    }
+    bool min_nearest = min == TINYGLTF_TEXTURE_FILTER_NEAREST || min == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
+                       min == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR;
+    if (min != -1 && !min_nearest && min != TINYGLTF_TEXTURE_FILTER_LINEAR &&
+        min != TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST && min != TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR)
+        warn(c, "sampler %zu: invalid minFilter %d (ignored)", sampler, min);
+    if (mag == -1)
+        return min_nearest ? GN_TEX_NEAREST : 0u;
+    return mag == TINYGLTF_TEXTURE_FILTER_NEAREST ? GN_TEX_NEAREST : 0u;
+}
+
 void load_images_and_textures(Ctx &c, scene *out)
 {
     const auto &m = c.m;
@@ -1557,7 +1625,10 @@ void load_images_and_textures(Ctx &c, scene *out)
     }
     for (const auto &alias : c.image_alias)
         c.image_map[size_t(alias.first)] = c.image_map[size_t(alias.second)];
-    out->textures = static_cast<scene_texture *>(util_calloc(m.textures.size(), sizeof(scene_texture)));
+    /* room for texture_slot's variants too: one per texture slot of a material at most */
+    c.textures_room = m.textures.size() + 5 * m.materials.size();
+    out->textures = static_cast<scene_texture *>(util_calloc(c.textures_room, sizeof(scene_texture)));
+    c.textures_out = out;
     c.texture_map.assign(m.textures.size(), GN_INVALID);
     for (size_t i = 0; i < m.textures.size(); i++) {
         const auto &t = m.textures[i];
@@ -1570,11 +1641,10 @@ void load_images_and_textures(Ctx &c, scene *out)
         uint32_t flags = 0;
         if (t.sampler >= 0) {
             const auto &s = m.samplers[size_t(t.sampler)];
-            flags = wrap_mode(c, size_t(t.sampler), s.wrapS) | wrap_mode(c, size_t(t.sampler), s.wrapT) << 2;
-            if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST)
-                flags |= GN_TEX_NEAREST;
+            flags = wrap_mode(c, size_t(t.sampler), s.wrapS) | wrap_mode(c, size_t(t.sampler), s.wrapT) << 2 |
+                    filter_mode(c, size_t(t.sampler), s.magFilter, s.minFilter);
         }
-        out->textures[out->num_textures] = scene_texture{c.image_map[size_t(t.source)], flags};
+        out->textures[out->num_textures] = scene_texture{c.image_map[size_t(t.source)], flags, {1, 0, 0, 0, 1, 0}};
         c.texture_map[i] = out->num_textures++;
     }
 }
@@ -1606,15 +1676,78 @@ const tinygltf::Value *extension(const tinygltf::Material &mat, const char *name
     return it == mat.extensions.end() ? nullptr : &it->second;
 }
 
-uint32_t texture_slot(Ctx &c, int index, int tex_coord, const std::string &what, const char *slot)
+/* A number pair of an extension object (KHR_texture_transform's offset and scale); false
+ * (with a warning) when it is there but not two finite numbers. */
+bool ext_pair(Ctx &c, const tinygltf::Value &ext, const char *key, double out[2], const std::string &what)
 {
-    if (index < 0)
+    if (!ext.Has(key))
+        return true;
+    const tinygltf::Value &v = ext.Get(key);
+    if (v.IsArray() && v.ArrayLen() == 2 && v.Get(0).IsNumber() && v.Get(1).IsNumber() &&
+        std::isfinite(v.Get(0).GetNumberAsDouble()) && std::isfinite(v.Get(1).GetNumberAsDouble())) {
+        out[0] = v.Get(0).GetNumberAsDouble();
+        out[1] = v.Get(1).GetNumberAsDouble();
+        return true;
+    }
+    warn(c, "%s: KHR_texture_transform %s is not two finite numbers (ignored)", what.c_str(), key);
+    return false;
+}
+
+/* The scene texture a material slot uses: the glTF texture's own one, or, when the
+ * reference reads TEXCOORD_1 or has a KHR_texture_transform, a copy with its set and
+ * transform (GnTexture), so each slot stays one index. */
+template <typename Info> uint32_t texture_slot(Ctx &c, const Info &info, const std::string &what, const char *slot)
+{
+    if (info.index < 0 || c.texture_map[size_t(info.index)] == GN_INVALID)
         return GN_INVALID;
-    if (tex_coord != 0) {
-        warn(c, "%s: %s uses TEXCOORD_%d, only TEXCOORD_0 is supported (texture ignored)", what.c_str(), slot, tex_coord);
+    int tex_coord = info.texCoord;
+    float xf[6] = {1, 0, 0, 0, 1, 0};
+    bool transformed = false;
+    auto it = info.extensions.find("KHR_texture_transform");
+    if (it != info.extensions.end() && it->second.IsObject()) {
+        const tinygltf::Value &e = it->second;
+        std::string where = what + " " + slot;
+        double offset[2] = {0, 0}, scale[2] = {1, 1};
+        double rotation = ext_number(c, e, "rotation", 0, where);
+        if (!std::isfinite(rotation)) {
+            warn(c, "%s: KHR_texture_transform rotation is not finite (ignored)", where.c_str());
+            rotation = 0;
+        }
+        ext_pair(c, e, "offset", offset, where);
+        ext_pair(c, e, "scale", scale, where);
+        if (e.Has("texCoord")) {
+            const tinygltf::Value &t = e.Get("texCoord");
+            if (t.IsInt() && t.GetNumberAsInt() >= 0)
+                tex_coord = t.GetNumberAsInt();
+            else
+                warn(c, "%s: KHR_texture_transform texCoord is not a non-negative integer (ignored)", where.c_str());
+        }
+        /* KHR_texture_transform: uv' = T R S uv, R = [cos sin; -sin cos] */
+        double cr = std::cos(rotation), sr = std::sin(rotation);
+        double r[6] = {cr * scale[0], sr * scale[1], offset[0], -sr * scale[0], cr * scale[1], offset[1]};
+        for (int k = 0; k < 6; k++) {
+            xf[k] = float(r[k]);
+            transformed |= xf[k] != (k == 0 || k == 4 ? 1.0f : 0.0f);
+        }
+    }
+    if (tex_coord > 1) {
+        warn(c, "%s: %s uses TEXCOORD_%d, only TEXCOORD_0 and TEXCOORD_1 are supported (texture ignored)", what.c_str(),
+             slot, tex_coord);
         return GN_INVALID;
     }
-    return c.texture_map[size_t(index)];
+    uint32_t base = c.texture_map[size_t(info.index)];
+    if (tex_coord == 0 && !transformed)
+        return base;
+    scene *out = c.textures_out;
+    if (out->num_textures == c.textures_room) { /* a caller beyond one call per slot */
+        c.textures_room *= 2;
+        out->textures = static_cast<scene_texture *>(util_realloc(out->textures, c.textures_room * sizeof(scene_texture)));
+    }
+    scene_texture t = out->textures[base];
+    t.flags |= tex_coord == 1 ? GN_TEX_UV1 : 0u;
+    memcpy(t.transform, xf, sizeof xf);
+    out->textures[out->num_textures] = t;
+    return out->num_textures++;
 }
 
 bool number_triple(const tinygltf::Value &v, float out[3])
@@ -1731,12 +1864,11 @@ void convert_material(Ctx &c, int mi, GnMaterial &g, scene_material_extras &x, c
         g.flags |= GN_MAT_BLEND;
     else if (mat.alphaMode != "OPAQUE")
         warn(c, "%s: unknown alphaMode '%s' (rendered opaque)", what.c_str(), mat.alphaMode.substr(0, 64).c_str());
-    g.tex_base = texture_slot(c, pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, what, "baseColorTexture");
-    g.tex_mr = texture_slot(c, pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, what,
-                            "metallicRoughnessTexture");
-    g.tex_normal = texture_slot(c, mat.normalTexture.index, mat.normalTexture.texCoord, what, "normalTexture");
-    g.tex_emissive = texture_slot(c, mat.emissiveTexture.index, mat.emissiveTexture.texCoord, what, "emissiveTexture");
-    g.tex_occlusion = texture_slot(c, mat.occlusionTexture.index, mat.occlusionTexture.texCoord, what, "occlusionTexture");
+    g.tex_base = texture_slot(c, pbr.baseColorTexture, what, "baseColorTexture");
+    g.tex_mr = texture_slot(c, pbr.metallicRoughnessTexture, what, "metallicRoughnessTexture");
+    g.tex_normal = texture_slot(c, mat.normalTexture, what, "normalTexture");
+    g.tex_emissive = texture_slot(c, mat.emissiveTexture, what, "emissiveTexture");
+    g.tex_occlusion = texture_slot(c, mat.occlusionTexture, what, "occlusionTexture");
     scene_phong_from_pbr(&g);
     read_gonio_extras(c, mat.extras, what, g, x);
 }

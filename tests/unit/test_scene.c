@@ -1096,23 +1096,25 @@ void test_scene_materials_lights_cameras(void)
     scene s;
     int w0 = util_warning_count();
     CHECKF(load_tri_scene(&s, body), "%s", load_log);
-    /* Expected warnings: EXT_unknown, texCoord 1, image 2 not a PNG (its buffer view holds
-     * floats), camera 1 yfov, light 1 intensity. */
-    CHECKF(util_warning_count() - w0 == 5, "%d warnings:\n%s", util_warning_count() - w0, load_log);
-    CHECK(strstr(load_log, "EXT_unknown") && !strstr(load_log, "MASK") && strstr(load_log, "TEXCOORD_1") &&
+    /* Expected warnings: EXT_unknown, image 2 not a PNG (its buffer view holds floats),
+     * camera 1 yfov, light 1 intensity. */
+    CHECKF(util_warning_count() - w0 == 4, "%d warnings:\n%s", util_warning_count() - w0, load_log);
+    CHECK(strstr(load_log, "EXT_unknown") && !strstr(load_log, "MASK") && !strstr(load_log, "TEXCOORD_1") &&
           strstr(load_log, "image 2") && strstr(load_log, "camera 1") && strstr(load_log, "light 1"));
     /* Images: 16-bit grey -> (0x1234 / 257 rounded = 18); grey+alpha expands to RGBA. */
     static const uint8_t g16[8] = {18, 18, 18, 255, 255, 255, 255, 255}, ga8[8] = {0x10, 0x10, 0x10, 0x80, 0xf0, 0xf0, 0xf0, 0x20};
-    CHECK(s.num_images == 2 && s.num_textures == 2);
-    if (s.num_images == 2 && s.num_textures == 2) {
+    /* texture 1 read through TEXCOORD_1 by metallicRoughnessTexture: a third scene texture */
+    CHECK(s.num_images == 2 && s.num_textures == 3);
+    if (s.num_images == 2 && s.num_textures == 3) {
         CHECK(s.images[0].width == 2 && s.images[0].height == 1 && memcmp(s.images[0].rgba8, g16, 8) == 0);
         CHECK(s.images[1].width == 2 && memcmp(s.images[1].rgba8, ga8, 8) == 0);
         /* CLAMP_TO_EDGE S (1), MIRRORED_REPEAT T (2 << 2), NEAREST (16). */
         CHECK(s.textures[0].flags == (1u | 2u << 2 | GN_TEX_NEAREST) && s.textures[1].flags == 0);
+        CHECK(s.textures[2].image == s.textures[1].image && s.textures[2].flags == GN_TEX_UV1);
     }
     CHECK(s.num_materials == 1);
     const GnMaterial *m = &s.materials[0];
-    CHECK(m->tex_base == 0 && m->tex_mr == GN_INVALID && m->tex_normal == 1 && m->tex_occlusion == GN_INVALID);
+    CHECK(m->tex_base == 0 && m->tex_mr == 2 && m->tex_normal == 1 && m->tex_occlusion == GN_INVALID);
     CHECK(m->flags == (GN_MAT_DOUBLE_SIDED | GN_MAT_UNLIT | GN_MAT_MASK) && m->alpha_cutoff == 0.25f);
     CHECK(m->normal_scale == 0.5f && m->occlusion_strength == 0.75f && m->transmission == 0.25f);
     CHECK(m->specular == 0.5f && near3(m->specular_color, 1, 0, 0, 0) && m->ior == 1.5f);
@@ -1147,8 +1149,25 @@ void test_scene_materials_lights_cameras(void)
     CHECK(util_warning_count() == w0 + 1 && strstr(load_log, "no_such_image.png"));
     CHECK(s.num_images == 0 && s.num_textures == 0 && s.num_materials == 1 && s.materials[0].tex_base == GN_INVALID);
     scene_destroy(&s);
+    /* KHR_texture_transform: the rows of T R S (spec: R = [cos sin; -sin cos]); rotation
+     * pi/2, scale (2, 3), offset (0.5, 0.25) -> (0, 3, 0.5), (-2, 0, 0.25). */
+    snprintf(body, sizeof body, "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
+                              "\"nodes\":[{\"mesh\":0}],\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],"
+                              "\"textures\":[{\"source\":0}],\"extensionsUsed\":[\"KHR_texture_transform\"],"
+                              "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,"
+                              "\"extensions\":{\"KHR_texture_transform\":{\"rotation\":1.5707963267948966,"
+                              "\"scale\":[2,3],\"offset\":[0.5,0.25]}}}}}]", png_g16);
+    CHECKF(load_tri_scene(&s, body), "%s", load_log);
+    CHECK(s.num_textures == 2 && s.materials[0].tex_base == 1);
+    if (s.num_textures == 2) {
+        const float *t = s.textures[1].transform, want[6] = {0, 3, 0.5f, -2, 0, 0.25f};
+        for (int k = 0; k < 6; k++)
+            CHECKF(fabsf(t[k] - want[k]) < 1e-6f, "transform[%d] = %g, want %g", k, t[k], want[k]);
+        CHECK(s.textures[0].transform[0] == 1 && s.textures[0].transform[4] == 1 && s.textures[0].transform[2] == 0);
+    }
+    scene_destroy(&s);
     /* An unsupported required extension refuses the file. */
-    CHECK(!load_tri_scene(&s, TRI_MESH ",\"nodes\":[{\"mesh\":0}],\"extensionsUsed\":[\"KHR_texture_transform\"],"
-                              "\"extensionsRequired\":[\"KHR_texture_transform\"]") &&
-          strstr(load_log, "requires unsupported extension KHR_texture_transform"));
+    CHECK(!load_tri_scene(&s, TRI_MESH ",\"nodes\":[{\"mesh\":0}],\"extensionsUsed\":[\"EXT_gonio_unknown\"],"
+                              "\"extensionsRequired\":[\"EXT_gonio_unknown\"]") &&
+          strstr(load_log, "requires unsupported extension EXT_gonio_unknown"));
 }

@@ -1,0 +1,197 @@
+#!/usr/bin/env bash
+# textures.sh: what a material's texture reads where (KHR_texture_transform, TEXCOORD_1,
+# samplers' wrap and filter modes) and KHR_mesh_quantization's integer attributes. The
+# scenes are glTF JSON written here by Python, not by gonio: a quad [-1, 1]^2 seen straight
+# on by an orthographic camera that fills the image with it, textured with a 4x4 image of
+# distinct texels and a NEAREST sampler, rendered with --mode albedo --spp 1 (the first
+# sample is the pixel centre). For every probed pixel the expected texel comes from the
+# specs' formulas, computed here: the spec's matrix T R S on the pixel's uv, the sampler's
+# wrap of the texel index, the sRGB decode of its bytes.
+. "$(dirname "$0")/../lib.sh"
+G=$GONIO
+command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
+N=48 # image size: 12 pixels a texel at uv scale 1
+
+# gen.py OUT.gltf JSON-OPTIONS: the scene; options: wrap [S, T], mag (filter), tt (the
+# KHR_texture_transform object), texcoord (the reference's), uv0/uv1 (the uv of the quad's
+# top-left and bottom-right corners per set, or null), quant (store attributes quantized),
+# declare_quant, normal (the quad's normal, for the quantization check in --mode normal).
+cat >"$tmp/gen.py" <<'PY'
+import base64, json, struct, sys
+out, opt = sys.argv[1], json.loads(sys.argv[2])
+def corners(a, b):  # uv at the quad's corners (-1,-1), (1,-1), (1,1), (-1,1); a top-left, b bottom-right
+    return [a[0], b[1], b[0], b[1], b[0], a[1], a[0], a[1]]
+pos = [-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0]
+nrm = opt.get("normal", [0, 0, 1]) * 4
+idx = [0, 1, 2, 0, 2, 3]
+q = opt.get("quant", False)
+blob, views, accs = b"", [], []
+def add(data, acc, stride=None):
+    global blob
+    while len(blob) % 4: blob += b"\0"
+    views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data)})
+    if stride: views[-1]["byteStride"] = stride
+    blob += data
+    acc["bufferView"] = len(views) - 1
+    accs.append(acc)
+    return len(accs) - 1
+attrs = {}
+if q:  # POSITION as unsigned shorts 0..2 (the node moves them back by -1), NORMAL as bytes
+    attrs["POSITION"] = add(struct.pack("<12H", *[int(v + 1) if i % 3 < 2 else 0 for i, v in enumerate(pos)]),
+                            {"componentType": 5123, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [2, 2, 0]})
+    attrs["NORMAL"] = add(struct.pack("<16b", *sum([[round(c * 127) for c in nrm[0:3]] + [0] for _ in range(4)], [])),
+                          {"componentType": 5120, "normalized": True, "count": 4, "type": "VEC3"}, 4)
+else:
+    attrs["POSITION"] = add(struct.pack("<12f", *pos), {"componentType": 5126, "count": 4, "type": "VEC3",
+                                                        "min": [-1, -1, 0], "max": [1, 1, 0]})
+    attrs["NORMAL"] = add(struct.pack("<12f", *nrm), {"componentType": 5126, "count": 4, "type": "VEC3"})
+for s in (0, 1):
+    c = opt.get("uv%d" % s)
+    if c is None: continue
+    uv = corners(*c)
+    if q:  # signed shorts, not normalized: the corners are integers here
+        attrs["TEXCOORD_%d" % s] = add(struct.pack("<8h", *[int(v) for v in uv]),
+                                       {"componentType": 5122, "count": 4, "type": "VEC2"})
+    else:
+        attrs["TEXCOORD_%d" % s] = add(struct.pack("<8f", *uv), {"componentType": 5126, "count": 4, "type": "VEC2"})
+ind = add(struct.pack("<6H", *idx), {"componentType": 5123, "count": 6, "type": "SCALAR"})
+# the 4x4 RGBA image: texel (i, j) (column, row from the top) has R = 40 + 60 i, G = 40 + 60 j
+import zlib
+rows = b"".join(b"\0" + b"".join(bytes([40 + 60 * i, 40 + 60 * j, 0, 255]) for i in range(4)) for j in range(4))
+def chunk(t, d): return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 4, 4, 8, 6, 0, 0, 0)) + \
+      chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b"")
+ref = {"index": 0}
+if "texcoord" in opt: ref["texCoord"] = opt["texcoord"]
+if "tt" in opt: ref["extensions"] = {"KHR_texture_transform": opt["tt"]}
+wrap = opt.get("wrap", [10497, 10497])
+sampler = {"wrapS": wrap[0], "wrapT": wrap[1]}
+if opt.get("mag", 9728) is not None: sampler["magFilter"] = opt.get("mag", 9728)
+if "min" in opt: sampler["minFilter"] = opt["min"]
+used = (["KHR_texture_transform"] if "tt" in opt else []) + (["KHR_mesh_quantization"] if opt.get("declare_quant", q) else [])
+doc = {
+    "asset": {"version": "2.0", "generator": "textures.sh"},
+    "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+    "bufferViews": views, "accessors": accs,
+    "images": [{"uri": "data:image/png;base64," + base64.b64encode(png).decode()}],
+    "samplers": [sampler], "textures": [{"source": 0, "sampler": 0}],
+    "materials": [{"pbrMetallicRoughness": {"baseColorTexture": ref, "metallicFactor": 0}}],
+    "meshes": [{"primitives": [{"attributes": attrs, "indices": ind, "material": 0}]}],
+    "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 100}}],
+    "nodes": [{"mesh": 0, "translation": [-1, -1, 0] if q else [0, 0, 0]}, {"camera": 0, "translation": [0, 0, 5]}],
+    "scenes": [{"nodes": [0, 1]}], "scene": 0,
+}
+if used: doc["extensionsUsed"] = used
+json.dump(doc, open(out, "w"))
+PY
+
+# probe.py IMAGE.exr JSON-OPTIONS: every 3rd pixel whose centre lies well inside one texel
+# (the expected one) must have that texel's linear colour in R and G.
+cat >"$tmp/probe.py" <<'PY'
+import json, math, subprocess, sys
+img, opt, tool, n = sys.argv[1], json.loads(sys.argv[2]), sys.argv[3], int(sys.argv[4])
+s = opt.get("texcoord", 0)
+tt = opt.get("tt", {})
+s = tt.get("texCoord", s)
+(a, b) = opt["uv%d" % s]
+ox, oy = tt.get("offset", [0, 0]); sx, sy = tt.get("scale", [1, 1]); r = tt.get("rotation", 0)
+def transform(u, v):  # KHR_texture_transform: T * R * S, R = [cos sin; -sin cos]
+    u, v = sx * u, sy * v
+    return math.cos(r) * u + math.sin(r) * v + ox, -math.sin(r) * u + math.cos(r) * v + oy
+def wrap(i, mode):
+    if mode == 33071: return min(max(i, 0), 3)
+    if mode == 33648:
+        m = i % 8
+        return m if m < 4 else 7 - m
+    return i % 4
+def lin(c):
+    c /= 255
+    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+wrap_st = opt.get("wrap", [10497, 10497])
+bad = checked = 0
+for py in range(1, n, 3):
+    for px in range(1, n, 3):
+        fx, fy = (px + 0.5) / n, (py + 0.5) / n  # 0..1 across the quad, from its top-left
+        u0, v0 = transform(a[0] + fx * (b[0] - a[0]), a[1] + fy * (b[1] - a[1]))
+        tx, ty = u0 * 4, v0 * 4
+        if min(abs(tx - round(tx)), abs(ty - round(ty))) < 0.05:
+            continue  # near a texel edge
+        i, j = wrap(math.floor(tx), wrap_st[0]), wrap(math.floor(ty), wrap_st[1])
+        want = (lin(40 + 60 * i), lin(40 + 60 * j))
+        got = [float(subprocess.check_output([tool, "at", img, ch, str(px), str(py)])) for ch in "RG"]
+        checked += 1
+        if abs(got[0] - want[0]) > 1e-3 or abs(got[1] - want[1]) > 1e-3:
+            bad += 1
+            if bad <= 5: print("pixel (%d, %d): got %.4f %.4f, want texel (%d, %d) = %.4f %.4f" % (px, py, *got, i, j, *want))
+print("%d pixels checked, %d wrong" % (checked, bad))
+sys.exit(1 if bad or checked < 50 else 0)
+PY
+
+scene() { python3 "$tmp/gen.py" "$tmp/$1.gltf" "$2"; }
+R() { "$G" render "$tmp/$1.gltf" --mode albedo --spp 1 --size ${N}x$N --quiet -o "$tmp/$1.exr" "${@:2}"; }
+# case NAME OPTIONS DESCRIPTION: write the scene, render it, probe it
+case_() {
+    scene "$1" "$2" && check "$3: renders" R "$1" && \
+        check "$3: texels where the spec puts them" python3 "$tmp/probe.py" "$tmp/$1.exr" "$2" "$TESTTOOL" $N
+}
+
+UV='"uv0": [[0, 0], [1, 1]]'
+WIDE='"uv0": [[-1, -1], [2, 2]]' # three tiles across: what wrap modes do outside [0, 1]
+case_ plain "{$UV}" "no transform"
+case_ repeat "{$WIDE, \"wrap\": [10497, 10497]}" "REPEAT outside [0,1]"
+case_ mirror "{$WIDE, \"wrap\": [33648, 33648]}" "MIRRORED_REPEAT outside [0,1]"
+case_ clamp "{$WIDE, \"wrap\": [33071, 33071]}" "CLAMP_TO_EDGE outside [0,1]"
+case_ mixed "{$WIDE, \"wrap\": [33071, 33648]}" "CLAMP S, MIRROR T"
+case_ offset "{$UV, \"tt\": {\"offset\": [0.25, -0.5]}}" "transform offset"
+case_ scale "{$UV, \"tt\": {\"scale\": [2, 0.5]}}" "transform scale"
+case_ rotation "{$UV, \"tt\": {\"rotation\": 0.5235988}}" "transform rotation (30 degrees)"
+case_ all "{$UV, \"wrap\": [33648, 10497], \"tt\": {\"offset\": [0.3, 0.1], \"rotation\": -1.1, \"scale\": [1.5, 0.75]}}" \
+    "transform offset, rotation and scale, mirrored S"
+# TEXCOORD_1: set 0 puts the whole quad in texel (0, 0); set 1 maps it as above
+UV01='"uv0": [[0.01, 0.01], [0.02, 0.02]], "uv1": [[0, 0], [1, 1]]'
+case_ uv1 "{$UV01, \"texcoord\": 1}" "texCoord 1 reads TEXCOORD_1"
+case_ uv1tt "{$UV01, \"texcoord\": 0, \"tt\": {\"texCoord\": 1, \"offset\": [0.5, 0]}}" \
+    "KHR_texture_transform's texCoord overrides the reference's"
+scene uv1none "{\"uv0\": [[0, 0], [1, 1]], \"texcoord\": 2}"
+"$G" render "$tmp/uv1none.gltf" --mode albedo --spp 1 --size 8x8 --quiet -o "$tmp/uv1none.exr" 2>"$tmp/uv1none.txt"
+check "texCoord 2 is dropped with a warning" grep -q "uses TEXCOORD_2, only TEXCOORD_0 and TEXCOORD_1" "$tmp/uv1none.txt"
+
+# Filters: bilinear (magFilter LINEAR) blends the two nearest texel centres linearly:
+# along row 30, pixel x's centre lies at p = (x + 0.5) / 12 - 0.5 texel centres, so R is
+# (1 - f) texel floor(p) + f the next, f = p - floor(p) (sRGB decoded before blending).
+# Without magFilter, minFilter NEAREST_MIPMAP_LINEAR's NEAREST is used.
+scene linear "{$UV, \"mag\": 9729}" && R linear
+check "LINEAR: bilinear between texel centres" python3 -c "
+import math, subprocess, sys
+lin = lambda c: (((c/255) + 0.055) / 1.055) ** 2.4
+bad = 0
+for x in range(6, 42):
+    p = (x + 0.5) / 12 - 0.5; i = math.floor(p); f = p - i
+    want = (1 - f) * lin(40 + 60 * i) + f * lin(40 + 60 * (i + 1))
+    got = float(subprocess.check_output([sys.argv[1], 'at', sys.argv[2], 'R', str(x), '30']))
+    if abs(got - want) > 1e-3 * want + 1e-4: bad += 1; print(x, got, want)
+sys.exit(1 if bad else 0)" "$TESTTOOL" "$tmp/linear.exr"
+scene minnear "{$UV, \"mag\": null, \"min\": 9986}" && R minnear
+check "no magFilter: minFilter NEAREST_MIPMAP_LINEAR samples nearest" \
+    python3 "$tmp/probe.py" "$tmp/minnear.exr" "{$UV}" "$TESTTOOL" $N
+
+# KHR_mesh_quantization: positions as unsigned shorts (moved by the node), normals as
+# normalized bytes, texture coordinates as signed shorts, which hold the float scene's
+# values exactly: the same image to the bit.
+scene float_q "{$WIDE, \"wrap\": [33648, 10497]}" && R float_q
+scene quant "{$WIDE, \"wrap\": [33648, 10497], \"quant\": true}"
+check "quantized mesh renders" R quant
+check "quantized mesh: the float original's image exactly" "$G" diff "$tmp/float_q.exr" "$tmp/quant.exr" --max-error 0
+# Normals: a byte's step is 1/127, so each component is off by at most 0.5/127 = 0.0039
+# before renormalisation, which changes the direction by at most about 2 x 0.0039.
+NRM='"normal": [0.6, 0.0, 0.8]'
+scene nfloat "{$UV, $NRM}" && "$G" render "$tmp/nfloat.gltf" --mode normal --spp 1 --size 16x16 --quiet -o "$tmp/nfloat.exr"
+scene nquant "{$UV, $NRM, \"quant\": true}"
+check "quantized normals render" "$G" render "$tmp/nquant.gltf" --mode normal --spp 1 --size 16x16 --quiet -o "$tmp/nquant.exr"
+check "quantized normals within their step" "$G" diff "$tmp/nfloat.exr" "$tmp/nquant.exr" --max-error 0.008
+scene undeclared "{$UV, \"quant\": true, \"declare_quant\": false}"
+check_fails "quantized attributes without KHR_mesh_quantization" 1 \
+    "$G" render "$tmp/undeclared.gltf" --mode albedo --spp 1 --size 8x8 --quiet -o "$tmp/undeclared.exr"
+check "error names the file and the extension" grep -q "undeclared.gltf: .*not allowed for attribute .*needs KHR_mesh_quantization" "$tmp/last"
+check "no output after the error" test ! -e "$tmp/undeclared.exr"
+finish
