@@ -658,6 +658,9 @@ int cmd_info(int argc, char **argv)
     printf("meshes         %u (primitive instances; %u glTF meshes, %u nodes)\n", sc.num_meshes,
            sc.num_gltf_meshes, sc.num_nodes);
     printf("materials      %u\n", sc.num_materials);
+    printf("variants       %u\n", sc.num_variants);
+    for (uint32_t i = 0; i < sc.num_variants; i++)
+        printf("variant %-6u \"%s\"\n", i, sc.variant_names[i]);
     printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
     printf("lights         %u\n", sc.num_lights);
     print_emitters(&sc);

@@ -60,6 +60,8 @@ typedef struct scene {
     GnMaterial *materials;
     scene_material_extras *material_extras;
     char (*material_names)[64];
+    uint32_t num_variants;      /* KHR_materials_variants of the file (any one selected or not) */
+    char (*variant_names)[64];
 
     uint32_t num_lights;
     GnLight *lights;
@@ -105,6 +107,11 @@ bool scene_load_scene(scene *out, const char *path, int scene_index);
  * percent-escapes and symlinks included; never the working directory): anything else is an
  * error naming the URI. True lets a scene read any file (--allow-outside-files). */
 void scene_allow_outside_files(bool allow);
+/* Loads that follow apply the KHR_materials_variants variant of this name: each primitive's
+ * mapping that lists it replaces the primitive's material (primitives without one keep
+ * theirs); a file without a variant of that name is an error listing the variants it has.
+ * NULL or "" (the default): the files' own materials. */
+void scene_select_variant(const char *name);
 /* Loads that follow see the file's animations at this time in seconds: every animation's
  * translation, rotation and scale channels (STEP, LINEAR with slerp for rotations,
  * CUBICSPLINE as glTF 2.0 defines them) replace the nodes' own, so meshes, cameras and
