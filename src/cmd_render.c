@@ -37,6 +37,8 @@ static const char render_usage[] =
     "  --size WxH          image size (default 512 on the longer side, the camera's aspect)\n"
     CAMERA_OPTIONS_HELP
     "  --scene N           render the file's glTF scene N (default: its default scene)\n"
+    "  --variant NAME      the materials of the file's KHR_materials_variants variant NAME\n"
+    "                      (gonio info lists them; default: the file's own materials)\n"
     "  --allow-outside-files  let the scene read files outside its folder (default: only\n"
     "                      regular files under it)\n"
     "  --seed S            random seed (default 0); renders with different seeds merge\n"
@@ -414,6 +416,8 @@ int cmd_render(int argc, char **argv)
                 if (!util_parse_int(val, 0, 1 << 24, &v))
                     return cli_usage_error("render", "--frame '%s': expected a frame number >= 0", val);
                 frame = (int)v;
+            } else if (!strcmp(a, "--variant")) {
+                scene_select_variant(val);
             } else if (!strcmp(a, "--fps")) {
                 if (!util_parse_float(val, &fps) || !(fps > 0 && fps <= 1e6f))
                     return cli_usage_error("render", "--fps '%s': expected frames per second > 0", val);

@@ -952,9 +952,12 @@ bool check_asset(Ctx &c)
     for (const auto &e : m.extensionsRequired)
         if (!supported(e))
             fail(c, "requires unsupported extension %s", e.c_str());
+    std::vector<std::string> warned; /* one warning each, however often the file lists it */
     for (const auto &e : m.extensionsUsed)
-        if (!supported(e))
+        if (!supported(e) && std::find(warned.begin(), warned.end(), e) == warned.end()) {
             warn(c, "uses unsupported extension %s (ignored)", e.c_str());
+            warned.push_back(e);
+        }
     return !c.failed;
 }
 
