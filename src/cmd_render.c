@@ -603,7 +603,8 @@ static const char info_usage[] =
     "Prints the scene's contents and its BVH statistics: the emissive triangles (the path\n"
     "tracer's area lights) and the materials that emit, and one line per camera (index, name,\n"
     "position, forward direction, vertical field of view or orthographic width x height;\n"
-    "the first is the one gonio render uses by default).\n";
+    "the first is the one gonio render uses by default) and the KHR_materials_variants\n"
+    "variants by index and name (for --variant).\n";
 
 /* The area lights as the path tracer sees them (render.c: build_emitters): triangles of
  * non-zero area whose material emits and is not unlit; prints the materials by name. */

@@ -82,11 +82,12 @@ typedef struct scene {
 /* Loads a .gltf or .glb file (GLB chosen by its magic, or by the extension). Every buffer,
  * view, accessor and reference is validated before use; structural errors (anything that
  * could make a read go out of bounds, unresolved references, node loops, non-finite
- * transforms, required extensions other than KHR_lights_punctual and KHR_materials_{unlit,
- * specular, transmission, ior, emissive_strength}) print an error naming the file and the
+ * transforms, required extensions other than KHR_lights_punctual, KHR_materials_{unlit,
+ * specular, transmission, ior, emissive_strength, variants}, KHR_draco_mesh_compression and
+ * EXT_meshopt_compression, compressed data its decoder rejects) print an error naming the file and the
  * problem and return false with *out zeroed. What can be skipped or repaired safely prints a
  * warning naming the file and the feature: points/lines primitives (strips and fans become
- * triangles), orthographic or invalid cameras, invalid lights, unknown optional extensions,
+ * triangles), orthographic or invalid cameras, invalid lights, unknown optional extensions (one warning each),
  * unknown alpha modes (rendered opaque), texCoord != 0 and missing or undecodable images (texture
  * slot GN_INVALID; PNG and JPEG only), out-of-range material values (clamped), non-unit
  * normals (renormalised), skins, morph targets, COLOR_0. Primitives without NORMAL get flat
