@@ -20,6 +20,18 @@ struct Out {
     tinygltf::Model &m;
     size_t max_elements;
     std::vector<std::string> *errors;
+    /* Bytes all decoded data may still take: a few hundred bytes of JSON naming one small
+     * compressed view many times must not ask for gigabytes before the loader's own limits. */
+    size_t budget;
+    bool take(const std::string &what, size_t bytes)
+    {
+        if (bytes <= budget) {
+            budget -= bytes;
+            return true;
+        }
+        return error(what + ": the decoded data would exceed " + std::to_string(max_elements * 16) +
+                     " bytes in all (the loader's limit)");
+    }
     bool error(const std::string &s)
     {
         errors->push_back(s);
@@ -96,6 +108,8 @@ bool meshopt_view(Out &o, size_t i)
     if (!filter_ok)
         return o.error(what + ": filter '" + filter + "' is not allowed with mode " + mode + " and byteStride " +
                        std::to_string(stride));
+    if (!o.take(what, size_t(count) * size_t(stride)))
+        return false;
     std::vector<unsigned char> dst(size_t(count) * size_t(stride));
     int r = attrs ? meshopt_decodeVertexBuffer(dst.data(), size_t(count), size_t(stride), src, size_t(len))
             : tris ? meshopt_decodeIndexBuffer(dst.data(), size_t(count), size_t(stride), src, size_t(len))
@@ -171,6 +185,8 @@ bool draco_primitive(Out &o, size_t mi, size_t pi)
                            " decoded points");
         if (np > o.max_elements)
             return o.error(what + ": " + std::to_string(np) + " points exceed the limit");
+        if (!o.take(what, np * size_t(nc) * 4))
+            return false;
         std::vector<unsigned char> bytes(np * size_t(nc) * 4);
         float val[4];
         for (size_t k = 0; k < np; k++) {
@@ -199,6 +215,8 @@ bool draco_primitive(Out &o, size_t mi, size_t pi)
             return o.error(what + ": indices accessor " + std::to_string(p.indices) + " (" +
                            std::to_string(acc.count) + " elements) does not match the " + std::to_string(nf) +
                            " decoded triangles");
+        if (!o.take(what, nf * 12))
+            return false;
         std::vector<unsigned char> bytes(nf * 12);
         for (size_t f = 0; f < nf; f++) {
             const draco::Mesh::Face &face = mesh.face(draco::FaceIndex(uint32_t(f)));
@@ -222,13 +240,13 @@ bool draco_primitive(Out &o, size_t mi, size_t pi)
 
 bool gltf_decompress(tinygltf::Model &m, size_t max_elements, std::vector<std::string> *errors)
 {
-    Out o{m, max_elements, errors};
+    Out o{m, max_elements, errors, max_elements * 16};
     size_t views = m.bufferViews.size();
     for (size_t i = 0; i < views; i++)
         if (ext(m.bufferViews[i].extensions, "EXT_meshopt_compression"))
             meshopt_view(o, i);
     /* Fallback buffers without a uri (EXT_meshopt_compression "fallback": true) hold no
-     * bytes (gltf_draco_json_patch gave them a placeholder): nothing may read them once
+     * bytes (gltf_json_patch gave them a placeholder): nothing may read them once
      * every compressed view over them is decoded. */
     for (size_t b = 0; b < m.buffers.size(); b++) {
         const tinygltf::Value *e = ext(m.buffers[b].extensions, "EXT_meshopt_compression");
@@ -246,7 +264,7 @@ bool gltf_decompress(tinygltf::Model &m, size_t max_elements, std::vector<std::s
     return errors->empty();
 }
 
-std::string gltf_draco_json_patch(const char *json, size_t len)
+std::string gltf_json_patch(const char *json, size_t len, bool glb)
 {
     if (!memmem(json, len, "KHR_draco_mesh_compression", 26) && !memmem(json, len, "EXT_meshopt_compression", 23))
         return "";
@@ -259,7 +277,8 @@ std::string gltf_draco_json_patch(const char *json, size_t len)
     /* tinygltf 2.7 also reads a buffer without uri as a file named "": meshopt's fallback
      * buffers get one byte and a mark that they hold no data (see gltf_decompress). */
     if (j.contains("buffers") && j["buffers"].is_array())
-        for (auto &b : j["buffers"])
+        for (size_t i = glb ? 1 : 0; i < j["buffers"].size(); i++) {
+            nlohmann::json &b = j["buffers"][i];
             if (b.is_object() && !b.contains("uri") && b.contains("extensions") && b["extensions"].is_object() &&
                 b["extensions"].contains("EXT_meshopt_compression") &&
                 b["extensions"]["EXT_meshopt_compression"].is_object()) {
@@ -268,6 +287,7 @@ std::string gltf_draco_json_patch(const char *json, size_t len)
                 b["extensions"]["EXT_meshopt_compression"]["gonio_no_data"] = true;
                 changed = true;
             }
+        }
     nlohmann::json &acc = j["accessors"];
     for (auto &mesh : j["meshes"]) {
         if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array())

@@ -1941,7 +1941,7 @@ bool parse(Ctx &c, uint8_t *data, size_t size)
         return fail(c, "empty file");
     if (!check_json_text(c, json, json_len))
         return false;
-    std::string patched = gltf_draco_json_patch(reinterpret_cast<const char *>(json), json_len);
+    std::string patched = gltf_json_patch(reinterpret_cast<const char *>(json), json_len, glb);
     std::vector<uint8_t> glb_patched;
     if (!patched.empty() && !glb) {
         data = reinterpret_cast<uint8_t *>(&patched[0]);
