@@ -18,7 +18,9 @@ ifeq ($(origin CXX),default)
 CXX := g++
 endif
 
-PKGS := vulkan glfw3 OpenEXR tinygltf nlohmann_json libpng zlib stb
+PKGS := vulkan glfw3 OpenEXR tinygltf nlohmann_json libpng zlib stb draco
+# meshoptimizer ships no pkg-config file (Debian 12): linked by name.
+LIBS_EXTRA := -lmeshoptimizer
 WARN := -Wall -Wextra -Wshadow -Werror
 CPPFLAGS += -Isrc -Iglsl -I$(BUILD)/spv -MMD -MP
 CFLAGS += -std=c11 -D_DEFAULT_SOURCE -pthread $(WARN)
@@ -55,7 +57,8 @@ LIB_OBJ := $(SRC_C:%.c=$(BUILD)/%.o) $(SRC_CXX:%.cpp=$(BUILD)/%.o)
 MAIN_OBJ := $(BUILD)/src/main.o
 TEST_SRC := $(wildcard tests/unit/*.c)
 TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/%.o)
-TOOL_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(wildcard tests/tool/*.c))
+TOOL_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(wildcard tests/tool/*.c)) \
+	$(patsubst %.cpp,$(BUILD)/%.o,$(wildcard tests/tool/*.cpp))
 SHADERS := $(wildcard glsl/*.comp)
 SPV_HDR := $(SHADERS:glsl/%.comp=$(BUILD)/spv/%.h)
 
@@ -67,14 +70,15 @@ TESTTOOL := $(BUILD)/testtool
 # nlohmann-json3-dev: the JSON library tinygltf parses with, which scene_gltf.cpp uses to check
 # the document itself (tinygltf's package does not depend on it).
 DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
-	libopenexr-dev libtinygltf-dev nlohmann-json3-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers help2man
+	libopenexr-dev libtinygltf-dev nlohmann-json3-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers help2man \
+	libdraco-dev libmeshoptimizer-dev
 # man-db: tests/regress/cli.sh renders the installed man page with man -l.
 # libmagickcore-6.q16-6-extra: ImageMagick's EXR coder (only a recommendation of imagemagick,
 # which --no-install-recommends leaves out); tests/regress/diff.sh writes EXRs with it.
 DEB_TEST := vulkan-validationlayers openexr xvfb xauth imagemagick libmagickcore-6.q16-6-extra \
 	x11-apps xdotool man-db
 DEPS_CHECK = { command -v glslangValidator && command -v spirv-val && command -v pkg-config \
-	&& command -v help2man && pkg-config --exists $(PKGS) && ls /usr/share/vulkan/icd.d/lvp_icd*.json; } >/dev/null 2>&1
+	&& command -v help2man && pkg-config --exists $(PKGS) && ls /usr/include/meshoptimizer.h && ls /usr/share/vulkan/icd.d/lvp_icd*.json; } >/dev/null 2>&1
 TEST_DEPS_CHECK = { ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json \
 	&& command -v exrheader && command -v xvfb-run && command -v xauth && command -v import \
 	&& command -v xwd && command -v xdotool && command -v man \
@@ -115,13 +119,13 @@ build/gonio: $(GONIO)
 	@ln -sf $(config)/gonio build/gonio
 
 $(GONIO): $(MAIN_OBJ) $(LIB_OBJ) | deps
-	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) -lm
+	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) $(LIBS_EXTRA) -lm
 
 $(UNIT): $(TEST_OBJ) $(LIB_OBJ) | deps
-	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) -lm
+	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) $(LIBS_EXTRA) -lm
 
 $(TESTTOOL): $(TOOL_OBJ) $(LIB_OBJ) | deps
-	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) -lm
+	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) $(LIBS_EXTRA) -lm
 
 $(BUILD)/%.o: %.c | deps $(SPV_HDR)
 	@mkdir -p $(dir $@)
@@ -170,7 +174,7 @@ fuzz: fuzz-deps
 fuzz-targets: $(FUZZ_TARGETS)
 .SECONDARY: $(FUZZ_TARGETS:build/fuzz/%=$(BUILD)/tests/fuzz/%.o)
 build/fuzz/fuzz_%: $(BUILD)/tests/fuzz/fuzz_%.o $(LIB_OBJ) | deps
-	$(CXX) $(LDFLAGS) -fsanitize=fuzzer -o $@ $^ $(PKG_LIBS) -lm
+	$(CXX) $(LDFLAGS) -fsanitize=fuzzer -o $@ $^ $(PKG_LIBS) $(LIBS_EXTRA) -lm
 fuzz-run: fuzz all test-deps
 	@GONIO=$(GONIO) FUZZ_TIME=$(FUZZ_TIME) tests/fuzz/run.sh $(FUZZ_TARGETS)
 

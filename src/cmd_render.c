@@ -37,6 +37,8 @@ static const char render_usage[] =
     "  --size WxH          image size (default 512 on the longer side, the camera's aspect)\n"
     CAMERA_OPTIONS_HELP
     "  --scene N           render the file's glTF scene N (default: its default scene)\n"
+    "  --variant NAME      the materials of the file's KHR_materials_variants variant NAME\n"
+    "                      (gonio info lists them; default: the file's own materials)\n"
     "  --allow-outside-files  let the scene read files outside its folder (default: only\n"
     "                      regular files under it)\n"
     "  --seed S            random seed (default 0); renders with different seeds merge\n"
@@ -414,6 +416,8 @@ int cmd_render(int argc, char **argv)
                 if (!util_parse_int(val, 0, 1 << 24, &v))
                     return cli_usage_error("render", "--frame '%s': expected a frame number >= 0", val);
                 frame = (int)v;
+            } else if (!strcmp(a, "--variant")) {
+                scene_select_variant(val);
             } else if (!strcmp(a, "--fps")) {
                 if (!util_parse_float(val, &fps) || !(fps > 0 && fps <= 1e6f))
                     return cli_usage_error("render", "--fps '%s': expected frames per second > 0", val);
@@ -599,7 +603,8 @@ static const char info_usage[] =
     "Prints the scene's contents and its BVH statistics: the emissive triangles (the path\n"
     "tracer's area lights) and the materials that emit, and one line per camera (index, name,\n"
     "position, forward direction, vertical field of view or orthographic width x height;\n"
-    "the first is the one gonio render uses by default).\n";
+    "the first is the one gonio render uses by default) and the KHR_materials_variants\n"
+    "variants by index and name (for --variant).\n";
 
 /* The area lights as the path tracer sees them (render.c: build_emitters): triangles of
  * non-zero area whose material emits and is not unlit; prints the materials by name. */
@@ -658,6 +663,9 @@ int cmd_info(int argc, char **argv)
     printf("meshes         %u (primitive instances; %u glTF meshes, %u nodes)\n", sc.num_meshes,
            sc.num_gltf_meshes, sc.num_nodes);
     printf("materials      %u\n", sc.num_materials);
+    printf("variants       %u\n", sc.num_variants);
+    for (uint32_t i = 0; i < sc.num_variants; i++)
+        printf("variant %-6u \"%s\"\n", i, sc.variant_names[i]);
     printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
     printf("lights         %u\n", sc.num_lights);
     print_emitters(&sc);

@@ -49,6 +49,7 @@ static const char usage[] =
     "  --frames N          quit after N frames (scripts, tests)\n"
     "  --screenshot FILE   on quitting, write what the window shows as PNG\n"
     "  --device N          Vulkan device index (see gonio devices)\n"
+    "  --variant NAME      the glTF KHR_materials_variants variant NAME's materials\n"
     "  --validate          enable the Vulkan validation layer; any message fails\n"
     "  --quiet             no informational messages\n";
 
@@ -800,6 +801,8 @@ int cmd_preview(int argc, char **argv)
                 if (image_format_of(val) != IMAGE_FORMAT_PNG)
                     return cli_usage_error("preview", "--screenshot '%s': expected a .png name", val);
                 screenshot = val;
+            } else if (!strcmp(a, "--variant")) {
+                scene_select_variant(val);
             } else if (!strcmp(a, "--device")) {
                 if (!util_parse_int(val, 0, 64, &v))
                     return cli_usage_error("preview", "--device '%s': expected an index (see gonio devices)", val);

@@ -21,6 +21,7 @@ void scene_destroy(scene *s)
     free(s->materials);
     free(s->material_extras);
     free(s->material_names);
+    free(s->variant_names);
     free(s->lights);
     free(s->images);
     free(s->textures);

@@ -63,6 +63,8 @@ typedef struct scene {
     GnMaterial *materials;
     scene_material_extras *material_extras;
     char (*material_names)[64];
+    uint32_t num_variants;      /* KHR_materials_variants of the file (any one selected or not) */
+    char (*variant_names)[64];
 
     uint32_t num_lights;
     GnLight *lights;
@@ -83,11 +85,12 @@ typedef struct scene {
 /* Loads a .gltf or .glb file (GLB chosen by its magic, or by the extension). Every buffer,
  * view, accessor and reference is validated before use; structural errors (anything that
  * could make a read go out of bounds, unresolved references, node loops, non-finite
- * transforms, required extensions other than KHR_lights_punctual and KHR_materials_{unlit,
- * specular, transmission, ior, emissive_strength}) print an error naming the file and the
+ * transforms, required extensions other than KHR_lights_punctual, KHR_materials_{unlit,
+ * specular, transmission, ior, emissive_strength, variants}, KHR_draco_mesh_compression and
+ * EXT_meshopt_compression, compressed data its decoder rejects) print an error naming the file and the
  * problem and return false with *out zeroed. What can be skipped or repaired safely prints a
  * warning naming the file and the feature: points/lines primitives (strips and fans become
- * triangles), orthographic or invalid cameras, invalid lights, unknown optional extensions,
+ * triangles), orthographic or invalid cameras, invalid lights, unknown optional extensions (one warning each),
  * unknown alpha modes (rendered opaque), texCoord > 1 and missing or undecodable images (texture
  * slot GN_INVALID; PNG and JPEG only), out-of-range material values (clamped), non-unit
  * normals (renormalised), skins, morph targets, COLOR_0. Primitives without NORMAL get flat
@@ -108,6 +111,11 @@ bool scene_load_scene(scene *out, const char *path, int scene_index);
  * percent-escapes and symlinks included; never the working directory): anything else is an
  * error naming the URI. True lets a scene read any file (--allow-outside-files). */
 void scene_allow_outside_files(bool allow);
+/* Loads that follow apply the KHR_materials_variants variant of this name: each primitive's
+ * mapping that lists it replaces the primitive's material (primitives without one keep
+ * theirs); a file without a variant of that name is an error listing the variants it has.
+ * NULL or "" (the default): the files' own materials. */
+void scene_select_variant(const char *name);
 /* Loads that follow see the file's animations at this time in seconds: every animation's
  * translation, rotation and scale channels (STEP, LINEAR with slerp for rotations,
  * CUBICSPLINE as glTF 2.0 defines them) replace the nodes' own, so meshes, cameras and

@@ -32,6 +32,7 @@ extern "C" {
 #include "tangent.h"
 #include "util.h"
 }
+#include "gltf_decompress.h"
 
 namespace {
 
@@ -51,7 +52,8 @@ const double MAX_RADIANCE = 1e9;
 const char *const SUPPORTED_EXTENSIONS[] = {
     "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_materials_specular",
     "KHR_materials_transmission", "KHR_materials_ior",               "KHR_materials_unlit",
-    "KHR_texture_transform",      "KHR_mesh_quantization"};
+    "KHR_texture_transform",      "KHR_mesh_quantization",           "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression",    "KHR_materials_variants"};
 
 using Json = nlohmann::json;
 
@@ -96,6 +98,7 @@ struct Ctx {
 };
 
 bool allow_outside_files = false; /* scene_allow_outside_files */
+std::string variant;              /* scene_select_variant */
 
 void vreport(const Ctx &c, bool error, const char *fmt, va_list ap)
 {
@@ -981,10 +984,76 @@ bool check_asset(Ctx &c)
     for (const auto &e : m.extensionsRequired)
         if (!supported(e))
             fail(c, "requires unsupported extension %s", e.c_str());
+    std::vector<std::string> warned; /* one warning each, however often the file lists it */
     for (const auto &e : m.extensionsUsed)
-        if (!supported(e))
+        if (!supported(e) && std::find(warned.begin(), warned.end(), e) == warned.end()) {
             warn(c, "uses unsupported extension %s (ignored)", e.c_str());
+            warned.push_back(e);
+        }
     return !c.failed;
+}
+
+/* Compressed views and primitives become plain ones before anything is checked or read. */
+bool decompress(Ctx &c)
+{
+    std::vector<std::string> errors;
+    if (gltf_decompress(c.m, MAX_ELEMENTS, &errors))
+        return true;
+    for (const auto &e : errors)
+        fail(c, "%s", e.c_str());
+    return false;
+}
+
+/* The names of the file's KHR_materials_variants, in order (empty without the extension). */
+std::vector<std::string> variant_names(const tinygltf::Model &m)
+{
+    std::vector<std::string> names;
+    auto it = m.extensions.find("KHR_materials_variants");
+    if (it == m.extensions.end() || !it->second.Has("variants") || !it->second.Get("variants").IsArray())
+        return names;
+    const tinygltf::Value &v = it->second.Get("variants");
+    for (size_t i = 0; i < v.ArrayLen(); i++) {
+        const tinygltf::Value &e = v.Get(int(i));
+        names.push_back(e.Has("name") && e.Get("name").IsString() ? e.Get("name").Get<std::string>() : "");
+    }
+    return names;
+}
+
+/* KHR_materials_variants: with a variant selected (scene_select_variant), each primitive's
+ * mapping that lists it replaces the primitive's material, before the materials are checked;
+ * a primitive without one keeps its own. No variant selected: the file's default materials. */
+bool select_variant(Ctx &c)
+{
+    if (variant.empty())
+        return true;
+    std::vector<std::string> names = variant_names(c.m);
+    auto at = std::find(names.begin(), names.end(), variant);
+    if (at == names.end()) {
+        std::string list;
+        for (const auto &n : names)
+            list += (list.empty() ? "" : ", ") + ("'" + n + "'");
+        return fail(c, "has no material variant '%s' (%s%s)", variant.c_str(), list.empty() ? "no variants" : "variants: ",
+                    list.c_str());
+    }
+    double want = double(at - names.begin());
+    for (size_t mi = 0; mi < c.m.meshes.size(); mi++)
+        for (auto &p : c.m.meshes[mi].primitives) {
+            auto e = p.extensions.find("KHR_materials_variants");
+            if (e == p.extensions.end() || !e->second.Has("mappings") || !e->second.Get("mappings").IsArray())
+                continue;
+            const tinygltf::Value &maps = e->second.Get("mappings");
+            for (size_t k = 0; k < maps.ArrayLen(); k++) {
+                const tinygltf::Value &mp = maps.Get(int(k));
+                if (!mp.Has("variants") || !mp.Get("variants").IsArray() || !mp.Has("material") ||
+                    !mp.Get("material").IsNumber())
+                    continue;
+                const tinygltf::Value &vs = mp.Get("variants");
+                for (size_t j = 0; j < vs.ArrayLen(); j++)
+                    if (vs.Get(int(j)).IsNumber() && vs.Get(int(j)).GetNumberAsDouble() == want)
+                        p.material = mp.Get("material").GetNumberAsInt();
+            }
+        }
+    return true;
 }
 
 /* ---- geometry ------------------------------------------------------------------------------- */
@@ -2476,6 +2545,26 @@ bool parse(Ctx &c, uint8_t *data, size_t size)
         return fail(c, "empty file");
     if (!check_json_text(c, json, json_len) || !check_document(c, json, json_len, glb))
         return false;
+    std::string patched = gltf_json_patch(reinterpret_cast<const char *>(json), json_len, glb);
+    std::vector<uint8_t> glb_patched;
+    if (!patched.empty() && !glb) {
+        data = reinterpret_cast<uint8_t *>(&patched[0]);
+        size = len = patched.size();
+    } else if (!patched.empty()) { /* the GLB again, with the new JSON chunk */
+        patched.resize((patched.size() + 3) & ~size_t(3), ' ');
+        size_t rest = len - size_t(json + json_len - data); /* the BIN chunk, if any */
+        glb_patched.resize(12 + 8 + patched.size() + rest);
+        uint8_t *g = glb_patched.data();
+        memcpy(g, data, 12);
+        uint32_t total = uint32_t(glb_patched.size()), jl = uint32_t(patched.size());
+        memcpy(g + 8, &total, 4);
+        memcpy(g + 12, &jl, 4);
+        memcpy(g + 16, "JSON", 4);
+        memcpy(g + 20, patched.data(), patched.size());
+        memcpy(g + 20 + patched.size(), json + json_len, rest);
+        data = g;
+        size = len = glb_patched.size();
+    }
     /* tinygltf calls any JSON under 4 bytes "too short"; padded, it says what is wrong. */
     std::string small = size < 4 ? std::string(reinterpret_cast<const char *>(data), size) + "   " : "";
     const char *text = small.empty() ? reinterpret_cast<const char *>(data) : small.c_str();
@@ -2523,7 +2612,7 @@ bool load(scene *out, const char *path, int scene_index)
     data.reset();
     if (!c.limit_error.empty())
         return fail(c, "%s", c.limit_error.c_str());
-    if (!check_asset(c) || !check_buffers_and_views(c))
+    if (!check_asset(c) || !decompress(c) || !select_variant(c) || !check_buffers_and_views(c))
         return false;
     for (size_t i = 0; i < c.m.accessors.size(); i++)
         check_accessor(c, int(i));
@@ -2554,6 +2643,13 @@ bool load(scene *out, const char *path, int scene_index)
     bake_lights(c, lights, out);
     out->num_gltf_meshes = uint32_t(c.m.meshes.size());
     out->num_nodes = uint32_t(c.m.nodes.size());
+    std::vector<std::string> variants = variant_names(c.m);
+    if (!variants.empty()) {
+        out->num_variants = uint32_t(variants.size());
+        out->variant_names = static_cast<char (*)[64]>(util_calloc(variants.size(), 64));
+        for (size_t i = 0; i < variants.size(); i++)
+            snprintf(out->variant_names[i], 64, "%s", variants[i].c_str());
+    }
     uint32_t dropped = scene_drop_invalid_triangles(out);
     if (dropped)
         warn(c, "dropped %u triangle(s) with non-finite or huge (|x| > 1e15) vertex positions", dropped);
@@ -2573,6 +2669,8 @@ void scene_animation_time(double seconds)
 }
 
 void scene_allow_outside_files(bool allow) { allow_outside_files = allow; }
+
+void scene_select_variant(const char *name) { variant = name ? name : ""; }
 
 bool scene_load_scene(scene *out, const char *path, int scene_index)
 {

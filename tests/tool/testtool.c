@@ -360,6 +360,9 @@ done:
     return rc;
 }
 
+/* compress.cpp: IN.gltf encoded with Draco or meshoptimizer, losslessly, into OUT.gltf. */
+int tool_compress(const char *how, const char *in, const char *out);
+
 int main(int argc, char **argv)
 {
     if (argc == 4 && !strcmp(argv[1], "same"))
@@ -372,12 +375,14 @@ int main(int argc, char **argv)
         return check_png(argv[2], argv[3], argv[4]);
     if (argc == 5 && !strcmp(argv[1], "pick"))
         return pick_channel(argv[2], argv[3], argv[4]);
+    if (argc == 5 && !strcmp(argv[1], "compress") && (!strcmp(argv[2], "draco") || !strcmp(argv[2], "meshopt")))
+        return tool_compress(argv[2], argv[3], argv[4]);
     if (argc == 4 && !strcmp(argv[1], "scene"))
         return write_scene(argv[2], argv[3]);
     if ((argc == 7 || argc == 8) && !strcmp(argv[1], "ref"))
         return write_ref(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]), argv[6],
                          argc == 8 ? atof(argv[7]) : 0.0);
-    fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n"
+    fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool compress draco|meshopt IN.gltf OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n"
                     "       testtool png depth|normal PNG REF.exr | testtool pick IN.exr CHANNEL OUT.exr\n"
                     "       testtool at IN.exr CHANNEL X Y | testtool same WHOLE.exr PART.exr\n");
     return 2;

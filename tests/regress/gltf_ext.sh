@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# gltf_ext.sh: compressed meshes, material variants and the extension rules.
+# Draco and meshopt: gonio's Cornell box and teapot encoded by the libraries' own encoders
+# (testtool compress: Draco without quantization, meshopt's lossless codecs) must render bit
+# for bit like the originals; corrupt compressed bytes are an error (exit 1) naming the file
+# and the primitive or buffer view, with no output. Variants: --variant NAME must render like
+# the same scene with that variant's materials written in, and unknown names fail.
+# Extensions: an unknown required one is an error naming it, unknown used ones warn once each.
+. "$(dirname "$0")/../lib.sh"
+G=$GONIO
+T=$TESTTOOL
+command -v python3 >/dev/null || skip_all "python3 is needed to edit the test scenes"
+R="--spp 4 --size 96x72 --quiet"
+
+"$G" scene cornell -o "$tmp/cornell.gltf" && "$G" teapot --level 4 -o "$tmp/teapot.gltf" || { fail "scenes"; finish; exit; }
+for s in cornell teapot; do
+    check "$s: render" "$G" render "$tmp/$s.gltf" -o "$tmp/$s.exr" $R
+    for k in draco meshopt; do
+        check "$s: $k encode" "$T" compress $k "$tmp/$s.gltf" "$tmp/$s-$k.gltf"
+        check "$s: $k file uses the extension" grep -q "$([ $k = draco ] && echo KHR_draco_mesh_compression || echo EXT_meshopt_compression)" "$tmp/$s-$k.gltf"
+        check "$s: $k render" "$G" render "$tmp/$s-$k.gltf" -o "$tmp/$s-$k.exr" $R
+        check "$s: $k decodes to the same image" "$T" same "$tmp/$s.exr" "$tmp/$s-$k.exr"
+    done
+done
+
+# Corrupt compressed bytes: every 7th byte of the last buffer (the compressed one) flipped.
+for k in draco meshopt; do
+    python3 - "$tmp/cornell-$k.gltf" "$tmp/bad-$k.gltf" <<'PY'
+import base64, json, sys
+d = json.load(open(sys.argv[1]))
+head, data = d["buffers"][-1]["uri"].split(",")
+raw = bytearray(base64.b64decode(data))
+for i in range(0, len(raw), 7):
+    raw[i] ^= 0x5A
+d["buffers"][-1]["uri"] = head + "," + base64.b64encode(bytes(raw)).decode()
+json.dump(d, open(sys.argv[2], "w"))
+PY
+    check_fails "$k: corrupt data is an error" 1 "$G" render "$tmp/bad-$k.gltf" -o "$tmp/bad-$k.exr" $R
+    what=$([ $k = draco ] && echo "primitive 0 (KHR_draco_mesh_compression): Draco cannot decode" ||
+        echo "(EXT_meshopt_compression): meshoptimizer cannot decode")
+    check "$k: the error names the file and the part" grep -q "bad-$k.gltf: .*$what" "$tmp/last"
+    check "$k: no output" test ! -e "$tmp/bad-$k.exr"
+done
+
+# Variants: "green_left" maps the red wall (mesh 3) to the green material (2).
+python3 - "$tmp/cornell.gltf" "$tmp/variants.gltf" "$tmp/green.gltf" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["extensionsUsed"] = d.get("extensionsUsed", []) + ["KHR_materials_variants"]
+d.setdefault("extensions", {})["KHR_materials_variants"] = {"variants": [{"name": "as_is"}, {"name": "green_left"}]}
+p = d["meshes"][3]["primitives"][0]
+assert p["material"] == 1
+p["extensions"] = {"KHR_materials_variants": {"mappings": [{"material": 2, "variants": [1]}, {"material": 1, "variants": [0]}]}}
+json.dump(d, open(sys.argv[2], "w"))
+del p["extensions"]
+p["material"] = 2
+json.dump(d, open(sys.argv[3], "w"))
+PY
+check "variants: info lists them" sh -c "'$G' info '$tmp/variants.gltf' | grep -q 'variant 1 .*\"green_left\"'"
+check "variants: default render" "$G" render "$tmp/variants.gltf" -o "$tmp/v-default.exr" $R
+check "variants: default is the file's own materials" "$T" same "$tmp/cornell.exr" "$tmp/v-default.exr"
+check "variants: --variant green_left" "$G" render "$tmp/variants.gltf" --variant green_left -o "$tmp/v-green.exr" $R
+check "variants: reference" "$G" render "$tmp/green.gltf" -o "$tmp/green.exr" $R
+check "variants: green_left has its material" "$T" same "$tmp/green.exr" "$tmp/v-green.exr"
+check_fails "variants: green_left differs from the default" 1 "$T" same "$tmp/cornell.exr" "$tmp/v-green.exr"
+check_fails "variants: unknown name" 1 "$G" render "$tmp/variants.gltf" --variant nosuch -o "$tmp/v-x.exr" $R
+check "variants: the error lists the variants" grep -q "no material variant 'nosuch' (variants: 'as_is', 'green_left')" "$tmp/last"
+
+# Extension rules.
+sed 's/"asset": {/"extensionsRequired": ["EXT_nosuch_a"],\n  "asset": {/' "$tmp/cornell.gltf" >"$tmp/req.gltf"
+check_fails "required unknown extension" 1 "$G" info "$tmp/req.gltf"
+check "the error names it" grep -q "req.gltf: requires unsupported extension EXT_nosuch_a" "$tmp/last"
+sed 's/"extensionsUsed": \[/"extensionsUsed": ["EXT_nosuch_b","EXT_nosuch_c","EXT_nosuch_b",/' "$tmp/cornell.gltf" >"$tmp/used.gltf"
+check_fails "used unknown extensions only warn" 0 "$G" info "$tmp/used.gltf"
+for e in EXT_nosuch_b EXT_nosuch_c; do
+    check "one warning for $e" test "$(grep -c "warning: .*used.gltf: uses unsupported extension $e" "$tmp/last")" = 1
+done
+finish
