@@ -2434,8 +2434,14 @@ void Doc::check()
     each(root, "buffers", "", [&](const Json &b, const std::string &p, size_t i) {
         string(b, "uri", p);
         /* tinygltf would read the folder as the buffer's file. */
-        if (!b.count("uri") && !(glb && i == 0))
-            error(p, "has no uri (only the first buffer of a GLB, its BIN chunk, may omit it)");
+        /* EXT_meshopt_compression's fallback buffers have no data: decoding fills them. */
+        const Json *ext = b.count("extensions") ? &b["extensions"] : nullptr;
+        bool fallback = ext && ext->is_object() && ext->count("EXT_meshopt_compression") &&
+                        (*ext)["EXT_meshopt_compression"].is_object() &&
+                        (*ext)["EXT_meshopt_compression"].count("fallback") &&
+                        (*ext)["EXT_meshopt_compression"]["fallback"] == true;
+        if (!b.count("uri") && !(glb && i == 0) && !fallback)
+            error(p, "has no uri (only the first buffer of a GLB, its BIN chunk, or a meshopt fallback buffer may omit it)");
         integer(b, "byteLength", p, 1, MAX, true);
     });
     each(root, "bufferViews", "", [&](const Json &v, const std::string &p, size_t) {
