@@ -1,5 +1,7 @@
 /* cli.c: option helpers shared by the subcommands. */
+#include <assert.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,6 +21,173 @@ void cli_set_command_line(int argc, char **argv)
 }
 
 const char *cli_command_line(void) { return command_line; }
+
+/* The option of c whose names include `name` (exactly), or -1. */
+static int find_option(const cli_command *c, const char *name, size_t len)
+{
+    for (int k = 0; k < c->num_options; k++) {
+        const char *n = c->options[k].names;
+        if (c->options[k].kind == CLI_TEXT)
+            continue;
+        while (n && *n) {
+            size_t l = strcspn(n, ",");
+            if (l == len && !strncmp(n, name, len))
+                return k;
+            n += l;
+            n += strspn(n, ", ");
+        }
+    }
+    return -1;
+}
+
+static int bad_value(const cli_command *c, const char *opt, const char *val, const char *expect)
+{
+    return cli_usage_error(c->name, "%s '%s': expected %s", opt, val, expect);
+}
+
+/* Stores val in option o's destination; -1 ok, else 2 after a usage error. */
+static int take_value(const cli_command *c, const cli_option *o, const char *opt, const char *val)
+{
+    long v;
+    float f;
+    switch (o->kind) {
+    case CLI_STRING:
+        *(const char **)o->dest = val;
+        return -1;
+    case CLI_INT:
+    case CLI_U32:
+        if (!util_parse_int(val, (long)o->min, (long)o->max, &v))
+            return bad_value(c, opt, val, o->expect);
+        if (o->kind == CLI_INT)
+            *(int *)o->dest = (int)v;
+        else
+            *(uint32_t *)o->dest = (uint32_t)v;
+        return -1;
+    case CLI_FLOAT:
+        if (!util_parse_float(val, &f) || !(f >= o->min && f <= o->max))
+            return bad_value(c, opt, val, o->expect);
+        *(float *)o->dest = f;
+        return -1;
+    case CLI_CALL:
+        if (o->call(c->name, opt, val, o->dest))
+            return -1;
+        return o->expect ? bad_value(c, opt, val, o->expect) : 2;
+    default:
+        return -1;
+    }
+}
+
+int cli_parse(const cli_command *c, int argc, char **argv, cli_args *out)
+{
+    bool options = true;
+    assert(c->num_options <= CLI_MAX_OPTIONS && c->max_args <= CLI_MAX_ARGS);
+    memset(out, 0, sizeof *out);
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *eq = a[0] == '-' && a[1] == '-' ? strchr(a, '=') : NULL;
+        size_t len = eq ? (size_t)(eq - a) : strlen(a);
+        if (!options || a[0] != '-' || !a[1]) {
+            if (out->num_args == c->max_args)
+                return cli_usage_error(c->name, "unexpected argument '%s'", a);
+            out->arg[out->num_args++] = a;
+            continue;
+        }
+        if (!strcmp(a, "--")) {
+            options = false;
+            continue;
+        }
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            cli_help(c, stdout);
+            return 0;
+        }
+        int k = find_option(c, a, len);
+        if (k < 0)
+            return cli_usage_error(c->name, "unknown option '%.*s'", (int)len, a);
+        const cli_option *o = &c->options[k];
+        char opt[64];
+        snprintf(opt, sizeof opt, "%.*s", (int)len, a);
+        out->given[k] = true;
+        if (o->kind == CLI_FLAG) {
+            if (eq)
+                return cli_usage_error(c->name, "%s takes no value", opt);
+            *(bool *)o->dest = true;
+            continue;
+        }
+        const char *val = eq ? eq + 1 : i + 1 < argc ? argv[++i] : NULL;
+        if (!val)
+            return cli_usage_error(c->name, "%s needs a value", opt);
+        int rc = take_value(c, o, opt, val);
+        if (rc >= 0)
+            return rc;
+    }
+    if (out->num_args < c->min_args)
+        return cli_usage_error(c->name, "%s", c->missing ? c->missing : "missing arguments");
+    return -1;
+}
+
+bool cli_given(const cli_command *c, const cli_args *a, const char *name)
+{
+    int k = find_option(c, name, strlen(name));
+    assert(k >= 0); /* a name the table does not have is a bug */
+    return k >= 0 && a->given[k];
+}
+
+/* The help column: option names and value, padded to it, then the text. */
+#define HELP_COLUMN 22
+
+void cli_help(const cli_command *c, FILE *f)
+{
+    fprintf(f, "usage: gonio %s%s%s\n", c->name, c->synopsis ? " " : "", c->synopsis ? c->synopsis : "");
+    if (c->intro)
+        fprintf(f, "\n%s", c->intro);
+    if (c->num_options)
+        fputc('\n', f);
+    for (int k = 0; k < c->num_options; k++) {
+        const cli_option *o = &c->options[k];
+        if (o->kind == CLI_TEXT) {
+            fputs(o->help, f);
+            continue;
+        }
+        int w = fprintf(f, "  %s%s%s", o->names, o->value ? " " : "", o->value ? o->value : "");
+        for (const char *line = o->help; *line;) {
+            size_t l = strcspn(line, "\n");
+            fprintf(f, "%*s%.*s\n", w < HELP_COLUMN ? HELP_COLUMN - w : 2, "", (int)l, line);
+            line += l + (line[l] == '\n');
+            w = 0;
+        }
+    }
+    if (c->epilog)
+        fprintf(f, "\n%s", c->epilog);
+}
+
+int cli_usage_error(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    fprintf(stderr, "gonio %s: ", cmd);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "\n(see gonio %s --help)\n", cmd);
+    return 2;
+}
+
+bool cli_gpu_create(gpu *g, int device_index, bool validate)
+{
+    const char *env = getenv("GONIO_VALIDATE");
+    gpu_desc d = {.device_index = device_index};
+    d.validate = validate || (env && strcmp(env, "1") == 0);
+    return gpu_create(g, &d);
+}
+
+bool cli_gpu_finish(gpu *g)
+{
+    bool validate = g->validate;
+    gpu_destroy(g);
+    if (validate && gpu_validation_message_count() > 0) {
+        util_error("%d Vulkan validation message(s) (see above)", gpu_validation_message_count());
+        return false;
+    }
+    return true;
+}
 
 /* Does the usage text list `opt` as an option that takes a value? An option line starts
  * (after indentation) with the option's names, ", " between aliases, and then one space and
@@ -95,35 +264,5 @@ const char *cli_value(int argc, char **argv, int *i)
         return NULL;
     }
     return argv[++*i];
-}
-
-int cli_usage_error(const char *cmd, const char *fmt, ...)
-{
-    va_list ap;
-    fprintf(stderr, "gonio %s: ", cmd);
-    va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fprintf(stderr, "\n(see gonio %s --help)\n", cmd);
-    return 2;
-}
-
-bool cli_gpu_create(gpu *g, int device_index, bool validate)
-{
-    const char *env = getenv("GONIO_VALIDATE");
-    gpu_desc d = {.device_index = device_index};
-    d.validate = validate || (env && strcmp(env, "1") == 0);
-    return gpu_create(g, &d);
-}
-
-bool cli_gpu_finish(gpu *g)
-{
-    bool validate = g->validate;
-    gpu_destroy(g);
-    if (validate && gpu_validation_message_count() > 0) {
-        util_error("%d Vulkan validation message(s) (see above)", gpu_validation_message_count());
-        return false;
-    }
-    return true;
 }
 

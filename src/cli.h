@@ -4,6 +4,7 @@
 #define GONIO_CLI_H
 
 #include <stdbool.h>
+#include <stdio.h>
 
 #include "gpu.h"
 
@@ -28,18 +29,83 @@ int cmd_preview(int argc, char **argv);
  * directory. */
 bool cli_load_builtin_scene(struct scene *out, const char *name);
 
-/* Shared option handling. cli_value returns argv[i + 1] (advancing *i) or reports a usage
- * error naming the option; cli_usage_error prints "gonio CMD: MESSAGE" and the hint to use
- * --help. */
+/* ---- options ----------------------------------------------------------------------------
+ * Every command declares its options once, as a table of cli_option; cli_parse reads argv
+ * against it (--opt value and --opt=value, -h/--help, "--" ending the options) and cli_help
+ * prints the --help text from it, so what --help lists is exactly what the command accepts
+ * (completion/gonio and the man page read that text). */
+typedef enum cli_kind {
+    CLI_FLAG,   /* bool *dest = true; takes no value */
+    CLI_STRING, /* const char **dest = the value */
+    CLI_INT,    /* int *dest: an integer in [min, max] */
+    CLI_U32,    /* uint32_t *dest: an integer in [min, max] */
+    CLI_FLOAT,  /* float *dest: a finite number in [min, max] */
+    CLI_CALL,   /* call(cmd, option, value, dest): false = usage error (printed by cli_parse
+                 * with `expect` when set, else by call) */
+    CLI_TEXT,   /* no option: `help` is printed as it is, in the options' place */
+} cli_kind;
+
+typedef struct cli_option {
+    const char *names; /* "--spp", or aliases "-o, --output" */
+    const char *value; /* the value's name in --help ("N", "FILE"); NULL for flags */
+    const char *help;  /* beside the names; further lines ('\n') under the first */
+    cli_kind kind;
+    void *dest;
+    double min, max;    /* CLI_INT, CLI_U32, CLI_FLOAT */
+    const char *expect; /* what a bad value should have been: "an integer 1..16777216" */
+    bool (*call)(const char *cmd, const char *opt, const char *value, void *dest);
+} cli_option;
+
+#define CLI_MAX_OPTIONS 64
+#define CLI_MAX_ARGS 8
+
+typedef struct cli_command {
+    const char *name;     /* "render" */
+    const char *synopsis; /* the usage line after "usage: gonio NAME " */
+    const char *intro;    /* paragraphs between the usage line and the options; or NULL */
+    const cli_option *options;
+    int num_options;
+    const char *epilog; /* paragraphs after the options; or NULL */
+    int min_args, max_args; /* positional arguments */
+    const char *missing;    /* the usage error when fewer than min_args: "no scene given" */
+} cli_command;
+#define CLI_OPTIONS(table) (table), (int)(sizeof(table) / sizeof *(table))
+
+/* What cli_parse found: the positional arguments and which options were given. */
+typedef struct cli_args {
+    const char *arg[CLI_MAX_ARGS];
+    int num_args;
+    bool given[CLI_MAX_OPTIONS];
+} cli_args;
+
+/* Parses argv[1..argc) (argv[0] the command's name). Returns -1 to go on, or the exit code
+ * the command should return: 0 after --help, 2 after a usage error (printed). */
+int cli_parse(const cli_command *c, int argc, char **argv, cli_args *out);
+/* Whether option `name` (any of its aliases) was on the command line. */
+bool cli_given(const cli_command *c, const cli_args *a, const char *name);
+void cli_help(const cli_command *c, FILE *f);
+
+/* Options every command that uses a device has, defined once. */
+#define CLI_OPT_DEVICE(dest)                                                                  \
+    {"--device", "N", "Vulkan device index (see gonio devices)", CLI_INT, (dest), 0, 64,    \
+     "an index (see gonio devices)", NULL}
+#define CLI_OPT_VALIDATE(dest)                                                                \
+    {"--validate", NULL, "enable the Vulkan validation layer; any message is an error",     \
+     CLI_FLAG, (dest), 0, 0, NULL, NULL}
+#define CLI_OPT_QUIET(dest, what)                                                             \
+    {"-q, --quiet", NULL, what, CLI_FLAG, (dest), 0, 0, NULL, NULL}
+#define CLI_OPT_ALLOW_OUTSIDE_FILES(dest)                                                     \
+    {"--allow-outside-files", NULL,                                                           \
+     "let the scene read files outside its folder (default: only\nregular files under it)",  \
+     CLI_FLAG, (dest), 0, 0, NULL, NULL}
+
+/* LEGACY (removed when every command uses cli_parse) */
 const char *cli_value(int argc, char **argv, int *i);
-/* cli_value for an option the command's usage text lists with a value (see cli.c); any
- * other option is reported as unknown, so a mistyped one never takes the next argument. */
 const char *cli_option_value(int argc, char **argv, int *i, const char *usage);
 bool cli_usage_lists_value(const char *usage, const char *opt);
-/* argv with every "--name=value" (after the command name) split into "--name" "value", so
- * each command's parser sees one form. Returns the new argc and sets *out (allocated, kept
- * until exit), or -1 after a usage error (a flag given a value). */
 int cli_split_equals(int argc, char **argv, char ***out);
+
+/* "gonio CMD: MESSAGE" and the hint to use --help; returns 2. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);
 /* The Vulkan device for a command: --device, --validate (or GONIO_VALIDATE=1 in the
  * environment). */

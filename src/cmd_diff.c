@@ -9,18 +9,6 @@
 #include <stdio.h>
 #include <string.h>
 
-static const char usage[] = "usage: gonio diff A.exr B.exr [--max-rmse X] [--max-rel-bias X] [--max-error X]\n"
-                            "                  [--channels R,G,B] [--quiet]\n"
-                            "  B is the reference; rel_bias = (mean A - mean B) / |mean B|\n";
-
-/* Same form as cli_usage_error, plus the usage text; kept here so that cmd_diff links
- * without main.c (the unit tests call it in-process). */
-static int bad_usage(const char *what, const char *arg)
-{
-    fprintf(stderr, "gonio diff: %s%s\n%s", what, arg, usage);
-    return 2;
-}
-
 /* "R,G,B" -> names; false on an empty, too long or surplus name. */
 static bool parse_channels(const char *list, char names[IMAGE_MAX_CHANNELS][32], int *n)
 {
@@ -106,50 +94,49 @@ static int diff_images(const char *const files[2], const image img[2], char name
     return status;
 }
 
+typedef struct channel_list {
+    char names[IMAGE_MAX_CHANNELS][32];
+    int n;
+} channel_list;
+
+static bool take_channels(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    (void)cmd, (void)opt;
+    channel_list *c = dest;
+    return parse_channels(val, c->names, &c->n);
+}
+
 int cmd_diff(int argc, char **argv)
 {
-    static const char *const limit_flags[3] = {"--max-rmse", "--max-rel-bias", "--max-error"};
-    double limits[3] = {-1, -1, -1}; /* negative: no limit */
-    char names[IMAGE_MAX_CHANNELS][32];
-    const char *files[2];
-    image img[2] = {{0}, {0}};
-    int num_files = 0, num_names = 0, status = 1;
+    float limits[3] = {-1, -1, -1}; /* negative: no limit */
+    channel_list channels = {.n = 0};
     bool quiet = false;
-
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        int k = 0;
-        while (k < 3 && strcmp(a, limit_flags[k]) != 0)
-            k++;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            fputs(usage, stdout);
-            return 0;
-        } else if (!strcmp(a, "--quiet")) {
-            quiet = true;
-        } else if (k < 3 || !strcmp(a, "--channels")) {
-            float v;
-            if (i + 1 >= argc)
-                return bad_usage("missing value after ", a);
-            a = argv[++i];
-            if (k == 3 && !parse_channels(a, names, &num_names))
-                return bad_usage("bad channel list: ", a);
-            if (k < 3 && (!util_parse_float(a, &v) || v < 0))
-                return bad_usage("not a non-negative number: ", a);
-            if (k < 3)
-                limits[k] = v;
-        } else if (a[0] == '-' && a[1]) {
-            return bad_usage("unknown option ", a);
-        } else if (num_files == 2) {
-            return bad_usage("unexpected argument ", a);
-        } else {
-            files[num_files++] = a;
-        }
-    }
-    if (num_files != 2)
-        return bad_usage("expected two images", "");
-
-    if (image_read_exr(&img[0], files[0]) && image_read_exr(&img[1], files[1]))
-        status = diff_images(files, img, names, num_names, limits, quiet);
+    const cli_option options[] = {
+        {"--max-rmse", "X", "exit 1 when the RMSE is above X", CLI_FLOAT, &limits[0], 0, 3e38,
+         "a number >= 0", NULL},
+        {"--max-rel-bias", "X", "exit 1 when |rel_bias| is above X", CLI_FLOAT, &limits[1], 0, 3e38,
+         "a number >= 0", NULL},
+        {"--max-error", "X", "exit 1 when the largest absolute difference is above X", CLI_FLOAT,
+         &limits[2], 0, 3e38, "a number >= 0", NULL},
+        {"--channels", "R,G,B", "compare these channels (default: R, G and B where both have\nthem, else the first channel of each)",
+         CLI_CALL, &channels, 0, 0, "a comma-separated list of channel names", take_channels},
+        CLI_OPT_QUIET(&quiet, "print no metrics (limits and errors still go to stderr)"),
+    };
+    const cli_command cmd = {
+        .name = "diff", .synopsis = "A.exr B.exr [options]",
+        .intro = "Compares two EXR images and prints rmse, psnr, mae, rel_bias and max_err. B is the\n"
+                 "reference: rel_bias = (mean A - mean B) / |mean B|. Exit 1 above a limit or on\n"
+                 "NaN/Inf values.\n",
+        CLI_OPTIONS(options), .min_args = 2, .max_args = 2, .missing = "expected two images"};
+    cli_args args;
+    image img[2] = {{0}, {0}};
+    int status = cli_parse(&cmd, argc, argv, &args);
+    double limit[3] = {limits[0], limits[1], limits[2]};
+    if (status >= 0)
+        return status;
+    status = 1;
+    if (image_read_exr(&img[0], args.arg[0]) && image_read_exr(&img[1], args.arg[1]))
+        status = diff_images(args.arg, img, channels.names, channels.n, limit, quiet);
     image_destroy(&img[0]);
     image_destroy(&img[1]);
     return status;

@@ -758,7 +758,7 @@ void test_image_diff_cli(void)
     CHECK(run_diff(out, err, sizeof out, (const char *[]){a, b, "--channels", "Z", NULL}) == 1 && strstr(err, "'Z'"));
 
     /* Bad usage: exit 2 with the usage line. */
-    CHECK(run_diff(out, err, sizeof out, (const char *[]){a, b, "--frobnicate", NULL}) == 2 && strstr(err, "usage:"));
+    CHECK(run_diff(out, err, sizeof out, (const char *[]){a, b, "--frobnicate", NULL}) == 2 && strstr(err, "gonio diff --help"));
     CHECK(run_diff(out, err, sizeof out, (const char *[]){a, b, "--max-rmse", NULL}) == 2);
     CHECK(run_diff(out, err, sizeof out, (const char *[]){a, b, "--max-rmse", "abc", NULL}) == 2);
     CHECK(run_diff(out, err, sizeof out, (const char *[]){a, b, "--max-rmse", "-1", NULL}) == 2);
