@@ -20,19 +20,6 @@
 #define SCENE_TEAPOT_LEVEL 8
 #define SCENE_TEAPOT_MAX_LEVEL 256 /* 4.2 M triangles: far past any use */
 
-static const char scene_usage[] =
-    "usage: gonio scene cornell -o FILE.gltf|FILE.glb\n"
-    "       gonio scene teapot [--level N] -o FILE.gltf|FILE.glb\n"
-    "       gonio teapot [--level N] -o FILE.gltf|FILE.glb\n"
-    "\n"
-    "Writes one of gonio's own scenes as a self-contained glTF 2.0 file.\n"
-    "  cornell             the Cornell box (published measurements, metres, one area light)\n"
-    "  teapot              the Utah teapot as in the lecture's OpenGL 1.x example\n"
-    "  -o, --output FILE   the file to write, in the format its name says: .gltf JSON with\n"
-    "                      the buffer embedded, .glb binary glTF (any other name is a usage error)\n"
-    "  --level N           teapot: N x N grid cells per Bezier patch, 1..256 (default 8);\n"
-    "                      64 N^2 - 8 N triangles\n";
-
 /* Rotation of a node whose -Z (view or light direction) is turned to the direction
  * (-cos(pitch) sin(yaw), -sin(pitch), -cos(pitch) cos(yaw)): q = q_y(yaw) q_x(-pitch). */
 static void yaw_pitch_quat(double yaw, double pitch, float q[4])
@@ -255,56 +242,57 @@ static bool write_teapot(const char *path, int level)
     return ok;
 }
 
-/* Options shared by both commands; name is the scene (NULL for `gonio teapot`). */
-static int run(int argc, char **argv, int first, const char *name)
+/* gonio scene NAME and gonio teapot: one option table; `teapot` is the second's name. */
+static int run(int argc, char **argv, bool teapot_command)
 {
     const char *out = NULL;
-    long level = SCENE_TEAPOT_LEVEL;
-    bool teapot = !name || !strcmp(name, "teapot");
-    for (int i = first; i < argc; i++) {
-        const char *a = argv[i], *val;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            fputs(scene_usage, stdout);
-            return 0;
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            if (!(out = cli_value(argc, argv, &i)))
-                return 2;
-        } else if (!strcmp(a, "--level") && teapot) {
-            if (!(val = cli_value(argc, argv, &i)))
-                return 2;
-            if (!util_parse_int(val, 1, SCENE_TEAPOT_MAX_LEVEL, &level))
-                return cli_usage_error(argv[0], "--level '%s': expected an integer 1..%d", val,
-                                       SCENE_TEAPOT_MAX_LEVEL);
-        } else {
-            return cli_usage_error(argv[0], "unknown option '%s'", a);
-        }
-    }
-    if (name && !teapot && strcmp(name, "cornell"))
-        return cli_usage_error(argv[0], "unknown scene '%s' (cornell or teapot)", name);
+    int level = SCENE_TEAPOT_LEVEL;
+    const cli_option options[] = {
+        {NULL, NULL, "  cornell             the Cornell box (published measurements, metres, one area light)\n"
+                     "  teapot              the Utah teapot as in the lecture's OpenGL 1.x example\n",
+         CLI_TEXT, NULL, 0, 0, NULL, NULL},
+        {"-o, --output", "FILE", "the file to write, in the format its name says: .gltf JSON with\n"
+                                 "the buffer embedded, .glb binary glTF (any other name is a usage error)",
+         CLI_STRING, &out, 0, 0, NULL, NULL},
+        {"--level", "N", "teapot: N x N grid cells per Bezier patch, 1..256 (default 8);\n"
+                         "64 N^2 - 8 N triangles",
+         CLI_INT, &level, 1, SCENE_TEAPOT_MAX_LEVEL, "an integer 1..256", NULL},
+    };
+    const cli_command cmd = {
+        .name = teapot_command ? "teapot" : "scene",
+        .synopsis = teapot_command ? "[--level N] -o FILE.gltf|FILE.glb"
+                                   : "cornell -o FILE.gltf|FILE.glb\n"
+                                     "       gonio scene teapot [--level N] -o FILE.gltf|FILE.glb",
+        .intro = "Writes one of gonio's own scenes as a self-contained glTF 2.0 file.\n",
+        /* gonio teapot has no scene names to list */
+        .options = options + teapot_command, .num_options = (int)(sizeof options / sizeof *options) - teapot_command,
+        .min_args = teapot_command ? 0 : 1, .max_args = teapot_command ? 0 : 1,
+        .missing = "which scene? (cornell or teapot)"};
+    cli_args args;
+    int rc = cli_parse(&cmd, argc, argv, &args);
+    if (rc >= 0)
+        return rc;
+    const char *name = teapot_command ? "teapot" : args.arg[0];
+    bool teapot = !strcmp(name, "teapot");
+    if (!teapot && strcmp(name, "cornell"))
+        return cli_usage_error(cmd.name, "unknown scene '%s' (cornell or teapot)", name);
+    if (!teapot && cli_given(&cmd, &args, "--level"))
+        return cli_usage_error(cmd.name, "--level is for the teapot");
     if (!out)
-        return cli_usage_error(argv[0], "missing -o FILE.gltf");
+        return cli_usage_error(cmd.name, "missing -o FILE.gltf");
     {
         const char *dot = strrchr(out, '.');
         if (!dot || (strcasecmp(dot, ".gltf") && strcasecmp(dot, ".glb")))
-            return cli_usage_error(argv[0], "-o '%s': expected a .gltf (JSON) or .glb (binary glTF) name", out);
+            return cli_usage_error(cmd.name, "-o '%s': expected a .gltf (JSON) or .glb (binary glTF) name", out);
     }
     if (!util_check_output(out))
         return 1;
-    return (teapot ? write_teapot(out, (int)level) : write_cornell(out)) ? 0 : 1;
+    return (teapot ? write_teapot(out, level) : write_cornell(out)) ? 0 : 1;
 }
 
-int cmd_scene(int argc, char **argv)
-{
-    if (argc >= 2 && (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h"))) {
-        fputs(scene_usage, stdout);
-        return 0;
-    }
-    if (argc < 2 || argv[1][0] == '-')
-        return cli_usage_error(argv[0], "which scene? (cornell or teapot)");
-    return run(argc, argv, 2, argv[1]);
-}
+int cmd_scene(int argc, char **argv) { return run(argc, argv, false); }
 
-int cmd_teapot(int argc, char **argv) { return run(argc, argv, 1, NULL); }
+int cmd_teapot(int argc, char **argv) { return run(argc, argv, true); }
 
 bool cli_load_builtin_scene(scene *out, const char *name)
 {
