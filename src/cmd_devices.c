@@ -1,0 +1,17 @@
+/* cmd_devices.c: `gonio devices`, the Vulkan devices gonio can use. */
+#include "cli.h"
+#include "gpu.h"
+
+int cmd_devices(int argc, char **argv)
+{
+    const cli_command cmd = {
+        .name = "devices",
+        .intro = "Lists the Vulkan devices: index (for --device), name, type, driver, API version.\n"
+                 "Without --device, gonio picks a discrete GPU, then an integrated one, then the CPU\n"
+                 "(lavapipe).\n"};
+    cli_args args;
+    int rc = cli_parse(&cmd, argc, argv, &args);
+    if (rc >= 0)
+        return rc;
+    return gpu_print_devices() ? 0 : 1;
+}
