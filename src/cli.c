@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "image.h"
 #include "util.h"
 
 static char command_line[4096];
@@ -80,15 +81,16 @@ static int take_value(const cli_command *c, const cli_option *o, const char *opt
 int cli_parse(const cli_command *c, int argc, char **argv, cli_args *out)
 {
     bool options = true;
-    assert(c->num_options <= CLI_MAX_OPTIONS && c->max_args <= CLI_MAX_ARGS);
+    assert(c->num_options <= CLI_MAX_OPTIONS);
     memset(out, 0, sizeof *out);
+    out->arg = argv + 1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *eq = a[0] == '-' && a[1] == '-' ? strchr(a, '=') : NULL;
         size_t len = eq ? (size_t)(eq - a) : strlen(a);
         if (!options || a[0] != '-' || !a[1]) {
             if (out->num_args == c->max_args)
                 return cli_usage_error(c->name, "unexpected argument '%s'", a);
-            out->arg[out->num_args++] = a;
+            argv[1 + out->num_args++] = (char *)a; /* never past i: the options read so far */
             continue;
         }
         if (!strcmp(a, "--")) {
@@ -129,6 +131,12 @@ bool cli_given(const cli_command *c, const cli_args *a, const char *name)
     int k = find_option(c, name, strlen(name));
     assert(k >= 0); /* a name the table does not have is a bug */
     return k >= 0 && a->given[k];
+}
+
+bool cli_take_exr_compression(const char *cmd, const char *opt, const char *value, void *dest)
+{
+    (void)cmd, (void)opt;
+    return image_exr_compression_from_name(value, dest);
 }
 
 /* The help column: option names and value, padded to it, then the text. */

@@ -57,7 +57,6 @@ typedef struct cli_option {
 } cli_option;
 
 #define CLI_MAX_OPTIONS 64
-#define CLI_MAX_ARGS 8
 
 typedef struct cli_command {
     const char *name;     /* "render" */
@@ -66,14 +65,15 @@ typedef struct cli_command {
     const cli_option *options;
     int num_options;
     const char *epilog; /* paragraphs after the options; or NULL */
-    int min_args, max_args; /* positional arguments */
+    int min_args, max_args; /* positional arguments; max_args -1: any number */
     const char *missing;    /* the usage error when fewer than min_args: "no scene given" */
 } cli_command;
 #define CLI_OPTIONS(table) (table), (int)(sizeof(table) / sizeof *(table))
 
-/* What cli_parse found: the positional arguments and which options were given. */
+/* What cli_parse found: the positional arguments (in argv, which it reorders as GNU getopt
+ * does: arg = argv + 1) and which options were given. */
 typedef struct cli_args {
-    const char *arg[CLI_MAX_ARGS];
+    char **arg;
     int num_args;
     bool given[CLI_MAX_OPTIONS];
 } cli_args;
@@ -104,6 +104,15 @@ const char *cli_value(int argc, char **argv, int *i);
 const char *cli_option_value(int argc, char **argv, int *i, const char *usage);
 bool cli_usage_lists_value(const char *usage, const char *opt);
 int cli_split_equals(int argc, char **argv, char ***out);
+
+/* EXR output options (render, merge). */
+bool cli_take_exr_compression(const char *cmd, const char *opt, const char *value, void *dest);
+#define CLI_OPT_EXR_HALF(dest)                                                                \
+    {"--half", NULL, "EXR: 16-bit half channels (default 32-bit float)", CLI_FLAG, (dest), 0, 0, NULL, NULL}
+#define CLI_OPT_EXR_COMPRESSION(dest)                                                         \
+    {"--compression", "C", "EXR: none, rle, zips, zip (default), piz, pxr24, b44, b44a",      \
+     CLI_CALL, (dest), 0, 0, "none, rle, zips, zip, piz, pxr24, b44 or b44a",                 \
+     cli_take_exr_compression}
 
 /* "gonio CMD: MESSAGE" and the hint to use --help; returns 2. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);

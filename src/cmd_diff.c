@@ -136,7 +136,7 @@ int cmd_diff(int argc, char **argv)
         return status;
     status = 1;
     if (image_read_exr(&img[0], args.arg[0]) && image_read_exr(&img[1], args.arg[1]))
-        status = diff_images(args.arg, img, channels.names, channels.n, limit, quiet);
+        status = diff_images((const char *const *)args.arg, img, channels.names, channels.n, limit, quiet);
     image_destroy(&img[0]);
     image_destroy(&img[1]);
     return status;

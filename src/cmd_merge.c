@@ -18,32 +18,6 @@
 #include "render_output.h"
 #include "util.h"
 
-static const char merge_usage[] =
-    "usage: gonio merge A.exr B.exr ... -o OUT.exr [--force] [--half] [--compression C]\n"
-    "\n"
-    "Combines renders of the same scene and settings made with different --seed values\n"
-    "into one, weighted by each file's sample count (its gonio:spp header): the result is\n"
-    "exactly the mean of all the samples, with gonio:spp their total. variance.R/G/B\n"
-    "channels are merged exactly too.\n"
-    "\n"
-    "Inputs rendered with --crop are placed by their EXR data windows: tiles assemble into\n"
-    "the frame (or the region they cover), and at every pixel the inputs covering it are\n"
-    "combined; every pixel must get the same number of samples (no holes, no uneven\n"
-    "overlaps). The sum.* channels of --resumable renders are left out.\n"
-    "\n"
-    "The inputs must be one render: the same frame size and channels, and the same gonio:scene\n"
-    "(a hash of the scene's content), gonio:size, gonio:mode, gonio:camera and options of the\n"
-    "mode (gonio:max-depth, gonio:estimator, gonio:env, gonio:shadows, gonio:ambient); each\n"
-    "gonio:spp a positive integer, their total at most 2147483647. Anything else is an error\n"
-    "naming both files and the field (exit 1, no output). A seed used twice in inputs that\n"
-    "overlap is an error too (its samples repeat and add nothing) unless --force. The output\n"
-    "records every seed in gonio:seeds, so merged files merge again.\n"
-    "\n"
-    "  -o, --output FILE   the merged OpenEXR (a .exr name; written atomically)\n"
-    "  --force             merge inputs that share a seed\n"
-    "  --half              16-bit half channels (default 32-bit float)\n"
-    "  --compression C     none, rle, zips, zip (default), piz, pxr24, b44, b44a\n";
-
 /* The channel whose mean a variance channel describes ("variance.R" -> "R"), or NULL. */
 static const char *variance_of(const char *name)
 {
@@ -167,46 +141,55 @@ static bool same_render(const char *a, const char *b)
     return true;
 }
 
+#define MERGE_INTRO \
+    "Combines renders of the same scene and settings made with different --seed values\n" \
+    "into one, weighted by each file's sample count (its gonio:spp header): the result is\n" \
+    "exactly the mean of all the samples, with gonio:spp their total. variance.R/G/B\n" \
+    "channels are merged exactly too.\n" \
+    "\n" \
+    "Inputs rendered with --crop are placed by their EXR data windows: tiles assemble into\n" \
+    "the frame (or the region they cover), and at every pixel the inputs covering it are\n" \
+    "combined; every pixel must get the same number of samples (no holes, no uneven\n" \
+    "overlaps). The sum.* channels of --resumable renders are left out.\n" \
+    "\n" \
+    "The inputs must be one render: the same frame size and channels, and the same gonio:scene\n" \
+    "(a hash of the scene's content), gonio:size, gonio:mode, gonio:camera and options of the\n" \
+    "mode (gonio:max-depth, gonio:estimator, gonio:env, gonio:shadows, gonio:ambient); each\n" \
+    "gonio:spp a positive integer, their total at most 2147483647. Anything else is an error\n" \
+    "naming both files and the field (exit 1, no output). A seed used twice in inputs that\n" \
+    "overlap is an error too (its samples repeat and add nothing) unless --force. The output\n" \
+    "records every seed in gonio:seeds, so merged files merge again.\n"
+
 int cmd_merge(int argc, char **argv)
 {
-    const char *out_path = NULL, **inputs = util_calloc((size_t)argc, sizeof *inputs);
-    int n = 0, rc = 1;
+    const char *out_path = NULL, **inputs;
+    int n, rc = 1;
     bool force = false;
     image *imgs = NULL, out = {0};
     image_exr_options exr = IMAGE_EXR_DEFAULTS;
+    const cli_option options[] = {
+        {"-o, --output", "FILE", "the merged OpenEXR (a .exr name; written atomically)", CLI_STRING, &out_path,
+         0, 0, NULL, NULL},
+        {"--force", NULL, "merge inputs that share a seed", CLI_FLAG, &force, 0, 0, NULL, NULL},
+        CLI_OPT_EXR_HALF(&exr.half),
+        CLI_OPT_EXR_COMPRESSION(&exr.compression),
+    };
+    const cli_command cmd = {
+        .name = "merge", .synopsis = "A.exr B.exr ... -o OUT.exr [--force] [--half] [--compression C]",
+        .intro = MERGE_INTRO, CLI_OPTIONS(options), .max_args = -1};
+    cli_args args;
+    if ((rc = cli_parse(&cmd, argc, argv, &args)) >= 0)
+        return rc;
+    rc = 1;
+    n = args.num_args;
+    inputs = util_calloc((size_t)n + 1, sizeof *inputs);
     int64_t *spp = NULL, total = 0;
     double seconds = 0;
     seed_list seeds = {.complete = true};
     char *seed_text = NULL;
 
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *val;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            fputs(merge_usage, stdout);
-            free(inputs);
-            return 0;
-        } else if (!strcmp(a, "--force")) {
-            force = true;
-        } else if (!strcmp(a, "--half")) {
-            exr.half = true;
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            if (!(out_path = cli_value(argc, argv, &i))) {
-                free(inputs);
-                return 2;
-            }
-        } else if (!strcmp(a, "--compression")) {
-            if (!(val = cli_value(argc, argv, &i)) || !image_exr_compression_from_name(val, &exr.compression)) {
-                free(inputs);
-                return val ? cli_usage_error("merge", "--compression '%s': expected none, rle, zips, zip, "
-                                             "piz, pxr24, b44 or b44a", val) : 2;
-            }
-        } else if (a[0] == '-' && a[1]) {
-            free(inputs);
-            return cli_usage_error("merge", "unknown option '%s'", a);
-        } else {
-            inputs[n++] = a;
-        }
-    }
+    for (int i = 0; i < n; i++)
+        inputs[i] = args.arg[i];
     if (!out_path || n < 1) {
         free(inputs);
         return cli_usage_error("merge", out_path ? "no input files" : "no output given (-o OUT.exr)");
