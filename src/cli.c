@@ -133,6 +133,13 @@ bool cli_given(const cli_command *c, const cli_args *a, const char *name)
     return k >= 0 && a->given[k];
 }
 
+bool cli_take_size(const char *cmd, const char *opt, const char *value, void *dest)
+{
+    (void)cmd, (void)opt;
+    int *wh = dest;
+    return util_parse_size(value, &wh[0], &wh[1]);
+}
+
 bool cli_take_exr_compression(const char *cmd, const char *opt, const char *value, void *dest)
 {
     (void)cmd, (void)opt;
@@ -158,7 +165,7 @@ void cli_help(const cli_command *c, FILE *f)
         int w = fprintf(f, "  %s%s%s", o->names, o->value ? " " : "", o->value ? o->value : "");
         for (const char *line = o->help; *line;) {
             size_t l = strcspn(line, "\n");
-            fprintf(f, "%*s%.*s\n", w < HELP_COLUMN ? HELP_COLUMN - w : 2, "", (int)l, line);
+            fprintf(f, "%*s%.*s\n", w + 2 <= HELP_COLUMN ? HELP_COLUMN - w : 2, "", (int)l, line);
             line += l + (line[l] == '\n');
             w = 0;
         }

@@ -105,6 +105,9 @@ const char *cli_option_value(int argc, char **argv, int *i, const char *usage);
 bool cli_usage_lists_value(const char *usage, const char *opt);
 int cli_split_equals(int argc, char **argv, char ***out);
 
+/* CLI_CALL parsers of values several commands take. */
+bool cli_take_size(const char *cmd, const char *opt, const char *value, void *dest); /* WxH: int[2] */
+
 /* EXR output options (render, merge). */
 bool cli_take_exr_compression(const char *cmd, const char *opt, const char *value, void *dest);
 #define CLI_OPT_EXR_HALF(dest)                                                                \

@@ -1,6 +1,7 @@
 /* cmd_bench.c: `gonio bench`: BVH build rate, primary and diffuse-bounce ray throughput
  * of the GLSL traversal, the time from start to the first finished pixel, and (--paths)
  * the path tracer's paths per second and time to reach an RMSE against a reference. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,30 +17,7 @@
 #include "scene_mesh.h"
 #include "util.h"
 
-static const char bench_usage[] =
-    "usage: gonio bench [SCENE.gltf | --generate N] [options]\n"
-    "\n"
-    "Prints the BVH build time (best of 3), the time from start to the first finished\n"
-    "pixel (load, build, upload, shader compile, one pass), and the throughput of\n"
-    "primary (camera) rays and diffuse bounce rays (cosine-distributed from the primary\n"
-    "hits) through the GPU traversal. Default scene: the Cornell box (gonio scene cornell).\n"
-    "\n"
-    "With --paths, the path tracer instead (--mode path: unbounded depth, MIS): the time to\n"
-    "the first finished path pass, paths per second, and the time and spp at which a\n"
-    "progressive render's RMSE (linear RGB) against a high-spp reference (with the\n"
-    "reference's own estimated noise removed) first falls below 0.05 and 0.02 (times count\n"
-    "the passes, not the RMSE checks).\n"
-    "\n"
-    "  --generate N     a procedural mesh of about N triangles (1000..50000000) instead of a scene\n"
-    "  --size WxH       rays per pass (default 512x512; --paths: 256x256)\n"
-    "  --seconds S      measure each rate for about S seconds (default 3)\n"
-    "  --paths          measure the path tracer\n"
-    "  --env V          --paths: constant environment radiance (default 0)\n"
-    "  --reference WxH:SPP  --paths: the RMSE reference (default 128x128:512)\n"
-    "  --device N       Vulkan device index\n"
-    "  --validate       enable the Vulkan validation layer\n";
-
-static bool build_scene(scene *sc, const char *path, long generate)
+static bool build_scene(scene *sc, const char *path, int generate)
 {
     meshgen_mesh m;
     if (!generate)
@@ -184,14 +162,68 @@ static bool bench_paths(renderer *r, render_settings *s, double t_start, float s
     return true;
 }
 
+typedef struct reference_option {
+    int *w, *h, *spp;
+} reference_option;
+
+/* --reference WxH:SPP */
+static bool take_reference(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    (void)cmd, (void)opt;
+    reference_option *r = dest;
+    char size[64];
+    long v;
+    const char *colon = strchr(val, ':');
+    if (!colon || colon - val >= (long)sizeof size)
+        return false;
+    snprintf(size, sizeof size, "%.*s", (int)(colon - val), val);
+    if (!util_parse_size(size, r->w, r->h) || !util_parse_int(colon + 1, 1, 1 << 20, &v))
+        return false;
+    *r->spp = (int)v;
+    return true;
+}
+
 int cmd_bench(int argc, char **argv)
 {
     const double t_start = util_now();
     const char *path = NULL; /* the built-in Cornell box */
-    long generate = 0, v;
+    int generate = 0;
     float seconds = 3, env = 0;
-    int device = -1, w = 0, h = 0, ref_w = 128, ref_h = 128, ref_spp = 512;
+    int device = -1, size[2] = {0, 0}, ref_w = 128, ref_h = 128, ref_spp = 512;
     bool validate = false, paths = false;
+    reference_option ref = {&ref_w, &ref_h, &ref_spp};
+    const cli_option options[] = {
+        /* meshgen_bench_mesh's 16 spheres and ground need about 1000 triangles. */
+        {"--generate", "N", "a procedural mesh of about N triangles (1000..50000000) instead of a scene",
+         CLI_INT, &generate, 1000, 50000000, "a triangle count 1000..50000000", NULL},
+        {"--size", "WxH", "rays per pass (default 512x512; --paths: 256x256)", CLI_CALL, size, 0, 0,
+         "WxH", cli_take_size},
+        {"--seconds", "S", "measure each rate for about S seconds (default 3)", CLI_FLOAT, &seconds,
+         FLT_MIN, 1e6, "a number > 0", NULL},
+        {"--paths", NULL, "measure the path tracer", CLI_FLAG, &paths, 0, 0, NULL, NULL},
+        {"--env", "V", "--paths: constant environment radiance (default 0)", CLI_FLOAT, &env, 0, 3e38,
+         "a radiance >= 0", NULL},
+        {"--reference", "WxH:SPP", "--paths: the RMSE reference (default 128x128:512)", CLI_CALL, &ref,
+         0, 0, "WxH:SPP", take_reference},
+        CLI_OPT_DEVICE(&device),
+        CLI_OPT_VALIDATE(&validate),
+    };
+    const cli_command command = {
+        .name = "bench", .synopsis = "[SCENE.gltf | --generate N] [options]",
+        .intro =
+            "Prints the BVH build time (best of 3), the time from start to the first finished\n"
+            "pixel (load, build, upload, shader compile, one pass), and the throughput of\n"
+            "primary (camera) rays and diffuse bounce rays (cosine-distributed from the primary\n"
+            "hits) through the GPU traversal. Default scene: the Cornell box (gonio scene cornell).\n"
+            "\n"
+            "With --paths, the path tracer instead (--mode path: unbounded depth, MIS): the time to\n"
+            "the first finished path pass, paths per second, and the time and spp at which a\n"
+            "progressive render's RMSE (linear RGB) against a high-spp reference (with the\n"
+            "reference's own estimated noise removed) first falls below 0.05 and 0.02 (times count\n"
+            "the passes, not the RMSE checks).\n",
+        CLI_OPTIONS(options), .max_args = 1};
+    cli_args args;
+    int rc;
     scene sc = {0};
     gpu g = {0};
     renderer r = {0};
@@ -203,51 +235,11 @@ int cmd_bench(int argc, char **argv)
     uint64_t n_primary = 0, n_diffuse = 0;
     int passes = 0;
 
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *val;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            fputs(bench_usage, stdout);
-            return 0;
-        } else if (!strcmp(a, "--validate")) {
-            validate = true;
-        } else if (!strcmp(a, "--paths")) {
-            paths = true;
-        } else if (a[0] == '-' && a[1]) {
-            if (!(val = cli_option_value(argc, argv, &i, bench_usage)))
-                return 2;
-            if (!strcmp(a, "--generate")) {
-                /* meshgen_bench_mesh's 16 spheres and ground need about 1000 triangles. */
-                if (!util_parse_int(val, 1000, 50000000, &generate))
-                    return cli_usage_error("bench", "--generate '%s': expected a triangle count 1000..50000000", val);
-            } else if (!strcmp(a, "--size")) {
-                if (!util_parse_size(val, &w, &h))
-                    return cli_usage_error("bench", "--size '%s': expected WxH", val);
-            } else if (!strcmp(a, "--seconds")) {
-                if (!util_parse_float(val, &seconds) || seconds <= 0)
-                    return cli_usage_error("bench", "--seconds '%s': expected a number > 0", val);
-            } else if (!strcmp(a, "--env")) {
-                if (!util_parse_float(val, &env) || !(env >= 0))
-                    return cli_usage_error("bench", "--env '%s': expected a radiance >= 0", val);
-            } else if (!strcmp(a, "--reference")) {
-                char size[64];
-                const char *colon = strchr(val, ':');
-                if (!colon || colon - val >= (long)sizeof size ||
-                    !(snprintf(size, sizeof size, "%.*s", (int)(colon - val), val),
-                      util_parse_size(size, &ref_w, &ref_h)) ||
-                    !util_parse_int(colon + 1, 1, 1 << 20, &v))
-                    return cli_usage_error("bench", "--reference '%s': expected WxH:SPP", val);
-                ref_spp = (int)v;
-            } else if (!strcmp(a, "--device")) {
-                if (!util_parse_int(val, 0, 64, &v))
-                    return cli_usage_error("bench", "--device '%s': expected an index", val);
-                device = (int)v;
-            } else {
-                return cli_usage_error("bench", "unknown option '%s'", a);
-            }
-        } else {
-            path = a;
-        }
-    }
+    if ((rc = cli_parse(&command, argc, argv, &args)) >= 0)
+        return rc;
+    if (args.num_args)
+        path = args.arg[0];
+    int w = size[0], h = size[1];
 
     if (!build_scene(&sc, path, generate))
         return 1;
