@@ -258,3 +258,8 @@ void camera_frame_string(const scene_camera *c, char *buf, size_t cap)
             n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, "%s%.9g", n ? "," : "", v[i][k]);
     snprintf(buf + n, n < cap ? cap - n : 0, ",%.9g,%.9g,%.9g", c->znear, c->zfar, c->yfov);
 }
+
+bool camera_take_option(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    return camera_parse_option((camera_option *)dest, cmd, opt, val) == 1;
+}

@@ -8,6 +8,8 @@
 
 #include "cli.h"
 #include "image.h"
+#include "render.h"
+#include "scene.h"
 #include "util.h"
 
 static char command_line[4096];
@@ -65,9 +67,13 @@ static int take_value(const cli_command *c, const cli_option *o, const char *opt
             *(uint32_t *)o->dest = (uint32_t)v;
         return -1;
     case CLI_FLOAT:
+    case CLI_DOUBLE:
         if (!util_parse_float(val, &f) || !(f >= o->min && f <= o->max))
             return bad_value(c, opt, val, o->expect);
-        *(float *)o->dest = f;
+        if (o->kind == CLI_FLOAT)
+            *(float *)o->dest = f;
+        else
+            *(double *)o->dest = f;
         return -1;
     case CLI_CALL:
         if (o->call(c->name, opt, val, o->dest))
@@ -140,6 +146,30 @@ bool cli_take_size(const char *cmd, const char *opt, const char *value, void *de
     return util_parse_size(value, &wh[0], &wh[1]);
 }
 
+bool cli_take_mode(const char *cmd, const char *opt, const char *value, void *dest)
+{
+    int m = render_mode_from_name(value);
+    if (m < 0) {
+        cli_usage_error(cmd, "%s '%s': expected one of %s", opt, value, render_mode_list());
+        return false;
+    }
+    *(uint32_t *)dest = (uint32_t)m;
+    return true;
+}
+
+bool cli_take_tonemap(const char *cmd, const char *opt, const char *value, void *dest)
+{
+    (void)cmd, (void)opt;
+    return image_tonemap_from_name(value, dest);
+}
+
+bool cli_take_variant(const char *cmd, const char *opt, const char *value, void *dest)
+{
+    (void)cmd, (void)opt, (void)dest;
+    scene_select_variant(value);
+    return true;
+}
+
 bool cli_take_exr_compression(const char *cmd, const char *opt, const char *value, void *dest)
 {
     (void)cmd, (void)opt;
@@ -203,81 +233,3 @@ bool cli_gpu_finish(gpu *g)
     }
     return true;
 }
-
-/* Does the usage text list `opt` as an option that takes a value? An option line starts
- * (after indentation) with the option's names, ", " between aliases, and then one space and
- * its value's name ("  --spp N   ...", "  -o, --output FILE   ..."); a flag's names are
- * followed by two or more spaces or the line's end. The usage text is thus the one list of a
- * command's options: what --help shows is what the command accepts. */
-bool cli_usage_lists_value(const char *usage, const char *opt)
-{
-    size_t len = strlen(opt);
-    for (const char *line = usage; *line; line = strchr(line, '\n') ? strchr(line, '\n') + 1 : "") {
-        const char *p = line;
-        bool named = false;
-        while (*p == ' ')
-            p++;
-        while (*p == '-') {
-            const char *name = p;
-            while (*p && *p != ' ' && *p != ',' && *p != '\n')
-                p++;
-            named |= (size_t)(p - name) == len && !strncmp(name, opt, len);
-            if (p[0] != ',' || p[1] != ' ' || p[2] != '-')
-                break;
-            p += 2;
-        }
-        if (named)
-            return p[0] == ' ' && p[1] && p[1] != ' ' && p[1] != '\n';
-    }
-    return false;
-}
-
-const char *cli_option_value(int argc, char **argv, int *i, const char *usage)
-{
-    if (!cli_usage_lists_value(usage, argv[*i])) {
-        cli_usage_error(argv[0], "unknown option '%s'", argv[*i]);
-        return NULL;
-    }
-    return cli_value(argc, argv, i);
-}
-
-/* Options that never take a value, in every command: "--quiet=yes" is an error, not
- * "--quiet" followed by an argument "yes". */
-static const char *const flags[] = {"--help", "--quiet", "--validate", "--no-shadows", "--paths",
-                                    "--albedo", "--sphere", "--list", "--version"};
-
-int cli_split_equals(int argc, char **argv, char ***out)
-{
-    int n = 0;
-    char **v = util_calloc((size_t)argc * 2 + 1, sizeof *v);
-    for (int i = 0; i < argc; i++) {
-        char *a = argv[i], *eq = strchr(a, '=');
-        if (i >= 2 && a[0] == '-' && a[1] == '-' && a[2] && eq && eq > a + 2) {
-            size_t len = (size_t)(eq - a);
-            for (size_t k = 0; k < sizeof flags / sizeof *flags; k++)
-                if (strlen(flags[k]) == len && !strncmp(a, flags[k], len)) {
-                    free(v);
-                    cli_usage_error(argv[1], "%.*s takes no value", (int)len, a);
-                    return -1;
-                }
-            v[n] = util_malloc(len + 1);
-            memcpy(v[n], a, len);
-            v[n++][len] = 0;
-            v[n++] = eq + 1;
-        } else {
-            v[n++] = a;
-        }
-    }
-    *out = v;
-    return n;
-}
-
-const char *cli_value(int argc, char **argv, int *i)
-{
-    if (*i + 1 >= argc) {
-        cli_usage_error(argv[0], "%s needs a value", argv[*i]);
-        return NULL;
-    }
-    return argv[++*i];
-}
-

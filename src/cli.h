@@ -40,6 +40,7 @@ typedef enum cli_kind {
     CLI_INT,    /* int *dest: an integer in [min, max] */
     CLI_U32,    /* uint32_t *dest: an integer in [min, max] */
     CLI_FLOAT,  /* float *dest: a finite number in [min, max] */
+    CLI_DOUBLE, /* double *dest: as CLI_FLOAT (read at float precision) */
     CLI_CALL,   /* call(cmd, option, value, dest): false = usage error (printed by cli_parse
                  * with `expect` when set, else by call) */
     CLI_TEXT,   /* no option: `help` is printed as it is, in the options' place */
@@ -51,7 +52,7 @@ typedef struct cli_option {
     const char *help;  /* beside the names; further lines ('\n') under the first */
     cli_kind kind;
     void *dest;
-    double min, max;    /* CLI_INT, CLI_U32, CLI_FLOAT */
+    double min, max;    /* CLI_INT, CLI_U32, CLI_FLOAT, CLI_DOUBLE */
     const char *expect; /* what a bad value should have been: "an integer 1..16777216" */
     bool (*call)(const char *cmd, const char *opt, const char *value, void *dest);
 } cli_option;
@@ -68,7 +69,10 @@ typedef struct cli_command {
     int min_args, max_args; /* positional arguments; max_args -1: any number */
     const char *missing;    /* the usage error when fewer than min_args: "no scene given" */
 } cli_command;
-#define CLI_OPTIONS(table) (table), (int)(sizeof(table) / sizeof *(table))
+/* A destination of the type its kind writes, or a compile error (the table's void * would
+ * take any pointer): CLI_AS(float, &x). */
+#define CLI_AS(type, p) _Generic((p), type *: (p))
+#define CLI_OPTIONS(table) .options = (table), .num_options = (int)(sizeof(table) / sizeof *(table))
 
 /* What cli_parse found: the positional arguments (in argv, which it reorders as GNU getopt
  * does: arg = argv + 1) and which options were given. */
@@ -87,31 +91,28 @@ void cli_help(const cli_command *c, FILE *f);
 
 /* Options every command that uses a device has, defined once. */
 #define CLI_OPT_DEVICE(dest)                                                                  \
-    {"--device", "N", "Vulkan device index (see gonio devices)", CLI_INT, (dest), 0, 64,    \
+    {"--device", "N", "Vulkan device index (see gonio devices)", CLI_INT, CLI_AS(int, dest), 0, 64, \
      "an index (see gonio devices)", NULL}
 #define CLI_OPT_VALIDATE(dest)                                                                \
     {"--validate", NULL, "enable the Vulkan validation layer; any message is an error",     \
-     CLI_FLAG, (dest), 0, 0, NULL, NULL}
+     CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL}
 #define CLI_OPT_QUIET(dest, what)                                                             \
-    {"-q, --quiet", NULL, what, CLI_FLAG, (dest), 0, 0, NULL, NULL}
+    {"-q, --quiet", NULL, what, CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL}
 #define CLI_OPT_ALLOW_OUTSIDE_FILES(dest)                                                     \
     {"--allow-outside-files", NULL,                                                           \
      "let the scene read files outside its folder (default: only\nregular files under it)",  \
-     CLI_FLAG, (dest), 0, 0, NULL, NULL}
-
-/* LEGACY (removed when every command uses cli_parse) */
-const char *cli_value(int argc, char **argv, int *i);
-const char *cli_option_value(int argc, char **argv, int *i, const char *usage);
-bool cli_usage_lists_value(const char *usage, const char *opt);
-int cli_split_equals(int argc, char **argv, char ***out);
+     CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL}
 
 /* CLI_CALL parsers of values several commands take. */
 bool cli_take_size(const char *cmd, const char *opt, const char *value, void *dest); /* WxH: int[2] */
+bool cli_take_mode(const char *cmd, const char *opt, const char *value, void *dest); /* uint32_t GN_MODE_* */
+bool cli_take_tonemap(const char *cmd, const char *opt, const char *value, void *dest); /* image_tonemap */
+bool cli_take_variant(const char *cmd, const char *opt, const char *value, void *dest); /* no dest: scene_select_variant */
 
 /* EXR output options (render, merge). */
 bool cli_take_exr_compression(const char *cmd, const char *opt, const char *value, void *dest);
 #define CLI_OPT_EXR_HALF(dest)                                                                \
-    {"--half", NULL, "EXR: 16-bit half channels (default 32-bit float)", CLI_FLAG, (dest), 0, 0, NULL, NULL}
+    {"--half", NULL, "EXR: 16-bit half channels (default 32-bit float)", CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL}
 #define CLI_OPT_EXR_COMPRESSION(dest)                                                         \
     {"--compression", "C", "EXR: none, rle, zips, zip (default), piz, pxr24, b44, b44a",      \
      CLI_CALL, (dest), 0, 0, "none, rle, zips, zip, piz, pxr24, b44 or b44a",                 \

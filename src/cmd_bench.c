@@ -195,13 +195,13 @@ int cmd_bench(int argc, char **argv)
     const cli_option options[] = {
         /* meshgen_bench_mesh's 16 spheres and ground need about 1000 triangles. */
         {"--generate", "N", "a procedural mesh of about N triangles (1000..50000000) instead of a scene",
-         CLI_INT, &generate, 1000, 50000000, "a triangle count 1000..50000000", NULL},
+         CLI_INT, CLI_AS(int, &generate), 1000, 50000000, "a triangle count 1000..50000000", NULL},
         {"--size", "WxH", "rays per pass (default 512x512; --paths: 256x256)", CLI_CALL, size, 0, 0,
          "WxH", cli_take_size},
-        {"--seconds", "S", "measure each rate for about S seconds (default 3)", CLI_FLOAT, &seconds,
+        {"--seconds", "S", "measure each rate for about S seconds (default 3)", CLI_FLOAT, CLI_AS(float, &seconds),
          FLT_MIN, 1e6, "a number > 0", NULL},
-        {"--paths", NULL, "measure the path tracer", CLI_FLAG, &paths, 0, 0, NULL, NULL},
-        {"--env", "V", "--paths: constant environment radiance (default 0)", CLI_FLOAT, &env, 0, 3e38,
+        {"--paths", NULL, "measure the path tracer", CLI_FLAG, CLI_AS(bool, &paths), 0, 0, NULL, NULL},
+        {"--env", "V", "--paths: constant environment radiance (default 0)", CLI_FLOAT, CLI_AS(float, &env), 0, 3e38,
          "a radiance >= 0", NULL},
         {"--reference", "WxH:SPP", "--paths: the RMSE reference (default 128x128:512)", CLI_CALL, &ref,
          0, 0, "WxH:SPP", take_reference},

@@ -16,31 +16,18 @@
 #include "util.h"
 
 
-static const char usage[] =
-    "usage: gonio brdf --list\n"
-    "       gonio brdf MODEL [--PARAM VALUE ...] [--theta DEG] -o LOBE.png [--size WxH]\n"
-    "       gonio brdf MODEL [--PARAM VALUE ...] --albedo\n"
-    "       gonio brdf MODEL [--PARAM VALUE ...] --sphere -o BALL.exr|BALL.png [--png BALL.png]\n"
-    "                  [--size WxH] [--spp N]\n"
-    "\n"
-    "  --list          the models, one a line: name, then each parameter=default\n"
-    "  --PARAM VALUE   a model parameter (see --list); colours as R,G,B or one value\n"
-    "  --theta DEG     lobe plot: incident (light) direction, degrees from the normal\n"
-    "                  (default 30); the curve is f(wi, wo) for wo in the plane of incidence\n"
-    "  --albedo        print 'theta_deg albedo_r albedo_g albedo_b' for theta = 0, 5, ..., 85, 89:\n"
-    "                  the directional albedo (reflected + transmitted fraction) of light from theta\n"
-    "  --sphere        render a unit sphere of the material: directional light + constant sky\n"
-    "  -o, --output FILE  the lobe plot: a .png; the sphere: a .exr (linear float OpenEXR) or\n"
-    "                  a .png (sRGB, clamped); any other name is a usage error\n"
-    "  --png FILE      sphere: also a PNG (sRGB, clamped)\n"
-    "  --size WxH      image size (lobe default 560x360, 560x560 with transmission; sphere 256x256)\n"
-    "  --spp N         sphere: samples per pixel (default 64)\n"
-    "  --device N      Vulkan device index (see gonio devices)\n"
-    "  --validate      enable the Vulkan validation layer\n";
-
 static int bad_usage(const char *fmt, const char *arg)
 {
     return cli_usage_error("brdf", fmt, arg);
+}
+
+/* The options before the model's parameters in cmd_brdf's table. */
+#define BRDF_FIXED_OPTIONS 11
+
+static bool take_param(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    (void)cmd;
+    return brdf_setting_set(dest, opt + 2, val);
 }
 
 static double luminance(vec3 c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
@@ -383,22 +370,67 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
 
 int cmd_brdf(int argc, char **argv)
 {
-    const brdf_model *m;
+    const brdf_model *m = NULL;
     brdf_setting s;
     const char *out = NULL, *png = NULL;
-    double theta = 30;
-    bool albedo = false, sphere = false, validate = false;
-    int w = 0, h = 0, spp = 64, device = -1, rc;
-    long lv;
+    float theta = 30;
+    bool albedo = false, sphere = false, validate = false, list = false;
+    int size[2] = {0, 0}, spp = 64, device = -1, rc;
     gpu g;
     brdf_runner r;
-    if (argc < 2)
-        return bad_usage("%s", "a model name or --list is needed");
-    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
-        fputs(usage, stdout);
-        return 0;
+    /* The model comes first: its parameters are options too. */
+    if (argc >= 2 && argv[1][0] != '-') {
+        if (!(m = brdf_model_find(argv[1])))
+            return 2;
+        brdf_setting_init(&s, m);
     }
-    if (!strcmp(argv[1], "--list")) {
+    cli_option options[BRDF_FIXED_OPTIONS + BRDF_MAX_PARAMS] = {
+        {"--list", NULL, "the models, one a line: name, then each parameter=default", CLI_FLAG, CLI_AS(bool, &list), 0, 0,
+         NULL, NULL},
+        {NULL, NULL, "  --PARAM VALUE       a model parameter (see --list); colours as R,G,B or one value\n",
+         CLI_TEXT, NULL, 0, 0, NULL, NULL},
+        {"--theta", "DEG", "lobe plot: incident (light) direction, degrees from the normal\n"
+                           "(default 30); the curve is f(wi, wo) for wo in the plane of incidence",
+         CLI_FLOAT, CLI_AS(float, &theta), 0, 90, "degrees in [0, 90]", NULL},
+        {"--albedo", NULL, "print 'theta_deg albedo_r albedo_g albedo_b' for theta = 0, 5, ...,\n"
+                           "85, 89: the directional albedo (reflected + transmitted fraction)\n"
+                           "of light from theta",
+         CLI_FLAG, CLI_AS(bool, &albedo), 0, 0, NULL, NULL},
+        {"--sphere", NULL, "render a unit sphere of the material: directional light + constant sky",
+         CLI_FLAG, CLI_AS(bool, &sphere), 0, 0, NULL, NULL},
+        {"-o, --output", "FILE", "the lobe plot: a .png; the sphere: a .exr (linear float OpenEXR)\n"
+                                 "or a .png (sRGB, clamped); any other name is a usage error",
+         CLI_STRING, CLI_AS(const char *, &out), 0, 0, NULL, NULL},
+        {"--png", "FILE", "sphere: also a PNG (sRGB, clamped)", CLI_STRING, CLI_AS(const char *, &png), 0, 0, NULL, NULL},
+        {"--size", "WxH", "image size (lobe default 560x360, 560x560 with transmission;\n"
+                          "sphere 256x256)",
+         CLI_CALL, size, 0, 0, "WxH (1..16384 each)", cli_take_size},
+        {"--spp", "N", "sphere: samples per pixel (default 64)", CLI_INT, CLI_AS(int, &spp), 1, 1 << 20,
+         "a count in [1, 1048576]", NULL},
+        CLI_OPT_DEVICE(&device),
+        CLI_OPT_VALIDATE(&validate),
+    };
+    char names[BRDF_MAX_PARAMS][48], help[BRDF_MAX_PARAMS][64];
+    int n = BRDF_FIXED_OPTIONS;
+    for (int i = 0; m && i < m->num_params; i++) { /* the model's parameters */
+        const brdf_param *p = &m->params[i];
+        snprintf(names[i], sizeof names[i], "--%s", p->name);
+        snprintf(help[i], sizeof help[i], "%s: in [%g, %g] (default %g)", m->name, p->min, p->max, p->def[0]);
+        options[n++] = (cli_option){names[i], p->count == 3 ? "R,G,B" : "V", help[i], CLI_CALL, &s, 0, 0, NULL,
+                                    take_param};
+    }
+    const cli_command command = {
+        .name = "brdf",
+        .synopsis = "--list\n"
+                    "       gonio brdf MODEL [--PARAM VALUE ...] [--theta DEG] -o LOBE.png [--size WxH]\n"
+                    "       gonio brdf MODEL [--PARAM VALUE ...] --albedo\n"
+                    "       gonio brdf MODEL [--PARAM VALUE ...] --sphere -o BALL.exr|BALL.png [--png BALL.png]\n"
+                    "                  [--size WxH] [--spp N]",
+        .options = options, .num_options = n, .max_args = m ? 1 : 0};
+    cli_args args;
+    if ((rc = cli_parse(&command, argc, argv, &args)) >= 0)
+        return rc;
+    if (list) {
         for (int i = 0; i < brdf_num_models; i++) {
             char line[256];
             brdf_setting_init(&s, &brdf_models[i]);
@@ -407,50 +439,9 @@ int cmd_brdf(int argc, char **argv)
         }
         return 0;
     }
-    if (!(m = brdf_model_find(argv[1])))
-        return 2;
-    brdf_setting_init(&s, m);
-    for (int i = 2; i < argc; i++) {
-        const char *a = argv[i], *v;
-        if (!strcmp(a, "--albedo")) {
-            albedo = true;
-        } else if (!strcmp(a, "--sphere")) {
-            sphere = true;
-        } else if (!strcmp(a, "--validate")) {
-            validate = true;
-        } else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            fputs(usage, stdout);
-            return 0;
-        } else if (strncmp(a, "--", 2) && strcmp(a, "-o")) {
-            return bad_usage("unexpected argument '%s'", a);
-        } else if (!cli_usage_lists_value(usage, a) && !brdf_param_find(m, a + 2)) {
-            return bad_usage("unknown option '%s' (gonio brdf --list: the models' parameters)", a);
-        } else if (!(v = cli_value(argc, argv, &i))) {
-            return 2;
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            out = v;
-        } else if (!strcmp(a, "--png")) {
-            png = v;
-        } else if (!strcmp(a, "--theta")) {
-            float t;
-            if (!util_parse_float(v, &t) || t < 0 || t > 90)
-                return bad_usage("--theta needs degrees in [0, 90], not '%s'", v);
-            theta = t;
-        } else if (!strcmp(a, "--size")) {
-            if (!util_parse_size(v, &w, &h))
-                return bad_usage("--size needs WxH (1..16384 each), not '%s'", v);
-        } else if (!strcmp(a, "--spp")) {
-            if (!util_parse_int(v, 1, 1 << 20, &lv))
-                return bad_usage("--spp needs a count in [1, 1048576], not '%s'", v);
-            spp = (int)lv;
-        } else if (!strcmp(a, "--device")) {
-            if (!util_parse_int(v, 0, 64, &lv))
-                return bad_usage("--device needs an index, not '%s'", v);
-            device = (int)lv;
-        } else if (!brdf_setting_set(&s, a + 2, v)) {
-            return 2;
-        }
-    }
+    if (!m)
+        return bad_usage("%s", "a model name or --list is needed");
+    int w = size[0], h = size[1];
     if (albedo + sphere > 1)
         return bad_usage("%s", "--albedo and --sphere are separate modes: give one");
     if (!albedo && !out)

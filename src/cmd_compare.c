@@ -29,33 +29,6 @@
 #define COMPARE_GAP 4          /* pixels between the tiles of the side-by-side image */
 #define COMPARE_PERCENTILE 0.99 /* heat maps saturate at this quantile of the errors */
 
-static const char usage[] =
-    "usage: gonio compare SCENE.gltf -o DIR [options]\n"
-    "       gonio compare --sweep LEVELS teapot -o DIR [options]\n"
-    "\n"
-    "Renders a scene with flat, Gouraud and per-pixel Phong shading (the Phong reflection\n"
-    "model of the lecture) and path-traced, and writes into DIR:\n"
-    "  MODE.exr, MODE.png        each mode's image (linear float EXR; sRGB PNG, clamped)\n"
-    "  side-by-side.png          the PNGs in a row, labelled with the mode and its RMSE\n"
-    "  diff-A-vs-B.png           heat map of |A - B| (mean over R, G, B, viridis; the legend\n"
-    "                            gives the scale) for each mode against phong and path\n"
-    "  metrics.csv               mode,reference,rmse,rel_bias,max_err (also printed)\n"
-    "With --sweep, renders the teapot at each tessellation level (e.g. 1,2,4,8,16,32) and\n"
-    "writes sweep.csv (flat's and Gouraud's error against per-pixel Phong shading, by\n"
-    "triangle count) and sweep.png (the plot, log-log).\n"
-    "\n"
-    "  -o, --output DIR    output directory (created if missing)\n"
-    "  --sweep LEVELS      the teapot at these tessellation levels (see above)\n"
-    "  --modes LIST        any of flat,gouraud,phong,path (default all four; phong and path\n"
-    "                      are the references); path is skipped when not available\n"
-    "  --spp N             path tracer samples per pixel (default 64); the local modes take\n"
-    "                      min(N, 16), which only anti-aliases them\n"
-    "  --size WxH          image size (default 320 wide, the camera's aspect)\n"
-    CAMERA_OPTIONS_HELP
-    "  --device N          Vulkan device index (see gonio devices)\n"
-    "  --validate          enable the Vulkan validation layer; any message fails\n"
-    "  --quiet             no progress and no table\n";
-
 typedef struct compare_opts {
     const char *dir;
     uint32_t modes[COMPARE_MAX_MODES];
@@ -525,60 +498,83 @@ static bool make_dir(const char *dir)
     return true;
 }
 
+#define COMPARE_INTRO                                                                          \
+    "Renders a scene with flat, Gouraud and per-pixel Phong shading (the Phong reflection\n"   \
+    "model of the lecture) and path-traced, and writes into DIR:\n"                             \
+    "  MODE.exr, MODE.png        each mode's image (linear float EXR; sRGB PNG, clamped)\n"     \
+    "  side-by-side.png          the PNGs in a row, labelled with the mode and its RMSE\n"     \
+    "  diff-A-vs-B.png           heat map of |A - B| (mean over R, G, B, viridis; the legend\n" \
+    "                            gives the scale) for each mode against phong and path\n"       \
+    "  metrics.csv               mode,reference,rmse,rel_bias,max_err (also printed)\n"         \
+    "With --sweep, renders the teapot at each tessellation level (e.g. 1,2,4,8,16,32) and\n"   \
+    "writes sweep.csv (flat's and Gouraud's error against per-pixel Phong shading, by\n"       \
+    "triangle count) and sweep.png (the plot, log-log).\n"
+
+typedef struct level_list {
+    int v[COMPARE_MAX_LEVELS];
+    int n;
+} level_list;
+
+static bool take_levels(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    (void)cmd, (void)opt;
+    level_list *l = dest;
+    return parse_levels(val, l->v, &l->n);
+}
+
+static bool take_modes(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    (void)cmd, (void)opt;
+    return parse_modes(val, dest);
+}
+
+static bool take_size(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    (void)cmd, (void)opt;
+    compare_opts *o = dest;
+    o->size_given = true;
+    return util_parse_size(val, &o->width, &o->height);
+}
+
 int cmd_compare(int argc, char **argv)
 {
     compare_opts o = {.modes = {GN_MODE_FLAT, GN_MODE_GOURAUD, GN_MODE_PHONG, GN_MODE_PATH},
                       .num_modes = 4, .spp = 64, .device = -1};
     const char *input = NULL, *sweep = NULL;
-    int levels[COMPARE_MAX_LEVELS], num_levels = 0, rc = 1, taken;
-    long v;
+    level_list sweep_levels = {.n = 0};
+    int rc = 1, scene_index = -1;
+    bool outside = false;
     gpu g = {0};
-
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *val;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            fputs(usage, stdout);
-            return 0;
-        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
-            o.quiet = true;
-        } else if (!strcmp(a, "--validate")) {
-            o.validate = true;
-        } else if (a[0] == '-' && a[1]) {
-            if (!(val = cli_option_value(argc, argv, &i, usage)))
-                return 2;
-            if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-                o.dir = val;
-            } else if (!strcmp(a, "--modes")) {
-                if (!parse_modes(val, &o))
-                    return cli_usage_error("compare", "--modes '%s': expected a list of flat, gouraud, phong, path (each once)", val);
-            } else if (!strcmp(a, "--sweep")) {
-                if (!parse_levels(val, levels, &num_levels))
-                    return cli_usage_error("compare", "--sweep '%s': expected up to %d increasing levels 1..256, e.g. 1,2,4,8", val, COMPARE_MAX_LEVELS);
-                sweep = val;
-            } else if (!strcmp(a, "--spp")) {
-                if (!util_parse_int(val, 1, 1 << 24, &v))
-                    return cli_usage_error("compare", "--spp '%s': expected an integer 1..16777216", val);
-                o.spp = (int)v;
-            } else if (!strcmp(a, "--size")) {
-                if (!util_parse_size(val, &o.width, &o.height))
-                    return cli_usage_error("compare", "--size '%s': expected WxH, e.g. 320x240", val);
-                o.size_given = true;
-            } else if ((taken = camera_parse_option(&o.camera, "compare", a, val))) {
-                if (taken == 2)
-                    return 2;
-            } else if (!strcmp(a, "--device")) {
-                if (!util_parse_int(val, 0, 64, &v))
-                    return cli_usage_error("compare", "--device '%s': expected an index (see gonio devices)", val);
-                o.device = (int)v;
-            } else {
-                return cli_usage_error("compare", "unknown option '%s'", a);
-            }
-        } else if (!input) {
-            input = a;
-        } else {
-            return cli_usage_error("compare", "unexpected argument '%s'", a);
-        }
-    }
+    const cli_option options[] = {
+        {"-o, --output", "DIR", "output directory (created if missing)", CLI_STRING, CLI_AS(const char *, &o.dir), 0, 0, NULL, NULL},
+        {"--sweep", "LEVELS", "the teapot at these tessellation levels (see above)", CLI_CALL, &sweep_levels,
+         0, 0, "up to 16 increasing levels 1..256, e.g. 1,2,4,8", take_levels},
+        {"--modes", "LIST", "any of flat,gouraud,phong,path (default all four; phong and path\n"
+                            "are the references); path is skipped when not available",
+         CLI_CALL, &o, 0, 0, "a list of flat, gouraud, phong, path (each once)", take_modes},
+        {"--spp", "N", "path tracer samples per pixel (default 64); the local modes take\n"
+                       "min(N, 16), which only anti-aliases them",
+         CLI_INT, CLI_AS(int, &o.spp), 1, 1 << 24, "an integer 1..16777216", NULL},
+        {"--size", "WxH", "image size (default 320 wide, the camera's aspect)", CLI_CALL, &o, 0, 0,
+         "WxH, e.g. 320x240", take_size},
+        CAMERA_OPTIONS(&o.camera),
+        {"--scene", "N", "compare the file's glTF scene N (default: its default scene)", CLI_INT, CLI_AS(int, &scene_index), 0, 1 << 20, "an index >= 0", NULL},
+        CLI_OPT_ALLOW_OUTSIDE_FILES(&outside),
+        CLI_OPT_DEVICE(&o.device),
+        CLI_OPT_VALIDATE(&o.validate),
+        CLI_OPT_QUIET(&o.quiet, "no progress and no table"),
+    };
+    const cli_command command = {
+        .name = "compare", .synopsis = "SCENE.gltf -o DIR [options]\n"
+                                       "       gonio compare --sweep LEVELS teapot -o DIR [options]",
+        .intro = COMPARE_INTRO, CLI_OPTIONS(options), .max_args = 1};
+    cli_args args;
+    if ((rc = cli_parse(&command, argc, argv, &args)) >= 0)
+        return rc;
+    rc = 1;
+    input = args.num_args ? args.arg[0] : NULL;
+    sweep = cli_given(&command, &args, "--sweep") ? "" : NULL;
+    scene_allow_outside_files(outside);
     if (!input)
         return cli_usage_error("compare", sweep ? "--sweep: no scene generator given (teapot)" : "no scene given");
     if (sweep && strcmp(input, "teapot"))
@@ -593,10 +589,10 @@ int cmd_compare(int argc, char **argv)
 
     if (sweep) {
         if (cli_gpu_create(&g, o.device, o.validate))
-            rc = run_sweep(&g, &o, levels, num_levels) ? 0 : 1;
+            rc = run_sweep(&g, &o, sweep_levels.v, sweep_levels.n) ? 0 : 1;
     } else {
         scene sc = {0};
-        if (!scene_load(&sc, input))
+        if (!scene_load_scene(&sc, input, scene_index))
             return 1;
         /* The comparison is of shading models under the scene's own lights; gonio render's
          * studio environment would light the local modes and the path tracer differently. */

@@ -112,12 +112,11 @@ int cmd_diff(int argc, char **argv)
     channel_list channels = {.n = 0};
     bool quiet = false;
     const cli_option options[] = {
-        {"--max-rmse", "X", "exit 1 when the RMSE is above X", CLI_FLOAT, &limits[0], 0, 3e38,
+        {"--max-rmse", "X", "exit 1 when the RMSE is above X", CLI_FLOAT, CLI_AS(float, &limits[0]), 0, 3e38,
          "a number >= 0", NULL},
-        {"--max-rel-bias", "X", "exit 1 when |rel_bias| is above X", CLI_FLOAT, &limits[1], 0, 3e38,
+        {"--max-rel-bias", "X", "exit 1 when |rel_bias| is above X", CLI_FLOAT, CLI_AS(float, &limits[1]), 0, 3e38,
          "a number >= 0", NULL},
-        {"--max-error", "X", "exit 1 when the largest absolute difference is above X", CLI_FLOAT,
-         &limits[2], 0, 3e38, "a number >= 0", NULL},
+        {"--max-error", "X", "exit 1 when the largest absolute difference is above X", CLI_FLOAT, CLI_AS(float, &limits[2]), 0, 3e38, "a number >= 0", NULL},
         {"--channels", "R,G,B", "compare these channels (default: R, G and B where both have\nthem, else the first channel of each)",
          CLI_CALL, &channels, 0, 0, "a comma-separated list of channel names", take_channels},
         CLI_OPT_QUIET(&quiet, "print no metrics (limits and errors still go to stderr)"),

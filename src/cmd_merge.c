@@ -168,9 +168,9 @@ int cmd_merge(int argc, char **argv)
     image *imgs = NULL, out = {0};
     image_exr_options exr = IMAGE_EXR_DEFAULTS;
     const cli_option options[] = {
-        {"-o, --output", "FILE", "the merged OpenEXR (a .exr name; written atomically)", CLI_STRING, &out_path,
+        {"-o, --output", "FILE", "the merged OpenEXR (a .exr name; written atomically)", CLI_STRING, CLI_AS(const char *, &out_path),
          0, 0, NULL, NULL},
-        {"--force", NULL, "merge inputs that share a seed", CLI_FLAG, &force, 0, 0, NULL, NULL},
+        {"--force", NULL, "merge inputs that share a seed", CLI_FLAG, CLI_AS(bool, &force), 0, 0, NULL, NULL},
         CLI_OPT_EXR_HALF(&exr.half),
         CLI_OPT_EXR_COMPRESSION(&exr.compression),
     };

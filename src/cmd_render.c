@@ -1,5 +1,6 @@
 /* cmd_render.c: `gonio render`. */
 #include <errno.h>
+#include <float.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -17,71 +18,6 @@
 #include "render_output.h"
 #include "scene.h"
 #include "util.h"
-
-static const char render_usage[] =
-    "usage: gonio render SCENE.gltf|.glb -o OUT.exr|OUT.png [options]\n"
-    "\n"
-    "  -o, --output FILE   the image, in the format its name says: .exr linear float RGBA\n"
-    "                      OpenEXR with the gonio:* header; .png the PNG --png writes\n"
-    "                      (any other name is a usage error); written atomically\n"
-    "  --png FILE          also write a PNG: tonemapped sRGB; in modes depth, normal and\n"
-    "                      cost a picture of the data: depth grey from white (nearest) to 20%\n"
-    "                      grey (farthest visible), normals 0.5 n + 0.5, cost a viridis heat\n"
-    "                      map up to the image's maximum (misses too: they walk the tree);\n"
-    "                      the background of depth and normals black\n"
-    "  --mode M            path (default: Monte Carlo path tracing), phong, gouraud, flat,\n"
-    "                      normal, albedo, depth, cost (depth: along the camera axis, 0 where\n"
-    "                      nothing is hit, in the EXR as in the depth AOV)\n"
-    "  --spp N             samples per pixel (default 16)\n"
-    "  --time SECONDS      render for this long instead of --spp\n"
-    "  --size WxH          image size (default 512 on the longer side, the camera's aspect)\n"
-    CAMERA_OPTIONS_HELP
-    "  --scene N           render the file's glTF scene N (default: its default scene)\n"
-    "  --variant NAME      the materials of the file's KHR_materials_variants variant NAME\n"
-    "                      (gonio info lists them; default: the file's own materials)\n"
-    "  --allow-outside-files  let the scene read files outside its folder (default: only\n"
-    "                      regular files under it)\n"
-    "  --seed S            random seed (default 0); renders with different seeds merge\n"
-    "  --frame N           the scene's glTF animations at frame N / --fps (all play at once:\n"
-    "                      node translation, rotation, scale; meshes, cameras, lights)\n"
-    "  --fps F             frames per second for --frame and --frames (default 24)\n"
-    "  --at SECONDS        the animations at this time\n"
-    "  --frames A-B        render frames A to B, one file each: -o and --png are patterns\n"
-    "                      with one %d (e.g. out/frame_%04d.exr); stops at the first failure\n"
-    "  --crop X0,Y0,X1,Y1  render only pixels [X0, X1) x [Y0, Y1) of the image, each as the\n"
-    "                      whole render has it, bit for bit: an EXR whose data window is the\n"
-    "                      region of the full display window (gonio merge assembles tiles);\n"
-    "                      values with a '.' are fractions of the size (0,0,0.5,0.5: the\n"
-    "                      top-left quarter; pixel = ceil(fraction x size), as pbrt's)\n"
-    "  --resumable         EXR: also write the exact sums (sum.* channels, 32-bit float)\n"
-    "                      that --resume goes on from; SIGTERM always writes them\n"
-    "  --resume FILE.exr   go on from a --resumable render of the same scene, camera, crop,\n"
-    "                      seed and options (checked): --spp is the total; the result is the\n"
-    "                      render of --spp in one run, bit for bit\n"
-    "  --aov LIST          extra EXR channels, exactly those listed: any of normal (normal.XYZ),\n"
-    "                      albedo (albedo.RGB), depth (depth.Z, 0 on a miss), variance\n"
-    "                      (variance.RGB: of each pixel's mean), comma-separated\n"
-    "  --half              EXR: 16-bit half channels (default 32-bit float)\n"
-    "  --compression C     EXR: none, rle, zips, zip (default), piz, pxr24, b44, b44a\n"
-    ENV_OPTIONS_HELP
-    "  --max-depth N       path: at most N bounces (default 0: unbounded, roulette ends paths)\n"
-    "  --brdf MODEL[:P=V]  path: render every material with a BRDF model (see gonio brdf\n"
-    "                      --list), e.g. --brdf torrance-sparrow:exponent=128:specular=0.5\n"
-    "  --estimator E       path: mis (default), light or bsdf: one strategy only (tests)\n"
-    "  --no-shadows        local modes: no shadow rays\n"
-    "  --ambient R,G,B | V local modes: the Phong model's global ambient light (default 0)\n"
-    "  --exposure E        PNG only: scale by 2^E before tonemapping (default 0)\n"
-    "  --tonemap T         PNG only: clamp (default), reinhard, aces\n"
-    "  --device N          Vulkan device index (see gonio devices)\n"
-    "  --validate          enable the Vulkan validation layer; any message fails the render\n"
-    "  --quiet             no progress and no summary line\n"
-    "\n"
-    "An option the mode or outputs do not use (--max-depth with phong, --ambient with path,\n"
-    "--exposure without --png) is a warning. Progress goes to stderr: a bar on a terminal;\n"
-    "in a log, a line at each tenth once a second has passed (by time with --time).\n"
-    "Exit status: 0 ok, 1 bad input or failed render, 2 bad usage; 128 + N after signal N\n"
-    "(130: Ctrl-C, 143: SIGTERM): the render stopped after its pass and wrote what it had.\n"
-    "A second signal quits at once and leaves no output.\n";
 
 static volatile sig_atomic_t stop_requested; /* the signal that asked, 0 = none */
 static bool signal_quiet;
@@ -111,56 +47,6 @@ static bool frame_pattern(const char *p)
     while (*c >= '0' && *c <= '9')
         c++;
     return *c == 'd' && !strchr(c, '%');
-}
-
-/* --frames A-B: cmd_render once per frame, --frame N in place of --frames and the output
- * patterns filled in. */
-static int render_frames(int argc, char **argv, int at)
-{
-    long a, b;
-    char *dash, range[64], **args = util_calloc((size_t)argc + 1, sizeof *args);
-    char frame[16], names[2][4096];
-    int rc = 0;
-    snprintf(range, sizeof range, "%s", argv[at + 1]);
-    dash = strchr(range + 1, '-');
-    if (dash)
-        *dash = 0;
-    if (!dash || !util_parse_int(range, 0, 1 << 24, &a) || !util_parse_int(dash + 1, 0, 1 << 24, &b) || b < a) {
-        free(args);
-        return cli_usage_error("render", "--frames '%s': expected A-B, frames 0 <= A <= B", argv[at + 1]);
-    }
-    for (int i = 1; i < argc; i++)
-        if ((!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output") || !strcmp(argv[i], "--png")) && i + 1 < argc &&
-            !frame_pattern(argv[i + 1])) {
-            free(args);
-            return cli_usage_error("render", "%s '%s': with --frames, a pattern with one %%d (e.g. frame_%%04d.exr)",
-                                   argv[i], argv[i + 1]);
-        } else if (!strcmp(argv[i], "--frame") || !strcmp(argv[i], "--at")) {
-            free(args);
-            return cli_usage_error("render", "--frames and %s exclude each other", argv[i]);
-        }
-    for (long f = a; f <= b && rc == 0 && !stop_requested; f++) {
-        int nout = 0;
-        snprintf(frame, sizeof frame, "%ld", f);
-        for (int i = 0; i < argc; i++) {
-            args[i] = argv[i];
-            if (i == at)
-                args[i] = "--frame";
-            else if (i == at + 1)
-                args[i] = frame;
-            else if (i > 0 && (!strcmp(argv[i - 1], "-o") || !strcmp(argv[i - 1], "--output") ||
-                               !strcmp(argv[i - 1], "--png")) && nout < 2) {
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wformat-nonliteral"
-                snprintf(names[nout], sizeof names[0], argv[i], (int)f); /* checked: frame_pattern */
-#pragma GCC diagnostic pop
-                args[i] = names[nout++];
-            }
-        }
-        rc = cmd_render(argc, args);
-    }
-    free(args);
-    return rc;
 }
 
 /* --crop X0,Y0,X1,Y1: pixels, or fractions when any value has a '.'. */
@@ -281,11 +167,9 @@ static void catch_signals(bool quiet)
     sigaction(SIGTERM, &sa, NULL);
 }
 
-/* Options that the chosen mode or outputs do not use: a warning each, never silence. Reads
- * argv again (values skipped) rather than flags set by the parser, so it sees what was
- * typed, defaults included. */
-static void warn_inapplicable(int argc, char **argv, const render_settings *s, const char *png_path,
-                              const char *out_path)
+/* Options that the chosen mode or outputs do not use: a warning each, never silence. */
+static void warn_inapplicable(const cli_command *c, const cli_args *args, const render_settings *s,
+                              const char *png_path, const char *out_path)
 {
     static const struct {
         const char *opt;
@@ -297,198 +181,246 @@ static void warn_inapplicable(int argc, char **argv, const render_settings *s, c
     const bool path = s->mode == GN_MODE_PATH;
     const bool png = png_path || (out_path && util_has_suffix(out_path, ".png"));
     const bool exr = out_path && util_has_suffix(out_path, ".exr");
-    for (int i = 1; i < argc; i++) {
-        for (size_t k = 0; k < sizeof rules / sizeof *rules; k++) {
-            if (strcmp(argv[i], rules[k].opt))
-                continue;
-            if (rules[k].when == 0 && !path)
-                util_warn("%s applies to --mode path only; ignored with --mode %s", rules[k].opt,
-                          render_mode_name(s->mode));
-            else if (rules[k].when == 1 && path)
-                util_warn("%s applies to the local modes only; ignored with --mode path", rules[k].opt);
-            else if (rules[k].when == 2 && !png)
-                util_warn("%s applies to the PNG only; ignored without a PNG output", rules[k].opt);
-            else if (rules[k].when == 5 && !exr)
-                util_warn("%s applies to the EXR only; ignored without an EXR output", rules[k].opt);
-            else if (rules[k].when == 4 && !path && s->mode != GN_MODE_ALBEDO)
-                util_warn("%s applies to --mode path (and albedo, its colour) only; ignored with "
-                          "--mode %s", rules[k].opt, render_mode_name(s->mode));
-            else if (rules[k].when == 3 && s->time_limit > 0)
-                util_warn("%s is ignored with --time: the render takes as many samples as fit",
-                          rules[k].opt);
-        }
-        if (cli_usage_lists_value(render_usage, argv[i]))
-            i++;
+    for (size_t k = 0; k < sizeof rules / sizeof *rules; k++) {
+        if (!cli_given(c, args, rules[k].opt))
+            continue;
+        if (rules[k].when == 0 && !path)
+            util_warn("%s applies to --mode path only; ignored with --mode %s", rules[k].opt,
+                      render_mode_name(s->mode));
+        else if (rules[k].when == 1 && path)
+            util_warn("%s applies to the local modes only; ignored with --mode path", rules[k].opt);
+        else if (rules[k].when == 2 && !png)
+            util_warn("%s applies to the PNG only; ignored without a PNG output", rules[k].opt);
+        else if (rules[k].when == 5 && !exr)
+            util_warn("%s applies to the EXR only; ignored without an EXR output", rules[k].opt);
+        else if (rules[k].when == 4 && !path && s->mode != GN_MODE_ALBEDO)
+            util_warn("%s applies to --mode path (and albedo, its colour) only; ignored with "
+                      "--mode %s", rules[k].opt, render_mode_name(s->mode));
+        else if (rules[k].when == 3 && s->time_limit > 0)
+            util_warn("%s is ignored with --time: the render takes as many samples as fit",
+                      rules[k].opt);
     }
 }
 
+/* Everything the command line says about one render (--frames: one per frame). */
+typedef struct render_job {
+    const char *scene_path, *out_path, *png_path, *brdf, *crop_text, *resume_path, *frames;
+    render_settings s;
+    camera_option cam;
+    env_option env;
+    crop_option crop;
+    bool size_given, quiet, validate, resumable, outside;
+    int frame;   /* --frame, -1 none */
+    float fps;
+    float at;    /* --at, -1 none */
+    int device, scene_index;
+    float exposure;
+    image_tonemap tm;
+    image_exr_options exr;
+} render_job;
+
+/* CLI_CALL parsers of render's own values. */
+static bool take_size(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    (void)cmd, (void)opt;
+    render_job *j = dest;
+    j->size_given = true;
+    return util_parse_size(val, &j->s.width, &j->s.height);
+}
+
+static bool take_crop(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    (void)cmd, (void)opt;
+    render_job *j = dest;
+    j->crop_text = val;
+    return parse_crop(val, &j->crop);
+}
+
+static bool take_aov(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    char buf[256], *tok, *save;
+    uint32_t *aov = dest;
+    snprintf(buf, sizeof buf, "%s", val);
+    *aov = 0;
+    for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        uint32_t bit = render_aov_from_name(tok);
+        if (!bit) {
+            cli_usage_error(cmd, "%s '%s': expected a list of normal, albedo, depth, variance", opt, tok);
+            return false;
+        }
+        *aov |= bit;
+    }
+    return *aov != 0 || (cli_usage_error(cmd, "%s '%s': expected a list of normal, albedo, depth, variance",
+                                         opt, val), false);
+}
+
+static bool take_ambient(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    (void)cmd, (void)opt;
+    render_settings *s = dest;
+    s->ambient_set = true;
+    return util_parse_rgb(val, s->ambient);
+}
+
+static bool take_brdf(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    (void)cmd, (void)opt;
+    *(const char **)dest = val;
+    return brdf_spec_check(val);
+}
+
+static bool take_estimator(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    (void)cmd, (void)opt;
+    uint32_t *strategy = dest;
+    if (!strcmp(val, "mis")) *strategy = 0;
+    else if (!strcmp(val, "light")) *strategy = GN_FRAME_LIGHT_ONLY;
+    else if (!strcmp(val, "bsdf")) *strategy = GN_FRAME_BSDF_ONLY;
+    else return false;
+    return true;
+}
+
+static int render_run(const render_job *job);
+
+/* --frames A-B: render_run once per frame, -o and --png filled in with the frame number. */
+static int render_frames(const render_job *job)
+{
+    long a, b;
+    char range[64], *dash, names[2][4096];
+    int rc = 0;
+    snprintf(range, sizeof range, "%s", job->frames);
+    dash = strchr(range + 1, '-');
+    if (dash)
+        *dash = 0;
+    if (!dash || !util_parse_int(range, 0, 1 << 24, &a) || !util_parse_int(dash + 1, 0, 1 << 24, &b) || b < a)
+        return cli_usage_error("render", "--frames '%s': expected A-B, frames 0 <= A <= B", job->frames);
+    const char *outs[2] = {job->out_path, job->png_path}, *opts[2] = {"-o", "--png"};
+    for (int k = 0; k < 2; k++)
+        if (outs[k] && !frame_pattern(outs[k]))
+            return cli_usage_error("render", "%s '%s': with --frames, a pattern with one %%d (e.g. frame_%%04d.exr)",
+                                   opts[k], outs[k]);
+    if (job->frame >= 0 || job->at >= 0)
+        return cli_usage_error("render", "--frames and %s exclude each other", job->frame >= 0 ? "--frame" : "--at");
+    for (long f = a; f <= b && rc == 0 && !stop_requested; f++) {
+        render_job one = *job;
+        one.frames = NULL;
+        one.frame = (int)f;
+        for (int k = 0; k < 2; k++) {
+            if (!outs[k])
+                continue;
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+            snprintf(names[k], sizeof names[k], outs[k], (int)f); /* checked: frame_pattern */
+#pragma GCC diagnostic pop
+        }
+        one.out_path = outs[0] ? names[0] : NULL;
+        one.png_path = outs[1] ? names[1] : NULL;
+        rc = render_run(&one);
+    }
+    return rc;
+}
+
+#define RENDER_EPILOG                                                                          \
+    "An option the mode or outputs do not use (--max-depth with phong, --ambient with path,\n"  \
+    "--exposure without --png) is a warning. Progress goes to stderr: a bar on a terminal;\n"  \
+    "in a log, a line at each tenth once a second has passed (by time with --time).\n"         \
+    "Exit status: 0 ok, 1 bad input or failed render, 2 bad usage; 128 + N after signal N\n"  \
+    "(130: Ctrl-C, 143: SIGTERM): the render stopped after its pass and wrote what it had.\n"  \
+    "A second signal quits at once and leaves no output.\n"
+
 int cmd_render(int argc, char **argv)
 {
-    const char *scene_path = NULL, *out_path = NULL, *png_path = NULL;
-    const char *brdf = NULL;
-    image env_map = {0};
-    render_settings s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .shadows = true,
-                         .progress = true, .stop = &stop_requested};
-    camera_option cam = {0};
-    env_option env = {0};
-    scene_camera view;
-    char camera_text[160];
-    bool size_given = false, quiet = false, validate = false, studio = false, resumable = false;
-    crop_option crop = {0};
-    int frame = -1;      /* --frame */
-    float fps = 24;
-    double at = -1;      /* --at, or the frame's time */
-    const char *crop_text = NULL, *resume_path = NULL;
-    image prev = {0};
-    int device = -1, scene_index = -1, taken;
-    float exposure = 0;
-    image_tonemap tm = IMAGE_TONEMAP_CLAMP;
-    image_exr_options exr = IMAGE_EXR_DEFAULTS;
-    const char *exr_option = NULL, *exr_path = NULL, *png_o = NULL; /* -o as EXR or as PNG */
-    long v;
-    scene sc = {0};
-    gpu g = {0};
-    renderer r = {0};
-    image img = {0};
-    render_stats st;
-    int rc = 1;
-
-    for (int i = 1; i + 1 < argc; i++)
-        if (!strcmp(argv[i], "--frames"))
-            return render_frames(argc, argv, i);
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *val;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            fputs(render_usage, stdout);
-            return 0;
-        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
-            quiet = true;
-        } else if (!strcmp(a, "--validate")) {
-            validate = true;
-        } else if (!strcmp(a, "--no-shadows")) {
-            s.shadows = false;
-        } else if (!strcmp(a, "--allow-outside-files")) {
-            scene_allow_outside_files(true);
-        } else if (!strcmp(a, "--resumable")) {
-            resumable = true;
-        } else if (!strcmp(a, "--half")) {
-            exr.half = true;
-            exr_option = "--half";
-        } else if (a[0] == '-' && a[1]) {
-            if (!(val = cli_option_value(argc, argv, &i, render_usage)))
-                return 2;
-            if ((taken = camera_parse_option(&cam, "render", a, val)) ||
-                (taken = env_parse_option(&env, "render", a, val))) {
-                if (taken == 2)
-                    return 2;
-            } else if (!strcmp(a, "--scene")) {
-                if (!util_parse_int(val, 0, 1 << 20, &v))
-                    return cli_usage_error("render", "--scene '%s': expected an index >= 0", val);
-                scene_index = (int)v;
-            } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-                out_path = val;
-            } else if (!strcmp(a, "--png")) {
-                png_path = val;
-            } else if (!strcmp(a, "--mode")) {
-                int m = render_mode_from_name(val);
-                if (m < 0)
-                    return cli_usage_error("render", "--mode '%s': expected one of %s", val,
-                                           render_mode_list());
-                s.mode = (uint32_t)m;
-            } else if (!strcmp(a, "--spp")) {
-                if (!util_parse_int(val, 1, 1 << 24, &v))
-                    return cli_usage_error("render", "--spp '%s': expected an integer 1..16777216", val);
-                s.spp = (int)v;
-            } else if (!strcmp(a, "--time")) {
-                float t;
-                if (!util_parse_float(val, &t) || t <= 0)
-                    return cli_usage_error("render", "--time '%s': expected seconds > 0", val);
-                s.time_limit = t;
-            } else if (!strcmp(a, "--size")) {
-                if (!util_parse_size(val, &s.width, &s.height))
-                    return cli_usage_error("render", "--size '%s': expected WxH, e.g. 640x480 (1..16384)", val);
-                size_given = true;
-            } else if (!strcmp(a, "--seed")) {
-                if (!util_parse_int(val, 0, 0xffffffffL, &v))
-                    return cli_usage_error("render", "--seed '%s': expected an integer 0..4294967295", val);
-                s.seed = (uint32_t)v;
-            } else if (!strcmp(a, "--frame")) {
-                if (!util_parse_int(val, 0, 1 << 24, &v))
-                    return cli_usage_error("render", "--frame '%s': expected a frame number >= 0", val);
-                frame = (int)v;
-            } else if (!strcmp(a, "--variant")) {
-                scene_select_variant(val);
-            } else if (!strcmp(a, "--fps")) {
-                if (!util_parse_float(val, &fps) || !(fps > 0 && fps <= 1e6f))
-                    return cli_usage_error("render", "--fps '%s': expected frames per second > 0", val);
-            } else if (!strcmp(a, "--at")) {
-                float t;
-                if (!util_parse_float(val, &t) || !(t >= 0 && t <= 1e9f))
-                    return cli_usage_error("render", "--at '%s': expected seconds >= 0", val);
-                at = t;
-            } else if (!strcmp(a, "--crop")) {
-                if (!parse_crop(val, &crop))
-                    return cli_usage_error("render", "--crop '%s': expected X0,Y0,X1,Y1 in pixels (integers) "
-                                           "or fractions 0..1", val);
-                crop_text = val;
-            } else if (!strcmp(a, "--resume")) {
-                resume_path = val;
-            } else if (!strcmp(a, "--aov")) {
-                char buf[256], *tok, *save;
-                snprintf(buf, sizeof buf, "%s", val);
-                s.aov = 0;
-                for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-                    uint32_t bit = render_aov_from_name(tok);
-                    if (!bit)
-                        return cli_usage_error("render", "--aov '%s': expected a list of normal, albedo, depth, variance", tok);
-                    s.aov |= bit;
-                }
-                if (!s.aov)
-                    return cli_usage_error("render", "--aov '%s': expected a list of normal, albedo, depth, variance", val);
-            } else if (!strcmp(a, "--compression")) {
-                if (!image_exr_compression_from_name(val, &exr.compression))
-                    return cli_usage_error("render", "--compression '%s': expected none, rle, zips, zip, piz, "
-                                           "pxr24, b44 or b44a", val);
-                exr_option = "--compression";
-            } else if (!strcmp(a, "--ambient")) {
-                if (!util_parse_rgb(val, s.ambient))
-                    return cli_usage_error("render", "--ambient '%s': expected R,G,B or one value >= 0", val);
-                s.ambient_set = true;
-            } else if (!strcmp(a, "--max-depth")) {
-                if (!util_parse_int(val, 0, 1 << 20, &v))
-                    return cli_usage_error("render", "--max-depth '%s': expected an integer >= 0", val);
-                s.max_depth = (int)v;
-            } else if (!strcmp(a, "--brdf")) {
-                if (!brdf_spec_check(val))
-                    return cli_usage_error("render", "--brdf '%s': see gonio brdf --list", val);
-                brdf = val;
-            } else if (!strcmp(a, "--estimator")) {
-                if (!strcmp(val, "mis")) s.strategy = 0;
-                else if (!strcmp(val, "light")) s.strategy = GN_FRAME_LIGHT_ONLY;
-                else if (!strcmp(val, "bsdf")) s.strategy = GN_FRAME_BSDF_ONLY;
-                else return cli_usage_error("render", "--estimator '%s': expected mis, light or bsdf", val);
-            } else if (!strcmp(a, "--exposure")) {
-                if (!util_parse_float(val, &exposure))
-                    return cli_usage_error("render", "--exposure '%s': expected a number", val);
-            } else if (!strcmp(a, "--tonemap")) {
-                if (!image_tonemap_from_name(val, &tm))
-                    return cli_usage_error("render", "--tonemap '%s': expected clamp, reinhard or aces", val);
-            } else if (!strcmp(a, "--device")) {
-                if (!util_parse_int(val, 0, 64, &v))
-                    return cli_usage_error("render", "--device '%s': expected an index (see gonio devices)", val);
-                device = (int)v;
-            } else {
-                return cli_usage_error("render", "unknown option '%s'", a);
-            }
-        } else if (!scene_path) {
-            scene_path = a;
-        } else {
-            return cli_usage_error("render", "unexpected argument '%s'", a);
-        }
-    }
-    warn_inapplicable(argc, argv, &s, png_path, out_path);
-    if (!scene_path)
-        return cli_usage_error("render", "no scene given");
+    render_job j = {.s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .shadows = true, .progress = true,
+                          .stop = &stop_requested},
+                    .frame = -1, .fps = 24, .at = -1, .device = -1, .scene_index = -1,
+                    .tm = IMAGE_TONEMAP_CLAMP, .exr = IMAGE_EXR_DEFAULTS};
+    bool no_shadows = false;
+    const cli_option options[] = {
+        {"-o, --output", "FILE", "the image, in the format its name says: .exr linear float RGBA\n"
+                                 "OpenEXR with the gonio:* header; .png the PNG --png writes\n"
+                                 "(any other name is a usage error); written atomically",
+         CLI_STRING, CLI_AS(const char *, &j.out_path), 0, 0, NULL, NULL},
+        {"--png", "FILE", "also write a PNG: tonemapped sRGB; in modes depth, normal and\n"
+                          "cost a picture of the data: depth grey from white (nearest) to 20%\n"
+                          "grey (farthest visible), normals 0.5 n + 0.5, cost a viridis heat\n"
+                          "map up to the image's maximum (misses too: they walk the tree);\n"
+                          "the background of depth and normals black",
+         CLI_STRING, CLI_AS(const char *, &j.png_path), 0, 0, NULL, NULL},
+        {"--mode", "M", "path (default: Monte Carlo path tracing), phong, gouraud, flat,\n"
+                        "normal, albedo, depth, cost (depth: along the camera axis, 0 where\n"
+                        "nothing is hit, in the EXR as in the depth AOV)",
+         CLI_CALL, &j.s.mode, 0, 0, NULL, cli_take_mode},
+        {"--spp", "N", "samples per pixel (default 16)", CLI_INT, CLI_AS(int, &j.s.spp), 1, 1 << 24,
+         "an integer 1..16777216", NULL},
+        {"--time", "SECONDS", "render for this long instead of --spp", CLI_DOUBLE, CLI_AS(double, &j.s.time_limit), FLT_MIN,
+         3e38, "seconds > 0", NULL},
+        {"--size", "WxH", "image size (default 512 on the longer side, the camera's aspect)", CLI_CALL, &j,
+         0, 0, "WxH, e.g. 640x480 (1..16384)", take_size},
+        CAMERA_OPTIONS(&j.cam),
+        {"--scene", "N", "render the file's glTF scene N (default: its default scene)", CLI_INT, CLI_AS(int, &j.scene_index), 0, 1 << 20, "an index >= 0", NULL},
+        {"--variant", "NAME", "the materials of the file's KHR_materials_variants variant NAME\n"
+                              "(gonio info lists them; default: the file's own materials)",
+         CLI_CALL, NULL, 0, 0, NULL, cli_take_variant},
+        CLI_OPT_ALLOW_OUTSIDE_FILES(&j.outside),
+        {"--seed", "S", "random seed (default 0); renders with different seeds merge", CLI_U32, CLI_AS(uint32_t, &j.s.seed), 0,
+         4294967295.0, "an integer 0..4294967295", NULL},
+        {"--frame", "N", "the scene's glTF animations at frame N / --fps (all play at once:\n"
+                         "node translation, rotation, scale; meshes, cameras, lights)",
+         CLI_INT, CLI_AS(int, &j.frame), 0, 1 << 24, "a frame number >= 0", NULL},
+        {"--fps", "F", "frames per second for --frame and --frames (default 24)", CLI_FLOAT, CLI_AS(float, &j.fps), FLT_MIN,
+         1e6, "frames per second > 0", NULL},
+        {"--at", "SECONDS", "the animations at this time", CLI_FLOAT, CLI_AS(float, &j.at), 0, 1e9, "seconds >= 0", NULL},
+        {"--frames", "A-B", "render frames A to B, one file each: -o and --png are patterns\n"
+                            "with one %d (e.g. out/frame_%04d.exr); stops at the first failure",
+         CLI_STRING, CLI_AS(const char *, &j.frames), 0, 0, NULL, NULL},
+        {"--crop", "X0,Y0,X1,Y1", "render only pixels [X0, X1) x [Y0, Y1) of the image, each as the\n"
+                                  "whole render has it, bit for bit: an EXR whose data window is the\n"
+                                  "region of the full display window (gonio merge assembles tiles);\n"
+                                  "values with a '.' are fractions of the size (0,0,0.5,0.5: the\n"
+                                  "top-left quarter; pixel = ceil(fraction x size), as pbrt's)",
+         CLI_CALL, &j, 0, 0, "X0,Y0,X1,Y1 in pixels (integers) or fractions 0..1", take_crop},
+        {"--resumable", NULL, "EXR: also write the exact sums (sum.* channels, 32-bit float)\n"
+                              "that --resume goes on from; SIGTERM always writes them",
+         CLI_FLAG, CLI_AS(bool, &j.resumable), 0, 0, NULL, NULL},
+        {"--resume", "FILE.exr", "go on from a --resumable render of the same scene, camera, crop,\n"
+                                 "seed and options (checked): --spp is the total; the result is the\n"
+                                 "render of --spp in one run, bit for bit",
+         CLI_STRING, CLI_AS(const char *, &j.resume_path), 0, 0, NULL, NULL},
+        {"--aov", "LIST", "extra EXR channels, exactly those listed: any of normal (normal.XYZ),\n"
+                          "albedo (albedo.RGB), depth (depth.Z, 0 on a miss), variance\n"
+                          "(variance.RGB: of each pixel's mean), comma-separated",
+         CLI_CALL, &j.s.aov, 0, 0, NULL, take_aov},
+        CLI_OPT_EXR_HALF(&j.exr.half),
+        CLI_OPT_EXR_COMPRESSION(&j.exr.compression),
+        ENV_OPTIONS(&j.env),
+        {"--max-depth", "N", "path: at most N bounces (default 0: unbounded, roulette ends paths)", CLI_INT, CLI_AS(int, &j.s.max_depth), 0, 1 << 20, "an integer >= 0", NULL},
+        {"--brdf", "MODEL[:P=V]", "path: render every material with a BRDF model (see gonio brdf\n"
+                                  "--list), e.g. --brdf torrance-sparrow:exponent=128:specular=0.5",
+         CLI_CALL, &j.brdf, 0, 0, "a model of gonio brdf --list", take_brdf},
+        {"--estimator", "E", "path: mis (default), light or bsdf: one strategy only (tests)", CLI_CALL,
+         &j.s.strategy, 0, 0, "mis, light or bsdf", take_estimator},
+        {"--no-shadows", NULL, "local modes: no shadow rays", CLI_FLAG, CLI_AS(bool, &no_shadows), 0, 0, NULL, NULL},
+        {"--ambient", "R,G,B | V", "local modes: the Phong model's global ambient light (default 0)", CLI_CALL,
+         &j.s, 0, 0, "R,G,B or one value >= 0", take_ambient},
+        {"--exposure", "E", "PNG only: scale by 2^E before tonemapping (default 0)", CLI_FLOAT, CLI_AS(float, &j.exposure),
+         -1e6, 1e6, "a number", NULL},
+        {"--tonemap", "T", "PNG only: clamp (default), reinhard, aces", CLI_CALL, &j.tm, 0, 0,
+         "clamp, reinhard or aces", cli_take_tonemap},
+        CLI_OPT_DEVICE(&j.device),
+        CLI_OPT_VALIDATE(&j.validate),
+        CLI_OPT_QUIET(&j.quiet, "no progress and no summary line"),
+    };
+    const cli_command command = {.name = "render", .synopsis = "SCENE.gltf|.glb -o OUT.exr|OUT.png [options]",
+                                 CLI_OPTIONS(options), .epilog = RENDER_EPILOG, .min_args = 1, .max_args = 1,
+                                 .missing = "no scene given"};
+    cli_args args;
+    int rc = cli_parse(&command, argc, argv, &args);
+    if (rc >= 0)
+        return rc;
+    j.scene_path = args.arg[0];
+    j.s.shadows = !no_shadows;
+    const char *out_path = j.out_path, *png_path = j.png_path, *exr_path = NULL;
+    warn_inapplicable(&command, &args, &j.s, png_path, out_path);
     if (!out_path && !png_path)
         return cli_usage_error("render", "no output given (-o OUT.exr and/or --png OUT.png)");
     /* The name says the format: -o OUT.png is the tonemapped PNG, as --png is. */
@@ -498,24 +430,59 @@ int cmd_render(int argc, char **argv)
         return cli_usage_error("render", "--png '%s': expected a .png name", png_path);
     if (out_path && image_format_of(out_path) == IMAGE_FORMAT_EXR)
         exr_path = out_path;
-    else
-        png_o = out_path;
+    const char *exr_option = cli_given(&command, &args, "--compression") ? "--compression"
+                             : cli_given(&command, &args, "--half")      ? "--half"
+                                                                         : NULL;
     if (exr_option && !exr_path)
         return cli_usage_error("render", "%s is for an EXR output (-o OUT.exr)", exr_option);
-    if (resumable && !exr_path)
+    if (j.resumable && !exr_path)
         return cli_usage_error("render", "--resumable is for an EXR output (-o OUT.exr)");
-    if (resume_path && image_format_of(resume_path) != IMAGE_FORMAT_EXR)
-        return cli_usage_error("render", "--resume '%s': expected a .exr render", resume_path);
+    if (j.resume_path && image_format_of(j.resume_path) != IMAGE_FORMAT_EXR)
+        return cli_usage_error("render", "--resume '%s': expected a .exr render", j.resume_path);
+    if (j.frame >= 0 && j.at >= 0 && !j.frames)
+        return cli_usage_error("render", "--frame and --at exclude each other");
+    return j.frames ? render_frames(&j) : render_run(&j);
+}
+
+/* One render of the job: load, render, write. */
+static int render_run(const render_job *job)
+{
+    const char *scene_path = job->scene_path, *out_path = job->out_path, *png_path = job->png_path;
+    const char *brdf = job->brdf, *crop_text = job->crop_text, *resume_path = job->resume_path;
+    image env_map = {0};
+    render_settings s = job->s;
+    camera_option cam = job->cam;
+    env_option env = job->env;
+    crop_option crop = job->crop;
+    scene_camera view;
+    char camera_text[160];
+    const bool size_given = job->size_given, quiet = job->quiet, resumable = job->resumable;
+    bool studio = false;
+    const int frame = job->frame, device = job->device, scene_index = job->scene_index;
+    double at = job->at;
+    image prev = {0};
+    image_exr_options exr = job->exr;
+    const char *exr_path = NULL, *png_o = NULL; /* -o as EXR or as PNG */
+    scene sc = {0};
+    gpu g = {0};
+    renderer r = {0};
+    image img = {0};
+    render_stats st;
+    int rc = 1;
+
+    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_EXR)
+        exr_path = out_path;
+    else
+        png_o = out_path;
     exr.exact_prefix = "sum"; /* sum.* and sum2.*: the state --resume needs exactly */
     util_set_quiet(quiet);
     s.progress = !quiet;
+    scene_allow_outside_files(job->outside);
     if ((out_path && !util_check_output(out_path)) || (png_path && !util_check_output(png_path)))
         return 1;
 
-    if (frame >= 0 && at >= 0)
-        return cli_usage_error("render", "--frame and --at exclude each other");
     if (frame >= 0)
-        at = frame / (double)fps;
+        at = frame / (double)job->fps;
     scene_animation_time(at);
     if (!scene_load_scene(&sc, scene_path, scene_index))
         return 1;
@@ -543,7 +510,7 @@ int cmd_render(int argc, char **argv)
     camera_describe(&cam, &sc, camera_text, sizeof camera_text);
     s.camera_label = camera_text;
     s.env_label = studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none";
-    if (!cli_gpu_create(&g, device, validate)) {
+    if (!cli_gpu_create(&g, device, job->validate)) {
         scene_destroy(&sc);
         image_destroy(&env_map);
         return 1;
@@ -576,9 +543,9 @@ int cmd_render(int argc, char **argv)
         if (exr_path)
             ok = image_write_exr_with(&img, exr_path, h.attrs, h.count, &exr);
         if (ok && png_o)
-            ok = render_write_png(&img, s.mode, png_o, exposure, tm);
+            ok = render_write_png(&img, s.mode, png_o, job->exposure, job->tm);
         if (ok && png_path)
-            ok = render_write_png(&img, s.mode, png_path, exposure, tm);
+            ok = render_write_png(&img, s.mode, png_path, job->exposure, job->tm);
         snprintf(seconds, sizeof seconds, "%.2f", st.seconds);
         if (ok && !quiet)
             /* One camera ray per pixel and sample: a whole path in path mode. */

@@ -253,10 +253,10 @@ static int run(int argc, char **argv, bool teapot_command)
          CLI_TEXT, NULL, 0, 0, NULL, NULL},
         {"-o, --output", "FILE", "the file to write, in the format its name says: .gltf JSON with\n"
                                  "the buffer embedded, .glb binary glTF (any other name is a usage error)",
-         CLI_STRING, &out, 0, 0, NULL, NULL},
+         CLI_STRING, CLI_AS(const char *, &out), 0, 0, NULL, NULL},
         {"--level", "N", "teapot: N x N grid cells per Bezier patch, 1..256 (default 8);\n"
                          "64 N^2 - 8 N triangles",
-         CLI_INT, &level, 1, SCENE_TEAPOT_MAX_LEVEL, "an integer 1..256", NULL},
+         CLI_INT, CLI_AS(int, &level), 1, SCENE_TEAPOT_MAX_LEVEL, "an integer 1..256", NULL},
     };
     const cli_command cmd = {
         .name = teapot_command ? "teapot" : "scene",

@@ -244,3 +244,8 @@ bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_se
     }
     return true;
 }
+
+bool env_take_option(const char *cmd, const char *opt, const char *val, void *dest)
+{
+    return env_parse_option((env_option *)dest, cmd, opt, val) == 1;
+}

@@ -24,18 +24,27 @@ typedef struct env_option {
     float intensity;         /* scale of the radiance (--env-intensity); 0 means 1 */
 } env_option;
 
-#define ENV_OPTIONS_HELP                                                                        \
-    "  --env R,G,B | V     constant environment radiance; 0: black (default: the scene's own\n" \
-    "                      lights, or gonio's studio environment when it has none)\n"          \
-    "  --env FILE          a lat-long HDR environment map, OpenEXR (.exr) or Radiance (.hdr),\n" \
-    "                      +Y up; importance sampled by the path tracer, its mean radiance is\n" \
-    "                      the local modes' ambient light\n"                                   \
-    "  --env-rotate DEG    turn the environment about +Y (right-handed, default 0)\n"          \
-    "  --env-intensity X   scale the environment's radiance (default 1)\n"
+/* The environment options of render and preview (cli.h: a cli_option list for a table). */
+#define ENV_OPTIONS(env)                                                                       \
+    {"--env", "R,G,B | V",                                                                     \
+     "constant environment radiance; 0: black (default: the scene's own\n"                     \
+     "lights, or gonio's studio environment when it has none)",                                \
+     CLI_CALL, (env), 0, 0, NULL, env_take_option},                                            \
+    {NULL, NULL,                                                                               \
+     "  --env FILE          a lat-long HDR environment map, OpenEXR (.exr) or Radiance (.hdr),\n" \
+     "                      +Y up; importance sampled by the path tracer, its mean radiance is\n" \
+     "                      the local modes' ambient light\n",                                 \
+     CLI_TEXT, NULL, 0, 0, NULL, NULL},                                                        \
+    {"--env-rotate", "DEG", "turn the environment about +Y (right-handed, default 0)",        \
+     CLI_CALL, (env), 0, 0, NULL, env_take_option},                                            \
+    {"--env-intensity", "X", "scale the environment's radiance (default 1)",                  \
+     CLI_CALL, (env), 0, 0, NULL, env_take_option}
 
 /* Takes opt (and its value) when it is an environment option: 1 taken, 0 not one, 2 after a
  * usage error printed for command cmd. */
 int env_parse_option(env_option *e, const char *cmd, const char *opt, const char *val);
+/* env_parse_option as a cli_option's call (dest: the env_option). */
+bool env_take_option(const char *cmd, const char *opt, const char *val, void *dest);
 
 /* Whether the scene brings light of its own: a punctual light, or an emissive material
  * brighter than 1 (core glTF's emissive range is a glow, not a light source). */

@@ -51,11 +51,8 @@ int main(int argc, char **argv)
         return 0;
     }
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
-        if (!strcmp(argv[1], commands[i].name)) {
-            static char **args; /* kept until exit (reachable, for the leak checker) */
-            int n = cli_split_equals(argc, argv, &args);
-            return n < 0 ? 2 : commands[i].fn(n - 1, args + 1);
-        }
+        if (!strcmp(argv[1], commands[i].name))
+            return commands[i].fn(argc - 1, argv + 1);
     fprintf(stderr, "gonio: unknown command '%s'\n\n", argv[1]);
     usage(stderr);
     return 2;

@@ -30,29 +30,6 @@ _Static_assert(IMAGE_TONEMAP_CLAMP == GN_TONEMAP_CLAMP && IMAGE_TONEMAP_ACES == 
 #define PREVIEW_MAX_BATCH 64             /* passes per frame at most */
 #define PREVIEW_IDLE_SECONDS 0.05        /* event wait once converged: repaints, not spins */
 
-static const char usage[] =
-    "usage: gonio preview SCENE.gltf|.glb [options]\n"
-    "\n"
-    "Opens a window and shows the render converging; press H in it for the keys.\n"
-    "\n"
-    "  --mode M            path (default), phong, gouraud, flat, normal, albedo, depth, cost\n"
-    "  --spp N             stop accumulating at N samples per pixel (default: never)\n"
-    "  --size WxH          initial window size (default 640 wide, the camera's aspect)\n"
-    CAMERA_OPTIONS_HELP
-    "  --seed S            random seed (default 0)\n"
-    "  --max-depth N       path tracer: maximum path length (default 0: roulette only)\n"
-    ENV_OPTIONS_HELP
-    "  --no-shadows        local modes: no shadow rays\n"
-    "  --exposure E        display scale 2^E (default 0)\n"
-    "  --tonemap T         clamp (default), reinhard, aces\n"
-    "  --prefix P          P writes P-NNN.exr and P-NNN.png (default gonio-preview)\n"
-    "  --frames N          quit after N frames (scripts, tests)\n"
-    "  --screenshot FILE   on quitting, write what the window shows as PNG\n"
-    "  --device N          Vulkan device index (see gonio devices)\n"
-    "  --variant NAME      the glTF KHR_materials_variants variant NAME's materials\n"
-    "  --validate          enable the Vulkan validation layer; any message fails\n"
-    "  --quiet             no informational messages\n";
-
 static const char keys_help[] =
     "gonio preview keys:\n"
     "  1..8                mode: path, phong, gouraud, flat, normal, albedo, depth, cost\n"
@@ -727,10 +704,8 @@ int cmd_preview(int argc, char **argv)
     preview *p = &pv;
     const char *scene_path = NULL, *screenshot = NULL;
     bool validate = false, size_given = false, ok = true;
-    int device = -1, width = 640, height = 480, max_frames = 0, frames = 0, last_passes = 0;
+    int device = -1, width, height, size[2] = {640, 480}, max_frames = 0, frames = 0, last_passes = 0;
     double submit_time = 0, last_frame;
-    long v;
-    int taken;
     camera_option cam = {0};
     env_option env = {0};
     image env_map = {0};
@@ -741,83 +716,57 @@ int cmd_preview(int argc, char **argv)
     p->s = (render_settings){.mode = GN_MODE_PATH, .camera = -1, .shadows = true};
     p->prefix = "gonio-preview";
     p->batch = 1;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *val;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            fputs(usage, stdout);
-            fputs("\n", stdout);
-            fputs(keys_help, stdout);
-            return 0;
-        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
-            util_set_quiet(true);
-        } else if (!strcmp(a, "--validate")) {
-            validate = true;
-        } else if (!strcmp(a, "--no-shadows")) {
-            p->s.shadows = false;
-        } else if (a[0] == '-' && a[1]) {
-            if (!(val = cli_option_value(argc, argv, &i, usage)))
-                return 2;
-            if ((taken = camera_parse_option(&cam, "preview", a, val)) ||
-                (taken = env_parse_option(&env, "preview", a, val))) {
-                if (taken == 2)
-                    return 2;
-            } else if (!strcmp(a, "--mode")) {
-                int m = render_mode_from_name(val);
-                if (m < 0)
-                    return cli_usage_error("preview", "--mode '%s': expected one of %s", val,
-                                           render_mode_list());
-                if (!renderer_mode_available((uint32_t)m))
-                    return cli_usage_error("preview", "--mode %s is not available yet", val);
-                p->s.mode = (uint32_t)m;
-            } else if (!strcmp(a, "--spp")) {
-                if (!util_parse_int(val, 1, 1 << 24, &v))
-                    return cli_usage_error("preview", "--spp '%s': expected an integer 1..16777216", val);
-                p->max_spp = (int)v;
-            } else if (!strcmp(a, "--size")) {
-                if (!util_parse_size(val, &width, &height))
-                    return cli_usage_error("preview", "--size '%s': expected WxH, e.g. 640x480", val);
-                size_given = true;
-            } else if (!strcmp(a, "--seed")) {
-                if (!util_parse_int(val, 0, 0xffffffffL, &v))
-                    return cli_usage_error("preview", "--seed '%s': expected an integer 0..4294967295", val);
-                p->s.seed = (uint32_t)v;
-            } else if (!strcmp(a, "--max-depth")) {
-                if (!util_parse_int(val, 0, 1 << 16, &v))
-                    return cli_usage_error("preview", "--max-depth '%s': expected an integer >= 0", val);
-                p->s.max_depth = (int)v;
-            } else if (!strcmp(a, "--exposure")) {
-                if (!util_parse_float(val, &p->exposure))
-                    return cli_usage_error("preview", "--exposure '%s': expected a number", val);
-            } else if (!strcmp(a, "--tonemap")) {
-                if (!image_tonemap_from_name(val, &p->tonemap))
-                    return cli_usage_error("preview", "--tonemap '%s': expected clamp, reinhard or aces", val);
-            } else if (!strcmp(a, "--prefix")) {
-                p->prefix = val;
-            } else if (!strcmp(a, "--frames")) {
-                if (!util_parse_int(val, 1, 1L << 30, &v))
-                    return cli_usage_error("preview", "--frames '%s': expected an integer >= 1", val);
-                max_frames = (int)v;
-            } else if (!strcmp(a, "--screenshot")) {
-                if (image_format_of(val) != IMAGE_FORMAT_PNG)
-                    return cli_usage_error("preview", "--screenshot '%s': expected a .png name", val);
-                screenshot = val;
-            } else if (!strcmp(a, "--variant")) {
-                scene_select_variant(val);
-            } else if (!strcmp(a, "--device")) {
-                if (!util_parse_int(val, 0, 64, &v))
-                    return cli_usage_error("preview", "--device '%s': expected an index (see gonio devices)", val);
-                device = (int)v;
-            } else {
-                return cli_usage_error("preview", "unknown option '%s'", a);
-            }
-        } else if (!scene_path) {
-            scene_path = a;
-        } else {
-            return cli_usage_error("preview", "unexpected argument '%s'", a);
-        }
-    }
-    if (!scene_path)
-        return cli_usage_error("preview", "no scene given");
+    bool no_shadows = false, quiet = false, outside = false;
+    int scene_index = -1;
+    const cli_option options[] = {
+        {"--mode", "M", "path (default), phong, gouraud, flat, normal, albedo, depth, cost", CLI_CALL,
+         &p->s.mode, 0, 0, NULL, cli_take_mode},
+        {"--spp", "N", "stop accumulating at N samples per pixel (default: never)", CLI_INT, CLI_AS(int, &p->max_spp), 1,
+         1 << 24, "an integer 1..16777216", NULL},
+        {"--size", "WxH", "initial window size (default 640 wide, the camera's aspect)", CLI_CALL, size, 0, 0,
+         "WxH, e.g. 640x480", cli_take_size},
+        CAMERA_OPTIONS(&cam),
+        {"--scene", "N", "show the file's glTF scene N (default: its default scene)", CLI_INT, CLI_AS(int, &scene_index),
+         0, 1 << 20, "an index >= 0", NULL},
+        {"--variant", "NAME", "the glTF KHR_materials_variants variant NAME's materials", CLI_CALL, NULL, 0, 0,
+         NULL, cli_take_variant},
+        CLI_OPT_ALLOW_OUTSIDE_FILES(&outside),
+        {"--seed", "S", "random seed (default 0)", CLI_U32, CLI_AS(uint32_t, &p->s.seed), 0, 4294967295.0,
+         "an integer 0..4294967295", NULL},
+        {"--max-depth", "N", "path tracer: maximum path length (default 0: roulette only)", CLI_INT, CLI_AS(int, &p->s.max_depth), 0, 1 << 16, "an integer >= 0", NULL},
+        ENV_OPTIONS(&env),
+        {"--no-shadows", NULL, "local modes: no shadow rays", CLI_FLAG, CLI_AS(bool, &no_shadows), 0, 0, NULL, NULL},
+        {"--exposure", "E", "display scale 2^E (default 0)", CLI_FLOAT, CLI_AS(float, &p->exposure), -1e6, 1e6, "a number",
+         NULL},
+        {"--tonemap", "T", "clamp (default), reinhard, aces", CLI_CALL, &p->tonemap, 0, 0,
+         "clamp, reinhard or aces", cli_take_tonemap},
+        {"--prefix", "P", "P writes P-NNN.exr and P-NNN.png (default gonio-preview)", CLI_STRING, CLI_AS(const char *, &p->prefix),
+         0, 0, NULL, NULL},
+        {"--frames", "N", "quit after N frames (scripts, tests)", CLI_INT, CLI_AS(int, &max_frames), 1, 1 << 30,
+         "an integer >= 1", NULL},
+        {"--screenshot", "FILE", "on quitting, write what the window shows as PNG", CLI_STRING, CLI_AS(const char *, &screenshot), 0,
+         0, NULL, NULL},
+        CLI_OPT_DEVICE(&device),
+        CLI_OPT_VALIDATE(&validate),
+        CLI_OPT_QUIET(&quiet, "no informational messages"),
+    };
+    const cli_command command = {.name = "preview", .synopsis = "SCENE.gltf|.glb [options]",
+                                 .intro = "Opens a window and shows the render converging; press H in it for the keys.\n",
+                                 CLI_OPTIONS(options), .epilog = keys_help, .min_args = 1, .max_args = 1,
+                                 .missing = "no scene given"};
+    cli_args args;
+    int rc = cli_parse(&command, argc, argv, &args);
+    if (rc >= 0)
+        return rc;
+    scene_path = args.arg[0];
+    width = size[0];
+    height = size[1];
+    size_given = cli_given(&command, &args, "--size");
+    p->s.shadows = !no_shadows;
+    util_set_quiet(quiet);
+    scene_allow_outside_files(outside);
+    if (screenshot && image_format_of(screenshot) != IMAGE_FORMAT_PNG)
+        return cli_usage_error("preview", "--screenshot '%s': expected a .png name", screenshot);
     if (screenshot && !util_check_output(screenshot))
         return 1;
 
@@ -828,7 +777,7 @@ int cmd_preview(int argc, char **argv)
                    "xvfb-run gonio preview %s", scene_path);
         return 1;
     }
-    if (!scene_load(&p->sc, scene_path)) {
+    if (!scene_load_scene(&p->sc, scene_path, scene_index)) {
         glfwTerminate();
         return 1;
     }
