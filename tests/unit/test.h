@@ -40,7 +40,17 @@ const char *test_assets_dir(void);
 struct gpu;
 bool test_open_gpu(struct gpu *g);
 
-/* Every suite file defines its tests and lists them in tests/unit/suites.h. */
+/* TEST(suite, name) { ... } defines a test and registers it (a constructor runs before
+ * main), so a test is written in one place: tests/unit/test_SUITE.c. They run in the order
+ * of their files' names, and in a file in the order they are written. */
 typedef void (*test_fn)(void);
+void test_register(const char *suite, const char *name, test_fn fn, const char *file, int line);
+#define TEST(suite, name)                                                                  \
+    static void test_##suite##_##name(void);                                               \
+    __attribute__((constructor)) static void test_register_##suite##_##name(void)          \
+    {                                                                                      \
+        test_register(#suite, #name, test_##suite##_##name, __FILE__, __LINE__);           \
+    }                                                                                      \
+    static void test_##suite##_##name(void)
 
 #endif

@@ -166,5 +166,5 @@ static void run(bool shadow)
     gpu_destroy(&g);
 }
 
-void test_alpha_camera_rays(void) { run(false); }
-void test_alpha_shadow_rays(void) { run(true); }
+TEST(alpha, camera_rays) { run(false); }
+TEST(alpha, shadow_rays) { run(true); }

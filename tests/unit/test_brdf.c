@@ -407,7 +407,7 @@ static bool check_energy(const measure *m, bool quadrature, char *why, size_t ca
 /* ---- the tests -------------------------------------------------------------------------- */
 
 /* Model table and parameter parsing: clear errors for bad names and values. */
-void test_brdf_model_table(void)
+TEST(brdf, model_table)
 {
     brdf_setting s;
     for (int i = 0; i < brdf_num_models; i++)
@@ -439,7 +439,7 @@ void test_brdf_model_table(void)
 /* No NaN or Inf anywhere, f >= 0, pdf >= 0, weight >= 0, sampled directions unit length,
  * and nothing from an opaque model below its surface: over random, grazing (|z| down to
  * 1e-8 and 0), normal, back-facing and degenerate (wi = +-wo) directions and edge randoms. */
-void test_brdf_finite_and_positive(void)
+TEST(brdf, finite_and_positive)
 {
     enum { N = 8192 };
     if (!open_runner())
@@ -498,7 +498,7 @@ void test_brdf_finite_and_positive(void)
 /* Helmholtz reciprocity f(wo, wi) = f(wi, wo) for every reflection; refraction instead obeys
  * f(wo, wi) / eta(wi)^2 = f(wi, wo) / eta(wo)^2 (eta of the side each direction is on),
  * because the transmitted solid angle is compressed by (eta_t / eta_i)^2. */
-void test_brdf_reciprocity(void)
+TEST(brdf, reciprocity)
 {
     enum { N = 4096 };
     if (!open_runner())
@@ -562,7 +562,7 @@ void test_brdf_reciprocity(void)
 /* Lambert: the directional albedo equals the albedo at every angle, by quadrature of eval
  * and by uniform-sphere Monte Carlo (independent of sample()); and cosine sampling makes
  * every weight exactly the albedo. */
-void test_brdf_lambert_albedo(void)
+TEST(brdf, lambert_albedo)
 {
     const double theta[] = {0, 30, 60, 85, 89.9};
     enum { N = CHUNK };
@@ -609,7 +609,7 @@ void test_brdf_lambert_albedo(void)
  * over all cases); pdf integrates to the fraction of non-Dirac samples (1 where sampling
  * never fails); each sample's weight and pdf equal f cos / pdf and pdf at its wi; the mean
  * weight equals the quadrature of f cos; and that albedo is <= 1 (energy conservation). */
-void test_brdf_sampling_matches_pdf(void)
+TEST(brdf, sampling_matches_pdf)
 {
     const double theta[] = {0, 40, 75, 110, 160};
     int tests = 0;
@@ -642,7 +642,7 @@ void test_brdf_sampling_matches_pdf(void)
 
 /* Energy conservation from normal to grazing incidence (and from inside glass): the sampled
  * white-furnace albedo is <= 1 within its error. */
-void test_brdf_energy(void)
+TEST(brdf, energy)
 {
     const double theta[] = {0, 30, 60, 80, 85, 89, 89.9, 100, 135, 179};
     if (!open_runner())
@@ -666,7 +666,7 @@ void test_brdf_energy(void)
 /* The checks have teeth: a pdf scaled by 1.1 fails the chi-square and the normalisation, and
  * a Lambert without its 1/pi (f scaled by pi) fails energy conservation and the agreement of
  * sample weights with eval. */
-void test_brdf_broken_variants_fail(void)
+TEST(brdf, broken_variants_fail)
 {
     brdf_setting s;
     measure m;
@@ -703,7 +703,7 @@ static double fresnel_complex(double cos_i, double complex n)
  * at Brewster's angle, 1 at grazing and beyond the critical angle (total internal
  * reflection), equal transmission both ways through the interface (Stokes); conductors
  * against complex arithmetic and ((n-1)^2+k^2)/((n+1)^2+k^2); Schlick at its end points. */
-void test_brdf_fresnel(void)
+TEST(brdf, fresnel)
 {
     enum { N = 64 };
     BrdfQuery q[N];
@@ -765,7 +765,7 @@ void test_brdf_fresnel(void)
 /* Dirac lobes: the mirror returns r(wo) with weight R (the lecture's Lo = Li(r(wo))); the
  * smooth dielectric reflects with probability F and refracts by Snell's law otherwise (always
  * reflecting past the critical angle); polished conductors and glTF weight by their Fresnel. */
-void test_brdf_delta_lobes(void)
+TEST(brdf, delta_lobes)
 {
     enum { N = 2000 };
     const double thetas[] = {0, 25, 50, 70, 85, 130, 150, 170};

@@ -273,7 +273,7 @@ static bool moller_trumbore(const float o[3], const float d[3], const float *p0,
     return *u >= 0 && *v >= 0 && *u + *v <= 1 && *t > 0;
 }
 
-void test_bvh_tri_intersect(void)
+TEST(bvh, tri_intersect)
 {
     const float v0[3] = {0, 0, 0}, v1[3] = {1, 0, 0}, v2[3] = {0, 1, 0};
     float t, u, v;
@@ -336,7 +336,7 @@ void test_bvh_tri_intersect(void)
 
 /* ---- builds ----------------------------------------------------------------------------- */
 
-void test_bvh_empty(void)
+TEST(bvh, empty)
 {
     bvh b;
     const float org[3] = {0, 0, 0}, dir[3] = {0, 0, 1};
@@ -349,7 +349,7 @@ void test_bvh_empty(void)
     bvh_destroy(&b); /* a zeroed struct is fine */
 }
 
-void test_bvh_single_triangle(void)
+TEST(bvh, single_triangle)
 {
     const float pos[9] = {0, 0, 0, 2, 0, 0, 0, 2, 0};
     const uint32_t idx[3] = {0, 1, 2};
@@ -369,7 +369,7 @@ void test_bvh_single_triangle(void)
     CHECK(b.nodes == NULL && b.num_nodes == 0);
 }
 
-void test_bvh_random_soup(void)
+TEST(bvh, random_soup)
 {
     const float lo[3] = {-3, -1, -2}, hi[3] = {5, 1, 2};
     for (uint64_t seed = 1; seed <= 3; seed++) {
@@ -386,7 +386,7 @@ void test_bvh_random_soup(void)
 /* Triangle pairs in every corner rotation and both relative windings (pairs only when wound
  * alike), lone triangles that shift the pairing by one, and bent quads: tri_rotation must
  * give each hit's barycentrics their corners (check_rays rebuilds the hit point from them). */
-void test_bvh_pairs(void)
+TEST(bvh, pairs)
 {
     const float lo[3] = {-2, -1, -1}, hi[3] = {2, 1, 3};
     for (uint64_t seed = 1; seed <= 3; seed++) {
@@ -406,7 +406,7 @@ void test_bvh_pairs(void)
 
 /* Identical centroids (no SAH plane exists), zero-area triangles, a point-like scene and a
  * geometric series of nested triangles that makes the SAH peel one triangle per level. */
-void test_bvh_degenerate(void)
+TEST(bvh, degenerate)
 {
     enum { N = 300 };
     float *pos = malloc(9 * N * sizeof(float));
@@ -455,7 +455,7 @@ void test_bvh_degenerate(void)
 /* Closed meshes: a ray from outside towards the inside must hit, also exactly through shared
  * edges and vertices, and rays lying in a face plane (edge-on, direction components 0) must
  * still find the neighbouring face at its edge. */
-void test_bvh_watertight(void)
+TEST(bvh, watertight)
 {
     meshgen_mesh cube = meshgen_edge_on(4);
     bvh b;
@@ -538,7 +538,7 @@ void test_bvh_watertight(void)
     meshgen_destroy(&s);
 }
 
-void test_bvh_sphere(void)
+TEST(bvh, sphere)
 {
     const float c[3] = {1, 2, 3};
     meshgen_mesh s = meshgen_uv_sphere(c, 2, 64, 32);
@@ -577,7 +577,7 @@ void test_bvh_sphere(void)
 
 /* The worst case for the walk: the ray down the z axis visits every node (what the GPU test of
  * llvmpipe's loop cap relies on) and hits only the last triangle. */
-void test_bvh_comb(void)
+TEST(bvh, comb)
 {
     enum { N = 40000 };
     meshgen_mesh m = meshgen_comb(N);
@@ -607,7 +607,7 @@ void test_bvh_comb(void)
     meshgen_destroy(&m);
 }
 
-void test_bvh_bench_mesh(void)
+TEST(bvh, bench_mesh)
 {
     meshgen_mesh m = meshgen_bench_mesh(20000);
     bvh b;
@@ -632,7 +632,7 @@ void test_bvh_bench_mesh(void)
 
 /* Same input, same bytes: also for a build big enough to use threads, and whatever the
  * position stride. */
-void test_bvh_determinism(void)
+TEST(bvh, determinism)
 {
     meshgen_mesh m = meshgen_bench_mesh(60000);
     float *wide = malloc(8 * (size_t)m.num_vertices * sizeof(float));

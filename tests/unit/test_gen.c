@@ -72,7 +72,7 @@ static vec3 tri_normal(const scene *s, uint32_t t, vec3 *centroid)
 
 /* ---- gltf_write ------------------------------------------------------------------------ */
 
-void test_gen_gltf_roundtrip(void)
+TEST(gen, gltf_roundtrip)
 {
     static const float quad_p[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
     static const float quad_n[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
@@ -214,7 +214,7 @@ done:
 
 /* The other base64 tail: 136 bytes = 3 * 45 + 1 ends in "==" (the round trip above has
  * 200 = 3 * 66 + 2, one '='). Also: no materials, lights or extensions. */
-void test_gen_gltf_base64_padding(void)
+TEST(gen, gltf_base64_padding)
 {
     static const float p[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0.5f, 1.5f, 0, 0, 1, 0};
     static const float uv[] = {0, 0, 1, 0, 1, 1, 0.5f, 1.5f, 0, 1};
@@ -246,7 +246,7 @@ void test_gen_gltf_base64_padding(void)
 
 /* A write that cannot be committed (the destination is a directory) fails, names the file
  * and leaves no temporary file behind. */
-void test_gen_gltf_unwritable(void)
+TEST(gen, gltf_unwritable)
 {
     static const float p[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     static const uint32_t idx[] = {0, 1, 2};
@@ -290,7 +290,7 @@ static double signed_volume(const teapot_mesh *m)
 /* Each of the 32 patches gives 2 N^2 triangles; the 8 patches with a pole (lid top and
  * bottom: 4 each) lose the N triangles of the collapsed row. Zero-area triangles: only at
  * level 1, where the spout tip's 2 patches have collinear corners (4 triangles). */
-void test_gen_teapot_counts(void)
+TEST(gen, teapot_counts)
 {
     static const int levels[] = {1, 2, 3, 5, 8};
     for (int l = 0; l < 5; l++) {
@@ -327,7 +327,7 @@ static int compare_u64(const void *a, const void *b)
  * traversed in opposite directions). The open boundary is, in grid edges: the lid's outer
  * edge and the rim's inner edge (4 patches each), both ends of the handle and of the spout
  * (2 patches each): 16 N. */
-void test_gen_teapot_topology(void)
+TEST(gen, teapot_topology)
 {
     for (int n = 5; n <= 8; n += 3) {
         teapot_mesh m;
@@ -354,7 +354,7 @@ void test_gen_teapot_topology(void)
     }
 }
 
-void test_gen_teapot_normals(void)
+TEST(gen, teapot_normals)
 {
     teapot_mesh m;
     uint32_t not_unit = 0, disagree = 0;
@@ -389,7 +389,7 @@ void test_gen_teapot_normals(void)
     teapot_destroy(&m);
 }
 
-void test_gen_teapot_convergence(void)
+TEST(gen, teapot_convergence)
 {
     teapot_mesh a, b;
     double va, vb;
@@ -416,7 +416,7 @@ void test_gen_teapot_convergence(void)
  *   y control values 0, -1.12, -2, -2 are monotone: |y| <= 2, reached at the corner. (Its
  *   radius peaks at 45 degrees, 2 sqrt(2) (1/8 + 3/8 + 3/8 0.56) = 2.008, but there |y| is
  *   only 1.42.) */
-void test_gen_teapot_bounds(void)
+TEST(gen, teapot_bounds)
 {
     const double s = 1 / 3.15, c[4] = {3.3, 3.525, 3.45, 3.2};
     const double depth = 2;
@@ -456,7 +456,7 @@ static bool run_command(int (*cmd)(int, char **), int expect, int argc, const ch
     return cmd(argc, args) == expect;
 }
 
-void test_gen_cornell(void)
+TEST(gen, cornell)
 {
     const char *path = tmp_file("cornell.gltf");
     const char *argv[] = {"scene", "cornell", "-o", path};
@@ -536,7 +536,7 @@ done:
     scene_destroy(&s);
 }
 
-void test_gen_teapot_scene(void)
+TEST(gen, teapot_scene)
 {
     const char *path = tmp_file("teapot.gltf");
     const char *argv[] = {"teapot", "--level", "4", "-o", path};
@@ -591,7 +591,7 @@ done:
     scene_destroy(&s);
 }
 
-void test_gen_scene_usage(void)
+TEST(gen, scene_usage)
 {
     const char *p = tmp_file("usage.gltf");
     const char *none[] = {"scene"}, *unknown[] = {"scene", "sphere", "-o", p};

@@ -216,7 +216,7 @@ static void compare_mesh(gpu *g, const char *what, const meshgen_mesh *m, const 
     free(any);
 }
 
-void test_gpu_traversal_random(void)
+TEST(gpu, traversal_random)
 {
     gpu g;
     const float lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1};
@@ -232,7 +232,7 @@ void test_gpu_traversal_random(void)
     gpu_destroy(&g);
 }
 
-void test_gpu_traversal_sphere(void)
+TEST(gpu, traversal_sphere)
 {
     gpu g;
     const float c[3] = {0.1f, -0.2f, 0.3f}, lo[3] = {-0.9f, -1.2f, -0.7f}, hi[3] = {1.1f, 0.8f, 1.3f};
@@ -249,7 +249,7 @@ void test_gpu_traversal_sphere(void)
 
 /* Trees shallow enough for the walk's stack in registers: a small soup, a coarse sphere and
  * triangle pairs in every corner order (compare_mesh walks them all three ways). */
-void test_gpu_traversal_shallow(void)
+TEST(gpu, traversal_shallow)
 {
     gpu g;
     const float lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c[3] = {0, 0, 0};
@@ -275,7 +275,7 @@ void test_gpu_traversal_shallow(void)
 
 /* Rays aimed exactly at shared edges and vertices of a closed mesh, and rays parallel to
  * faces (edge-on): a watertight walk never lets the first kind through. */
-void test_gpu_traversal_edges(void)
+TEST(gpu, traversal_edges)
 {
     gpu g;
     meshgen_mesh m = meshgen_edge_on(4);
@@ -330,7 +330,7 @@ void test_gpu_traversal_edges(void)
  * than llvmpipe lets one invocation run (65,535 in total, silently), so with the budget a
  * walk stops, says so, and is resumed by the next dispatch: the answer is still exact. The
  * same holds where the cap itself stops a walk. */
-void test_gpu_traversal_deep(void)
+TEST(gpu, traversal_deep)
 {
     gpu g;
     meshgen_mesh m = meshgen_comb(50000);
@@ -394,7 +394,7 @@ static int wrap_reference(int i, int n, int mode)
     return mode == 2 && m >= n ? p - 1 - m : m;
 }
 
-void test_gpu_texture_wrap(void)
+TEST(gpu, texture_wrap)
 {
     static const int sizes[] = {1, 2, 3, 5, 7, 64, 100, 255, 1000, 2048, 4095, 8193};
     static const int centres[] = {0, 1, -1, 1 << 12, -(1 << 12), (1 << 24) - 20000, -(1 << 24) + 20000};

@@ -184,7 +184,7 @@ static void write_raw_exr(const char *path, exr_storage_t storage, exr_compressi
 
 /* ---- EXR --------------------------------------------------------------------------------- */
 
-void test_image_exr_roundtrip(void)
+TEST(image, exr_roundtrip)
 {
     /* 19 rows: two ZIP chunks of 16 lines. Names given unsorted; EXR sorts them. */
     static const char *const names[5] = {"R", "G", "B", "normal.X", "A"};
@@ -257,7 +257,7 @@ void test_image_exr_roundtrip(void)
     remove_dir(dir);
 }
 
-void test_image_exr_half(void)
+TEST(image, exr_half)
 {
     /* Distinct values per channel and pixel, all exact in half precision; data windows not at
      * the origin are read relative to their top-left corner. */
@@ -296,7 +296,7 @@ void test_image_exr_half(void)
     remove_dir(dir);
 }
 
-void test_image_exr_tiled(void)
+TEST(image, exr_tiled)
 {
     /* 7x5 in 3x2 tiles: partial tiles on the right and bottom; float, uint and half channels. */
     enum { W = 7, H = 5 };
@@ -352,7 +352,7 @@ static void check_read_fails(const char *path, const char *why)
         image_destroy(&img);
 }
 
-void test_image_exr_bad_files(void)
+TEST(image, exr_bad_files)
 {
     static const char *const names[3] = {"R", "G", "B"};
     char dir[64], good[128], bad[128], msg[256];
@@ -418,7 +418,7 @@ void test_image_exr_bad_files(void)
     remove_dir(dir);
 }
 
-void test_image_exr_write_fails(void)
+TEST(image, exr_write_fails)
 {
     static const char *const names[1] = {"Y"};
     char dir[64], path[256], ro[128], msg[1024];
@@ -498,7 +498,7 @@ static uint8_t to8(float v, float exposure, image_tonemap tm)
     return out[0];
 }
 
-void test_image_srgb(void)
+TEST(image, srgb)
 {
     /* Reference bytes: round(255 * OETF(x)) with OETF(x) = 12.92 x (x <= 0.0031308), else
      * 1.055 x^(1/2.4) - 0.055, worked out separately. 0.002 is on the linear branch (the power
@@ -528,7 +528,7 @@ void test_image_srgb(void)
     }
 }
 
-void test_image_png(void)
+TEST(image, png)
 {
     static const char *const grey[1] = {"Y"};
     static const char *const rgba_names[4] = {"A", "B", "G", "R"};
@@ -599,7 +599,7 @@ static void fill(image *img, const float *v)
 
 static bool near(double a, double b) { return fabs(a - b) <= 1e-9 * fmax(1, fabs(b)); }
 
-void test_image_metrics(void)
+TEST(image, metrics)
 {
     static const char *const y[1] = {"Y"}, *const z[1] = {"Z"}, *const rgb[3] = {"R", "G", "B"};
     static const char *const rgbaz[5] = {"A", "B", "G", "R", "Z"}, *const r_only[1] = {"R"};
@@ -701,7 +701,7 @@ static double metric(const char *out, const char *name)
     return NAN;
 }
 
-void test_image_diff_cli(void)
+TEST(image, diff_cli)
 {
     static const char *const rgb[4] = {"R", "G", "B", "normal.X"};
     char dir[64], a[128], b[128], small[128], nan[128], out[4096], err[4096];
@@ -773,7 +773,7 @@ void test_image_diff_cli(void)
 
 static const uint8_t *px_at(const draw_canvas *c, int x, int y) { return c->rgba + 4 * (y * c->width + x); }
 
-void test_image_draw_text(void)
+TEST(image, draw_text)
 {
     /* Starts and ends with 'H', whose outer columns are ink on every row: the box is tight. */
     static const char *const texts[3] = {"H", "Hgj{|}~ 0.5, (x) @#$ H", "H\x01\xff" "H"};
@@ -818,7 +818,7 @@ void test_image_draw_text(void)
     draw_destroy(&c);
 }
 
-void test_image_draw_shapes(void)
+TEST(image, draw_shapes)
 {
     draw_canvas c;
     char dir[64], path[128];
@@ -902,7 +902,7 @@ void test_image_draw_shapes(void)
     draw_destroy(&c);
 }
 
-void test_image_draw_colormap(void)
+TEST(image, draw_colormap)
 {
     double prev = -1;
     /* matplotlib viridis: entries 0, 128 and 255 of its 256-colour table. */

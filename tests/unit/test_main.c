@@ -1,5 +1,5 @@
-/* test_main.c: runs every unit test listed in suites.h, or those whose "suite.name" contains
- * argv[1]. Prints "N passed, N failed, N skipped" at the end; exit 1 on any failure. */
+/* test_main.c: runs every unit test (TEST in tests/unit/test.h), or those whose
+ * "suite.name" contains argv[1]. Prints "N passed, N failed, N skipped" at the end; exit 1 on any failure. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
 #include <stdlib.h>
@@ -30,28 +30,44 @@ const char *test_assets_dir(void)
     return path;
 }
 
-/* SUITES_FILE lets a module be built and tested alone: -DSUITES_FILE='"suite_bvh.h"' */
-#ifndef SUITES_FILE
-#define SUITES_FILE "suites.h"
-#endif
+#define MAX_TESTS 512
 
-#define TEST(suite, name) void test_##suite##_##name(void);
-#include SUITES_FILE
-#undef TEST
-
-static const struct {
-    const char *name;
+typedef struct test_case {
+    char name[96]; /* "suite.name" */
     test_fn fn;
-} tests[] = {
-#define TEST(suite, name) {#suite "." #name, test_##suite##_##name},
-#include SUITES_FILE
-#undef TEST
-    {NULL, NULL}};
+    const char *file;
+    int line;
+} test_case;
+
+static test_case tests[MAX_TESTS];
+static int num_tests;
+
+void test_register(const char *suite, const char *name, test_fn fn, const char *file, int line)
+{
+    if (num_tests == MAX_TESTS) {
+        fprintf(stderr, "test_main.c: more than %d tests: raise MAX_TESTS\n", MAX_TESTS);
+        exit(1);
+    }
+    test_case *t = &tests[num_tests++];
+    snprintf(t->name, sizeof t->name, "%s.%s", suite, name);
+    t->fn = fn;
+    t->file = file;
+    t->line = line;
+}
+
+/* By file, then line: the order does not depend on the linker's. */
+static int by_place(const void *pa, const void *pb)
+{
+    const test_case *a = pa, *b = pb;
+    int c = strcmp(a->file, b->file);
+    return c ? c : a->line - b->line;
+}
 
 int main(int argc, char **argv)
 {
     int passed = 0, failed = 0, skipped = 0;
-    for (int i = 0; tests[i].name; i++) {
+    qsort(tests, (size_t)num_tests, sizeof *tests, by_place);
+    for (int i = 0; i < num_tests; i++) {
         int before;
         if (argc > 1 && !strstr(tests[i].name, argv[1]))
             continue;

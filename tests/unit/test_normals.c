@@ -59,7 +59,7 @@ static bool open_assets(gpu *g)
  * quad of normal +Z, u along +X, v along -Y): the generated tangents must give the same
  * normals. (Before the loader generated them, per-triangle uv tangents of the opposite
  * handedness gave RMSE 0.24.) */
-void test_normals_generated_tangents(void)
+TEST(normals, generated_tangents)
 {
     const char *dir = "asset-generator/Mesh_PrimitiveAttribute";
     char a[256], b[256];
@@ -101,7 +101,7 @@ void test_normals_generated_tangents(void)
  * from the front, each mapped cell's normals must be its geometric twin's, and on both the
  * upper half of a bump faces up (+Y) and the right half right: the pattern that a flipped
  * green channel or wrong handedness turns around. */
-void test_normals_tangent_test_layout(void)
+TEST(normals, tangent_test_layout)
 {
     enum { S = 480 };
     const float dist = 6, th = 1.25f / 6; /* the frame spans [-1.25, 1.25] at z = 0 */
@@ -159,7 +159,7 @@ static void scale_normals(scene *sc)
  * environment at grazing view: where the shading normal would turn away from the viewer, a
  * BSDF sees the viewer below the surface and gives black; bent back (surface_at), every
  * pixel of the quad is lit. */
-void test_normals_strong_scale(void)
+TEST(normals, strong_scale)
 {
     const float ang = 1.2f; /* 69 degrees from the normal, looking down at the quad */
     GnCamera cam = front_camera(0, 0.2f);

@@ -82,7 +82,7 @@ static void tmp_file(char *out, size_t cap, const char *name)
     snprintf(out, cap, "/tmp/gonio-test-path-%d-%s", (int)getpid(), name);
 }
 
-void test_path_furnace(void)
+TEST(path, furnace)
 {
     static const struct {
         const char *extras; /* NULL: glTF Lambertian (specular 0) of albedo 0.5 */
@@ -134,7 +134,7 @@ void test_path_furnace(void)
 
 /* A lat-long map under which the sphere is lit: constant 1 (the furnace again, through map
  * sampling), and a bright band, where MIS and BSDF sampling only must agree. */
-void test_path_env_map(void)
+TEST(path, env_map)
 {
     char scene_path[256], map_path[256];
     const char *names[] = {"R", "G", "B"};
@@ -213,7 +213,7 @@ static double max_block_z(const image *a, const image *b, int bs)
  * converge to the same image; and the test notices a missing bounce. 256 spp: BSDF sampling
  * finds the small light rarely, and below that its variance estimates run low (at 128 spp
  * the z of a correct render reaches 9). */
-void test_path_estimators(void)
+TEST(path, estimators)
 {
     static const uint32_t strategies[] = {0, GN_FRAME_LIGHT_ONLY, GN_FRAME_BSDF_ONLY};
     const char *brdf = "ggx:alpha=0.25:specular=0.3";
@@ -258,7 +258,7 @@ static double rmse_rgb(const image *a, const image *b)
 
 /* RMSE against a 512 spp render falls as 1/sqrt(spp): the fitted log-log slope over
  * 4..64 spp is -1/2, once the reference's own noise (its variance channel) is taken out. */
-void test_path_convergence(void)
+TEST(path, convergence)
 {
     gpu g = {0};
     image ref = {0};
@@ -400,7 +400,7 @@ static void ref_radiance(const scene *sc, double *o, double *d, uint64_t *rng, d
     }
 }
 
-void test_path_cornell_reference(void)
+TEST(path, cornell_reference)
 {
     enum { W = 32, H = 32, SPP = 256 };
     const char *names[] = {"R", "G", "B", "variance.R", "variance.G", "variance.B"};
@@ -457,7 +457,7 @@ void test_path_cornell_reference(void)
  * clock, but its dispatches start at multiples of the kernel's samples per dispatch, so it
  * must give exactly the image of the same samples taken one dispatch per submission. (With
  * batches of 1, 2, 4... samples, the sums of a pixel's samples were grouped differently.) */
-void test_path_batching(void)
+TEST(path, batching)
 {
     gpu g = {0};
     scene sc = {0};
@@ -494,7 +494,7 @@ void test_path_batching(void)
 }
 
 /* The same settings twice give the same bits. */
-void test_path_determinism(void)
+TEST(path, determinism)
 {
     gpu g = {0};
     image a = {0}, b = {0};
@@ -515,7 +515,7 @@ void test_path_determinism(void)
 
 /* gonio merge on hand-made files: means weight by spp, variances by the sums of squares
  * they imply (computed here by hand for two pixels of two samples each). */
-void test_path_merge(void)
+TEST(path, merge)
 {
     const char *names[] = {"R", "variance.R"};
     char a_path[256], b_path[256], o_path[256];
@@ -556,7 +556,7 @@ void test_path_merge(void)
 /* gonio merge refuses sample counts that are not positive integers (whatever type the
  * header stores them as), a total past the header's int, and a repeated seed (unless
  * --force); each refusal exits 1 and writes nothing. */
-void test_path_merge_checks(void)
+TEST(path, merge_checks)
 {
     const char *names[] = {"R"};
     static const struct { image_attr_type type; int i; double d; const char *what; } bad[] = {

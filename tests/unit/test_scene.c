@@ -165,7 +165,7 @@ static float nearest_vertex(const scene *s, float x, float y, float z)
 
 /* ---- scene helpers ------------------------------------------------------------------------ */
 
-void test_scene_phong_mapping(void)
+TEST(scene, phong_mapping)
 {
     GnMaterial m;
     scene_material_default(&m);
@@ -199,7 +199,7 @@ void test_scene_phong_mapping(void)
     CHECK(m.phong_shininess == 10000);
 }
 
-void test_scene_default_material(void)
+TEST(scene, default_material)
 {
     GnMaterial m;
     scene_material_default(&m);
@@ -226,7 +226,7 @@ static bool projects_inside(const scene_camera *c, const float p[3])
 
 static bool orthonormal(const scene_camera *c);
 
-void test_scene_default_camera(void)
+TEST(scene, default_camera)
 {
     static const float boxes[][6] = {
         {-1, -1, -1, 1, 1, 1}, {0, 0, 0, 100, 1, 1}, {1000, 2000, -3000, 1001, 2010, -2999}, {-5, 0, 0, 5, 0, 0}};
@@ -269,7 +269,7 @@ void test_scene_default_camera(void)
     }
 }
 
-void test_scene_drop_invalid_triangles(void)
+TEST(scene, drop_invalid_triangles)
 {
     scene s;
     memset(&s, 0, sizeof s);
@@ -348,7 +348,7 @@ static const struct {
     {"gltf/WaterBottle/glTF/WaterBottle.gltf", 4510, 2549, 1, 1, 1, 1, 4, 4, 0, 0, 0},
 };
 
-void test_scene_sample_models(void)
+TEST(scene, sample_models)
 {
     if (!test_assets_dir()) {
         test_skip("no test assets");
@@ -379,7 +379,7 @@ void test_scene_sample_models(void)
     }
 }
 
-void test_scene_triangle(void)
+TEST(scene, triangle)
 {
     static const char *const files[] = {"gltf/Triangle/glTF/Triangle.gltf", "gltf/Triangle/glTF-Embedded/Triangle.gltf",
                                         "gltf/TriangleWithoutIndices/glTF/TriangleWithoutIndices.gltf",
@@ -409,7 +409,7 @@ void test_scene_triangle(void)
     }
 }
 
-void test_scene_simple_meshes(void)
+TEST(scene, simple_meshes)
 {
     if (!test_assets_dir()) {
         test_skip("no test assets");
@@ -434,7 +434,7 @@ void test_scene_simple_meshes(void)
     scene_destroy(&s);
 }
 
-void test_scene_box(void)
+TEST(scene, box)
 {
     if (!test_assets_dir()) {
         test_skip("no test assets");
@@ -456,7 +456,7 @@ void test_scene_box(void)
 }
 
 /* .glb and data-URI variants must give exactly the geometry, materials and images of the .gltf. */
-void test_scene_variants_identical(void)
+TEST(scene, variants_identical)
 {
     static const char *const sets[][3] = {
         {"gltf/Box/glTF/Box.gltf", "gltf/Box/glTF-Binary/Box.glb", "gltf/Box/glTF-Embedded/Box.gltf"},
@@ -490,7 +490,7 @@ void test_scene_variants_identical(void)
     }
 }
 
-void test_scene_orientation(void)
+TEST(scene, orientation)
 {
     if (!test_assets_dir()) {
         test_skip("no test assets");
@@ -529,7 +529,7 @@ static bool orthonormal(const scene_camera *c)
     return fabsf(r[0] - c->right[0]) < 1e-5f && fabsf(r[1] - c->right[1]) < 1e-5f && fabsf(r[2] - c->right[2]) < 1e-5f;
 }
 
-void test_scene_cameras(void)
+TEST(scene, cameras)
 {
     if (!test_assets_dir()) {
         test_skip("no test assets");
@@ -571,7 +571,7 @@ void test_scene_cameras(void)
     scene_destroy(&s);
 }
 
-void test_scene_textures(void)
+TEST(scene, textures)
 {
     static const struct {
         const char *file;
@@ -598,7 +598,7 @@ void test_scene_textures(void)
     }
 }
 
-void test_scene_khr_materials(void)
+TEST(scene, khr_materials)
 {
     if (!test_assets_dir()) {
         test_skip("no test assets");
@@ -633,7 +633,7 @@ void test_scene_khr_materials(void)
     scene_destroy(&s);
 }
 
-void test_scene_lights(void)
+TEST(scene, lights)
 {
     if (!test_assets_dir()) {
         test_skip("no test assets");
@@ -663,7 +663,7 @@ void test_scene_lights(void)
 /* Two Asset Generator sets (attribute formats, vertex colours, texture combinations): all load
  * and satisfy the invariants. The other two sets decode one 3 MB PNG per model for little more
  * coverage, which would double the suite's time. */
-void test_scene_asset_generator(void)
+TEST(scene, asset_generator)
 {
     static const char *const sets[] = {"Material_MetallicRoughness", "Mesh_PrimitiveAttribute"};
     if (!test_assets_dir()) {
@@ -772,7 +772,7 @@ static void walk_corpus(const char *dir, const char *rel)
         closedir(d);
 }
 
-void test_scene_invalid_corpus(void)
+TEST(scene, invalid_corpus)
 {
     if (!test_assets_dir()) {
         test_skip("no test assets");
@@ -832,7 +832,7 @@ static bool load_tri_scene(scene *s, const char *body)
     return load(s, "/tmp/gonio_scene_test.gltf");
 }
 
-void test_scene_transforms(void)
+TEST(scene, transforms)
 {
     scene s;
     /* Mirror (scale -1 on X): positions mirrored, the winding swapped so the face still faces
@@ -865,7 +865,7 @@ void test_scene_transforms(void)
     scene_destroy(&s);
 }
 
-void test_scene_primitive_modes(void)
+TEST(scene, primitive_modes)
 {
     scene s;
     int w0 = util_warning_count();
@@ -884,7 +884,7 @@ void test_scene_primitive_modes(void)
     scene_destroy(&s);
 }
 
-void test_scene_bad_geometry(void)
+TEST(scene, bad_geometry)
 {
     scene s;
     /* Three non-indexed triangles; the 2nd has a NaN corner, the 3rd a corner at 1e20: both
@@ -967,7 +967,7 @@ void test_scene_bad_geometry(void)
     CHECK(!load_tri_scene(&s, body) && strstr(load_log, "nested deeper"));
 }
 
-void test_scene_truncated_files(void)
+TEST(scene, truncated_files)
 {
     if (!test_assets_dir()) {
         test_skip("no test assets");
@@ -995,7 +995,7 @@ void test_scene_truncated_files(void)
 
 /* A GLB built here: the triangle scene's JSON (buffer 0 = the BIN chunk), BIN, then a chunk of
  * unknown type that must be skipped. */
-void test_scene_glb_container(void)
+TEST(scene, glb_container)
 {
     char json[4096];
     snprintf(json, sizeof json, "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":%zu}]," TRI_ACCESSORS
@@ -1032,7 +1032,7 @@ void test_scene_glb_container(void)
     free(glb);
 }
 
-void test_scene_sparse_accessor(void)
+TEST(scene, sparse_accessor)
 {
     scene s;
     /* Accessor 6: the 3 triangle positions with vertex 1 replaced by (5, 0, 0) through a sparse
@@ -1065,7 +1065,7 @@ void test_scene_sparse_accessor(void)
 static const char png_g16[] = "iVBORw0KGgoAAAANSUhEUgAAAAIAAAABEAAAAACB2fwVAAAADUlEQVR4nGMQMvn/HwAD5gJFLkKWdQAAAABJRU5ErkJggg==";
 static const char png_ga8[] = "iVBORw0KGgoAAAANSUhEUgAAAAIAAAABCAQAAABeK7cBAAAADUlEQVR4nGMQaPigAAADxQGhlMj5CAAAAABJRU5ErkJggg==";
 
-void test_scene_materials_lights_cameras(void)
+TEST(scene, materials_lights_cameras)
 {
     char body[8192];
     snprintf(body, sizeof body,

@@ -196,7 +196,7 @@ static void unit_normals(float n[9])
 /* Gouraud: the vertex pass lights each vertex with its own normal and the view direction
  * from that vertex (and the opposite side with the flipped normal), and every pixel inside
  * the triangle is the barycentric interpolation of those colours. */
-void test_shading_gouraud_triangle(void)
+TEST(shading, gouraud_triangle)
 {
     float normals[9] = {0.3f, 0, 1, -0.2f, 0.3f, 1, 0, -0.4f, 1};
     shade_params p = {.kd = {0.6f, 0.3f, 0.2f}, .ks = {0.5f, 0.4f, 0.3f}, .ka = {0.1f, 0.2f, 0.3f},
@@ -254,7 +254,7 @@ void test_shading_gouraud_triangle(void)
 
 /* Flat: every pixel of a triangle has the colour of the Phong model at its centroid with
  * the face normal, seen from the centroid; neighbouring triangles differ. */
-void test_shading_flat_constant(void)
+TEST(shading, flat_constant)
 {
     const float centre[3] = {0, 0, 0};
     shade_params p = {.kd = {0.7f, 0.5f, 0.3f}, .ks = {0.4f, 0.4f, 0.4f}, .shininess = 16,
@@ -318,7 +318,7 @@ void test_shading_flat_constant(void)
 
 /* Phong shading of sphere meshes approaches the analytic sphere's shading (exact normal at
  * the exact hit) as the tessellation grows: the error falls at every step and ends small. */
-void test_shading_phong_sphere(void)
+TEST(shading, phong_sphere)
 {
     const float centre[3] = {0, 0, 0};
     shade_params p = {.kd = {0.6f, 0.6f, 0.6f}, .ks = {0.5f, 0.5f, 0.5f}, .shininess = 20,
@@ -373,7 +373,7 @@ void test_shading_phong_sphere(void)
 /* The classic failure of Gouraud shading: a point light above the middle of a large flat
  * triangle puts a sharp highlight inside it that reaches none of its vertices. Per-pixel
  * Phong shading shows it; Gouraud shading, which only knows the vertex colours, cannot. */
-void test_shading_highlight_missed(void)
+TEST(shading, highlight_missed)
 {
     const float up[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
     shade_params p = {.kd = {0.1f, 0.1f, 0.1f}, .ks = {1, 1, 1}, .shininess = 200,

@@ -35,7 +35,7 @@ static void check_vertex(const float *nrm, const uint32_t *remap, const float *t
  * (1, 0, 0, 1)): normal +Z, u along +X, v along -Y. The image's up is +Y, so the bitangent
  * is +Y and w = +1. With u mirrored (u along -X) the tangent is -X and w = -1: the
  * bitangent stays +Y. */
-void test_tangent_plane(void)
+TEST(tangent, plane)
 {
     const float pos[] = {0.5f, -0.5f, 0, -0.5f, -0.5f, 0, -0.5f, 0.5f, 0, 0.5f, 0.5f, 0};
     const float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
@@ -57,7 +57,7 @@ void test_tangent_plane(void)
 /* Two quads side by side sharing the edge x = 1, the right one a mirror image of the left in
  * uv (u = x, then u = 2 - x; the shared vertices have one uv): the seam's two vertices are
  * split, the left side keeps tangent +X and w = +1, the right gets -X and w = -1. */
-void test_tangent_mirror_seam(void)
+TEST(tangent, mirror_seam)
 {
     const float pos[] = {0, 0, 0, 1, 0, 0, 2, 0, 0, 0, 1, 0, 1, 1, 0, 2, 1, 0};
     const float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
@@ -82,7 +82,7 @@ void test_tangent_mirror_seam(void)
  * direction (-sin phi, 0, cos phi): by symmetry the angle-weighted chords of the two
  * neighbouring faces average to it, and a seam vertex's one chord projects onto it. Seen from
  * outside, u runs right to left (a mirrored mapping), so w = -1 with the bitangent +Y. */
-void test_tangent_cylinder(void)
+TEST(tangent, cylinder)
 {
     enum { N = 12 };
     float pos[2 * (N + 1) * 3], nrm[2 * (N + 1) * 3], uv[2 * (N + 1) * 2];
@@ -116,7 +116,7 @@ void test_tangent_cylinder(void)
 
 /* A triangle with no uv area still gets a unit tangent orthogonal to its normal, and one
  * beside a good triangle takes that one's tangent. */
-void test_tangent_degenerate(void)
+TEST(tangent, degenerate)
 {
     const float pos[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
     const float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
