@@ -140,14 +140,14 @@ precise float max_nn(float a, float b) { return a > b ? a : b; }
 precise float min_nn(float a, float b) { return a < b ? a : b; }
 
 // Slab test of one child box: entry distance, or +inf on a miss. The far distance is
-// scaled by 1 + 2 gamma(3) (Ize 2013) so rounding never loses a box the triangle test hits.
+// scaled by GN_BVH_TFAR_SCALE so rounding never loses a box the triangle test hits.
 float box_enter(RayPre r, vec3 bmin, vec3 bmax, float tmin, float tmax)
 {
     // The near and far planes by the sign of the direction: the same values as min and
     // max of the two slab distances (boxes have min <= max), for fewer SIMD instructions.
     vec3 lo = (mix(bmin, bmax, r.neg) - r.o) * r.inv, hi = (mix(bmax, bmin, r.neg) - r.o) * r.inv;
     float enter = max_nn(max_nn(lo.x, lo.y), max_nn(lo.z, tmin));
-    float leave = min_nn(min_nn(hi.x, hi.y), min_nn(hi.z, tmax)) * 1.0000004;
+    float leave = min_nn(min_nn(hi.x, hi.y), min_nn(hi.z, tmax)) * GN_BVH_TFAR_SCALE;
     return enter <= leave ? enter : 1e38;
 }
 

@@ -163,6 +163,10 @@ typedef uint32_t uint;
 #define GN_BVH_LEAF 0x80000000u
 #define GN_BVH_COUNT_SHIFT 27
 #define GN_BVH_FIRST 0x07ffffffu
+/* A slab test's far distance is scaled by this, so rounding never loses a box the triangle
+ * test hits: 1 + 2 gamma(3) (Ize 2013; gamma(n) = n u / (1 - n u), u = 2^-24) is just above
+ * 1 + 3 ulp, so 1 + 4 ulp (src/bvh.c and glsl/bvh.glsl, one value). */
+#define GN_BVH_TFAR_SCALE 1.00000048f
 GN_STRUCT(GnBvhNode) {
     vec3 a_min; uint a_index;
     vec3 a_max; uint a_count;

@@ -45,9 +45,6 @@ _Static_assert(GN_WALK_STACK - 2 >= BVH_MAX_DEPTH - 1, "glsl/bvh.glsl's stack mu
 
 /* Traversal constants, shared with glsl/bvh.glsl. */
 #define BVH_STACK 64
-/* 1 + 2 gamma(3) (Ize 2013, pbrt's gamma(n) = n u / (1 - n u), u = 2^-24), rounded up: the
- * far slab distance times this bounds every rounding error of the slab test. */
-#define BVH_TFAR_SCALE 1.00000048f
 /* A direction component smaller than this is treated as parallel to its slabs: the inverse
  * becomes +-BVH_PARALLEL_INV (finite, so no 0 * inf NaN and no inf on GPUs that assume
  * none). Boxes are padded (see pad_up) so that a parallel ray lying exactly in a box face
@@ -884,7 +881,7 @@ static inline bool box_enter(const ray *r, const vec3 *lo, const vec3 *hi, float
     float y0 = (lo->y - r->org[1]) * r->inv[1], y1 = (hi->y - r->org[1]) * r->inv[1];
     float z0 = (lo->z - r->org[2]) * r->inv[2], z1 = (hi->z - r->org[2]) * r->inv[2];
     float tn = maxf(maxf(minf(x0, x1), minf(y0, y1)), maxf(minf(z0, z1), tmin));
-    float tf = minf(minf(maxf(x0, x1), maxf(y0, y1)), maxf(z0, z1)) * BVH_TFAR_SCALE;
+    float tf = minf(minf(maxf(x0, x1), maxf(y0, y1)), maxf(z0, z1)) * GN_BVH_TFAR_SCALE;
     *enter = tn;
     return tn <= minf(tf, tmax);
 }
