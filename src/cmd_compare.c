@@ -212,10 +212,6 @@ static bool run_compare(renderer *r, const compare_opts *o)
 
     for (int i = 0; i < o->num_modes && ok; i++) {
         uint32_t m = o->modes[i];
-        if (!renderer_mode_available(m)) {
-            util_warn("compare: mode %s is not available in this build (skipped)", render_mode_name(m));
-            continue;
-        }
         if (!render_one(r, o, m, &imgs[n]))
             ok = false;
         else

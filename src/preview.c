@@ -82,6 +82,7 @@ typedef struct preview {
 
     int spp, max_spp, batch;       /* samples accumulated, the limit (0: none), passes/frame */
     bool restart, save, redraw, quit_key; /* redraw: the display changed, not the samples */
+    bool failed; /* an error was reported: the window closes, exit status 1 */
     float exposure;
     image_tonemap tonemap;
     const char *prefix;
@@ -212,10 +213,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         return;
     if (key >= GLFW_KEY_1 && key <= GLFW_KEY_8) {
         uint32_t m = mode_keys[key - GLFW_KEY_1];
-        if (!renderer_mode_available(m)) {
-            fprintf(stderr, "gonio preview: mode %s is not available yet; staying in %s\n",
-                    render_mode_name(m), render_mode_name(p->s.mode));
-        } else if (m != p->s.mode) {
+        if (m != p->s.mode) {
             p->s.mode = m;
             p->restart = true;
         }
@@ -398,7 +396,8 @@ static bool swapchain_create(preview *p)
     if (!(caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_DST_BIT)) {
         util_error("%s: the window's images cannot be copied to (no transfer-dst usage)",
                    p->g.props.deviceName);
-        exit(1);
+        p->failed = true;
+        return false;
     }
     sci.surface = p->surface;
     sci.minImageCount = caps.minImageCount + 1;
@@ -556,8 +555,10 @@ static bool frame(preview *p, double *submit_time, int *last_passes)
         p->s.width = (int)p->extent.width;
         p->s.height = (int)p->extent.height;
         /* The start camera frames the scene for the image's aspect, as `gonio render` does. */
-        if ((!p->moved && !camera_start(p)) || !renderer_begin(&p->r, &p->s, &fr))
-            exit(1); /* the only failure is a camera index, checked before */
+        if ((!p->moved && !camera_start(p)) || !renderer_begin(&p->r, &p->s, &fr)) {
+            p->failed = true; /* said why */
+            return false;
+        }
         display_resize(p);
         p->spp = 0;
         p->restart = false;
@@ -815,6 +816,10 @@ int cmd_preview(int argc, char **argv)
                 continue; /* woken early by an event that changed nothing */
             fly(p, (float)fmin(now - last_frame, 0.1));
             if (!frame(p, &submit_time, &last_passes)) {
+                if (p->failed) {
+                    ok = false;
+                    break;
+                }
                 glfwWaitEventsTimeout(PREVIEW_IDLE_SECONDS); /* minimised */
                 continue;
             }

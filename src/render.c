@@ -947,11 +947,6 @@ gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
     return p;
 }
 
-bool renderer_mode_available(uint32_t mode)
-{
-    return mode < GN_MODE_COUNT;
-}
-
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,
                              uint32_t count)
 {
@@ -1174,10 +1169,7 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
     char why[256];
 
     memset(stats, 0, sizeof *stats);
-    if (!renderer_mode_available(s->mode)) {
-        util_error("--mode %s is not available yet", render_mode_name(s->mode));
-        return false;
-    }
+    assert(s->mode < GN_MODE_COUNT);
     if (r->failed)
         return false;
     render_region(s, region);

@@ -1,8 +1,8 @@
 /* render.h: a scene on the GPU and the progressive sample passes that render it.
  *
- * Work is submitted as short dispatches of one sample per pixel each (DESIGN.md: keeps a
- * window responsive, GPU watchdogs quiet, llvmpipe's loop cap away, and lets an interrupted
- * render write what it has). Samples depend only on (pixel, sample, dimension, seed). */
+ * Work is submitted as short dispatches of a few samples per pixel each (renderer.path_samples:
+ * keeps a window responsive, GPU watchdogs quiet, llvmpipe's loop cap away, and lets an
+ * interrupted render write what it has). Samples depend only on (pixel, sample, dimension, seed). */
 #ifndef GONIO_RENDER_H
 #define GONIO_RENDER_H
 
@@ -131,7 +131,6 @@ const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode
 
 /* The kernel of a mode (created on first use, kept until renderer_destroy). */
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode);
-bool renderer_mode_available(uint32_t mode);
 /* Records one sample pass (sample `sample_index` in every pixel) and a barrier. Call
  * renderer_begin first. */
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,

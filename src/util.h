@@ -1,7 +1,7 @@
 /* util.h: error reporting, timing and small parsing helpers shared by every module.
  *
- * Three kinds of failure, three treatments (STYLE.md): a Vulkan/driver failure stops in
- * VK_CHECK with the call, file, line and VkResult name; bad user input is reported with
+ * Three kinds of failure, three treatments: a Vulkan/driver failure stops in GPU_CHECK
+ * (src/gpu.h) with the call, file, line and VkResult name; bad user input is reported with
  * util_error (naming the file and the problem) and returned as `false` up to main, which
  * exits 1; a programmer's mistake is an assert. */
 #ifndef GONIO_UTIL_H

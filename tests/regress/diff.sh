@@ -72,9 +72,11 @@ err_has "text.exr"
 run 1 "missing channel" "$tmp/black.exr" "$tmp/dot.exr" --channels Z
 err_has "'Z'"
 
-# Bad usage: exit 2 with the usage line; --help: usage on stdout, exit 0.
+# Bad usage: exit 2 with the problem and where to look, as every command; --help: usage
+# on stdout, exit 0.
 run 2 "no arguments"
-err_has "usage:"
+err_has "gonio diff: expected two images"
+err_has "(see gonio diff --help)"
 run 2 "unknown option" "$tmp/black.exr" "$tmp/dot.exr" --frobnicate
 run 2 "missing value" "$tmp/black.exr" "$tmp/dot.exr" --max-rmse
 run 2 "not a number" "$tmp/black.exr" "$tmp/dot.exr" --max-rmse 0.1x
