@@ -1,0 +1,178 @@
+#!/usr/bin/env python3
+# peer.py: make bench-peer. gonio beside Mitsuba 3 (its LLVM variant, on the same CPU cores)
+# on scenes the project did not shape (scenes.py): per scene, gonio's steady-state paths/s
+# (a high-spp render minus a low-spp one over the time between, so start-up cancels),
+# Mitsuba's paths/s (a render after a first one, which compiles its kernels), the ratio of
+# their times for the same paths, and how far the two images agree. Both renderers use
+# unbounded depth with Russian roulette from the third bounce on, q = min(max(beta), 0.95)
+# (Mitsuba's rr_depth 3; its beta also carries eta^2 inside glass), NEE with MIS (power
+# heuristic), a box pixel filter and independent random samples.
+#
+#   peer.py --gonio build/release/gonio [--out DIR] [--size N] [--spp N] [--low N]
+#           [--reps N] [--only a,b] [--check-furnace]
+#
+# --check-furnace: the converter's test (tests/regress/peer.sh): the white furnace in both
+# renderers at 64x64, exit 1 unless each is 0.8 inside the sphere and the two agree.
+import argparse
+import os
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+here = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, here)
+import scenes  # noqa: E402
+import to_mitsuba  # noqa: E402
+
+
+def gonio_render(args, sc, spp, seed, exr):
+    cmd = [args.gonio, "render", sc["gltf"], "-o", exr, "--size", f"{args.size}x{args.size}",
+           "--spp", str(spp), "--seed", str(seed), "--env", str(sc["env"]), "--quiet"]
+    if "look_at" in sc:
+        cmd += ["--look-at", ",".join(",".join(str(x) for x in v) for v in sc["look_at"]),
+                "--fov", str(sc["fov"])]
+    t = time.perf_counter()
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    t = time.perf_counter() - t
+    if r.returncode != 0:
+        sys.exit(f"peer: {' '.join(cmd)} failed (exit {r.returncode}):\n{r.stderr}")
+    return t, r.stderr.strip()
+
+
+def read_exr(mi, path):
+    b = mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False)
+    return np.array(b, dtype=np.float64)
+
+
+def mitsuba_render(mi, dr, scene, spp):
+    t = time.perf_counter()
+    img = mi.render(scene, spp=spp)
+    dr.eval(img)
+    dr.sync_thread()
+    return time.perf_counter() - t, np.array(img, dtype=np.float64)
+
+
+def agreement(a, b):
+    """(mean bias of a against b, relative; relMSE of a against b over pixels and RGB)."""
+    bias = (a.mean() - b.mean()) / b.mean()
+    relmse = np.mean((a - b) ** 2 / (b ** 2 + 1e-2))
+    return bias, relmse
+
+
+def save_png(mi, path, *imgs):
+    img = np.concatenate(imgs, axis=1).astype(np.float32)
+    mi.Bitmap(img).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.UInt8, srgb_gamma=True).write(path)
+
+
+def setup_mitsuba():
+    import drjit as dr
+    import mitsuba as mi
+    mi.set_variant("llvm_ad_rgb")
+    return mi, dr
+
+
+def check_furnace(args):
+    """The white furnace at 64x64: gonio and Mitsuba each 0.8 inside the sphere (the
+    analytic answer) and the two images equal in mean, each within 4 standard errors
+    estimated from the images' own pixel spread (a false failure about 1 in 16000)."""
+    mi, dr = setup_mitsuba()
+    args.size = 64
+    spp = 16
+    out = os.path.join(args.out, "check")
+    sc = [s for s in scenes.generate(out, args.assets, args.cornell) if s["name"] == "furnace"][0]
+    exr = os.path.join(out, "furnace.exr")
+    gonio_render(args, sc, spp, 0, exr)
+    g = read_exr(mi, exr)
+    scene = mi.load_dict(to_mitsuba.scene_dict(mi, sc["gltf"], os.path.join(out, "mitsuba"),
+                                               args.size, args.size, spp, sc["env"]))
+    _, m = mitsuba_render(mi, dr, scene, spp)
+    # Pixels well inside the silhouette: the sphere (radius 1, 3.2 away) spans
+    # tan(asin(1 / 3.2)) / tan(0.35) = 0.90 of the half height; take 0.8 of that.
+    n = args.size
+    y, x = np.mgrid[0:n, 0:n] + 0.5
+    inside = np.hypot(x - n / 2, y - n / 2) < 0.8 * 0.90 * n / 2
+    ok = True
+    for name, img in (("gonio", g), ("mitsuba", m)):
+        v = img[inside].mean(axis=1)
+        se = v.std() / np.sqrt(v.size)
+        good = abs(v.mean() - 0.8) < 4 * se + 1e-4
+        ok &= good
+        print(f"{name:8s} inside the sphere {v.mean():.5f} (analytic 0.8, standard error {se:.5f})"
+              f" {'ok' if good else 'FAIL'}")
+    d = (g - m).mean(axis=2).reshape(-1)
+    se = d.std() / np.sqrt(d.size)
+    good = abs(d.mean()) < 4 * se + 1e-4
+    ok &= good
+    print(f"gonio - mitsuba, mean over the image {d.mean():+.5f} (standard error {se:.5f})"
+          f" {'ok' if good else 'FAIL'}")
+    return 0 if ok else 1
+
+
+def main():
+    ap = argparse.ArgumentParser(description="gonio beside Mitsuba 3 on the bench scenes")
+    ap.add_argument("--gonio", required=True)
+    ap.add_argument("--out", default="build/peer")
+    ap.add_argument("--assets", default=os.environ.get("GONIO_ASSETS", "../shared/assets"))
+    ap.add_argument("--cornell", default="scenes/cornell.gltf")
+    ap.add_argument("--size", type=int, default=256)
+    ap.add_argument("--spp", type=int, default=64)
+    ap.add_argument("--low", type=int, default=8)
+    ap.add_argument("--reps", type=int, default=2)
+    ap.add_argument("--only", default="")
+    ap.add_argument("--check-furnace", action="store_true")
+    args = ap.parse_args()
+    if args.check_furnace:
+        return check_furnace(args)
+
+    mi, dr = setup_mitsuba()
+    out = os.path.abspath(args.out)
+    os.makedirs(os.path.join(out, "img"), exist_ok=True)
+    todo = scenes.generate(os.path.join(out, "scenes"), args.assets, args.cornell)
+    if not any(s["name"] == "bunny" for s in todo):
+        print(f"peer: {args.assets}/mesh/stanford-bunny.obj is absent: skipping the bunny scenes")
+    if not any(s["name"] == "helmet" for s in todo):
+        print(f"peer: {args.assets}/gltf/DamagedHelmet is absent: skipping the helmet")
+    if args.only:
+        todo = [s for s in todo if s["name"] in args.only.split(",")]
+    px = args.size * args.size
+    print(f"{args.size}x{args.size}, {args.spp} spp (gonio: {args.spp} minus {args.low} spp), "
+          f"{args.reps} runs each, alternating; M paths/s")
+    print(f"{'scene':16s} {'run':>3s} {'gonio':>7s} {'mitsuba':>7s} {'ratio':>6s}  "
+          f"{'bias':>7s} {'relMSE':>7s} {'floor':>7s}")
+    rows = {}
+    for sc in todo:
+        work = os.path.join(out, "mitsuba", sc["name"])
+        scene = mi.load_dict(to_mitsuba.scene_dict(mi, sc["gltf"], work, args.size, args.size, args.spp,
+                                                   sc["env"], sc.get("look_at"), sc.get("fov")))
+        mitsuba_render(mi, dr, scene, args.spp)  # compiles its kernels
+        imgs = []
+        for rep in range(args.reps):
+            exr = os.path.join(out, f"{sc['name']}-gonio{rep}.exr")
+            t_lo, _ = gonio_render(args, sc, args.low, rep, os.path.join(out, "low.exr"))
+            t_hi, warn = gonio_render(args, sc, args.spp, rep, exr)
+            g_rate = px * (args.spp - args.low) / (t_hi - t_lo)
+            t_m, m = mitsuba_render(mi, dr, scene, args.spp)
+            m_rate = px * args.spp / t_m
+            g = read_exr(mi, exr)
+            imgs.append(g)
+            bias, relmse = agreement(g, m)
+            # gonio against gonio of another seed: the relMSE that noise alone gives.
+            floor = agreement(imgs[0], g)[1] if rep else float("nan")
+            rows.setdefault(sc["name"], []).append(g_rate)
+            print(f"{sc['name']:16s} {rep + 1:3d} {g_rate * 1e-6:7.3f} {m_rate * 1e-6:7.3f} "
+                  f"{g_rate / m_rate:6.2f}  {100 * bias:+6.2f}% {relmse:7.4f} {floor:7.4f}", flush=True)
+            if warn:
+                print(f"  gonio: {warn}")
+        save_png(mi, os.path.join(out, "img", sc["name"] + ".png"), imgs[0], m)
+    if "bunny" in rows and "bunny-shuffled" in rows:
+        for rep, (a, b) in enumerate(zip(rows["bunny"], rows["bunny-shuffled"])):
+            print(f"shuffled index buffer, run {rep + 1}: gonio {b * 1e-6:.3f} vs {a * 1e-6:.3f} M paths/s"
+                  f" unshuffled: ratio {b / a:.3f}")
+    print(f"images (gonio | mitsuba): {os.path.join(out, 'img')}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
