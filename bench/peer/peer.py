@@ -46,6 +46,19 @@ def read_exr(mi, path):
     return np.array(b, dtype=np.float64)
 
 
+def gonio_leaves(args, gltf):
+    """gonio bench's line on the BVH's leaf primitives (triangle pairs and singles)."""
+    r = subprocess.run([args.gonio, "bench", gltf, "--size", "16x16", "--seconds", "0.05"],
+                       capture_output=True, text=True)
+    return next((l.split(None, 3)[3] for l in r.stdout.splitlines() if l.startswith("bvh leaf prims")),
+                "(gonio bench failed)")
+
+
+def machine():
+    cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
+    return f"{cpu}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}"
+
+
 def mitsuba_render(mi, dr, scene, spp):
     t = time.perf_counter()
     img = mi.render(scene, spp=spp)
@@ -137,6 +150,7 @@ def main():
     if args.only:
         todo = [s for s in todo if s["name"] in args.only.split(",")]
     px = args.size * args.size
+    print(f"machine: {machine()}; Mitsuba {mi.__version__} ({mi.variant()}), Dr.Jit {dr.__version__}")
     print(f"{args.size}x{args.size}, {args.spp} spp (gonio: {args.spp} minus {args.low} spp), "
           f"{args.reps} runs each, alternating; M paths/s")
     print(f"{'scene':16s} {'run':>3s} {'gonio':>7s} {'mitsuba':>7s} {'ratio':>6s}  "
@@ -152,7 +166,8 @@ def main():
             exr = os.path.join(out, f"{sc['name']}-gonio{rep}.exr")
             t_lo, _ = gonio_render(args, sc, args.low, rep, os.path.join(out, "low.exr"))
             t_hi, warn = gonio_render(args, sc, args.spp, rep, exr)
-            g_rate = px * (args.spp - args.low) / (t_hi - t_lo)
+            # Start-up noise can exceed a short render's time: then there is no figure.
+            g_rate = px * (args.spp - args.low) / (t_hi - t_lo) if t_hi > t_lo else float("nan")
             t_m, m = mitsuba_render(mi, dr, scene, args.spp)
             m_rate = px * args.spp / t_m
             g = read_exr(mi, exr)
@@ -170,6 +185,10 @@ def main():
         for rep, (a, b) in enumerate(zip(rows["bunny"], rows["bunny-shuffled"])):
             print(f"shuffled index buffer, run {rep + 1}: gonio {b * 1e-6:.3f} vs {a * 1e-6:.3f} M paths/s"
                   f" unshuffled: ratio {b / a:.3f}")
+        for name in ("bunny", "bunny-shuffled"):
+            gltf = [s["gltf"] for s in todo if s["name"] == name][0]
+            print(f"  {name}: bvh leaf prims {gonio_leaves(args, gltf)}")
+    print(f"load average at the end: {os.getloadavg()[0]:.1f}")
     print(f"images (gonio | mitsuba): {os.path.join(out, 'img')}")
     return 0
 

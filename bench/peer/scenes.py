@@ -168,7 +168,7 @@ def generate(out, assets, gonio_scene_gltf, seed=1):
         meshes.append((f"sphere{k}", P, N, I[rng.permutation(len(I))], mat))
     path = os.path.join(out, "spheres.gltf")
     gltf_io.write(path, meshes, [lambert((0.6, 0.6, 0.6)), emitter((1, 1, 1), 30), GLASS, GOLD, PLASTIC],
-                  ((0, 1.6, 3.6), (0, 0.45, 0), (0, 1, 0), 0.6), EXT)
+                  ((0, 1.5, 3.8), (0, 0.4, 0), (0, 1, 0), 0.8), EXT)
     scenes.append({"name": "spheres", "gltf": path, "env": 0})
 
     # Mostly background: one small rough-gold sphere, 20% of the pixels, under a dim
