@@ -54,6 +54,26 @@ def gonio_leaves(args, gltf):
                 "(gonio bench failed)")
 
 
+def shuffled(args, a, b):
+    """gonio's paths/s on B (A with its index buffer shuffled) against A's, the two timed
+    in turn (ABBAAB...), so that the machine's load drifts alike through both."""
+    px = args.size * args.size
+    ratios = []
+    for rep in range(max(args.reps, 3)):
+        rate = {}
+        for sc in ((a, b) if rep % 2 == 0 else (b, a)):
+            exr = os.path.join(args.out, "shuffle.exr")
+            t_lo, _ = gonio_render(args, sc, args.low, 0, exr)
+            t_hi, _ = gonio_render(args, sc, args.spp, 0, exr)
+            rate[sc["name"]] = px * (args.spp - args.low) / (t_hi - t_lo) if t_hi > t_lo else float("nan")
+        ratios.append(rate[b["name"]] / rate[a["name"]])
+        print(f"{b['name']}, run {rep + 1}: gonio {rate[b['name']] * 1e-6:.3f} M paths/s against "
+              f"{rate[a['name']] * 1e-6:.3f} for {a['name']}: ratio {ratios[-1]:.3f}", flush=True)
+    print(f"{b['name']} / {a['name']}: median ratio {np.nanmedian(ratios):.3f}")
+    for sc in (a, b):
+        print(f"  {sc['name']}: bvh leaf prims {gonio_leaves(args, sc['gltf'])}")
+
+
 def machine():
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "?")
     return f"{cpu}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}"
@@ -155,8 +175,9 @@ def main():
           f"{args.reps} runs each, alternating; M paths/s")
     print(f"{'scene':16s} {'run':>3s} {'gonio':>7s} {'mitsuba':>7s} {'ratio':>6s}  "
           f"{'bias':>7s} {'relMSE':>7s} {'floor':>7s}")
-    rows = {}
     for sc in todo:
+        if "shuffle_of" in sc:
+            continue
         work = os.path.join(out, "mitsuba", sc["name"])
         scene = mi.load_dict(to_mitsuba.scene_dict(mi, sc["gltf"], work, args.size, args.size, args.spp,
                                                    sc["env"], sc.get("look_at"), sc.get("fov")))
@@ -175,19 +196,14 @@ def main():
             bias, relmse = agreement(g, m)
             # gonio against gonio of another seed: the relMSE that noise alone gives.
             floor = agreement(imgs[0], g)[1] if rep else float("nan")
-            rows.setdefault(sc["name"], []).append(g_rate)
             print(f"{sc['name']:16s} {rep + 1:3d} {g_rate * 1e-6:7.3f} {m_rate * 1e-6:7.3f} "
                   f"{g_rate / m_rate:6.2f}  {100 * bias:+6.2f}% {relmse:7.4f} {floor:7.4f}", flush=True)
             if warn:
                 print(f"  gonio: {warn}")
         save_png(mi, os.path.join(out, "img", sc["name"] + ".png"), imgs[0], m)
-    if "bunny" in rows and "bunny-shuffled" in rows:
-        for rep, (a, b) in enumerate(zip(rows["bunny"], rows["bunny-shuffled"])):
-            print(f"shuffled index buffer, run {rep + 1}: gonio {b * 1e-6:.3f} vs {a * 1e-6:.3f} M paths/s"
-                  f" unshuffled: ratio {b / a:.3f}")
-        for name in ("bunny", "bunny-shuffled"):
-            gltf = [s["gltf"] for s in todo if s["name"] == name][0]
-            print(f"  {name}: bvh leaf prims {gonio_leaves(args, gltf)}")
+    for b in (s for s in todo if "shuffle_of" in s):
+        a = [s for s in todo if s["name"] == b["shuffle_of"]][0]
+        shuffled(args, a, b)
     print(f"load average at the end: {os.getloadavg()[0]:.1f}")
     print(f"images (gonio | mitsuba): {os.path.join(out, 'img')}")
     return 0

@@ -2,7 +2,8 @@
 # shaped for gonio's layout: triangles in random order, quads split along the diagonal the
 # project's generator does not use, meshes as scanned (the bunny) or as other tools write
 # them (DamagedHelmet, read in place). Each scene is a dict: name, gltf, env (constant
-# radiance or 0), look_at (eye, target, up) and fov (degrees) when the file has no camera.
+# radiance or 0), look_at (eye, target, up) and fov (degrees) when the file has no camera,
+# shuffle_of (the scene it is with its index buffer shuffled).
 import os
 
 import numpy as np
@@ -196,6 +197,7 @@ def generate(out, assets, gonio_scene_gltf, seed=1):
             gltf_io.write(path, [("ground", gP, gN, gI, 0), ("light", lP, lN, lI, 1),
                                  ("bunny", V, N, FF, 2)], mats, cam, EXT)
             scenes.append({"name": name, "gltf": path, "env": 0})
+        scenes[-1]["shuffle_of"] = "bunny"  # gonio only, timed in turn with the bunny
 
     helmet = os.path.join(assets, "gltf", "DamagedHelmet", "glTF", "DamagedHelmet.gltf")
     if os.path.isfile(helmet):
