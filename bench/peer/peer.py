@@ -15,6 +15,7 @@
 # renderers at 64x64, exit 1 unless each is 0.8 inside the sphere and the two agree.
 import argparse
 import os
+import resource
 import subprocess
 import sys
 import time
@@ -33,17 +34,28 @@ def gonio_render(args, sc, spp, seed, exr):
     if "look_at" in sc:
         cmd += ["--look-at", ",".join(",".join(str(x) for x in v) for v in sc["look_at"]),
                 "--fov", str(sc["fov"])]
-    t = time.perf_counter()
+    t, c = time.perf_counter(), _child_cpu()
     r = subprocess.run(cmd, capture_output=True, text=True)
-    t = time.perf_counter() - t
+    t, c = time.perf_counter() - t, _child_cpu() - c
     if r.returncode != 0:
         sys.exit(f"peer: {' '.join(cmd)} failed (exit {r.returncode}):\n{r.stderr}")
-    return t, r.stderr.strip()
+    return t, c, r.stderr.strip()
+
+
+def _child_cpu():
+    u = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return u.ru_utime + u.ru_stime
 
 
 def read_exr(mi, path):
     b = mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False)
     return np.array(b, dtype=np.float64)
+
+
+def steady(paths, lo, hi):
+    """paths / (hi - lo): the steady-state rate; none where start-up noise exceeds the
+    difference of the two renders' times."""
+    return paths / (hi - lo) if hi > lo else float("nan")
 
 
 def gonio_leaves(args, gltf):
@@ -63,13 +75,17 @@ def shuffled(args, a, b):
         rate = {}
         for sc in ((a, b) if rep % 2 == 0 else (b, a)):
             exr = os.path.join(args.out, "shuffle.exr")
-            t_lo, _ = gonio_render(args, sc, args.low, 0, exr)
-            t_hi, _ = gonio_render(args, sc, args.spp, 0, exr)
-            rate[sc["name"]] = px * (args.spp - args.low) / (t_hi - t_lo) if t_hi > t_lo else float("nan")
-        ratios.append(rate[b["name"]] / rate[a["name"]])
-        print(f"{b['name']}, run {rep + 1}: gonio {rate[b['name']] * 1e-6:.3f} M paths/s against "
-              f"{rate[a['name']] * 1e-6:.3f} for {a['name']}: ratio {ratios[-1]:.3f}", flush=True)
-    print(f"{b['name']} / {a['name']}: median ratio {np.nanmedian(ratios):.3f}")
+            t_lo, c_lo, _ = gonio_render(args, sc, args.low, 0, exr)
+            t_hi, c_hi, _ = gonio_render(args, sc, args.spp, 0, exr)
+            rate[sc["name"]] = (steady(px * (args.spp - args.low), t_lo, t_hi),
+                                steady(px * (args.spp - args.low), c_lo, c_hi))
+        ra, rb = rate[a["name"]], rate[b["name"]]
+        ratios.append((rb[0] / ra[0], rb[1] / ra[1]))
+        print(f"{b['name']}, run {rep + 1}: gonio {rb[0] * 1e-6:.3f} M paths/s against {ra[0] * 1e-6:.3f}"
+              f" for {a['name']}: ratio {ratios[-1][0]:.3f}; per CPU second {rb[1] * 1e-6:.3f} against "
+              f"{ra[1] * 1e-6:.3f}: ratio {ratios[-1][1]:.3f}", flush=True)
+    med = np.nanmedian(np.array(ratios), axis=0)
+    print(f"{b['name']} / {a['name']}: median ratio {med[0]:.3f}, per CPU second {med[1]:.3f}")
     for sc in (a, b):
         print(f"  {sc['name']}: bvh leaf prims {gonio_leaves(args, sc['gltf'])}")
 
@@ -80,11 +96,12 @@ def machine():
 
 
 def mitsuba_render(mi, dr, scene, spp):
-    t = time.perf_counter()
+    """(wall seconds, CPU seconds of all the process's threads, the image)."""
+    t, c = time.perf_counter(), time.process_time()
     img = mi.render(scene, spp=spp)
     dr.eval(img)
     dr.sync_thread()
-    return time.perf_counter() - t, np.array(img, dtype=np.float64)
+    return time.perf_counter() - t, time.process_time() - c, np.array(img, dtype=np.float64)
 
 
 def agreement(a, b):
@@ -120,7 +137,7 @@ def check_furnace(args):
     g = read_exr(mi, exr)
     scene = mi.load_dict(to_mitsuba.scene_dict(mi, sc["gltf"], os.path.join(out, "mitsuba"),
                                                args.size, args.size, spp, sc["env"]))
-    _, m = mitsuba_render(mi, dr, scene, spp)
+    m = mitsuba_render(mi, dr, scene, spp)[2]
     # Pixels well inside the silhouette: the sphere (radius 1, 3.2 away) spans
     # tan(asin(1 / 3.2)) / tan(0.35) = 0.90 of the half height; take 0.8 of that.
     n = args.size
@@ -173,7 +190,7 @@ def main():
     print(f"machine: {machine()}; Mitsuba {mi.__version__} ({mi.variant()}), Dr.Jit {dr.__version__}")
     print(f"{args.size}x{args.size}, {args.spp} spp (gonio: {args.spp} minus {args.low} spp), "
           f"{args.reps} runs each, alternating; M paths/s")
-    print(f"{'scene':16s} {'run':>3s} {'gonio':>7s} {'mitsuba':>7s} {'ratio':>6s}  "
+    print(f"{'scene':16s} {'run':>3s} {'gonio':>7s} {'mitsuba':>7s} {'ratio':>6s} {'cpu':>6s}  "
           f"{'bias':>7s} {'relMSE':>7s} {'floor':>7s}")
     for sc in todo:
         if "shuffle_of" in sc:
@@ -185,19 +202,20 @@ def main():
         imgs = []
         for rep in range(args.reps):
             exr = os.path.join(out, f"{sc['name']}-gonio{rep}.exr")
-            t_lo, _ = gonio_render(args, sc, args.low, rep, os.path.join(out, "low.exr"))
-            t_hi, warn = gonio_render(args, sc, args.spp, rep, exr)
-            # Start-up noise can exceed a short render's time: then there is no figure.
-            g_rate = px * (args.spp - args.low) / (t_hi - t_lo) if t_hi > t_lo else float("nan")
-            t_m, m = mitsuba_render(mi, dr, scene, args.spp)
-            m_rate = px * args.spp / t_m
+            t_lo, c_lo, _ = gonio_render(args, sc, args.low, rep, os.path.join(out, "low.exr"))
+            t_hi, c_hi, warn = gonio_render(args, sc, args.spp, rep, exr)
+            g_rate = steady(px * (args.spp - args.low), t_lo, t_hi)
+            g_cpu = steady(px * (args.spp - args.low), c_lo, c_hi)
+            t_m, c_m, m = mitsuba_render(mi, dr, scene, args.spp)
+            m_rate, m_cpu = px * args.spp / t_m, px * args.spp / c_m
             g = read_exr(mi, exr)
             imgs.append(g)
             bias, relmse = agreement(g, m)
             # gonio against gonio of another seed: the relMSE that noise alone gives.
             floor = agreement(imgs[0], g)[1] if rep else float("nan")
             print(f"{sc['name']:16s} {rep + 1:3d} {g_rate * 1e-6:7.3f} {m_rate * 1e-6:7.3f} "
-                  f"{g_rate / m_rate:6.2f}  {100 * bias:+6.2f}% {relmse:7.4f} {floor:7.4f}", flush=True)
+                  f"{g_rate / m_rate:6.2f} {g_cpu / m_cpu:6.2f}  {100 * bias:+6.2f}% {relmse:7.4f} {floor:7.4f}",
+                  flush=True)
             if warn:
                 print(f"  gonio: {warn}")
         save_png(mi, os.path.join(out, "img", sc["name"] + ".png"), imgs[0], m)
