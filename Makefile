@@ -1,6 +1,6 @@
 # gonio: build, run, test, bench.
 #   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
-#   make run | test | test-farm | bench | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
+#   make run | test | test-farm | bench | bench-peer | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
 #   make fuzz (libFuzzer targets, clang, in build/fuzz) | fuzz-run [FUZZ_TIME=60]
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
 # is printed and make stops.
@@ -91,7 +91,7 @@ FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
 	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
 
 .PHONY: all deps test-deps run test unit regress bench clean install shaders docs-images \
-	fuzz fuzz-deps fuzz-targets fuzz-run test-farm
+	fuzz fuzz-deps fuzz-targets fuzz-run test-farm bench-peer
 all: $(GONIO) build/gonio
 
 deps:
@@ -164,6 +164,15 @@ unit: $(UNIT)
 
 bench: all
 	@tests/bench.sh $(GONIO)
+
+# gonio beside Mitsuba 3 on scenes it did not shape (bench/peer, docs/performance.md):
+# Mitsuba, Dr.Jit and a libLLVM for it come from PyPI into build/peer/venv (bench/peer/env.sh);
+# python3-venv makes the venv. It skips, saying why, where they cannot be installed.
+DEB_PEER := python3-venv
+PEER_DEPS_CHECK = { python3 -c 'import ensurepip, venv'; } >/dev/null 2>&1
+bench-peer: all
+	@if ! $(PEER_DEPS_CHECK); then ( $(call apt_install,$(DEB_PEER)) ) || true; fi
+	@bench/peer/run.sh $(GONIO) $(PEER_ARGS)
 
 # libFuzzer targets over scene_load and image_read_exr (tests/fuzz); fuzz-run runs each for
 # FUZZ_TIME seconds from seeds of ../shared/assets and EXRs gonio writes (tests/fuzz/run.sh).

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# run.sh GONIO [peer.py options]: make bench-peer. Installs Mitsuba 3 in build/peer/venv
+# where it is missing, then runs peer.py; where Mitsuba cannot be had it says why and
+# exits 0.
+set -u
+cd "$(dirname "$0")/../.."
+. bench/peer/env.sh
+G=${1:-build/gonio}
+shift
+if ! peer_env install; then
+    echo "bench-peer: skipped: $PEER_WHY"
+    exit 0
+fi
+exec "$PEER_PY" bench/peer/peer.py --gonio "$G" "$@"
