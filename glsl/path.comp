@@ -66,15 +66,20 @@ bool suspended; // this lane's walk stopped unfinished: the path waits for the n
 void trace_begin(float tmin, float tmax)
 {
     walk_start(tmax);
-    tr_lo = tmin;
-    tr_max = tmax;
-    tr_k = 0u;
+    if (GN_HAS(GN_FEAT_ALPHA)) {
+        tr_lo = tmin;
+        tr_max = tmax;
+        tr_k = 0u;
+    }
 }
 
 // Goes on with the ray of trace_begin where `on`; the same hit as trace_visible(o, d, tmin, tmax, any_hit,
 // dim) once the walk is over, whatever number of calls that took.
-Hit trace_resume(bool on, vec3 o, vec3 d, bool any_hit, uint dim)
+Hit trace_resume(bool on, vec3 o, vec3 d, float tmin, bool any_hit, uint dim)
 {
+    // (without surfaces cut away tr_lo is the ray's own tmin: one value less kept live)
+    if (!GN_HAS(GN_FEAT_ALPHA))
+        tr_lo = tmin;
     bool alpha = GN_HAS(GN_FEAT_ALPHA) && (frame.flags & GN_FRAME_ALPHA) != 0u;
     RayPre r = ray_pre(o, d);
     // (off: the loop conditions see GN_INVALID, so no visit, and the lane's walk is kept)
@@ -386,10 +391,14 @@ void path_save(uint behind)
     pstate[ps_base] = behind;
     pstate[ps_base + 1u] = phase | (prev_delta ? 2u : 0u) | (covered ? 4u : 0u) | (alive ? 8u : 0u);
     pstate[ps_base + 2u] = depth;
-    pstate[ps_base + 3u] = tr_k;
+    pstate[ps_base + 3u] = GN_HAS(GN_FEAT_ALPHA) ? tr_k : 0u;
     ps_v(4u, o); ps_v(7u, d); ps_f(10u, tmin); ps_v(11u, radiance); ps_v(14u, beta);
     ps_f(17u, prev_pdf); ps_v(18u, normal); ps_v(21u, albedo); ps_f(24u, depth_aov);
-    ps_v(25u, so); ps_v(28u, sd); ps_f(31u, smax); ps_v(32u, c); ps_f(35u, tr_lo); ps_f(36u, tr_max);
+    ps_v(25u, so); ps_v(28u, sd); ps_f(31u, smax); ps_v(32u, c);
+    if (GN_HAS(GN_FEAT_ALPHA)) {
+        ps_f(35u, tr_lo);
+        ps_f(36u, tr_max);
+    }
     ps_f(37u, walk.hit.t); ps_f(38u, walk.hit.u); ps_f(39u, walk.hit.v);
     pstate[ps_base + 40u] = walk.hit.tri;
     pstate[ps_base + 41u] = walk.hit.steps;
@@ -472,13 +481,13 @@ void main()
         ended = true;
         if (LOOP_CAP > 0u) // (the vertex's loops other than its walks)
             loop_left -= min(loop_left, frame.loop_overhead);
-        bool ray = phase == PHASE_RAY;
-        Hit h = trace_resume(ray && !suspended, o, d, false, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
         // One vertex, in a loop of one iteration: a path's end is a `break` out of it.
         // (llvmpipe masks lanes for a break cheaply; a continue or an early return masks
         // every later statement again and cost a third of the speed.)
         do {
-            if (!ray || suspended)
+            if (phase == PHASE_RAY) {
+            Hit h = trace_resume(true, o, d, tmin, false, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
+            if (suspended)
                 break;
             alive = false;
             tmin = 0.0;
@@ -566,19 +575,21 @@ void main()
                 phase = PHASE_SHADOW;
                 trace_begin(0.0, smax);
             }
-        } while (false);
-        bool shadow_on = phase == PHASE_SHADOW && !suspended;
-        Hit sh = trace_resume(shadow_on, so, sd, true, DIM_ALPHA + DIM_ALPHA_RAY * (2u * depth + 1u));
-        if (shadow_on && !suspended) {
-            if (sh.tri == GN_INVALID)
-                radiance += c;
-            phase = PHASE_RAY;
-        }
-        // A path's vertex is over when its rays are: alive, it goes on with the next ray.
-        if (!suspended && phase == PHASE_RAY && alive) {
+            }
+            if (phase == PHASE_SHADOW) {
+                Hit sh = trace_resume(true, so, sd, 0.0, true, DIM_ALPHA + DIM_ALPHA_RAY * (2u * depth + 1u));
+                if (suspended)
+                    break;
+                if (sh.tri == GN_INVALID)
+                    radiance += c;
+                phase = PHASE_RAY;
+            }
+            // A path's vertex is over when its rays are: alive, it goes on with the next ray.
+            if (!alive)
+                break;
             ended = false;
             trace_begin(0.0, 1e30);
-        }
+        } while (false);
         if (suspended || path_step() == samples)
             break;
     }
