@@ -4,11 +4,11 @@
 // boxes, triangle test and step count; it tests leaves as it meets them, this walk postpones
 // them (below), so the two visit the same nodes in a different order.
 //
-// llvmpipe ends an invocation's loops silently after 65,535 iterations in total (DESIGN.md;
-// the count is per SIMD group of 8 invocations). A walk is bounded by
-// frame.traversal_budget node visits, sized so that the cap is not reached in practice;
-// a walk stopped by either reports `truncated` instead of a silently wrong answer, keeps
-// its state for a resume, and the host counts those.
+// llvmpipe ends an invocation's loops silently after 65,535 iterations in total (the count
+// is per SIMD group of 8 invocations: docs/architecture.md, The loop cap). A walk is bounded
+// by a budget of node visits and, in a kernel specialised with LOOP_CAP > 0 (the path
+// tracer on llvmpipe), by the loop passes its SIMD group has left; a walk stopped by either
+// reports `truncated` and keeps its whole state, so the caller can resume it later.
 #ifndef GONIO_BVH_GLSL
 #define GONIO_BVH_GLSL
 
@@ -20,6 +20,15 @@
 // one lane at a time with a branch on each lane's mask; a shift register of K values costs
 // it 2K vector selects a node visit instead (Cornell box paths: +6%).
 layout(constant_id = GN_SPEC_WALK_REGS) const uint WALK_REGS = 0u;
+
+// LOOP_CAP > 0: the loop passes a SIMD group may run (src/render.c sets it below llvmpipe's
+// cap), shared out as LOOP_CAP / gl_SubgroupSize to each lane (a subgroup is llvmpipe's SIMD
+// group): loop_left is what this lane has left. A loop costs the group its longest lane's
+// passes plus the test that ends it, which is at most the sum over the lanes in it of their
+// passes plus one; so while every lane stays within its share, the group stays within the
+// cap, with no need to know what the other lanes do (the kernel counts its other loops).
+layout(constant_id = GN_SPEC_LOOP_CAP) const uint LOOP_CAP = 0u;
+uint loop_left = 0u;
 
 GnBvhNode bvh_node(uint i)
 {
@@ -209,17 +218,23 @@ void walk_regs_update(bool push, bool pop, uint x)
 // off (it never jumps over an `if`), so a loop body that tested nodes and leaves together
 // would pay a triangle test on every node visit; split, a node visit pays only its own
 // work, and the triangle loop runs once per leaf.
+//
+// With LOOP_CAP > 0 the walk also stops (truncated) when the lane's loop_left runs out. It is
+// counted in node visits: lim is the step count at which the lane's passes are spent, less
+// the other passes (leaves, loop tests) as they come, so the node loop's test stays one
+// comparison.
 void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
 {
 #define w walk
-    uint end = w.hit.steps + budget;
+    uint end = w.hit.steps + budget, lim = w.hit.steps + loop_left;
     w.hit.truncated = false;
     // No early returns and no breaks: llvmpipe masks every later statement of a loop body
     // again after either, so the loop conditions end the walk. An index without
     // GN_BVH_LEAF is an inner node (GN_INVALID has that bit set too).
-    while (w.node != GN_INVALID && !w.hit.truncated) {
-        // Inner nodes while the budget lasts.
-        while ((w.node & GN_BVH_LEAF) == 0u && w.hit.steps < end) {
+    while (w.node != GN_INVALID && !w.hit.truncated && (LOOP_CAP == 0u || w.hit.steps < lim)) {
+        // Inner nodes while the budget (and the lane's loop passes) last.
+        uint e = LOOP_CAP > 0u ? min(end, lim) : end;
+        while ((w.node & GN_BVH_LEAF) == 0u && w.hit.steps < e) {
             w.hit.steps++;
             GnBvhNode n = bvh_node(w.node);
             // (an empty child b has an inverted box: box_enter misses it)
@@ -249,8 +264,8 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
         // An inner node here: the budget (or llvmpipe's loop cap) ended the loop above early.
         w.hit.truncated = (w.node & GN_BVH_LEAF) == 0u;
         bool leaf = !w.hit.truncated && w.node != GN_INVALID;
-        uint last = walk_leaf_last(w.node);
-        for (uint i = walk_leaf_first(w.node); leaf && i <= last && !(any_hit && w.hit.tri != GN_INVALID); i++) {
+        uint last = walk_leaf_last(w.node), i = walk_leaf_first(w.node), i0 = i;
+        for (; leaf && i <= last && !(any_hit && w.hit.tri != GN_INVALID); i++) {
             GnTriPair q = bvh_pair(i);
             float t, u, v;
             uint which;
@@ -258,6 +273,9 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
                 w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = 2u * i + which;
             }
         }
+        // (+ 3: the tests that ended the two loops, and this pass of the enclosing one)
+        if (LOOP_CAP > 0u)
+            lim -= min(lim, (leaf ? i - i0 : 0u) + 3u);
         bool found = any_hit && w.hit.tri != GN_INVALID; // any hit: the walk is over
         uint top = WALK_REGS > 0u ? w.regs[0] : w.stack[w.sp - 1]; // read by every lane, as above
         if (WALK_REGS > 0u)
@@ -272,6 +290,9 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
     // caller can resume instead of taking a silent miss.
     if (w.node != GN_INVALID)
         w.hit.truncated = true;
+    // (- 1: the test that ended the loop)
+    if (LOOP_CAP > 0u)
+        loop_left = lim > w.hit.steps ? lim - w.hit.steps - 1u : 0u;
 #undef w
 }
 

@@ -8,6 +8,7 @@
 // take their one strategy exactly; Russian roulette after ROULETTE_DEPTH bounces.
 // docs/path-tracing.md derives the estimator and names the tests that check it.
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_basic : require
 
 // Specialised on the scene's features (GN_FEAT_* in shared.h): code no lane can need is
 // compiled away, which llvmpipe (running both sides of every branch) needs most.
@@ -40,13 +41,7 @@ uint envdata(uint i) { return texelFetch(env_texels, int(i)).x; }
 layout(push_constant) uniform PushBlock { GnPush push; };
 
 #define ROULETTE_DEPTH 3u
-// A ray's own loop iterations besides its walk (light selection, map searches), in node
-// visits (a visit costs up to 19 iterations): charged so the whole path stays under
-// llvmpipe's loop cap with frame.traversal_budget node visits per path.
-#define TRACE_OVERHEAD 4u
-
-uint budget;    // node visits left to this path
-bool truncated; // a walk ran out of budget: the path was cut short
+layout(std430, binding = GN_BIND_PSTATE) buffer StateBlock { uint pstate[]; };
 
 uint sample_now; // the sample index of the path being traced
 vec4 rng(uint pixel, uint dim)
@@ -58,12 +53,57 @@ float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
 
 float power_heuristic(float a, float b) { return a * a / (a * a + b * b); }
 
-// dim: the first random dimension of the ray's crossings of BLEND surfaces (trace_visible).
-Hit trace(vec3 o, vec3 d, float tmin, float tmax, bool any_hit, uint dim)
+// ---- resumable rays --------------------------------------------------------------------------
+// A ray is traced in steps that resume `walk` (glsl/bvh.glsl) until it is over: with
+// LOOP_CAP > 0 a walk stops when its SIMD group has used its loop passes, and the path is
+// then saved whole (path_save) and resumed by the next dispatch. trace_visible's crossings of
+// surfaces cut away are resumable too: tr_lo is the walk's tmin (the last surface crossed)
+// and tr_k the crossings so far.
+float tr_lo, tr_max;
+uint tr_k;
+bool suspended; // this lane's walk stopped unfinished: the path waits for the next dispatch
+
+void trace_begin(float tmin, float tmax)
 {
-    trace_visible(o, d, tmin, tmax, any_hit, budget, dim);
-    budget -= min(walk.hit.steps + TRACE_OVERHEAD, budget);
-    truncated = truncated || walk.hit.truncated;
+    walk_start(tmax);
+    if (GN_HAS(GN_FEAT_ALPHA)) {
+        tr_lo = tmin;
+        tr_max = tmax;
+        tr_k = 0u;
+    }
+}
+
+// Goes on with the ray of trace_begin where `on`; the same hit as trace_visible(o, d, tmin, tmax, any_hit,
+// dim) once the walk is over, whatever number of calls that took.
+Hit trace_resume(bool on, vec3 o, vec3 d, float tmin, bool any_hit, uint dim)
+{
+    // (without surfaces cut away tr_lo is the ray's own tmin: one value less kept live)
+    if (!GN_HAS(GN_FEAT_ALPHA))
+        tr_lo = tmin;
+    bool alpha = GN_HAS(GN_FEAT_ALPHA) && (frame.flags & GN_FRAME_ALPHA) != 0u;
+    RayPre r = ray_pre(o, d);
+    // (off: the loop conditions see GN_INVALID, so no visit, and the lane's walk is kept)
+    uint node = walk.node;
+    walk.node = on ? node : GN_INVALID;
+    bvh_walk(r, tr_lo, any_hit && !alpha, 1u << 30);
+    if (GN_HAS(GN_FEAT_ALPHA)) {
+        while (on && alpha && walk.node == GN_INVALID && walk.hit.tri != GN_INVALID &&
+               rng_uniform4(rng_pixel, rng_sample, dim + (tr_k & (DIM_ALPHA_RAY - 1u)), frame.seed).x >=
+                   surface_opacity(walk.hit.tri, walk.hit.u, walk.hit.v)) {
+            // (t > the hit's own t: the watertight test gives the same t for the same ray and
+            // triangle, so the surface just crossed is not found again)
+            uint steps = walk.hit.steps;
+            tr_lo = walk.hit.t;
+            walk_start(tr_max);
+            walk.hit.steps = steps;
+            tr_k++;
+            loop_left -= min(loop_left, 1u); // (the loop's test: in loop_overhead)
+            bvh_walk(r, tr_lo, false, 1u << 30);
+        }
+    }
+    if (!on)
+        walk.node = node;
+    suspended = suspended || (on && walk.node != GN_INVALID);
     return walk.hit;
 }
 
@@ -272,25 +312,33 @@ vec3 offset_origin(vec3 p, vec3 ng, vec3 w)
 // a lot; a lane that starts its next path at once, instead of idling, keeps the group busy.
 // Every sample is still the same function of (pixel, sample index, dimension).
 //
-// After each vertex path_step adds up a finished sample and starts the next path; the loop
-// ends once this invocation has taken all its samples.
+// Under llvmpipe's loop cap (LOOP_CAP > 0) a path whose walk runs out of the group's loop
+// passes is saved whole in pstate (path_save) with the samples after it, and the next
+// dispatch of the kernel, in the same or the next submission, finishes those first
+// (path_load): the pixel's samples are still added up one at a time in sample order, so the
+// bits do not depend on where a path was interrupted. The host dispatches again, taking no
+// new samples, until no pixel is pending (status[1]; src/render.c: renderer_finish).
 uvec2 px;
 uint pixel;
 uint samples, taken;
+uint pstate_behind = 0u; // samples pending from the last dispatch (0: none), the first one saved
 vec4 sum;
 vec3 sum_sq, sum_n, sum_a;
 float sum_depth;
-// The current path.
-uint depth;
-vec3 o, d, radiance, beta, normal, albedo;
-float tmin, prev_pdf, depth_aov;
-bool prev_delta, covered, ended;
+// The current path: its ray (o, d from tmin) and, in phase PHASE_SHADOW, the shadow ray
+// (so, sd up to smax) whose contribution c it adds if nothing blocks it; alive: the path goes
+// on after this vertex (o, d already the next ray).
+#define PHASE_RAY 0u
+#define PHASE_SHADOW 1u
+uint depth, phase;
+vec3 o, d, radiance, beta, normal, albedo, so, sd, c;
+float tmin, prev_pdf, depth_aov, smax;
+bool prev_delta, covered, ended, alive;
 
 void path_start()
 {
-    sample_now = push.sample_index + taken;
+    sample_now = push.sample_index - pstate_behind + taken;
     rng_sample = sample_now;
-    budget = frame.traversal_budget;
     depth = 0u;
     camera_ray(vec2(px) + rng(pixel, 0u).xy, o, d, tmin);
     radiance = vec3(0.0);
@@ -302,6 +350,8 @@ void path_start()
     albedo = vec3(0.0);
     depth_aov = 0.0;
     ended = false;
+    phase = PHASE_RAY;
+    trace_begin(tmin, 1e30);
 }
 
 // After a path vertex: the next vertex, or (the path ended) the sample added up and the
@@ -327,6 +377,70 @@ uint path_step()
     return taken;
 }
 
+// ---- a path's saved state (GN_BIND_PSTATE: frame.state_stride words a pixel) -----------------
+// Word 0: the pixel's samples still to take, the saved one included (0: none pending); then
+// the path and its walk. Read and written only by LOOP_CAP kernels.
+uint ps_base;
+void ps_f(uint k, float x) { pstate[ps_base + k] = floatBitsToUint(x); }
+void ps_v(uint k, vec3 x) { ps_f(k, x.x); ps_f(k + 1u, x.y); ps_f(k + 2u, x.z); }
+float pl_f(uint k) { return uintBitsToFloat(pstate[ps_base + k]); }
+vec3 pl_v(uint k) { return vec3(pl_f(k), pl_f(k + 1u), pl_f(k + 2u)); }
+
+void path_save(uint behind)
+{
+    pstate[ps_base] = behind;
+    pstate[ps_base + 1u] = phase | (prev_delta ? 2u : 0u) | (covered ? 4u : 0u) | (alive ? 8u : 0u);
+    pstate[ps_base + 2u] = depth;
+    pstate[ps_base + 3u] = GN_HAS(GN_FEAT_ALPHA) ? tr_k : 0u;
+    ps_v(4u, o); ps_v(7u, d); ps_f(10u, tmin); ps_v(11u, radiance); ps_v(14u, beta);
+    ps_f(17u, prev_pdf); ps_v(18u, normal); ps_v(21u, albedo); ps_f(24u, depth_aov);
+    ps_v(25u, so); ps_v(28u, sd); ps_f(31u, smax); ps_v(32u, c);
+    if (GN_HAS(GN_FEAT_ALPHA)) {
+        ps_f(35u, tr_lo);
+        ps_f(36u, tr_max);
+    }
+    ps_f(37u, walk.hit.t); ps_f(38u, walk.hit.u); ps_f(39u, walk.hit.v);
+    pstate[ps_base + 40u] = walk.hit.tri;
+    pstate[ps_base + 41u] = walk.hit.steps;
+    pstate[ps_base + 42u] = walk.node;
+    pstate[ps_base + 43u] = uint(walk.sp);
+    if (WALK_REGS > 0u) {
+        for (uint k = 0u; k < WALK_REGS; k++)
+            pstate[ps_base + GN_PATH_STATE_WORDS + k] = walk.regs[k];
+    } else {
+        for (int k = 1; k < walk.sp; k++)
+            pstate[ps_base + GN_PATH_STATE_WORDS + uint(k)] = walk.stack[k];
+    }
+}
+
+void path_load()
+{
+    uint f = pstate[ps_base + 1u];
+    phase = f & 1u; prev_delta = (f & 2u) != 0u; covered = (f & 4u) != 0u; alive = (f & 8u) != 0u;
+    depth = pstate[ps_base + 2u];
+    tr_k = pstate[ps_base + 3u];
+    o = pl_v(4u); d = pl_v(7u); tmin = pl_f(10u); radiance = pl_v(11u); beta = pl_v(14u);
+    prev_pdf = pl_f(17u); normal = pl_v(18u); albedo = pl_v(21u); depth_aov = pl_f(24u);
+    so = pl_v(25u); sd = pl_v(28u); smax = pl_f(31u); c = pl_v(32u); tr_lo = pl_f(35u); tr_max = pl_f(36u);
+    walk.hit.t = pl_f(37u); walk.hit.u = pl_f(38u); walk.hit.v = pl_f(39u);
+    walk.hit.tri = pstate[ps_base + 40u];
+    walk.hit.steps = pstate[ps_base + 41u];
+    walk.hit.truncated = false;
+    walk.node = pstate[ps_base + 42u];
+    walk.sp = int(pstate[ps_base + 43u]);
+    if (WALK_REGS > 0u) {
+        for (uint k = 0u; k < WALK_REGS; k++)
+            walk.regs[k] = pstate[ps_base + GN_PATH_STATE_WORDS + k];
+    } else {
+        walk.stack[0] = GN_INVALID;
+        for (int k = 1; k < walk.sp; k++)
+            walk.stack[k] = pstate[ps_base + GN_PATH_STATE_WORDS + uint(k)];
+    }
+    sample_now = push.sample_index - pstate_behind;
+    rng_sample = sample_now;
+    ended = false;
+}
+
 void main()
 {
     px = tile_pixel();
@@ -338,8 +452,11 @@ void main()
     rng_pixel = pixel;
     bool light_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_LIGHT_ONLY) != 0u;
     bool bsdf_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_BSDF_ONLY) != 0u;
-    truncated = false;
-    samples = max(push.pad0, 1u);
+    suspended = false;
+    ps_base = slot * frame.state_stride;
+    if (LOOP_CAP > 0u)
+        pstate_behind = pstate[ps_base];
+    samples = pstate_behind + push.pad0;
     taken = 0u;
     // The sums go on from the buffers, one sample at a time in sample order, so a pixel's
     // sum is the same float whichever dispatches (or runs: --resume) took its samples.
@@ -352,17 +469,28 @@ void main()
     sum_a = aov_on ? aov[3u * slot + 1u].xyz : vec3(0.0);
     sum_depth = aov_on ? aov[3u * slot + 2u].x : 0.0;
 
-    path_start();
-    while (true) {
-        // One path vertex, in a loop of one iteration: a path's end is a `break` out of it.
+    if (pstate_behind > 0u)
+        path_load();
+    else if (samples > 0u)
+        path_start();
+    // One path vertex an iteration: the walk of its ray, the vertex shaded (its light sample
+    // and next ray chosen), the walk of its shadow ray, in that order; a path resumed in its
+    // shadow ray's walk starts at the third.
+    loop_left = LOOP_CAP / gl_SubgroupSize;
+    while (samples > 0u) {
+        ended = true;
+        if (LOOP_CAP > 0u) // (the vertex's loops other than its walks)
+            loop_left -= min(loop_left, frame.loop_overhead);
+        // One vertex, in a loop of one iteration: a path's end is a `break` out of it.
         // (llvmpipe masks lanes for a break cheaply; a continue or an early return masks
         // every later statement again and cost a third of the speed.)
-        ended = true;
         do {
-            Hit h = trace(o, d, tmin, 1e30, false, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
-            tmin = 0.0;
-            if (h.truncated)
+            if (phase == PHASE_RAY) {
+            Hit h = trace_resume(true, o, d, tmin, false, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
+            if (suspended)
                 break;
+            alive = false;
+            tmin = 0.0;
             if (h.tri == GN_INVALID) {
                 vec3 le = env_radiance(d);
                 float w = 1.0;
@@ -404,6 +532,7 @@ void main()
             vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
             vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
 
+            bool shadow = false;
             if (frame.num_emitters > 0u && bsdf_has_smooth(b)) {
                 LightSample ls = light_sample(s.p, ul.xyz);
                 vec3 wi = vec3(dot(ls.wi, tx), dot(ls.wi, ty), dot(ls.wi, n));
@@ -414,40 +543,71 @@ void main()
                     float pb;
                     bsdf_eval_pdf(b, wo, wi, f, pb);
                     float w = ls.delta || light_only ? 1.0 : power_heuristic(ls.pdf, pb);
-                    vec3 c = beta * f * abs(wi.z) * ls.L * (w / ls.pdf);
+                    c = beta * f * abs(wi.z) * ls.L * (w / ls.pdf);
                     if (luminance(c) > 0.0) {
-                        Hit sh = trace(offset_origin(s.p, ng, ls.wi), ls.wi, 0.0, ls.dist * (1.0 - 1e-3), true,
-                                       DIM_ALPHA + DIM_ALPHA_RAY * (2u * depth + 1u));
-                        if (sh.tri == GN_INVALID && !sh.truncated)
-                            radiance += c;
+                        // (walked below, after the next ray is chosen: the state a walk that
+                        // stops leaves to save is then the two rays, c and the path's sums)
+                        shadow = true;
+                        so = offset_origin(s.p, ng, ls.wi);
+                        sd = ls.wi;
+                        smax = ls.dist * (1.0 - 1e-3);
                     }
                 }
             }
 
             BsdfSample bs = bsdf_sample(b, wo, ub.xyz);
-            if (bs.flags == 0u)
-                break;
             vec3 wi = bs.wi.x * tx + bs.wi.y * ty + bs.wi.z * n;
-            if (dot(ng, wi) * bs.wi.z <= 0.0)
-                break;
-            beta *= bs.weight;
-            prev_delta = (bs.flags & BRDF_FLAG_DELTA) != 0u;
-            prev_pdf = bs.pdf;
-            o = offset_origin(s.p, ng, wi);
-            d = wi;
-            if (depth + 1u >= ROULETTE_DEPTH) {
-                float q = min(max(beta.r, max(beta.g, beta.b)), 0.95);
-                if (ul.w >= q)
-                    break;
-                beta /= q;
+            alive = bs.flags != 0u && dot(ng, wi) * bs.wi.z > 0.0;
+            if (alive) {
+                beta *= bs.weight;
+                prev_delta = (bs.flags & BRDF_FLAG_DELTA) != 0u;
+                prev_pdf = bs.pdf;
+                o = offset_origin(s.p, ng, wi);
+                d = wi;
+                if (depth + 1u >= ROULETTE_DEPTH) {
+                    float q = min(max(beta.r, max(beta.g, beta.b)), 0.95);
+                    alive = ul.w < q;
+                    if (alive)
+                        beta /= q;
+                }
             }
+            if (shadow) {
+                phase = PHASE_SHADOW;
+                trace_begin(0.0, smax);
+            }
+            }
+            if (phase == PHASE_SHADOW) {
+                Hit sh = trace_resume(true, so, sd, 0.0, true, DIM_ALPHA + DIM_ALPHA_RAY * (2u * depth + 1u));
+                if (suspended)
+                    break;
+                if (sh.tri == GN_INVALID)
+                    radiance += c;
+                phase = PHASE_RAY;
+            }
+            // A path's vertex is over when its rays are: alive, it goes on with the next ray.
+            if (!alive)
+                break;
             ended = false;
+            trace_begin(0.0, 1e30);
         } while (false);
-        if (path_step() == samples)
+        if (suspended || path_step() == samples)
             break;
     }
-    // Fewer samples than asked for: llvmpipe's loop cap ended the loop (the rest count 0).
-    if (truncated || taken < samples)
+    // The rest, and the path it stopped in, wait for the next dispatch.
+    uint behind = suspended ? samples - taken : 0u;
+    if (LOOP_CAP > 0u) {
+        if (suspended)
+            path_save(behind);
+        else if (pstate_behind > 0u)
+            pstate[ps_base] = 0u;
+        if ((behind > 0u) != (pstate_behind > 0u))
+            atomicAdd(status[1], behind > 0u ? 1u : ~0u);
+        // A walk stopped with passes left: llvmpipe's own cap stopped it, the count is wrong.
+        if (suspended && loop_left > 0u)
+            atomicAdd(status[0], 1u);
+    }
+    // Fewer samples than asked for and nothing pending: llvmpipe's loop cap ended the loop.
+    if (!suspended && taken < samples)
         atomicAdd(status[0], 1u);
     accum[slot] = sum;
     if (squares_on)

@@ -45,10 +45,11 @@ typedef uint32_t uint;
 #define GN_BIND_VCOLOR 11u   /* vec4[2] per vertex: Gouraud colours of the front and back side;
                                  the first one's w holds the vertex's material (uint bits) */
 #define GN_BIND_EMITTERS 12u /* GnEmitter[]: emissive triangles for light sampling */
-#define GN_BIND_STATUS 13u   /* uint[4]: [0] rays whose walk hit the traversal budget */
+#define GN_BIND_STATUS 13u   /* uint[4]: [0] rays whose walk hit the traversal budget, [1] pixels pending (path) */
 #define GN_BIND_SQUARES 14u  /* vec4[] per pixel: sum of squared radiance samples (variance) */
 #define GN_BIND_ENV 15u      /* float[]: environment map and its sampling tables (path.comp) */
-#define GN_BIND_COUNT 16u
+#define GN_BIND_PSTATE 16u   /* uint[]: per pixel, a path left unfinished by the loop cap (path.comp) */
+#define GN_BIND_COUNT 17u
 
 /* Work-group size of the 2D image kernels: 8x8 matches lavapipe's 8-wide SIMD rows and is a
  * good default for GPUs (64 threads = 2 warps / 1 wavefront). */
@@ -63,6 +64,11 @@ typedef uint32_t uint;
  * levels, whose walks put off at most one node per level. */
 #define GN_WALK_REGS_MAX 8
 #define GN_SPEC_WALK_REGS 2u
+/* The path kernel's loop passes per SIMD group before its walks stop (specialization constant
+ * 3; 0: none; glsl/bvh.glsl: LOOP_CAP), set below llvmpipe's loop cap. */
+#define GN_SPEC_LOOP_CAP 3u
+/* Words of a path's saved state (glsl/path.comp: path_save) before its walk's stack. */
+#define GN_PATH_STATE_WORDS 44u
 #define GN_TILE_X 8u
 #define GN_TILE_Y 8u
 
@@ -288,20 +294,20 @@ GN_STRUCT(GnFrame) {
     vec3 ambient; float emitter_power;   /* ambient: global ambient light of the Phong model */
     vec3 env_color; uint num_nodes;      /* constant environment radiance */
     vec3 bounds_min; float depth_scale;
-    vec3 bounds_max; uint traversal_budget; /* max BVH steps per ray (see DESIGN: loop cap) */
+    vec3 bounds_max; uint traversal_budget; /* max BVH steps per ray (docs/architecture.md: the loop cap) */
     uint env_width; uint env_height;     /* GN_FRAME_ENV_MAP: the lat-long map's size */
     float env_select; float env_norm;    /* env's selection probability; 1 / mean map weight */
     float env_cos; float env_sin;        /* the map turned by a about +Y (right-handed): cos a, -sin a */
     uint crop_x; uint crop_y;            /* the region's top-left pixel in the whole image */
     uint crop_width; uint crop_height;   /* the region's size: the dispatch and the buffers */
-    uint pad_crop0; uint pad_crop1;
+    uint loop_overhead; uint state_stride; /* path, LOOP_CAP > 0: loop passes a vertex costs besides its walks; words per pixel of GN_BIND_PSTATE */
 } GN_END(GnFrame); /* 224 bytes */
 
 /* Per-dispatch values (push constants). */
 GN_STRUCT(GnPush) {
     uint sample_index;   /* index of the (first) sample this pass takes in every pixel */
     uint pass_flags;
-    uint pad0;           /* path.comp: how many samples, sample_index on (1..GN_PATH_SAMPLES) */
+    uint pad0;           /* path.comp: how many samples, sample_index on (0..GN_PATH_SAMPLES; 0: only finish those pending) */
     uint pad1;
 } GN_END(GnPush);
 

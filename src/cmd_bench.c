@@ -86,6 +86,7 @@ static double path_pass(renderer *r, uint32_t first, uint32_t count)
     VkCommandBuffer cmd = gpu_begin(r->g);
     renderer_record_samples(r, cmd, GN_MODE_PATH, first, count);
     gpu_submit_wait(r->g, cmd);
+    renderer_finish(r, GN_MODE_PATH, first + count);
     return util_now() - t0;
 }
 

@@ -542,6 +542,10 @@ static bool frame(preview *p, double *submit_time, int *last_passes)
         else if (gpu_seconds > 1.5 * PREVIEW_FRAME_SECONDS && p->batch > 1)
             p->batch /= 2;
     }
+    /* The paths of the last frame that llvmpipe's loop cap interrupted, finished before
+     * anything reads the sums (that frame showed those pixels a little dark). */
+    if (*last_passes > 0)
+        renderer_finish(&p->r, p->s.mode, (uint32_t)p->spp);
     *last_passes = 0;
     if (p->save) {
         p->save = false;

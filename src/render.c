@@ -114,8 +114,8 @@ static bool loop_capped(const gpu *g)
  * walk budget, but on llvmpipe all of them share the loop cap (65,535 iterations per SIMD
  * group), so the number is what fits half the cap for typical paths: 16 rays (8 vertices,
  * each with a shadow ray) of sah_cost node visits, about 3 loop iterations a visit, and 2
- * for the lanes of a group not walking in step. A path that goes beyond is still counted
- * and reported, never silently cut (glsl/bvh.glsl). */
+ * for the lanes of a group not walking in step. Paths that go beyond are saved and finished
+ * by the next dispatch (glsl/path.comp), so the number is a matter of speed only. */
 static uint32_t path_samples(const renderer *r)
 {
     /* GPUs: 16, which kept the lanes busy there too, and keeps one dispatch of a large
@@ -407,7 +407,7 @@ void renderer_destroy(renderer *r)
     gpu_buffer *bufs[] = {&r->frame, &r->nodes, &r->tris, &r->prims, &r->vertices,
                           &r->materials, &r->lights, &r->texels, &r->textures, &r->emitters,
                           &r->vcolor, &r->status, &r->accum, &r->aov,
-                          &r->squares, &r->env};
+                          &r->squares, &r->env, &r->pstate};
     if (r->g) {
         for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
             gpu_buffer_destroy(r->g, bufs[i]);
@@ -548,6 +548,7 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
         {GN_BIND_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->status},
         {GN_BIND_SQUARES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->squares},
         {GN_BIND_ENV, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->env},
+        {GN_BIND_PSTATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->pstate},
     };
     memcpy(b, all, sizeof all);
     return sizeof all / sizeof *all;
@@ -679,6 +680,40 @@ static bool upload_env_map(renderer *r, const image *map)
     return true;
 }
 
+static uint32_t log2_up(uint32_t n)
+{
+    uint32_t k = 0;
+    while (k < 32 && (1ull << k) < n)
+        k++;
+    return k;
+}
+
+/* The path kernel's loop cap (glsl/path.comp, glsl/bvh.glsl: LOOP_CAP) on llvmpipe, and what
+ * the kernel needs for it: the loop passes one path vertex may cost besides its walks'
+ * counted ones (frame->loop_overhead: the binary searches of the light table and of the
+ * environment map, each loop's final test, the walks' loops reached with no lane left in
+ * them), and the words of a saved path. The cap leaves room under llvmpipe's 65,535 for two
+ * more vertices once the walks stop and for saving and loading a path with its stack.
+ * GONIO_LOOP_CAP=N lowers it (tests: paths interrupted and resumed many times). */
+static uint32_t state_stride(const renderer *r, uint32_t mode);
+static void loop_setup(renderer *r, GnFrame *frame)
+{
+    const char *forced = getenv("GONIO_LOOP_CAP");
+    /* (at most 32 + 34 + 68: the overhead the fixed cap below leaves room for) */
+    uint32_t overhead = 32 + (frame->num_emitters > 1 ? log2_up(frame->num_emitters) + 2 : 0) +
+                        (frame->flags & GN_FRAME_ENV_MAP ? log2_up(frame->env_width) + log2_up(frame->env_height) + 4 : 0);
+    frame->loop_overhead = overhead;
+    frame->state_stride = r->state_stride = state_stride(r, GN_MODE_PATH);
+    /* One value for every render of the process, so the cached kernel stays valid. */
+    r->loop_cap = r->state_stride && !getenv("XX_NOCAP") ? 65535u - 4096u - 4 * 134u : 0;
+    if (r->loop_cap && forced && atol(forced) > 0 && (uint32_t)atol(forced) < r->loop_cap) {
+        /* each lane's share (of up to 8) at least two vertices' overhead and then a node
+         * visit or a leaf: progress */
+        uint32_t least = 8 * (2 * 134u + 64);
+        r->loop_cap = (uint32_t)atol(forced) > least ? (uint32_t)atol(forced) : least;
+    }
+}
+
 /* The path tracer's frame: the environment, the normalised light table and the budget. */
 static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
 {
@@ -722,9 +757,8 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
      * (tests/regress/path.sh) and for ruling it out when chasing a bug. */
     if (getenv("GONIO_ALL_FEATURES"))
         r->path_features = GN_FEAT_ALL;
-    /* Each path gets the budget of one ray per invocation; path_samples keeps the
-     * invocation's paths together under llvmpipe's loop cap. */
-    frame->traversal_budget = traversal_budget(r->g, 1);
+    frame->traversal_budget = traversal_budget(r->g, 1); /* (unused: path.comp has loop_cap) */
+    loop_setup(r, frame);
     return true;
 }
 
@@ -770,6 +804,7 @@ static bool frame_setup(renderer *r, const render_settings *s, const int region[
     frame->bounds_max = v3(r->sc->bounds_max);
     frame->ambient = v3(s->ambient_set ? s->ambient : r->sc->ambient);
     frame->traversal_budget = traversal_budget(r->g, 1 + (s->shadows ? r->num_lights : 0));
+    r->state_stride = 0; /* path_begin sets it, and the loop cap, for the path kernel */
     return s->mode != GN_MODE_PATH || path_begin(r, s, frame);
 }
 
@@ -783,7 +818,20 @@ static VkDeviceSize squares_pixel_bytes(uint32_t aov) { return aov & RENDER_AOV_
  * rest for the scene and the image), at most 8 maxComputeWorkGroupCount[1] rows and each row
  * within maxComputeWorkGroupCount[0] work groups. 0 (with an error naming the limit and the
  * numbers) when not even one row fits; *why (may be NULL) names what bounds it, else NULL. */
-static int band_rows(const renderer *r, int w, int h, uint32_t aov, char *why, size_t why_size)
+/* Words a pixel of the path kernel's saved state (glsl/path.comp: path_save) takes under a
+ * loop cap, 0 without one: the path, and the walk's stack, which holds at most one entry a
+ * tree level (plus the sentinel). */
+static uint32_t walk_regs(const renderer *r);
+static uint32_t state_stride(const renderer *r, uint32_t mode)
+{
+    uint32_t regs = walk_regs(r), stack = r->tree.depth + 2 < GN_WALK_STACK ? r->tree.depth + 2 : GN_WALK_STACK;
+    if (mode != GN_MODE_PATH || !loop_capped(r->g))
+        return 0;
+    return GN_PATH_STATE_WORDS + (regs ? regs : stack);
+}
+
+static int band_rows(const renderer *r, int w, int h, uint32_t aov, uint32_t mode, char *why,
+                     size_t why_size)
 {
     const char *limit_name;
     const VkDeviceSize limit = gpu_storage_limit(r->g, &limit_name), heap = gpu_host_heap(r->g) / 2;
@@ -819,6 +867,19 @@ static int band_rows(const renderer *r, int w, int h, uint32_t aov, char *why, s
             snprintf(why, why_size, "its %d rows need more work groups than the device's "
                      "maxComputeWorkGroupCount[1] (%u)", h, gpu_max_groups(r->g, 1));
     }
+    /* The path kernel's saved paths (state_stride) are one more storage buffer, within the
+     * device's own limit (GONIO_MAX_BUFFER_BYTES is for the accumulation buffers' bands). */
+    const VkDeviceSize state = 4 * (VkDeviceSize)state_stride(r, mode) * (VkDeviceSize)w;
+    VkDeviceSize state_limit = r->g->props.limits.maxStorageBufferRange;
+    if (r->g->max_allocation && r->g->max_allocation < state_limit)
+        state_limit = r->g->max_allocation;
+    if (state && state_limit / state < rows) {
+        rows = state_limit / state;
+        if (rows < (VkDeviceSize)h && why)
+            snprintf(why, why_size, "its %llu-byte buffer of paths left for the next pass exceeds "
+                     "the device's storage buffer range (%llu bytes)",
+                     (unsigned long long)(state * (VkDeviceSize)h), (unsigned long long)state_limit);
+    }
     if (rows == 0) {
         util_error("%s: a row of %d pixels needs %llu bytes of accumulation buffers, more than this "
                    "device allows (%s: %llu bytes; half the memory heap: %llu bytes)", r->sc->path, w,
@@ -836,11 +897,12 @@ static int band_rows(const renderer *r, int w, int h, uint32_t aov, char *why, s
 static void size_buffers(renderer *r, int w, int h, uint32_t aov)
 {
     const VkDeviceSize pixels = (VkDeviceSize)w * h;
-    gpu_buffer *bufs[3] = {&r->accum, &r->aov, &r->squares};
-    const VkDeviceSize need[3] = {16 * pixels, aov_pixel_bytes(aov) ? aov_pixel_bytes(aov) * pixels : 16,
-                                  squares_pixel_bytes(aov) ? squares_pixel_bytes(aov) * pixels : 16};
+    gpu_buffer *bufs[4] = {&r->accum, &r->aov, &r->squares, &r->pstate};
+    const VkDeviceSize need[4] = {16 * pixels, aov_pixel_bytes(aov) ? aov_pixel_bytes(aov) * pixels : 16,
+                                  squares_pixel_bytes(aov) ? squares_pixel_bytes(aov) * pixels : 16,
+                                  r->state_stride ? 4 * (VkDeviceSize)r->state_stride * pixels : 16};
     bool changed = false;
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < 4; i++) {
         if (bufs[i]->buffer && bufs[i]->size >= need[i] && bufs[i]->size / 2 <= need[i])
             continue;
         gpu_buffer_destroy(r->g, bufs[i]);
@@ -873,7 +935,7 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     free_bands(r);
     if (r->failed)
         return false;
-    int rows = band_rows(r, rw, rh, s->aov, why, sizeof why);
+    int rows = band_rows(r, rw, rh, s->aov, s->mode, why, sizeof why);
     if (rows == 0)
         return false;
     if (rows < rh) {
@@ -888,6 +950,7 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     gpu_buffer_fill_zero(g, &r->accum);
     gpu_buffer_fill_zero(g, &r->aov);
     gpu_buffer_fill_zero(g, &r->squares);
+    gpu_buffer_fill_zero(g, &r->pstate);
     gpu_buffer_fill_zero(g, &r->status);
     return s->mode != GN_MODE_GOURAUD || light_vertices(r);
 }
@@ -918,10 +981,11 @@ const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode
     spec->values[0] = mode;
     spec->values[1] = kernel_features(r, mode);
     spec->values[2] = walk_regs(r);
-    for (uint32_t i = 0; i < 3; i++)
+    spec->values[3] = 0; /* the loop cap: only the path kernel's (renderer_pipeline) */
+    for (uint32_t i = 0; i < 4; i++)
         spec->entries[i] = (VkSpecializationMapEntry){i, i * (uint32_t)sizeof(uint32_t), sizeof(uint32_t)};
-    assert(spec->entries[2].constantID == GN_SPEC_WALK_REGS);
-    spec->info = (VkSpecializationInfo){3, spec->entries, sizeof spec->values, spec->values};
+    assert(spec->entries[2].constantID == GN_SPEC_WALK_REGS && spec->entries[3].constantID == GN_SPEC_LOOP_CAP);
+    spec->info = (VkSpecializationInfo){4, spec->entries, sizeof spec->values, spec->values};
     return &spec->info;
 }
 
@@ -942,6 +1006,7 @@ gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
             .local_size = {GN_TILE_X, GN_TILE_Y, 1}, .push_size = sizeof(GnPush),
             .bindings = b, .num_bindings = renderer_bindings(r, b),
             .specialization = renderer_specialize(r, mode, &spec)};
+        spec.values[3] = mode == GN_MODE_PATH ? r->loop_cap : 0u;
         gpu_pipeline_create(r->g, p, &pd);
     }
     return p;
@@ -958,6 +1023,23 @@ void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, ui
         gpu_dispatch(cmd, renderer_pipeline(r, mode), &push, (uint32_t)r->width, (uint32_t)r->height, 1);
         gpu_barrier(cmd);
     }
+}
+
+uint32_t renderer_finish(renderer *r, uint32_t mode, uint32_t next)
+{
+    uint32_t n = 0;
+    /* status[1]: the pixels pending after the last dispatch. Each dispatch that takes no new
+     * samples gives every pending pixel one more invocation's worth of loop passes. */
+    volatile const uint32_t *pending = (const uint32_t *)r->status.mapped + 1;
+    while (mode == GN_MODE_PATH && r->loop_cap && *pending) {
+        VkCommandBuffer cmd = gpu_begin(r->g);
+        GnPush push = {next, 0, 0, 0};
+        gpu_dispatch(cmd, renderer_pipeline(r, mode), &push, (uint32_t)r->width, (uint32_t)r->height, 1);
+        gpu_barrier(cmd);
+        gpu_submit_wait(r->g, cmd);
+        n++;
+    }
+    return n;
 }
 
 uint32_t render_aov_from_name(const char *name)
@@ -1124,6 +1206,7 @@ static bool begin_bands(renderer *r, const render_settings *s, const int region[
     if (!frame_setup(r, s, region, frame))
         return false;
     size_buffers(r, rw, rows, s->aov);
+    gpu_buffer_fill_zero(r->g, &r->pstate);
     gpu_buffer_fill_zero(r->g, &r->status);
     r->band_accum = util_calloc(4 * pixels, sizeof(float));
     if (s->aov & RENDER_AOV_GPU)
@@ -1175,7 +1258,7 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
     render_region(s, region);
     const int rw = region[2] - region[0], rh = region[3] - region[1];
     const VkDeviceSize pixels = (VkDeviceSize)rw * rh;
-    if ((rows = band_rows(r, rw, rh, s->aov, why, sizeof why)) == 0)
+    if ((rows = band_rows(r, rw, rh, s->aov, s->mode, why, sizeof why)) == 0)
         return false;
     bands = (rh + rows - 1) / rows;
     if (bands > 1) {
@@ -1218,6 +1301,7 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
             cmd = gpu_begin(g);
             renderer_record_samples(r, cmd, s->mode, (uint32_t)done, (uint32_t)n);
             gpu_submit_wait(g, cmd);
+            stats->resumes += renderer_finish(r, s->mode, (uint32_t)(done + n));
             if (bands > 1)
                 band_swap(r, &frame, region, rows, b, false);
         }
@@ -1248,10 +1332,15 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
     stats->rays = (uint64_t)pixels * (uint64_t)(done - (s->resume ? s->resume_spp : 0));
     stats->setup_seconds = r->setup_seconds;
     stats->truncated = ((const uint32_t *)r->status.mapped)[0];
+    if (getenv("GONIO_DEBUG_RESUMES")) /* tests/regress/path.sh: the interrupted paths were there */
+        fprintf(stderr, "gonio: debug: %u dispatch(es) finished paths the loop cap interrupted\n",
+                stats->resumes);
+    /* The path kernel resumes what the loop cap interrupts (glsl/path.comp): a count here
+     * means its count of loop passes is wrong, a bug, and the image may be too dark. */
     if (stats->truncated && s->mode == GN_MODE_PATH)
-        util_warn("%s: in %u pixel pass(es) a path needed more BVH steps than its budget (%u "
-                  "node visits) and was cut short; the image is slightly too dark there",
-                  r->sc->path, stats->truncated, frame.traversal_budget);
+        util_warn("%s: internal error: in %u pixel pass(es) llvmpipe's loop cap stopped a path "
+                  "that the kernel did not stop first; the image may be too dark there",
+                  r->sc->path, stats->truncated);
     else if (stats->truncated)
         util_warn("%s: %u ray(s) needed more BVH steps than the per-ray budget (%u) and may be "
                   "wrong", r->sc->path, stats->truncated, frame.traversal_budget);

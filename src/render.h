@@ -1,8 +1,9 @@
 /* render.h: a scene on the GPU and the progressive sample passes that render it.
  *
- * Work is submitted as short dispatches of a few samples per pixel each (renderer.path_samples:
- * keeps a window responsive, GPU watchdogs quiet, llvmpipe's loop cap away, and lets an
- * interrupted render write what it has). Samples depend only on (pixel, sample, dimension, seed). */
+ * Work is submitted as short dispatches of a few samples per pixel each (keeps a window
+ * responsive, GPU watchdogs quiet, and lets an interrupted render write what it has; the
+ * path kernel finishes in a later dispatch what llvmpipe's loop cap interrupts:
+ * docs/architecture.md). Samples depend only on (pixel, sample, dimension, seed). */
 #ifndef GONIO_RENDER_H
 #define GONIO_RENDER_H
 
@@ -67,7 +68,8 @@ typedef struct render_stats {
     double first_pass_seconds;
     double setup_seconds;   /* BVH build and upload */
     uint64_t rays;          /* camera rays traced (pixels * spp) */
-    uint32_t truncated;     /* rays (path: pixel passes) cut short by the traversal budget */
+    uint32_t truncated;     /* rays cut short by the traversal budget (path: 0, or a bug) */
+    uint32_t resumes;       /* path: dispatches that only finished paths the loop cap interrupted */
     int bands;              /* horizontal bands the region was rendered in (1: one piece) */
 } render_stats;
 
@@ -83,6 +85,9 @@ typedef struct renderer {
     gpu_pipeline pipelines[GN_MODE_COUNT]; /* created on first use */
     gpu_pipeline vertex_pass; /* Gouraud's per-vertex lighting (glsl/vertex.comp) */
     gpu_buffer squares, env; /* path: per-pixel sums of squares; the environment map */
+    gpu_buffer pstate;        /* path under a loop cap: the paths left pending (GN_BIND_PSTATE) */
+    uint32_t loop_cap;        /* path: the kernel's LOOP_CAP (glsl/bvh.glsl), 0 without a cap */
+    uint32_t state_stride;    /* words a pixel of pstate (frame_setup), 0 without a cap */
     GnEmitter *emitter_table; /* path: lights, then a slot for the environment */
     double *emitter_weight;   /* their selection weights (flux / pi) */
     const image *env_source;  /* the map now in `env` */
@@ -123,18 +128,23 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
 /* Specialization constants of the render kernels: constant 0 = mode (or a kernel's own
  * variant); constant 1 = the GN_FEAT_* set (the path kernel reads it; others ignore it). */
 typedef struct renderer_spec {
-    uint32_t values[3];
-    VkSpecializationMapEntry entries[3];
+    uint32_t values[4];
+    VkSpecializationMapEntry entries[4];
     VkSpecializationInfo info;
 } renderer_spec;
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec);
 
 /* The kernel of a mode (created on first use, kept until renderer_destroy). */
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode);
+bool renderer_mode_available(uint32_t mode);
 /* Records one sample pass (sample `sample_index` in every pixel) and a barrier. Call
  * renderer_begin first. */
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,
                              uint32_t count);
+/* After the submission of renderer_record_samples(..., first, count) has completed: the path
+ * kernel's pixels left pending by llvmpipe's loop cap (glsl/path.comp) finished, by further
+ * dispatches that take no new samples, so every pixel has all first + count samples. */
+uint32_t renderer_finish(renderer *r, uint32_t mode, uint32_t next); /* returns the dispatches */
 /* The accumulated image divided by spp: R, G, B, A and the AOV channels of the set aov
  * (RENDER_AOV_*; the GPU ones need a render with them, variance any). */
 void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out);

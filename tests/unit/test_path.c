@@ -479,6 +479,7 @@ TEST(path, batching)
                 VkCommandBuffer cmd = gpu_begin(&g);
                 renderer_record_samples(&r, cmd, GN_MODE_PATH, i, spp - i < per ? spp - i : per);
                 gpu_submit_wait(&g, cmd);
+                renderer_finish(&r, GN_MODE_PATH, spp - i < per ? (uint32_t)spp : i + per);
             }
             renderer_resolve(&r, spp, false, &b);
             for (int c = 0; same && c < 4; c++)
@@ -606,4 +607,65 @@ TEST(path, merge_checks)
     unlink(a_path);
     unlink(b_path);
     unlink(o_path);
+}
+
+/* A path longer than one invocation may run: camera rays down the axis of the comb (50,000
+ * teeth whose boxes all hold the axis, src/meshgen.c) visit every node before they reach the
+ * triangle across its far end, far more loop iterations than llvmpipe lets an invocation
+ * run. Every surface emits radiance 1 (both sides) and reflects nothing (black, no specular),
+ * so each sample is exactly 1 whatever happens after the first hit: the image must be 1
+ * everywhere. A path cut short would give 0 (the answer before paths were resumed), one
+ * dropped or added twice a sum that is not spp. */
+TEST(path, loop_cap)
+{
+    char path[256];
+    gpu g = {0};
+    scene sc = {0};
+    renderer r = {0};
+    image img = {0};
+    render_stats st = {0};
+    meshgen_mesh m = meshgen_comb(50000);
+    gltf_write_mesh mesh = {.num_vertices = m.num_vertices, .positions = m.positions,
+                            .num_indices = 3 * m.num_triangles, .indices = m.indices};
+    gltf_write_material mat = {.base_color = {0, 0, 0, 1}, .roughness = 1, .emissive = {1, 1, 1},
+                               .has_specular = true, .double_sided = true};
+    /* (half a degree's hundredth: the rays stay within 0.3 of the axis, off every tooth, and
+     * all meet the far triangle) */
+    gltf_write_camera cam = {.yfov = 1.2e-5f, .aspect = 1};
+    gltf_write_node nodes[] = {{.kind = GLTF_WRITE_NODE_MESH},
+                               {.kind = GLTF_WRITE_NODE_CAMERA, .translation = {0, 0, -1},
+                                .rotation = {0, 1, 0, 0}}};
+    gltf_write_desc d = {.meshes = &mesh, .num_meshes = 1, .materials = &mat, .num_materials = 1,
+                         .cameras = &cam, .num_cameras = 1, .nodes = nodes, .num_nodes = 2};
+    render_settings s = {.width = 8, .height = 8, .spp = 3, .camera = 0, .seed = 1,
+                         .mode = GN_MODE_PATH};
+    tmp_file(path, sizeof path, "comb.gltf");
+    CHECK(gltf_write_file(path, &d));
+    meshgen_destroy(&m);
+    if (!test_open_gpu(&g))
+        return;
+    if (scene_load(&sc, path)) {
+        renderer_create(&r, &g, &sc);
+        if (renderer_render(&r, &s, &img, &st)) {
+            int wrong = 0;
+            for (int p = 0; p < 64; p++)
+                for (int c = 0; c < 4; c++)
+                    wrong += img.planes[c][p] != 1.0f;
+            CHECKF(wrong == 0, "%d of 256 values are not exactly 1 (pixel 0: %g %g %g %g)", wrong,
+                   img.planes[0][0], img.planes[1][0], img.planes[2][0], img.planes[3][0]);
+            CHECKF(st.truncated == 0, "%u pixel passes were cut short", st.truncated);
+            if (strstr(g.props.deviceName, "llvmpipe"))
+                CHECKF(st.resumes > 0, "no path needed resuming on %s: the test tests nothing",
+                       g.props.deviceName);
+            printf("    comb: %u dispatch(es) finished interrupted paths\n", st.resumes);
+        } else {
+            CHECKF(false, "rendering the comb failed");
+        }
+        renderer_destroy(&r);
+    } else {
+        CHECKF(false, "loading %s failed", path);
+    }
+    image_destroy(&img);
+    scene_destroy(&sc);
+    gpu_destroy(&g);
 }
