@@ -292,14 +292,15 @@ vec3 medium_transmittance(uint id, float t)
     return exp(-sigma * t);
 }
 
-// The index of material m in the path's channel. Dispersion as glTF defines it: n(lambda) =
+// The index of material m in the path's channel (at least 1: KHR_materials_ior's 0, a
+// mirror's F0 of 1, has no refraction to take a ratio of). Dispersion as glTF defines it: n(lambda) =
 // max(n_d + (n_d - 1) / V (523655 / lambda^2 - 1.5168), 1), V = 20 / dispersion, at the
 // Fraunhofer lines C (656.3 nm) for red, d (587.56 nm, where n = n_d) for green and F
 // (486.1 nm) for blue.
 float medium_ior(GnMaterial m)
 {
     if (m.dispersion <= 0.0 || channel > 2u || m.ior < 1.0)
-        return m.ior;
+        return max(m.ior, 1.0);
     float k = channel == 0u ? 523655.0 / (656.3 * 656.3) - 1.5168
             : channel == 2u ? 523655.0 / (486.1 * 486.1) - 1.5168 : 0.0;
     return max(m.ior + (m.ior - 1.0) * m.dispersion / 20.0 * k, 1.0);
@@ -311,14 +312,14 @@ float medium_ior_of(uint id) { return id == GN_INVALID ? 1.0 : medium_ior(materi
 // first dispersive interface (u: uniform; the throughput of the one channel times 3, its
 // selection's inverse probability) and sets b.ior to the interface's ratio (the back side's
 // medium over the front side's). Returns the medium on the far side of the interface.
-uint medium_interface(Surface s, GnMaterial m, inout Bsdf b, float u, inout vec3 beta)
+uint medium_interface(Surface s, GnMaterial m, inout Bsdf b, float u, inout vec3 throughput)
 {
     uint top = medium_top();
     if (b.dielectric <= 0.0)
         return top;
     if (m.dispersion > 0.0 && channel > 2u && m.brdf == BRDF_GLTF) {
         channel = min(uint(u * 3.0), 2u);
-        beta *= vec3(channel == 0u, channel == 1u, channel == 2u) * 3.0;
+        throughput *= vec3(channel == 0u, channel == 1u, channel == 2u) * 3.0;
     }
     if (!medium_of(m)) { // no medium: glass against vacuum, as without the extension
         if (m.brdf == BRDF_GLTF)
