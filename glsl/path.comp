@@ -297,6 +297,122 @@ bool bsdf_has_smooth(Bsdf b)
            (b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN);
 }
 
+// ---- media: KHR_materials_volume and _dispersion (GN_FEAT_VOLUME) --------------------------
+// The media a path is inside, innermost last, as material ids: a closed transmissive mesh
+// with a volume is entered by a transmission through a front face and left by one through a
+// back face, so nested and touching media (a glass of water: water inside glass) have the
+// right one on top, and the index at an interface is the ratio of the two sides' media.
+// Paths start in vacuum (index 1, no absorption); a fifth nested medium is not entered.
+#define MEDIA_MAX 4u
+uint media[MEDIA_MAX];
+uint media_n;
+vec3 seg_from; // where the path's current segment starts: the vertex, not the offset origin
+uint channel; // dispersion: the colour channel the path carries since its first dispersive
+              // interface (3: all of them)
+
+void media_start()
+{
+    media_n = 0u;
+    channel = 3u;
+}
+
+uint medium_top() { return media_n > 0u ? media[media_n - 1u] : GN_INVALID; }
+
+// Does material m bound a medium? (a BRDF-model override shades it as it is, without)
+bool medium_of(GnMaterial m) { return m.volume != 0u && m.brdf == BRDF_GLTF; }
+
+// Beer-Lambert transmittance over distance t in medium `id`: exp(-sigma_a t), sigma_a =
+// -ln(attenuation colour) / attenuation distance (colour floored so that black stays finite).
+vec3 medium_transmittance(uint id, float t)
+{
+    if (id == GN_INVALID)
+        return vec3(1.0);
+    GnMaterial m = material_at(id);
+    vec3 sigma = -log(max(m.attenuation_color, vec3(1e-30))) / m.attenuation_distance;
+    return exp(-sigma * t);
+}
+
+// The index of material m in the path's channel (at least 1: KHR_materials_ior's 0, a
+// mirror's F0 of 1, has no refraction to take a ratio of). Dispersion as glTF defines it: n(lambda) =
+// max(n_d + (n_d - 1) / V (523655 / lambda^2 - 1.5168), 1), V = 20 / dispersion, at the
+// Fraunhofer lines C (656.3 nm) for red, d (587.56 nm, where n = n_d) for green and F
+// (486.1 nm) for blue.
+float medium_ior(GnMaterial m)
+{
+    if (m.dispersion <= 0.0 || channel > 2u || m.ior < 1.0)
+        return max(m.ior, 1.0);
+    float k = channel == 0u ? 523655.0 / (656.3 * 656.3) - 1.5168
+            : channel == 2u ? 523655.0 / (486.1 * 486.1) - 1.5168 : 0.0;
+    return max(m.ior + (m.ior - 1.0) * m.dispersion / 20.0 * k, 1.0);
+}
+
+float medium_ior_of(uint id) { return id == GN_INVALID ? 1.0 : medium_ior(material_at(id)); }
+
+// At a hit on material m (surface s) with a dielectric part: picks the path's channel at its
+// first dispersive interface (u: uniform; the throughput of the one channel times 3, its
+// selection's inverse probability) and sets b.ior to the interface's ratio (the back side's
+// medium over the front side's). Returns the medium on the far side of the interface.
+uint medium_interface(Surface s, GnMaterial m, inout Bsdf b, float u, inout vec3 throughput)
+{
+    uint top = medium_top();
+    if (b.dielectric <= 0.0)
+        return top;
+    if (m.dispersion > 0.0 && channel > 2u && m.brdf == BRDF_GLTF) {
+        channel = min(uint(u * 3.0), 2u);
+        throughput *= vec3(channel == 0u, channel == 1u, channel == 2u) * 3.0;
+    }
+    if (!medium_of(m)) { // no medium: glass against vacuum, as without the extension
+        if (m.brdf == BRDF_GLTF)
+            b.ior = max(medium_ior(m), 1.01);
+        return top;
+    }
+    float inner, outer;
+    uint far = top;
+    if (s.front) {
+        inner = medium_ior(m);
+        outer = medium_ior_of(top);
+        far = s.material;
+    } else {
+        // Leaving m: outside is what is left when m's innermost entry goes (m not entered,
+        // as for a camera inside it: the medium the path is in).
+        int j = -1;
+        for (uint i = 0u; i < media_n; i++)
+            if (media[i] == s.material) j = int(i);
+        if (j >= 0) {
+            far = int(media_n) - 1 == j ? (j > 0 ? media[j - 1] : GN_INVALID) : top;
+            inner = medium_ior_of(top);
+        } else {
+            inner = medium_ior(m);
+        }
+        outer = medium_ior_of(far);
+    }
+    float eta = inner / outer;
+    // The rough BTDF collapses to a Dirac at 1 (bsdf_gltf): kept as far off it as there.
+    if (b.shape >= BRDF_ALPHA_MIN)
+        eta = eta >= 1.0 ? max(eta, 1.01) : min(eta, 1.0 / 1.01);
+    b.ior = eta;
+    return far;
+}
+
+// After a transmission through material `id`: the medium entered (front) or left (back).
+void medium_cross(uint id, bool front)
+{
+    if (front) {
+        if (media_n < MEDIA_MAX)
+            media[media_n++] = id;
+        return;
+    }
+    bool found = false;
+    for (int i = int(media_n) - 1; i >= 0; i--)
+        if (!found && media[i] == id) {
+            found = true;
+            for (uint k = uint(i); k + 1u < media_n; k++)
+                media[k] = media[k + 1u];
+        }
+    if (found)
+        media_n--;
+}
+
 // Offset of a ray origin off the surface, to the side of w (scaled to the coordinates'
 // magnitude so float rounding of the hit point cannot put it behind the surface).
 vec3 offset_origin(vec3 p, vec3 ng, vec3 w)
@@ -352,6 +468,9 @@ void path_start()
     ended = false;
     phase = PHASE_RAY;
     trace_begin(tmin, 1e30);
+    if (GN_HAS(GN_FEAT_VOLUME))
+        media_start();
+    seg_from = o;
 }
 
 // After a path vertex: the next vertex, or (the path ended) the sample added up and the
@@ -399,6 +518,12 @@ void path_save(uint behind)
         ps_f(35u, tr_lo);
         ps_f(36u, tr_max);
     }
+    if (GN_HAS(GN_FEAT_VOLUME)) { // the media the path is in (path.comp: media)
+        for (uint k = 0u; k < MEDIA_MAX; k++)
+            pstate[ps_base + 44u + k] = media[k];
+        pstate[ps_base + 48u] = media_n | channel << 8u;
+        ps_v(49u, seg_from);
+    }
     ps_f(37u, walk.hit.t); ps_f(38u, walk.hit.u); ps_f(39u, walk.hit.v);
     pstate[ps_base + 40u] = walk.hit.tri;
     pstate[ps_base + 41u] = walk.hit.steps;
@@ -422,6 +547,13 @@ void path_load()
     o = pl_v(4u); d = pl_v(7u); tmin = pl_f(10u); radiance = pl_v(11u); beta = pl_v(14u);
     prev_pdf = pl_f(17u); normal = pl_v(18u); albedo = pl_v(21u); depth_aov = pl_f(24u);
     so = pl_v(25u); sd = pl_v(28u); smax = pl_f(31u); c = pl_v(32u); tr_lo = pl_f(35u); tr_max = pl_f(36u);
+    if (GN_HAS(GN_FEAT_VOLUME)) {
+        for (uint k = 0u; k < MEDIA_MAX; k++)
+            media[k] = pstate[ps_base + 44u + k];
+        media_n = pstate[ps_base + 48u] & 0xffu;
+        channel = pstate[ps_base + 48u] >> 8u;
+        seg_from = pl_v(49u);
+    }
     walk.hit.t = pl_f(37u); walk.hit.u = pl_f(38u); walk.hit.v = pl_f(39u);
     walk.hit.tri = pstate[ps_base + 40u];
     walk.hit.steps = pstate[ps_base + 41u];
@@ -489,6 +621,9 @@ void main()
             Hit h = trace_resume(true, o, d, tmin, false, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
             if (suspended)
                 break;
+            if (GN_HAS(GN_FEAT_VOLUME)) // absorption by the medium the segment crossed
+                beta *= medium_transmittance(medium_top(), h.tri == GN_INVALID ? h.t : distance(seg_from, o + h.t * d));
+                break;
             alive = false;
             tmin = 0.0;
             if (h.tri == GN_INVALID) {
@@ -531,6 +666,9 @@ void main()
             sampling_basis(n, tx, ty);
             vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
             vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
+            uint far = GN_INVALID; // the medium beyond a transmitting surface
+            if (GN_HAS(GN_FEAT_VOLUME))
+                far = medium_interface(s, m, b, ub.w, beta);
 
             bool shadow = false;
             if (frame.num_emitters > 0u && bsdf_has_smooth(b)) {
@@ -544,6 +682,8 @@ void main()
                     bsdf_eval_pdf(b, wo, wi, f, pb);
                     float w = ls.delta || light_only ? 1.0 : power_heuristic(ls.pdf, pb);
                     c = beta * f * abs(wi.z) * ls.L * (w / ls.pdf);
+                    if (GN_HAS(GN_FEAT_VOLUME))
+                        c *= medium_transmittance(wi.z * wo.z > 0.0 ? medium_top() : far, ls.dist);
                     if (luminance(c) > 0.0) {
                         // (walked below, after the next ray is chosen: the state a walk that
                         // stops leaves to save is then the two rays, c and the path's sums)
@@ -560,9 +700,12 @@ void main()
             alive = bs.flags != 0u && dot(ng, wi) * bs.wi.z > 0.0;
             if (alive) {
                 beta *= bs.weight;
+                if (GN_HAS(GN_FEAT_VOLUME) && (bs.flags & BRDF_FLAG_TRANSMISSION) != 0u && medium_of(m))
+                    medium_cross(s.material, s.front);
                 prev_delta = (bs.flags & BRDF_FLAG_DELTA) != 0u;
                 prev_pdf = bs.pdf;
                 o = offset_origin(s.p, ng, wi);
+                seg_from = s.p;
                 d = wi;
                 if (depth + 1u >= ROULETTE_DEPTH) {
                     float q = min(max(beta.r, max(beta.g, beta.b)), 0.95);

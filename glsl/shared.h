@@ -67,8 +67,9 @@ typedef uint32_t uint;
 /* The path kernel's loop passes per SIMD group before its walks stop (specialization constant
  * 3; 0: none; glsl/bvh.glsl: LOOP_CAP), set below llvmpipe's loop cap. */
 #define GN_SPEC_LOOP_CAP 3u
-/* Words of a path's saved state (glsl/path.comp: path_save) before its walk's stack. */
-#define GN_PATH_STATE_WORDS 44u
+/* Words of a path's saved state (glsl/path.comp: path_save) before its walk's stack: 44 of the
+ * path and its walk, 8 of its media (GN_FEAT_VOLUME). */
+#define GN_PATH_STATE_WORDS 52u
 #define GN_TILE_X 8u
 #define GN_TILE_Y 8u
 
@@ -147,10 +148,11 @@ typedef uint32_t uint;
 #define GN_FEAT_VARIANCE (1u << 26)     /* sums of squares (--aov variance) */
 #define GN_FEAT_TEX_TRANSFORM (1u << 27) /* KHR_texture_transform (GnTexture.transform) */
 #define GN_FEAT_UV1 (1u << 28)          /* textures reading TEXCOORD_1 (GN_TEX_UV1) */
+#define GN_FEAT_VOLUME (1u << 30)       /* KHR_materials_volume media, _dispersion */
 #define GN_FEAT_LOBES (GN_FEAT_MIRROR | GN_FEAT_PHONG | GN_FEAT_BLINN | GN_FEAT_TS | \
                        GN_FEAT_BECKMANN | GN_FEAT_GGX)
 #define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
-#define GN_FEAT_ALL 0x1fffffffu
+#define GN_FEAT_ALL (0x1fffffffu | GN_FEAT_VOLUME)
 
 /* ---- BVH: both children's boxes in one 64-byte node (Aila & Laine 2009, "Understanding
  * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only
@@ -230,7 +232,14 @@ GN_STRUCT(GnMaterial) {
     vec3 phong_diffuse; float phong_pad0;
     vec3 phong_specular; float phong_pad1;
     vec3 phong_emission; float phong_pad2;
-} GN_END(GnMaterial); /* 192 bytes */
+    /* KHR_materials_volume (read by kernels with GN_FEAT_VOLUME; docs/path-tracing.md):
+     * volume 1 when the material bounds a medium (the extension with thicknessFactor > 0),
+     * whose absorption is sigma_a = -ln(attenuation_color) / attenuation_distance (+inf: no
+     * absorption). thickness is the rasterizers' stand-in for the real geometry: kept for
+     * `gonio info`, unused in shading. dispersion: KHR_materials_dispersion, 20 / Abbe number. */
+    vec3 attenuation_color; float attenuation_distance;
+    float thickness; float dispersion; uint volume; float volume_pad0;
+} GN_END(GnMaterial); /* 224 bytes */
 
 /* glTF KHR_lights_punctual light in world space. color = colour * intensity (W/sr for point
  * and spot, W/m^2 for directional: gonio reads photometric units as radiometric). direction
@@ -338,7 +347,8 @@ GN_STATIC_ASSERT(sizeof(GnTriPair) == 48, "GnTriPair layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");
 GN_STATIC_ASSERT(sizeof(GnVertex) == 80, "GnVertex layout");
 GN_STATIC_ASSERT(offsetof(GnVertex, u1) == 64, "GnVertex layout");
-GN_STATIC_ASSERT(sizeof(GnMaterial) == 192, "GnMaterial layout");
+GN_STATIC_ASSERT(sizeof(GnMaterial) == 224, "GnMaterial layout");
+GN_STATIC_ASSERT(offsetof(GnMaterial, attenuation_color) == 192, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, brdf_params) == 112, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, phong_ambient) == 128, "GnMaterial layout");
 GN_STATIC_ASSERT(sizeof(GnLight) == 64, "GnLight layout");

@@ -34,6 +34,25 @@ static void print_emitters(const scene *sc)
     free(count);
 }
 
+/* The materials with a medium or dispersion, as the path tracer reads them (glsl/path.comp:
+ * sigma_a = -ln(attenuation colour) / attenuation distance). */
+static void print_media(const scene *sc)
+{
+    for (uint32_t i = 0; i < sc->num_materials; i++) {
+        const GnMaterial *m = &sc->materials[i];
+        const float *c = &m->attenuation_color.x;
+        double sigma[3];
+        if (!m->volume && !(m->dispersion > 0))
+            continue;
+        for (int k = 0; k < 3; k++)
+            sigma[k] = c[k] >= 1 ? 0 : -log(c[k] > 1e-30f ? c[k] : 1e-30f) / m->attenuation_distance;
+        printf("medium %-7u \"%s\" %s attenuation (%g, %g, %g) distance %g (sigma_a %g, %g, %g), "
+               "thickness %g, ior %g, dispersion %g\n", i, sc->material_names[i][0] ? sc->material_names[i] : "(unnamed)",
+               m->volume ? "volume" : "thin-walled", c[0], c[1], c[2], m->attenuation_distance, sigma[0], sigma[1],
+               sigma[2], m->thickness, m->ior, m->dispersion);
+    }
+}
+
 int cmd_info(int argc, char **argv)
 {
     bool outside = false;
@@ -43,8 +62,11 @@ int cmd_info(int argc, char **argv)
         .intro = "Prints the scene's contents and its BVH statistics: the emissive triangles (the path\n"
                  "tracer's area lights) and the materials that emit, and one line per camera (index, name,\n"
                  "position, forward direction, vertical field of view or orthographic width x height;\n"
-                 "the first is the one gonio render uses by default) and the KHR_materials_variants\n"
-                 "variants by index and name (for --variant).\n",
+                 "the first is the one gonio render uses by default), the KHR_materials_variants\n"
+                 "variants by index and name (for --variant), and one line per material that bounds a\n"
+                 "medium (KHR_materials_volume) or disperses (KHR_materials_dispersion): attenuation\n"
+                 "colour and distance, the absorption coefficient they give, thickness (unused by the\n"
+                 "path tracer), IOR and dispersion.\n",
         CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given"};
     cli_args args;
     scene sc = {0};
@@ -70,6 +92,7 @@ int cmd_info(int argc, char **argv)
     printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
     printf("lights         %u\n", sc.num_lights);
     print_emitters(&sc);
+    print_media(&sc);
     printf("cameras        %u\n", sc.num_cameras);
     for (uint32_t i = 0; i < sc.num_cameras; i++) {
         const scene_camera *c = &sc.cameras[i];

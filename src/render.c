@@ -167,6 +167,9 @@ static uint32_t material_features(const GnMaterial *m)
         }
         if (t > 0 && metal_lo < 1)
             f |= (smooth ? GN_FEAT_SMOOTH_GLASS : 0u) | (rough ? GN_FEAT_ROUGH_GLASS : 0u);
+        /* KHR_materials_volume and _dispersion act only where the glass can transmit */
+        if (t > 0 && metal_lo < 1 && (m->volume || m->dispersion > 0))
+            f |= GN_FEAT_VOLUME;
         break;
     }
     case BRDF_LAMBERT:

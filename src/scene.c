@@ -147,6 +147,8 @@ void scene_material_default(GnMaterial *m)
     m->occlusion_strength = 1;
     m->alpha_cutoff = 0.5f;
     m->tex_base = m->tex_mr = m->tex_normal = m->tex_emissive = m->tex_occlusion = GN_INVALID;
+    m->attenuation_color = (vec3){1, 1, 1}; /* KHR_materials_volume: no absorption */
+    m->attenuation_distance = INFINITY;
     scene_phong_from_pbr(m);
 }
 

@@ -86,7 +86,8 @@ typedef struct scene {
  * view, accessor and reference is validated before use; structural errors (anything that
  * could make a read go out of bounds, unresolved references, node loops, non-finite
  * transforms, required extensions other than KHR_lights_punctual, KHR_materials_{unlit,
- * specular, transmission, ior, emissive_strength, variants}, KHR_draco_mesh_compression and
+ * specular, transmission, ior, emissive_strength, variants, volume, dispersion},
+ * KHR_draco_mesh_compression and
  * EXT_meshopt_compression, compressed data its decoder rejects) print an error naming the file and the
  * problem and return false with *out zeroed. What can be skipped or repaired safely prints a
  * warning naming the file and the feature: points/lines primitives (strips and fans become

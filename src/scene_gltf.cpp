@@ -53,7 +53,8 @@ const char *const SUPPORTED_EXTENSIONS[] = {
     "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_materials_specular",
     "KHR_materials_transmission", "KHR_materials_ior",               "KHR_materials_unlit",
     "KHR_texture_transform",      "KHR_mesh_quantization",           "KHR_draco_mesh_compression",
-    "EXT_meshopt_compression",    "KHR_materials_variants"};
+    "EXT_meshopt_compression",    "KHR_materials_variants",          "KHR_materials_volume",
+    "KHR_materials_dispersion"};
 
 using Json = nlohmann::json;
 
@@ -1920,6 +1921,34 @@ void convert_material(Ctx &c, int mi, GnMaterial &g, scene_material_extras &x, c
         double ior = ext_number(c, *e, "ior", 1.5, what);
         g.ior = ior == 0 ? 0.0f : ranged(c, ior, 1, INFINITY, what, "ior");
     }
+    if (const tinygltf::Value *e = extension(mat, "KHR_materials_volume")) {
+        /* The spec's thicknessFactor 0 (its default) means thin-walled: no medium. Any other
+         * thickness only says there is one: the path tracer follows the real geometry
+         * (docs/path-tracing.md), so the value and thicknessTexture are not used in shading. */
+        g.thickness = ranged(c, ext_number(c, *e, "thicknessFactor", 0, what), 0, INFINITY, what, "thicknessFactor");
+        g.volume = g.thickness > 0;
+        double dist = ext_number(c, *e, "attenuationDistance", INFINITY, what);
+        if (dist > 0)
+            g.attenuation_distance = float(dist); /* beyond float's range: +inf, no absorption */
+        else
+            warn(c, "%s: attenuationDistance %g must be positive (ignored)", what.c_str(), dist);
+        float t[3];
+        if (e->IsObject() && e->Has("attenuationColor")) {
+            if (number_triple(e->Get("attenuationColor"), t) && t[0] >= 0 && t[0] <= 1 && t[1] >= 0 &&
+                t[1] <= 1 && t[2] >= 0 && t[2] <= 1)
+                g.attenuation_color = vec3{t[0], t[1], t[2]};
+            else
+                warn(c, "%s: attenuationColor must be 3 numbers in [0, 1] (ignored)", what.c_str());
+        }
+        if (e->IsObject() && e->Has("thicknessTexture")) {
+            const tinygltf::Value &tt = e->Get("thicknessTexture");
+            const tinygltf::Value *ix = tt.IsObject() && tt.Has("index") ? &tt.Get("index") : nullptr;
+            if (!ix || !ix->IsInt() || ix->GetNumberAsInt() < 0 || size_t(ix->GetNumberAsInt()) >= c.m.textures.size())
+                warn(c, "%s: thicknessTexture does not name a texture (ignored)", what.c_str());
+        }
+    }
+    if (const tinygltf::Value *e = extension(mat, "KHR_materials_dispersion"))
+        g.dispersion = ranged(c, ext_number(c, *e, "dispersion", 0, what), 0, INFINITY, what, "dispersion");
     if (extension(mat, "KHR_materials_unlit"))
         g.flags |= GN_MAT_UNLIT;
     if (mat.doubleSided)

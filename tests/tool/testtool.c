@@ -314,6 +314,38 @@ static int print_value(const char *in, const char *name, int x, int y)
     return 0;
 }
 
+/* Per channel of R, G, B over the whole image: the mean and the centroid's x (the
+ * value-weighted mean column; -1 for a black channel), for the volume tests:
+ * `mean R G B cx R G B`, %.9g. */
+static int rgb_stats(const char *path)
+{
+    image img;
+    const char *names[3] = {"R", "G", "B"};
+    double mean[3], cx[3];
+    if (!image_read_exr(&img, path))
+        return 1;
+    for (int k = 0; k < 3; k++) {
+        int c = image_channel(&img, names[k]);
+        double sum = 0, sx = 0;
+        if (c < 0) {
+            fprintf(stderr, "testtool: %s has no channel %s\n", path, names[k]);
+            image_destroy(&img);
+            return 1;
+        }
+        for (int y = 0; y < img.height; y++)
+            for (int x = 0; x < img.width; x++) {
+                double v = img.planes[c][(size_t)y * img.width + x];
+                sum += v;
+                sx += v * x;
+            }
+        mean[k] = sum / ((double)img.width * img.height);
+        cx[k] = sum > 0 ? sx / sum : -1;
+    }
+    printf("mean %.9g %.9g %.9g cx %.9g %.9g %.9g\n", mean[0], mean[1], mean[2], cx[0], cx[1], cx[2]);
+    image_destroy(&img);
+    return 0;
+}
+
 /* PART's pixels sit at (x0, y0) of the display window (image.h); so do WHOLE's. */
 static int same_bits(const char *whole, const char *part)
 {
@@ -369,6 +401,8 @@ int main(int argc, char **argv)
         return same_bits(argv[2], argv[3]);
     if (argc == 3 && !strcmp(argv[1], "stats"))
         return stats(argv[2]);
+    if (argc == 3 && !strcmp(argv[1], "rgb"))
+        return rgb_stats(argv[2]);
     if (argc == 6 && !strcmp(argv[1], "at"))
         return print_value(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]));
     if (argc == 5 && !strcmp(argv[1], "png") && (!strcmp(argv[2], "depth") || !strcmp(argv[2], "normal")))
@@ -384,6 +418,6 @@ int main(int argc, char **argv)
                          argc == 8 ? atof(argv[7]) : 0.0);
     fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool compress draco|meshopt IN.gltf OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n"
                     "       testtool png depth|normal PNG REF.exr | testtool pick IN.exr CHANNEL OUT.exr\n"
-                    "       testtool at IN.exr CHANNEL X Y | testtool same WHOLE.exr PART.exr\n");
+                    "       testtool at IN.exr CHANNEL X Y | testtool same WHOLE.exr PART.exr | testtool rgb IN.exr\n");
     return 2;
 }

@@ -210,6 +210,9 @@ TEST(scene, default_material)
     CHECK(m.tex_base == GN_INVALID && m.tex_mr == GN_INVALID && m.tex_normal == GN_INVALID &&
           m.tex_emissive == GN_INVALID && m.tex_occlusion == GN_INVALID);
     CHECK(near3(m.phong_diffuse, 0, 0, 0, 0) && near3(m.phong_specular, 1, 1, 1, 0) && m.phong_shininess == 1);
+    /* KHR_materials_volume: white, +infinity, thin-walled; no dispersion. */
+    CHECK(near3(m.attenuation_color, 1, 1, 1, 0) && isinf(m.attenuation_distance) && m.attenuation_distance > 0);
+    CHECK(m.volume == 0 && m.thickness == 0 && m.dispersion == 0);
 }
 
 /* Projects a point with the pinhole model of GnCamera; true when it is inside the image and
@@ -307,7 +310,7 @@ TEST(scene, drop_invalid_triangles)
  * materials = the file's plus one default when a drawn primitive has none; DamagedHelmet (a
  * normal map, no TANGENT) has 10 more, the vertices its MikkTSpace tangents split (seams
  * where the uv chart is mirrored). Warnings: the unsupported features visible in the JSON
- * (KHR_materials_volume, _iridescence, KHR_xmp). */
+ * (KHR_materials_iridescence, KHR_xmp). */
 static const struct {
     const char *path;
     uint32_t tris, verts, prims, meshes, nodes, mats, images, textures, cameras, lights;
@@ -327,7 +330,7 @@ static const struct {
     {"gltf/Duck/glTF/Duck.gltf", 4212, 2399, 1, 1, 3, 1, 1, 1, 1, 0, 0},
     {"gltf/EmissiveStrengthTest/glTF-Binary/EmissiveStrengthTest.glb", 90, 188, 6, 6, 6, 6, 1, 1, 0, 0, 0},
     {"gltf/EmissiveStrengthTest/glTF/EmissiveStrengthTest.gltf", 90, 188, 6, 6, 6, 6, 1, 1, 0, 0, 0},
-    {"gltf/IridescenceSuzanne/glTF/IridescenceSuzanne.gltf", 11808, 9963, 3, 3, 4, 3, 1, 1, 0, 1, 2},
+    {"gltf/IridescenceSuzanne/glTF/IridescenceSuzanne.gltf", 11808, 9963, 3, 3, 4, 3, 1, 1, 0, 1, 1},
     {"gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf", 6000, 4555, 3, 3, 8, 3, 7, 7, 0, 5, 0},
     {"gltf/MetalRoughSpheresNoTextures/glTF-Binary/MetalRoughSpheresNoTextures.glb", 1040409, 528291, 123, 102, 119, 99, 0, 0, 0, 0, 0},
     {"gltf/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf", 1040409, 528291, 123, 102, 119, 99, 0, 0, 0, 0, 0},
@@ -339,7 +342,7 @@ static const struct {
     {"gltf/Suzanne/glTF/Suzanne.gltf", 3936, 11808, 1, 1, 1, 1, 2, 2, 0, 0, 0},
     {"gltf/TextureCoordinateTest/glTF-Binary/TextureCoordinateTest.glb", 10, 20, 5, 5, 5, 5, 1, 1, 0, 0, 0},
     {"gltf/TextureCoordinateTest/glTF/TextureCoordinateTest.gltf", 10, 20, 5, 5, 5, 5, 1, 1, 0, 0, 0},
-    {"gltf/TransmissionRoughnessTest/glTF/TransmissionRoughnessTest.gltf", 77792, 47260, 9, 9, 10, 9, 5, 9, 0, 0, 1},
+    {"gltf/TransmissionRoughnessTest/glTF/TransmissionRoughnessTest.gltf", 77792, 47260, 9, 9, 10, 9, 5, 9, 0, 0, 0},
     {"gltf/TransmissionTest/glTF/TransmissionTest.gltf", 128775, 66902, 22, 22, 25, 14, 9, 9, 1, 0, 1},
     {"gltf/Triangle/glTF-Embedded/Triangle.gltf", 1, 3, 1, 1, 1, 1, 0, 0, 0, 0, 0},
     {"gltf/Triangle/glTF/Triangle.gltf", 1, 3, 1, 1, 1, 1, 0, 0, 0, 0, 0},
@@ -830,6 +833,43 @@ static bool load_tri_scene(scene *s, const char *body)
 {
     write_tri_scene("/tmp/gonio_scene_test.gltf", body);
     return load(s, "/tmp/gonio_scene_test.gltf");
+}
+
+/* KHR_materials_volume and _dispersion: the values read, glTF's defaults, thicknessFactor 0
+ * as thin-walled (no medium), and a warning for each bad value (the default kept, or clamped). */
+TEST(scene, volume)
+{
+    const char *body =
+        "\"extensionsUsed\":[\"KHR_materials_transmission\",\"KHR_materials_volume\",\"KHR_materials_dispersion\"],"
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":3,\"material\":0}]}],"
+        "\"materials\":["
+        "{\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+        "\"KHR_materials_volume\":{\"thicknessFactor\":0.5,\"attenuationColor\":[0.5,0.25,1],\"attenuationDistance\":2},"
+        "\"KHR_materials_dispersion\":{\"dispersion\":0.4}}},"
+        "{\"extensions\":{\"KHR_materials_volume\":{}}},"
+        "{\"extensions\":{\"KHR_materials_volume\":{\"thicknessFactor\":1,\"attenuationColor\":[1.5,0,0],"
+        "\"attenuationDistance\":0,\"thicknessTexture\":{\"index\":3}},\"KHR_materials_dispersion\":{\"dispersion\":-1}}}],"
+        "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]";
+    scene s;
+    int w0 = util_warning_count();
+    CHECKF(load_tri_scene(&s, body), "%s", load_log);
+    CHECKF(util_warning_count() - w0 == 4, "%d warnings:\n%s", util_warning_count() - w0, load_log);
+    CHECK(strstr(load_log, "material 2: attenuationColor") && strstr(load_log, "material 2: attenuationDistance 0") &&
+          strstr(load_log, "material 2: thicknessTexture") && strstr(load_log, "material 2: dispersion -1") &&
+          !strstr(load_log, "unsupported"));
+    CHECK(s.num_materials == 3);
+    if (s.num_materials != 3) {
+        scene_destroy(&s);
+        return;
+    }
+    const GnMaterial *m = s.materials;
+    CHECK(m[0].volume == 1 && m[0].thickness == 0.5f && near3(m[0].attenuation_color, 0.5f, 0.25f, 1, 0) &&
+          m[0].attenuation_distance == 2 && m[0].dispersion == 0.4f && m[0].transmission == 1);
+    CHECK(m[1].volume == 0 && m[1].thickness == 0 && near3(m[1].attenuation_color, 1, 1, 1, 0) &&
+          isinf(m[1].attenuation_distance) && m[1].dispersion == 0);
+    CHECK(m[2].volume == 1 && near3(m[2].attenuation_color, 1, 1, 1, 0) && isinf(m[2].attenuation_distance) &&
+          m[2].dispersion == 0);
+    scene_destroy(&s);
 }
 
 TEST(scene, transforms)
