@@ -623,7 +623,6 @@ void main()
                 break;
             if (GN_HAS(GN_FEAT_VOLUME)) // absorption by the medium the segment crossed
                 beta *= medium_transmittance(medium_top(), h.tri == GN_INVALID ? h.t : distance(seg_from, o + h.t * d));
-                break;
             alive = false;
             tmin = 0.0;
             if (h.tri == GN_INVALID) {
