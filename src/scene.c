@@ -147,6 +147,9 @@ void scene_material_default(GnMaterial *m)
     m->occlusion_strength = 1;
     m->alpha_cutoff = 0.5f;
     m->tex_base = m->tex_mr = m->tex_normal = m->tex_emissive = m->tex_occlusion = GN_INVALID;
+    m->tex_clearcoat = m->tex_clearcoat_roughness = m->tex_clearcoat_normal = GN_INVALID;
+    m->tex_sheen_color = m->tex_sheen_roughness = GN_INVALID;
+    m->clearcoat_normal_scale = 1;
     scene_phong_from_pbr(m);
 }
 
