@@ -138,6 +138,42 @@ void test_path_furnace(void)
     gpu_destroy(&g);
 }
 
+/* KHR_materials_unlit: the base colour is the radiance the surface sends, whatever lights
+ * it, and it reflects nothing: an unlit sphere seen by camera rays under no, a unit and a
+ * bright (20) environment shows exactly its base colour in every pixel it covers. */
+void test_path_unlit(void)
+{
+    const float base[3] = {0.2f, 0.5f, 0.8f};
+    char path[256];
+    gpu g = {0};
+    if (!test_open_gpu(&g))
+        return;
+    tmp_file(path, sizeof path, "unlit.gltf");
+    gltf_write_material mat = {.base_color = {base[0], base[1], base[2], 1}, .roughness = 0.5f, .unlit = true};
+    write_sphere(path, &mat);
+    const float envs[3] = {0, 1, 20};
+    for (int e = 0; e < 3; e++) {
+        render_settings s = {.width = 24, .height = 24, .spp = 8, .camera = 0,
+                             .env = {envs[e], envs[e], envs[e]}, .seed = 3};
+        image img = {0};
+        if (!render_file(&g, path, NULL, s, &img))
+            continue;
+        int a = image_channel(&img, "A"), covered = 0, bad = 0;
+        for (int p = 0; p < img.width * img.height; p++) {
+            if (img.planes[a][p] != 1.0f)
+                continue;
+            covered++;
+            for (int c = 0; c < 3; c++)
+                bad += fabsf(img.planes[c][p] - base[c]) > 1e-6f;
+        }
+        CHECKF(covered > 100, "env %g: only %d covered pixels", envs[e], covered);
+        CHECKF(bad == 0, "env %g: %d pixel values differ from the base colour", envs[e], bad);
+        image_destroy(&img);
+    }
+    unlink(path);
+    gpu_destroy(&g);
+}
+
 /* A lat-long map under which the sphere is lit: constant 1 (the furnace again, through map
  * sampling), and a bright band, where MIS and BSDF sampling only must agree. */
 void test_path_env_map(void)
