@@ -18,6 +18,14 @@
 
 #include "brdf_models.h"
 #include "sampling.glsl"
+#include "sheen_albedo.h"
+// The sheen's table (sheen_albedo.h) comes in a texel buffer of float bits (src/brdf.c:
+// brdf_sheen_table): as a constant array llvmpipe took minutes to compile the kernel. A kernel
+// that has the table elsewhere defines BRDF_SHEEN_FETCH before including this file.
+#ifndef BRDF_SHEEN_FETCH
+layout(binding = BRDF_BIND_SHEEN) uniform usamplerBuffer sheen_table;
+#define BRDF_SHEEN_FETCH(i) uintBitsToFloat(texelFetch(sheen_table, (i)).x)
+#endif
 
 #define BRDF_PI 3.14159265358979
 // Below this GGX/Beckmann alpha a lobe is treated as smooth (a Dirac lobe): a narrower
@@ -49,6 +57,11 @@ struct Bsdf {
     vec3 tint; float dielectric;      // dielectric part: transmission tint, weight (0: none)
     vec3 couple_f0; float couple_f90; // Schlick of the layer over the diffuse (0, 0: none)
     float f90;                        // Schlick F90 of the lobe
+    // The layers over all of the above (bsdf_layers; GN_FEAT_LAYERS): a clear coat, a GGX
+    // dielectric of index 1.5 with its own normal, and a sheen (Charlie distribution).
+    float coat;                       // the coat's weight (0: none)
+    vec3 coat_n; float coat_alpha;    // the coat's normal (unit, local frame); its GGX alpha
+    vec3 sheen; float sheen_r;        // the sheen's colour (0: none); its roughness
 };
 
 struct BsdfSample {
@@ -353,7 +366,7 @@ void brdf_rough_dielectric(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
 
 // Probabilities of sampling the diffuse layer, the lobe and the dielectric from wo: their
 // albedo estimates at wo, normalised.
-vec3 brdf_part_probs(Bsdf b, vec3 wo)
+vec3 brdf_part_weights(Bsdf b, vec3 wo)
 {
     vec3 p = vec3(0.0);
     if (wo.z > 0.0) {
@@ -366,15 +379,20 @@ vec3 brdf_part_probs(Bsdf b, vec3 wo)
     }
     if (GN_HAS(GN_FEAT_GLASS) && wo.z != 0.0)
         p.z = b.dielectric;
+    return p;
+}
+
+vec3 brdf_part_probs(Bsdf b, vec3 wo)
+{
+    vec3 p = brdf_part_weights(b, wo);
     float sum = p.x + p.y + p.z;
     return sum > 0.0 ? p / sum : vec3(0.0);
 }
 
-// ---- the public BSDF API ------------------------------------------------------------------
+// ---- the base: the sum of the parts ------------------------------------------------------
 
-// f(wo, wi) and pdf(wo, wi) of the non-Dirac parts, in one pass (light sampling with MIS
-// needs both).
-void bsdf_eval_pdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
+// f(wo, wi) and pdf(wo, wi) of the base's non-Dirac parts.
+void brdf_base_eval_pdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
 {
     vec3 p = brdf_part_probs(b, wo);
     f = vec3(0.0);
@@ -395,26 +413,10 @@ void bsdf_eval_pdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
     }
 }
 
-vec3 bsdf_eval(Bsdf b, vec3 wo, vec3 wi)
-{
-    vec3 f;
-    float pdf;
-    bsdf_eval_pdf(b, wo, wi, f, pdf);
-    return f;
-}
-
-float bsdf_pdf(Bsdf b, vec3 wo, vec3 wi)
-{
-    vec3 f;
-    float pdf;
-    bsdf_eval_pdf(b, wo, wi, f, pdf);
-    return pdf;
-}
-
 // Picks a part with u.x (then reuses u.x, rescaled, for reflect-or-refract) and a direction
 // from it with u.yz. A non-Dirac direction gets the pdf of the whole mixture (one-sample
 // MIS over the parts), so weight = eval * |cos| / pdf exactly.
-BsdfSample bsdf_sample(Bsdf b, vec3 wo, vec3 u)
+BsdfSample brdf_base_sample(Bsdf b, vec3 wo, vec3 u)
 {
     BsdfSample s;
     s.wi = vec3(0.0, 0.0, 1.0);
@@ -468,7 +470,7 @@ BsdfSample bsdf_sample(Bsdf b, vec3 wo, vec3 u)
         return s;
     vec3 f;
     float pdf;
-    bsdf_eval_pdf(b, wo, wi, f, pdf);
+    brdf_base_eval_pdf(b, wo, wi, f, pdf);
     if (!(pdf > 0.0))
         return s;
     s.wi = wi;
@@ -476,6 +478,285 @@ BsdfSample bsdf_sample(Bsdf b, vec3 wo, vec3 u)
     s.weight = f * abs(wi.z) / pdf;
     s.flags = reflect ? BRDF_FLAG_REFLECTION : BRDF_FLAG_TRANSMISSION;
     return s;
+}
+
+// ---- the layers: KHR_materials_clearcoat and _sheen over the base ---------------------------
+// f = coat + (1 - c F(min)) (sheen + (1 - s E(max)) base), docs/brdf.md:
+// - coat: c F(max(n_c.wo, n_c.wi)) D V of GGX (alpha_c) about the coat's normal n_c, with
+//   Schlick's F of F0 = 0.04 (index 1.5); the extension's README takes both Fresnel weights
+//   at n_c.wo, which is not reciprocal; at the mirror direction the two agree. F(max) <= F(wo)
+//   keeps the coat's albedo below c F(n_c.wo), and the base's weight 1 - c F(min) below
+//   1 - c F(n_c.wo): the sum never exceeds 1;
+// - sheen: colour D_Charlie V (Estevez & Kulla 2017) / max(1, E(wo), E(wi)), E the lobe's
+//   directional albedo (sheen_albedo.h), which exceeds 1 within a few degrees of grazing
+//   (up to 1.5 at low roughness): the division keeps the albedo <= 1 and the lobe
+//   reciprocal, and changes nothing elsewhere; the base scaled by
+//   1 - max(colour) max(min(E, 1)(wo), min(E, 1)(wi)), the README's min of its two scalings;
+// - light through the base (transmission) crosses the layers once, on the side it is outside.
+#define BRDF_COAT_F0 0.04
+#define BRDF_SHEEN_R_MIN 0.07 // tests/tool/sheen_table.c: a narrower sheen is too grazing to tabulate
+// Below this cosine (0.06 degrees from grazing, under the table's first row but 0) the sheen
+// is 0: its albedo there climbs to 3 before it falls to 0 at grazing, which no table row
+// could follow.
+#define BRDF_SHEEN_COS_MIN 0.001
+
+bool brdf_has_layers(Bsdf b)
+{
+    return b.coat > 0.0 || any(greaterThan(b.sheen, vec3(0.0)));
+}
+
+float brdf_coat_fresnel(float c)
+{
+    return brdf_fresnel_schlick(c, vec3(BRDF_COAT_F0), 1.0).x;
+}
+
+// w in the coat's frame (normal b.coat_n).
+vec3 brdf_to_coat(Bsdf b, vec3 w)
+{
+    vec3 t, bt;
+    sampling_basis(b.coat_n, t, bt);
+    return vec3(dot(w, t), dot(w, bt), dot(w, b.coat_n));
+}
+
+vec3 brdf_from_coat(Bsdf b, vec3 w)
+{
+    vec3 t, bt;
+    sampling_basis(b.coat_n, t, bt);
+    return w.x * t + w.y * bt + w.z * b.coat_n;
+}
+
+float brdf_max3(vec3 v) { return max(v.r, max(v.g, v.b)); }
+
+// E(cos theta, roughness) of the sheen lobe before its normalisation: bilinear in the table
+// (rows at cos = (i / (N - 1))^2).
+float brdf_sheen_table(float c, float r)
+{
+    vec2 x = vec2(sqrt(clamp(c, 0.0, 1.0)), clamp(r, 0.0, 1.0)) * float(SHEEN_N - 1);
+    ivec2 i = min(ivec2(x), ivec2(SHEEN_N - 2));
+    vec2 f = x - vec2(i);
+    int k = i.x * SHEEN_N + i.y;
+    return mix(mix(BRDF_SHEEN_FETCH(k), BRDF_SHEEN_FETCH(k + 1), f.y),
+               mix(BRDF_SHEEN_FETCH(k + SHEEN_N), BRDF_SHEEN_FETCH(k + SHEEN_N + 1), f.y), f.x);
+}
+
+// The directional albedo of the (normalised) sheen lobe is at most min(E, 1).
+float brdf_sheen_albedo(float c, float r)
+{
+    return min(brdf_sheen_table(c, r), 1.0);
+}
+
+float brdf_sheen_alpha(float r)
+{
+    r = max(r, BRDF_SHEEN_R_MIN);
+    return r * r;
+}
+
+// Charlie: D = (2 + 1/alpha) sin^(1/alpha) / (2 pi) (Estevez & Kulla 2017); h unit, h.z > 0.
+float brdf_d_charlie(vec3 h, float a)
+{
+    return (2.0 + 1.0 / a) * pow(max(dot(h.xy, h.xy), 0.0), 0.5 / a) / (2.0 * BRDF_PI);
+}
+
+// Estevez & Kulla's fit of Lambda for Charlie, as KHR_materials_sheen gives it.
+float brdf_sheen_l(float x, float a)
+{
+    float t = (1.0 - a) * (1.0 - a);
+    return mix(21.5473, 25.3245, t) / (1.0 + mix(3.82987, 3.32435, t) * pow(x, mix(0.19823, 0.16801, t))) +
+           mix(-1.97760, -1.27393, t) * x + mix(-4.32054, -4.85967, t);
+}
+
+float brdf_sheen_lambda(float c, float a)
+{
+    return c < 0.5 ? exp(brdf_sheen_l(c, a)) : exp(2.0 * brdf_sheen_l(0.5, a) - brdf_sheen_l(1.0 - c, a));
+}
+
+// The sheen's f (colour 1) and the pdf of its half-vector sampling, both above the surface.
+void brdf_sheen(Bsdf b, vec3 wo, vec3 wi, out float f, out float pdf)
+{
+    float a = brdf_sheen_alpha(b.sheen_r);
+    vec3 h = normalize(wo + wi);
+    float d = brdf_d_charlie(h, a);
+    float norm = max(1.0, max(brdf_sheen_table(wo.z, b.sheen_r), brdf_sheen_table(wi.z, b.sheen_r)));
+    f = d / ((1.0 + brdf_sheen_lambda(wo.z, a) + brdf_sheen_lambda(wi.z, a)) * 4.0 * wo.z * wi.z * norm);
+    if (min(wo.z, wi.z) < BRDF_SHEEN_COS_MIN)
+        f = 0.0;
+    pdf = d * h.z / (4.0 * dot(wo, h));
+}
+
+// The weights of the coat, the sheen and the base (the layers below the sheen) at wo, before
+// normalisation: their albedo estimates.
+vec3 brdf_layer_weights(Bsdf b, vec3 wo)
+{
+    float co = brdf_to_coat(b, wo).z;
+    float c = wo.z > 0.0 && co > 0.0 ? b.coat * brdf_coat_fresnel(co) : 0.0;
+    float e = wo.z > 0.0 ? brdf_sheen_albedo(wo.z, b.sheen_r) : 0.0;
+    vec3 pb = brdf_part_weights(b, wo);
+    return vec3(c, (1.0 - c) * e * (b.sheen.r + b.sheen.g + b.sheen.b) / 3.0,
+                (1.0 - c) * (1.0 - brdf_max3(b.sheen) * e) * (pb.x + pb.y + pb.z));
+}
+
+vec3 brdf_layer_probs(Bsdf b, vec3 wo)
+{
+    vec3 p = brdf_layer_weights(b, wo);
+    float sum = p.x + p.y + p.z;
+    return sum > 0.0 ? p / sum : vec3(0.0);
+}
+
+// What the layers leave of the layers below them between wo and wi (symmetric in the two):
+// x what the coat leaves of the sheen and the base, y what the sheen leaves of the base.
+vec2 brdf_layer_scale(Bsdf b, vec3 wo, vec3 wi)
+{
+    if (wo.z <= 0.0 && wi.z <= 0.0)
+        return vec2(1.0);
+    float co = clamp(brdf_to_coat(b, wo).z, 0.0, 1.0), ci = clamp(brdf_to_coat(b, wi).z, 0.0, 1.0);
+    float so = max(wo.z, 0.0), si = max(wi.z, 0.0), c, e;
+    if (wo.z > 0.0 && wi.z > 0.0) {
+        c = min(co, ci);
+        e = max(brdf_sheen_albedo(so, b.sheen_r), brdf_sheen_albedo(si, b.sheen_r));
+    } else { // through the base: the layers once, at the outside direction
+        c = wo.z > 0.0 ? co : ci;
+        e = brdf_sheen_albedo(max(so, si), b.sheen_r);
+    }
+    return vec2(1.0 - b.coat * brdf_coat_fresnel(c), 1.0 - brdf_max3(b.sheen) * e);
+}
+
+// f and pdf of the coat's and the sheen's lobes (non-Dirac), each pdf that of its own sampling.
+void brdf_layer_lobes(Bsdf b, vec3 wo, vec3 wi, out vec3 fc, out float pc, out vec3 fs, out float ps)
+{
+    fc = vec3(0.0);
+    pc = 0.0;
+    fs = vec3(0.0);
+    ps = 0.0;
+    if (wo.z <= 0.0 || wi.z <= 0.0)
+        return;
+    if (b.coat > 0.0 && b.coat_alpha >= BRDF_ALPHA_MIN) {
+        vec3 o = brdf_to_coat(b, wo), i = brdf_to_coat(b, wi);
+        if (o.z > 0.0 && i.z > 0.0) {
+            float a = b.coat_alpha;
+            vec3 h = normalize(o + i);
+            float d = brdf_d_ggx(h, a);
+            fc = vec3(b.coat * brdf_coat_fresnel(max(o.z, i.z)) * d * brdf_v_ggx(o, i, a));
+            pc = brdf_g1_ggx(o, a) * d / (4.0 * o.z);
+        }
+    }
+    if (any(greaterThan(b.sheen, vec3(0.0)))) {
+        float f;
+        brdf_sheen(b, wo, wi, f, ps);
+        fs = b.sheen * f;
+    }
+}
+
+// ---- the public BSDF API ------------------------------------------------------------------
+
+// f(wo, wi) and pdf(wo, wi) of the non-Dirac parts, in one pass (light sampling with MIS
+// needs both). Without layers exactly the base's.
+void bsdf_eval_pdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
+{
+    brdf_base_eval_pdf(b, wo, wi, f, pdf);
+    if (GN_HAS(GN_FEAT_LAYERS) && brdf_has_layers(b)) {
+        vec3 p = brdf_layer_probs(b, wo), fc, fs;
+        float pc, ps;
+        brdf_layer_lobes(b, wo, wi, fc, pc, fs, ps);
+        vec2 k = brdf_layer_scale(b, wo, wi);
+        f = fc + k.x * (fs + f * k.y);
+        pdf = p.x * pc + p.y * ps + p.z * pdf;
+    }
+}
+
+// The layers' own sampling: u.x picks the coat, the sheen or the base (then u.x rescaled for
+// the base's own choice); a Dirac coat or base lobe keeps its one strategy.
+BsdfSample bsdf_sample(Bsdf b, vec3 wo, vec3 u)
+{
+    if (!GN_HAS(GN_FEAT_LAYERS) || !brdf_has_layers(b))
+        return brdf_base_sample(b, wo, u);
+    BsdfSample s;
+    s.wi = vec3(0.0, 0.0, 1.0);
+    s.weight = vec3(0.0);
+    s.pdf = 0.0;
+    s.flags = 0u;
+    vec3 p = brdf_layer_probs(b, wo);
+    vec3 wi;
+    uint flags = BRDF_FLAG_REFLECTION;
+    if (u.x < p.x) {
+        vec3 o = brdf_to_coat(b, wo);
+        if (b.coat_alpha < BRDF_ALPHA_MIN) {
+            s.wi = brdf_from_coat(b, vec3(-o.xy, o.z));
+            if (s.wi.z <= 0.0)
+                return s;
+            s.pdf = p.x;
+            s.weight = vec3(b.coat * brdf_coat_fresnel(o.z) / p.x);
+            s.flags = BRDF_FLAG_REFLECTION | BRDF_FLAG_DELTA;
+            return s;
+        }
+        vec3 h = brdf_ggx_sample_vndf(o, b.coat_alpha, u.yz), i = 2.0 * dot(o, h) * h - o;
+        if (i.z <= 0.0)
+            return s; // below the coat: outside the coat's pdf (brdf_layer_lobes)
+        wi = brdf_from_coat(b, i);
+    } else if (u.x < p.x + p.y) {
+        // Charlie's normal with density D cos: sin = u^(alpha / (2 alpha + 1))
+        float a = brdf_sheen_alpha(b.sheen_r), st = pow(u.y, a / (2.0 * a + 1.0)), phi = 2.0 * BRDF_PI * u.z;
+        vec3 h = vec3(st * cos(phi), st * sin(phi), sqrt(max(0.0, 1.0 - st * st)));
+        float oh = dot(wo, h);
+        if (oh <= 0.0)
+            return s; // the other half vector -h would be below: no sample of the sheen
+        wi = 2.0 * oh * h - wo;
+    } else if (p.z > 0.0) {
+        float x = min((u.x - p.x - p.y) / p.z, 0.99999994);
+        BsdfSample bs = brdf_base_sample(b, wo, vec3(x, u.yz));
+        if (bs.flags == 0u)
+            return bs;
+        if ((bs.flags & BRDF_FLAG_DELTA) != 0u) {
+            vec2 k = brdf_layer_scale(b, wo, bs.wi);
+            bs.weight *= k.x * k.y / p.z;
+            bs.pdf *= p.z;
+            return bs;
+        }
+        wi = bs.wi;
+        flags = bs.flags;
+    } else {
+        return s;
+    }
+    if ((wi.z * wo.z > 0.0) != (flags == BRDF_FLAG_REFLECTION))
+        return s;
+    vec3 f;
+    float pdf;
+    bsdf_eval_pdf(b, wo, wi, f, pdf);
+    if (!(pdf > 0.0))
+        return s;
+    s.wi = wi;
+    s.pdf = pdf;
+    s.weight = f * abs(wi.z) / pdf;
+    s.flags = flags;
+    return s;
+}
+
+// The layers on a base Bsdf: coat weight c, roughness cr, normal cn (local frame); sheen
+// colour sc, roughness sr. c = 0 and sc = 0 leave b exactly as it is.
+Bsdf bsdf_layers(Bsdf b, float c, float cr, vec3 cn, vec3 sc, float sr)
+{
+    b.coat = clamp(c, 0.0, 1.0);
+    float a = clamp(cr, 0.0, 1.0);
+    b.coat_alpha = a * a;
+    b.coat_n = cn;
+    b.sheen = clamp(sc, vec3(0.0), vec3(1.0));
+    b.sheen_r = clamp(sr, 0.0, 1.0);
+    return b;
+}
+
+vec3 bsdf_eval(Bsdf b, vec3 wo, vec3 wi)
+{
+    vec3 f;
+    float pdf;
+    bsdf_eval_pdf(b, wo, wi, f, pdf);
+    return f;
+}
+
+float bsdf_pdf(Bsdf b, vec3 wo, vec3 wi)
+{
+    vec3 f;
+    float pdf;
+    bsdf_eval_pdf(b, wo, wi, f, pdf);
+    return pdf;
 }
 
 // ---- construction ---------------------------------------------------------------------------
@@ -496,6 +777,11 @@ Bsdf brdf_empty()
     b.couple_f0 = vec3(0.0);
     b.couple_f90 = 0.0;
     b.f90 = 1.0;
+    b.coat = 0.0;
+    b.coat_n = vec3(0.0, 0.0, 1.0);
+    b.coat_alpha = 0.0;
+    b.sheen = vec3(0.0);
+    b.sheen_r = 0.0;
     return b;
 }
 

@@ -11,7 +11,7 @@
 #include "shared.h"
 
 /* ---- model ids (GnMaterial.brdf) ------------------------------------------------------ */
-#define BRDF_GLTF 0u             /* glTF metallic-roughness (+ specular, transmission, ior) */
+#define BRDF_GLTF 0u             /* glTF metallic-roughness (+ specular, transmission, ior, clearcoat, sheen) */
 #define BRDF_LAMBERT 1u          /* colour = albedo */
 #define BRDF_MIRROR 2u           /* colour = reflectance; the lecture's delta BRDF */
 #define BRDF_PHONG 3u            /* colour = diffuse; specular, exponent */
@@ -36,6 +36,10 @@
 #define BRDF_P_DIELECTRIC_IOR 0
 #define BRDF_P_DIELECTRIC_ALPHA 1 /* GGX alpha; 0 = smooth glass (delta) */
 
+/* The sheen's albedo table (brdf.glsl) in the BRDF kernels (brdf_test.comp, brdf_sphere.comp):
+ * an R32UI texel buffer of SHEEN_N x SHEEN_N float bits. */
+#define BRDF_BIND_SHEEN 2
+
 /* ---- BsdfSample.flags ----------------------------------------------------------------- */
 #define BRDF_FLAG_REFLECTION 1u
 #define BRDF_FLAG_TRANSMISSION 2u
@@ -47,10 +51,13 @@
 #define BRDF_OP_FRESNEL 4u /* Fresnel functions at cos = wo.z (see BrdfResult) */
 
 /* A material and the directions to query it with. model BRDF_GLTF: color = base colour,
- * params = (metallic, roughness, specular, ior), extra = (specular colour, transmission).
+ * params = (metallic, roughness, specular, ior), extra = (specular colour, transmission),
+ * layer = (clearcoat, clearcoat roughness, sheen roughness, the coat normal's tilt from +z
+ * toward +x in radians: a test-only stand-in for a clearcoat normal map), sheen.rgb = sheen
+ * colour (bsdf_layers).
  * Otherwise color and params are those of bsdf_from_model and extra is unused.
  * BRDF_OP_FRESNEL: params.x = eta (dielectric), color = eta and extra.xyz = k (conductor),
- * params.y = F0 and params.z = F90 (Schlick). */
+ * params.y = F0 and params.z = F90 (Schlick), params.w = sheen roughness (the sheen's table). */
 GN_STRUCT(BrdfQuery) {
     vec3 color; uint model;
     vec4 params;
@@ -58,10 +65,13 @@ GN_STRUCT(BrdfQuery) {
     vec3 wo; uint op;   /* wo: toward the viewer, local frame (normal = +z) */
     vec3 wi; float pad0; /* wi: toward the light */
     vec3 u; float pad1;  /* the sample's random numbers in [0, 1) */
-} GN_END(BrdfQuery); /* 96 bytes */
+    vec4 layer;
+    vec4 sheen;
+} GN_END(BrdfQuery); /* 128 bytes */
 
 /* BRDF_OP_EVAL: f, pdf. BRDF_OP_SAMPLE: s_* (s_f, s_pdf_eval: eval and pdf at s_wi).
- * BRDF_OP_FRESNEL: f = (dielectric, Schlick, 0), s_f = conductor (RGB). */
+ * BRDF_OP_FRESNEL: f = (dielectric, Schlick, the sheen's albedo E from its table), s_f =
+ * conductor (RGB). */
 GN_STRUCT(BrdfResult) {
     vec3 f; float pdf;
     vec3 s_wi; float s_pdf;
@@ -79,11 +89,13 @@ GN_STRUCT(BrdfSphere) {
     vec3 light_dir; uint width;        /* unit, toward the light */
     vec3 light_irradiance; uint height; /* W/m^2 on a surface facing the light */
     vec3 env; uint max_depth;          /* environment radiance; path length limit */
-} GN_END(BrdfSphere); /* 96 bytes */
+    vec4 layer;
+    vec4 sheen;
+} GN_END(BrdfSphere); /* 128 bytes */
 
 #ifndef VULKAN
-GN_STATIC_ASSERT(sizeof(BrdfSphere) == 96, "BrdfSphere layout");
-GN_STATIC_ASSERT(sizeof(BrdfQuery) == 96, "BrdfQuery layout");
+GN_STATIC_ASSERT(sizeof(BrdfSphere) == 128, "BrdfSphere layout");
+GN_STATIC_ASSERT(sizeof(BrdfQuery) == 128, "BrdfQuery layout");
 GN_STATIC_ASSERT(offsetof(BrdfQuery, wo) == 48, "BrdfQuery layout");
 GN_STATIC_ASSERT(sizeof(BrdfResult) == 64, "BrdfResult layout");
 #endif

@@ -30,7 +30,8 @@ void main()
     r.s_pdf_eval = 0.0;
     if ((q.op & BRDF_OP_FRESNEL) != 0u) {
         r.f = vec3(brdf_fresnel_dielectric(q.wo.z, q.params.x),
-                   brdf_fresnel_schlick(q.wo.z, vec3(q.params.y), q.params.z).x, 0.0);
+                   brdf_fresnel_schlick(q.wo.z, vec3(q.params.y), q.params.z).x,
+                   brdf_sheen_table(q.wo.z, q.params.w));
         r.s_f = brdf_fresnel_conductor(q.wo.z, q.color, q.extra.xyz);
         results[i] = r;
         return;
@@ -38,6 +39,8 @@ void main()
     Bsdf b = q.model == BRDF_GLTF
         ? bsdf_gltf(q.color, q.params.x, q.params.y, q.params.z, q.extra.xyz, q.params.w, q.extra.w)
         : bsdf_from_model(q.model, q.color, q.params);
+    if (q.model == BRDF_GLTF)
+        b = bsdf_layers(b, q.layer.x, q.layer.y, vec3(sin(q.layer.w), 0.0, cos(q.layer.w)), q.sheen.rgb, q.layer.z);
     if ((q.op & BRDF_OP_EVAL) != 0u)
         bsdf_eval_pdf(b, q.wo, q.wi, r.f, r.pdf);
     if ((q.op & BRDF_OP_SAMPLE) != 0u) {

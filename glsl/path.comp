@@ -17,6 +17,8 @@
 layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
 
 #include "bvh.glsl"
+// The sheen's albedo table heads the texel buffer in scenes with layers (src/render.c).
+#define BRDF_SHEEN_FETCH(i) uintBitsToFloat(texelFetch(texels, (i)).x)
 #include "brdf.glsl"
 
 layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
@@ -286,7 +288,10 @@ Bsdf material_bsdf(Surface s, GnMaterial m)
 {
     if (GN_HAS(GN_FEAT_MODELS) && (!GN_HAS(GN_FEAT_GLTF) || m.brdf != BRDF_GLTF)) // the colour of a conductor is its index, never a texture's
         return bsdf_from_model(m.brdf, m.brdf == BRDF_CONDUCTOR ? m.base_color.rgb : s.base, m.brdf_params);
-    return bsdf_gltf(s.base, s.metallic, s.roughness, m.specular, m.specular_color, m.ior, m.transmission);
+    Bsdf b = bsdf_gltf(s.base, s.metallic, s.roughness, m.specular, m.specular_color, m.ior, m.transmission);
+    if (GN_HAS(GN_FEAT_LAYERS)) // the coat's normal in the local frame: main() sets it
+        b = bsdf_layers(b, s.coat, s.coat_roughness, vec3(0.0, 0.0, 1.0), s.sheen, s.sheen_roughness);
+    return b;
 }
 
 // Does b have a part that light sampling can reach (anything but Dirac lobes)?
@@ -294,7 +299,9 @@ bool bsdf_has_smooth(Bsdf b)
 {
     return any(greaterThan(b.diffuse, vec3(0.0))) ||
            (b.lobe != BRDF_LOBE_NONE && b.lobe != BRDF_LOBE_MIRROR) ||
-           (b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN);
+           (b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN) ||
+           (GN_HAS(GN_FEAT_LAYERS) && (any(greaterThan(b.sheen, vec3(0.0))) ||
+                                       (b.coat > 0.0 && b.coat_alpha >= BRDF_ALPHA_MIN)));
 }
 
 // ---- media: KHR_materials_volume and _dispersion (GN_FEAT_VOLUME) --------------------------
@@ -664,6 +671,10 @@ void main()
             vec3 n = flip ? -s.n : s.n, ng = flip ? -s.ng : s.ng, tx, ty;
             sampling_basis(n, tx, ty);
             vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
+            if (GN_HAS(GN_FEAT_LAYERS)) {
+                vec3 cn = flip ? -s.coat_n : s.coat_n;
+                b.coat_n = normalize(vec3(dot(cn, tx), dot(cn, ty), dot(cn, n)));
+            }
             vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
             uint far = GN_INVALID; // the medium beyond a transmitting surface
             if (GN_HAS(GN_FEAT_VOLUME))

@@ -13,7 +13,7 @@
 // ~18 ms per dispatch of the path kernel (7x the whole render of a 32x32 image).
 layout(std430, binding = GN_BIND_FRAME) readonly buffer FrameBlock { GnFrame frame; };
 // The BVH nodes (GnBvhNode = 4 texels), triangle pairs (GnTriPair = 3), shading triangles
-// (GnPrim = 1), vertices (GnVertex = 4), materials (GnMaterial = 14), textures (GnTexture =
+// (GnPrim = 1), vertices (GnVertex = 4), materials (GnMaterial = 17), textures (GnTexture =
 // 1; their RGBA8 images: R32UI) and path.comp's lights (GnEmitter = 1) are read from texel
 // buffers, not storage buffers: llvmpipe fetches a storage buffer with per-lane offsets one
 // lane and one component at a time, branching on each lane's mask, a texel buffer with
@@ -64,7 +64,7 @@ bool vertex_colors() { return GN_HAS(GN_FEAT_VERTEX_COLOR) && (frame.flags & GN_
 // Fields a kernel does not read are never fetched: the compiler drops unused texel loads.
 GnMaterial material_at(uint i)
 {
-    uint k = 14u * i;
+    uint k = 17u * i;
     vec4 t0 = texel_f(material_texels, k), t1 = texel_f(material_texels, k + 1u);
     vec4 t2 = texel_f(material_texels, k + 2u), t3 = texel_f(material_texels, k + 3u);
     uvec4 t4 = texelFetch(material_texels, int(k + 4u)), t5 = texelFetch(material_texels, int(k + 5u));
@@ -73,12 +73,16 @@ GnMaterial material_at(uint i)
     vec4 t9 = texel_f(material_texels, k + 9u), t10 = texel_f(material_texels, k + 10u);
     vec4 t11 = texel_f(material_texels, k + 11u), t12 = texel_f(material_texels, k + 12u);
     uvec4 t13 = texelFetch(material_texels, int(k + 13u));
+    uvec4 t14 = texelFetch(material_texels, int(k + 14u)), t15 = texelFetch(material_texels, int(k + 15u));
+    vec4 t16 = texel_f(material_texels, k + 16u);
     return GnMaterial(t0, t1.xyz, t1.w, t2.xyz, t2.w, t3.x, t3.y, t3.z, t3.w,
                       uintBitsToFloat(t4.x), uintBitsToFloat(t4.y), t4.z, t4.w,
                       t5.x, t5.y, t5.z, t5.w, t6.x, t6.y, t6.z, t6.w,
                       t7, t8.xyz, t8.w, t9.xyz, t9.w, t10.xyz, t10.w, t11.xyz, t11.w,
                       t12.xyz, t12.w, uintBitsToFloat(t13.x), uintBitsToFloat(t13.y), t13.z,
-                      uintBitsToFloat(t13.w));
+                      uintBitsToFloat(t13.w),
+                      uintBitsToFloat(t14.x), uintBitsToFloat(t14.y), t14.z, t14.w,
+                      t15.x, uintBitsToFloat(t15.y), t15.z, t15.w, t16.xyz, t16.w);
 }
 
 // ---- random numbers that depend only on (pixel, sample, dimension, seed) ---------------
@@ -219,6 +223,14 @@ struct Surface {
     float occlusion;
     uint material;
     bool front;       // the ray hit the side the triangle's winding calls front
+    // KHR_materials_clearcoat and _sheen (GN_FEAT_LAYERS; else 0): the coat's weight,
+    // roughness and normal (the mesh's, or its own normal map's: never normalTexture's),
+    // the sheen's colour and roughness
+    float coat;
+    float coat_roughness;
+    vec3 coat_n;
+    vec3 sheen;
+    float sheen_roughness;
 };
 
 // tri: BVH-order triangle index; (u, v): barycentrics of v1 and v2; d: ray direction.
@@ -268,10 +280,42 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     s.occlusion = 1.0;
     if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_occlusion != GN_INVALID)
         s.occlusion = 1.0 + m.occlusion_strength * (texture_sample(m.tex_occlusion, s.uv, false).r - 1.0);
+    s.coat = 0.0;
+    s.coat_roughness = 0.0;
+    s.coat_n = n;
+    s.sheen = vec3(0.0);
+    s.sheen_roughness = 0.0;
+    vec4 tg = w * a.tangent + u * b.tangent + v * c.tangent;
+    if (GN_HAS(GN_FEAT_LAYERS)) {
+        s.coat = m.clearcoat;
+        s.coat_roughness = m.clearcoat_roughness;
+        if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_clearcoat != GN_INVALID)
+            s.coat *= texture_sample(m.tex_clearcoat, s.uv, false).r;
+        if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_clearcoat_roughness != GN_INVALID)
+            s.coat_roughness *= texture_sample(m.tex_clearcoat_roughness, s.uv, false).g;
+        s.sheen = m.sheen_color;
+        s.sheen_roughness = m.sheen_roughness;
+        if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_sheen_color != GN_INVALID)
+            s.sheen *= texture_sample(m.tex_sheen_color, s.uv, true).rgb;
+        if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_sheen_roughness != GN_INVALID)
+            s.sheen_roughness *= texture_sample(m.tex_sheen_roughness, s.uv, false).a;
+        if (GN_HAS(GN_FEAT_TEXTURES) && s.coat > 0.0 && m.tex_clearcoat_normal != GN_INVALID) {
+            vec3 tangent = tg.xyz - n * dot(n, tg.xyz);
+            if (dot(tangent, tangent) > 1e-20) {
+                tangent = normalize(tangent);
+                vec3 bitangent = (tg.w < 0.0 ? -1.0 : 1.0) * cross(n, tangent);
+                vec3 tn = texture_sample(m.tex_clearcoat_normal, s.uv, false).xyz * 2.0 - 1.0;
+                tn.xy *= m.clearcoat_normal_scale;
+                vec3 nm = tn.x * tangent + tn.y * bitangent + tn.z * n;
+                if (dot(nm, nm) > 1e-20)
+                    s.coat_n = normalize(nm);
+            }
+        }
+        s.coat_n = shading_normal_valid(flip ? -s.coat_n : s.coat_n, ng, -d);
+    }
     if (GN_HAS(GN_FEAT_NORMAL_MAP) && m.tex_normal != GN_INVALID) {
         // The vertex tangents: the mesh's TANGENT or the loader's MikkTSpace ones, which
         // glTF asks for (src/tangent.c); bitangent = cross(normal, tangent) w, toward -v.
-        vec4 tg = w * a.tangent + u * b.tangent + v * c.tangent;
         vec3 tangent = tg.xyz - n * dot(n, tg.xyz);
         if (dot(tangent, tangent) > 1e-20) {
             tangent = normalize(tangent);

@@ -148,11 +148,12 @@ typedef uint32_t uint;
 #define GN_FEAT_VARIANCE (1u << 26)     /* sums of squares (--aov variance) */
 #define GN_FEAT_TEX_TRANSFORM (1u << 27) /* KHR_texture_transform (GnTexture.transform) */
 #define GN_FEAT_UV1 (1u << 28)          /* textures reading TEXCOORD_1 (GN_TEX_UV1) */
+#define GN_FEAT_LAYERS (1u << 29)       /* KHR_materials_clearcoat and _sheen (brdf.glsl: bsdf_layers) */
 #define GN_FEAT_VOLUME (1u << 30)       /* KHR_materials_volume media, _dispersion */
 #define GN_FEAT_LOBES (GN_FEAT_MIRROR | GN_FEAT_PHONG | GN_FEAT_BLINN | GN_FEAT_TS | \
                        GN_FEAT_BECKMANN | GN_FEAT_GGX)
 #define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
-#define GN_FEAT_ALL (0x1fffffffu | GN_FEAT_VOLUME)
+#define GN_FEAT_ALL 0x7fffffffu
 
 /* ---- BVH: both children's boxes in one 64-byte node (Aila & Laine 2009, "Understanding
  * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only
@@ -239,7 +240,12 @@ GN_STRUCT(GnMaterial) {
      * `gonio info`, unused in shading. dispersion: KHR_materials_dispersion, 20 / Abbe number. */
     vec3 attenuation_color; float attenuation_distance;
     float thickness; float dispersion; uint volume; float volume_pad0;
-} GN_END(GnMaterial); /* 224 bytes */
+    /* KHR_materials_clearcoat: factor, roughness factor and their textures (R, G); the coat's
+     * normal map and its scale (GN_INVALID: the mesh's normal, not normalTexture's) */
+    float clearcoat; float clearcoat_roughness; uint tex_clearcoat; uint tex_clearcoat_roughness;
+    uint tex_clearcoat_normal; float clearcoat_normal_scale; uint tex_sheen_color; uint tex_sheen_roughness;
+    vec3 sheen_color; float sheen_roughness; /* KHR_materials_sheen factors (textures: RGB, A) */
+} GN_END(GnMaterial); /* 272 bytes */
 
 /* glTF KHR_lights_punctual light in world space. color = colour * intensity (W/sr for point
  * and spot, W/m^2 for directional: gonio reads photometric units as radiometric). direction
@@ -347,8 +353,10 @@ GN_STATIC_ASSERT(sizeof(GnTriPair) == 48, "GnTriPair layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");
 GN_STATIC_ASSERT(sizeof(GnVertex) == 80, "GnVertex layout");
 GN_STATIC_ASSERT(offsetof(GnVertex, u1) == 64, "GnVertex layout");
-GN_STATIC_ASSERT(sizeof(GnMaterial) == 224, "GnMaterial layout");
+GN_STATIC_ASSERT(sizeof(GnMaterial) == 272, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, attenuation_color) == 192, "GnMaterial layout");
+GN_STATIC_ASSERT(offsetof(GnMaterial, clearcoat) == 224, "GnMaterial layout");
+GN_STATIC_ASSERT(offsetof(GnMaterial, sheen_color) == 256, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, brdf_params) == 112, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, phong_ambient) == 128, "GnMaterial layout");
 GN_STATIC_ASSERT(sizeof(GnLight) == 64, "GnLight layout");

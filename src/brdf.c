@@ -41,14 +41,18 @@ const brdf_model brdf_models[] = {
      {COLOR("tint", BRDF_SLOT_COLOR, 1, 1, 1, 0, 1),
       SCALAR("ior", P(BRDF_P_DIELECTRIC_IOR), 1.5f, 1.01f, 4),
       SCALAR("alpha", P(BRDF_P_DIELECTRIC_ALPHA), 0, 0, 1)}},
-    {"gltf", BRDF_GLTF, "glTF metallic-roughness + KHR_materials_specular/transmission/ior", 7,
+    {"gltf", BRDF_GLTF, "glTF metallic-roughness + KHR_materials_specular/transmission/ior/clearcoat/sheen", 11,
      {COLOR("base-color", BRDF_SLOT_COLOR, 0.8f, 0.8f, 0.8f, 0, 1),
       SCALAR("metallic", P(0), 0, 0, 1), SCALAR("roughness", P(1), 0.5f, 0, 1),
       SCALAR("specular", P(2), 1, 0, 1), SCALAR("ior", P(3), 1.5f, 1, 4),
       COLOR("specular-color", BRDF_SLOT_EXTRA, 1, 1, 1, 0, 100),
-      SCALAR("transmission", BRDF_SLOT_EXTRA + 3, 0, 0, 1)}},
+      SCALAR("transmission", BRDF_SLOT_EXTRA + 3, 0, 0, 1),
+      SCALAR("clearcoat", BRDF_SLOT_LAYER, 0, 0, 1), SCALAR("clearcoat-roughness", BRDF_SLOT_LAYER + 1, 0, 0, 1),
+      COLOR("sheen-color", BRDF_SLOT_SHEEN, 0, 0, 0, 0, 1), SCALAR("sheen-roughness", BRDF_SLOT_LAYER + 2, 0, 0, 1)}},
 };
 const int brdf_num_models = (int)(sizeof brdf_models / sizeof *brdf_models);
+
+const float brdf_sheen_table[BRDF_SHEEN_TABLE_SIZE] = {SHEEN_ALBEDO_VALUES};
 
 const brdf_model *brdf_model_find(const char *name)
 {
@@ -126,7 +130,7 @@ static bool setting_set(brdf_setting *s, const char *name, const char *value, bo
     float v[3];
     int n;
     if (!p) {
-        char list[256];
+        char list[512];
         param_list(s->model, spec, list, sizeof list);
         util_error("BRDF model %s has no %s%s; it accepts %s", s->model->name, pre, name, list);
         return false;
@@ -218,6 +222,8 @@ void brdf_setting_to_query(const brdf_setting *s, BrdfQuery *q)
     q->color = (vec3){v[0], v[1], v[2]};
     q->params = (vec4){v[3], v[4], v[5], v[6]};
     q->extra = (vec4){v[7], v[8], v[9], v[10]};
+    q->layer = (vec4){v[11], v[12], v[13], v[BRDF_SLOT_COAT_TILT]};
+    q->sheen = (vec4){v[14], v[15], v[16], 0};
 }
 
 void brdf_format_setting(char *out, size_t cap, const brdf_setting *s)
@@ -243,12 +249,15 @@ void brdf_runner_create(brdf_runner *r, gpu *g, uint32_t capacity)
                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
     gpu_buffer_create(g, &r->results, sizeof(BrdfResult) * (VkDeviceSize)capacity,
                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+    gpu_buffer_create_texels_as(g, &r->sheen, brdf_sheen_table, sizeof(float) * BRDF_SHEEN_TABLE_SIZE,
+                                VK_FORMAT_R32_UINT);
     const gpu_binding bind[] = {
         {0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->queries},
         {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->results},
+        {BRDF_BIND_SHEEN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->sheen},
     };
     gpu_pipeline_desc pd = {.name = "brdf_test", .code = spv_brdf_test, .code_size = sizeof spv_brdf_test,
-                            .local_size = {64, 1, 1}, .push_size = 4, .bindings = bind, .num_bindings = 2};
+                            .local_size = {64, 1, 1}, .push_size = 4, .bindings = bind, .num_bindings = 3};
     gpu_pipeline_create(g, &r->pipeline, &pd);
 }
 
@@ -257,6 +266,7 @@ void brdf_runner_destroy(brdf_runner *r)
     if (!r->g)
         return;
     gpu_pipeline_destroy(r->g, &r->pipeline);
+    gpu_buffer_destroy(r->g, &r->sheen);
     gpu_buffer_destroy(r->g, &r->results);
     gpu_buffer_destroy(r->g, &r->queries);
     memset(r, 0, sizeof *r);

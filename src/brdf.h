@@ -10,14 +10,19 @@
 
 #include "brdf_models.h"
 #include "gpu.h"
+#include "sheen_albedo.h"
 
 /* Where a setting's values go: v[0..2] the colour, v[3..6] the four scalars (brdf_params),
- * v[7..10] glTF's extra (specular colour, transmission). */
+ * v[7..10] glTF's extra (specular colour, transmission), v[11..13] glTF's layers (clearcoat,
+ * clearcoat roughness, sheen roughness), v[14..16] the sheen colour (BrdfQuery.layer, .sheen). */
 #define BRDF_SLOT_COLOR 0
 #define BRDF_SLOT_PARAMS 3
 #define BRDF_SLOT_EXTRA 7
-#define BRDF_NUM_SLOTS 11
-#define BRDF_MAX_PARAMS 8
+#define BRDF_SLOT_LAYER 11
+#define BRDF_SLOT_SHEEN 14
+#define BRDF_SLOT_COAT_TILT 17 /* the coat normal's tilt (BrdfQuery.layer.w): no parameter, tests only */
+#define BRDF_NUM_SLOTS 18
+#define BRDF_MAX_PARAMS 12
 
 typedef struct brdf_param {
     const char *name; /* option name without the leading "--" */
@@ -39,6 +44,11 @@ typedef struct brdf_setting {
     const brdf_model *model;
     float v[BRDF_NUM_SLOTS];
 } brdf_setting;
+
+/* The sheen's directional albedo (glsl/sheen_albedo.h), SHEEN_N x SHEEN_N floats, which every
+ * kernel that builds a sheen reads from a texel buffer (brdf.glsl: brdf_sheen_table). */
+extern const float brdf_sheen_table[];
+#define BRDF_SHEEN_TABLE_SIZE (SHEEN_N * SHEEN_N)
 
 extern const brdf_model brdf_models[];
 extern const int brdf_num_models;
@@ -72,7 +82,7 @@ void brdf_format_setting(char *out, size_t cap, const brdf_setting *s);
 /* Batches BrdfQuery records through brdf_test.comp. */
 typedef struct brdf_runner {
     gpu *g;
-    gpu_buffer queries, results;
+    gpu_buffer queries, results, sheen;
     gpu_pipeline pipeline;
     uint32_t capacity;
 } brdf_runner;

@@ -300,10 +300,10 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
 {
     BrdfQuery q;
     BrdfSphere scene;
-    gpu_buffer sbuf, accum;
+    gpu_buffer sbuf, accum, sheen;
     gpu_pipeline p;
     image img;
-    char desc[256];
+    char desc[512];
     const char *names[] = {"R", "G", "B"};
     vec4 *px = util_malloc(sizeof *px * (size_t)w * (size_t)h);
     bool ok = true;
@@ -314,6 +314,8 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
     scene.model = q.model;
     scene.params = q.params;
     scene.extra = q.extra;
+    scene.layer = q.layer;
+    scene.sheen = q.sheen;
     scene.light_dir = (vec3){-0.5f / 0.9718f, 0.6f / 0.9718f, 0.55f / 0.9718f}; /* upper left, front */
     scene.light_irradiance = (vec3){2.5f, 2.5f, 2.5f};
     scene.env = (vec3){0.3f, 0.3f, 0.3f};
@@ -324,12 +326,15 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
     gpu_buffer_create(g, &accum, sizeof *px * (VkDeviceSize)w * (VkDeviceSize)h, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       GPU_MEMORY_HOST);
     gpu_buffer_fill_zero(g, &accum);
+    gpu_buffer_create_texels_as(g, &sheen, brdf_sheen_table, sizeof(float) * BRDF_SHEEN_TABLE_SIZE,
+                                VK_FORMAT_R32_UINT);
     {
         const gpu_binding bind[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &sbuf},
-                                    {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &accum}};
+                                    {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &accum},
+                                    {BRDF_BIND_SHEEN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &sheen}};
         gpu_pipeline_desc pd = {.name = "brdf_sphere", .code = spv_brdf_sphere, .code_size = sizeof spv_brdf_sphere,
                                 .local_size = {GN_TILE_X, GN_TILE_Y, 1}, .push_size = sizeof(GnPush),
-                                .bindings = bind, .num_bindings = 2};
+                                .bindings = bind, .num_bindings = 3};
         gpu_pipeline_create(g, &p, &pd);
     }
     /* a few samples per submission keeps every dispatch short (GPU watchdogs) */
@@ -360,6 +365,7 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
         ok = image_write_png_from(&img, png, 0, IMAGE_TONEMAP_CLAMP);
     image_destroy(&img);
     gpu_pipeline_destroy(g, &p);
+    gpu_buffer_destroy(g, &sheen);
     gpu_buffer_destroy(g, &accum);
     gpu_buffer_destroy(g, &sbuf);
     free(px);

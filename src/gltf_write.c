@@ -109,7 +109,7 @@ static const char *item(uint32_t i) { return i ? ",\n    " : "\n    "; }
 static void write_material(FILE *f, const gltf_write_material *m)
 {
     bool ext = m->emissive_strength != 0.0f || m->has_specular || m->ior != 0.0f ||
-               m->transmission != 0.0f;
+               m->transmission != 0.0f || m->unlit;
     fputs("{\"pbrMetallicRoughness\":{\"baseColorFactor\":", f);
     write_floats(f, m->base_color, 4);
     fprintf(f, ",\"metallicFactor\":%.9g,\"roughnessFactor\":%.9g}", m->metallic, m->roughness);
@@ -143,9 +143,13 @@ static void write_material(FILE *f, const gltf_write_material *m)
             fprintf(f, "%s\"KHR_materials_ior\":{\"ior\":%.9g}", sep, m->ior);
             sep = ",";
         }
-        if (m->transmission != 0.0f)
+        if (m->transmission != 0.0f) {
             fprintf(f, "%s\"KHR_materials_transmission\":{\"transmissionFactor\":%.9g}", sep,
                     m->transmission);
+            sep = ",";
+        }
+        if (m->unlit)
+            fprintf(f, "%s\"KHR_materials_unlit\":{}", sep);
         fputc('}', f);
     }
     if (m->extras) {
@@ -299,15 +303,16 @@ static uint8_t *make_buffer(const gltf_write_desc *d, size_t *size)
 
 static void write_json(FILE *f, const gltf_write_desc *d, const uint8_t *buf, size_t size)
 {
-    const char *used[6];
+    const char *used[7];
     int num_used = 0;
-    bool strength = false, specular = false, ior = false, transmission = false;
+    bool strength = false, specular = false, ior = false, transmission = false, unlit = false;
     uint32_t a = 0;
     for (uint32_t i = 0; i < d->num_materials; i++) {
         strength |= d->materials[i].emissive_strength != 0.0f;
         specular |= d->materials[i].has_specular;
         ior |= d->materials[i].ior != 0.0f;
         transmission |= d->materials[i].transmission != 0.0f;
+        unlit |= d->materials[i].unlit;
     }
     if (d->num_lights)
         used[num_used++] = "KHR_lights_punctual";
@@ -319,6 +324,8 @@ static void write_json(FILE *f, const gltf_write_desc *d, const uint8_t *buf, si
         used[num_used++] = "KHR_materials_ior";
     if (transmission)
         used[num_used++] = "KHR_materials_transmission";
+    if (unlit)
+        used[num_used++] = "KHR_materials_unlit";
 
     fputs("{\n  \"asset\": {\"version\":\"2.0\",\"generator\":\"gonio\"}", f);
     if (num_used) {

@@ -35,6 +35,7 @@ typedef struct gltf_write_material {
     float specular, specular_color[3];
     float ior;                 /* KHR_materials_ior; 0: not written */
     float transmission;        /* KHR_materials_transmission; 0: not written */
+    bool unlit;                /* KHR_materials_unlit */
     bool double_sided;
     const char *alpha_mode;    /* "MASK" or "BLEND"; NULL: OPAQUE (not written) */
     float alpha_cutoff;        /* MASK only; 0: not written (glTF's 0.5) */

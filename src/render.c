@@ -170,6 +170,14 @@ static uint32_t material_features(const GnMaterial *m)
         /* KHR_materials_volume and _dispersion act only where the glass can transmit */
         if (t > 0 && metal_lo < 1 && (m->volume || m->dispersion > 0))
             f |= GN_FEAT_VOLUME;
+        /* bsdf_layers: a coat or a sheen (their textures only scale the factors) */
+        if (m->clearcoat > 0 || m->sheen_color.x > 0 || m->sheen_color.y > 0 || m->sheen_color.z > 0) {
+            f |= GN_FEAT_LAYERS;
+            if (m->tex_clearcoat != GN_INVALID || m->tex_clearcoat_roughness != GN_INVALID ||
+                m->tex_clearcoat_normal != GN_INVALID || m->tex_sheen_color != GN_INVALID ||
+                m->tex_sheen_roughness != GN_INVALID)
+                f |= GN_FEAT_TEXTURES;
+        }
         break;
     }
     case BRDF_LAMBERT:
@@ -261,11 +269,19 @@ static bool texels_fit(const renderer *r, const char *what, uint64_t count)
     return false;
 }
 
+/* Texels of the sheen's albedo table (brdf_sheen_table) at the head of the texel buffer,
+ * where a material has layers (glsl/path.comp reads it from there); 0 elsewhere, so other
+ * scenes keep their buffer as it was. */
+static uint32_t sheen_prefix(const renderer *r)
+{
+    return r->material_features & GN_FEAT_LAYERS ? BRDF_SHEEN_TABLE_SIZE : 0;
+}
+
 /* The scene's buffers against the device's limits, before any is made. */
 static bool scene_fits(renderer *r)
 {
     const scene *sc = r->sc;
-    uint64_t texels = 1; /* the texel buffer's trailing zero */
+    uint64_t texels = 1 + sheen_prefix(r); /* the texel buffer's trailing zero */
     uint32_t largest = 0;
     for (uint32_t i = 0; i < sc->num_images; i++) {
         texels += (uint64_t)sc->images[i].width * sc->images[i].height;
@@ -307,12 +323,12 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
     bvh_build(&r->tree, &sc->vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc->indices,
               sc->num_triangles);
     assert(r->tree.num_tris < (1u << 27)); /* glsl/bvh.glsl packs leaves' first triangles in 27 bits */
+    for (uint32_t i = 0; i < sc->num_materials; i++)
+        r->material_features |= material_features(&sc->materials[i]);
     if (!scene_fits(r)) {
         r->failed = true;
         return false;
     }
-    for (uint32_t i = 0; i < sc->num_materials; i++)
-        r->material_features |= material_features(&sc->materials[i]);
     if (sc->vertex_colors)
         r->material_features |= GN_FEAT_VERTEX_COLOR;
     for (uint32_t i = 0; i < sc->num_textures; i++) {
@@ -337,12 +353,14 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
     }
 
     image_offset = util_calloc(sc->num_images + 1, sizeof *image_offset);
+    total_texels = sheen_prefix(r);
     for (uint32_t i = 0; i < sc->num_images; i++) {
         image_offset[i] = total_texels;
         total_texels += sc->images[i].width * sc->images[i].height;
     }
     texels = util_malloc(sizeof *texels * (total_texels + 1));
     texels[total_texels] = 0; /* the buffer is never empty */
+    memcpy(texels, brdf_sheen_table, sizeof *texels * sheen_prefix(r));
     for (uint32_t i = 0; i < sc->num_images; i++)
         memcpy(texels + image_offset[i], sc->images[i].rgba8,
                (size_t)sc->images[i].width * sc->images[i].height * 4);
@@ -1364,6 +1382,10 @@ static void apply_setting(GnMaterial *m, const brdf_setting *st)
         m->ior = st->v[BRDF_SLOT_PARAMS + 3];
         memcpy(&m->specular_color.x, st->v + BRDF_SLOT_EXTRA, 3 * sizeof(float));
         m->transmission = st->v[BRDF_SLOT_EXTRA + 3];
+        m->clearcoat = st->v[BRDF_SLOT_LAYER];
+        m->clearcoat_roughness = st->v[BRDF_SLOT_LAYER + 1];
+        m->sheen_roughness = st->v[BRDF_SLOT_LAYER + 2];
+        memcpy(&m->sheen_color.x, st->v + BRDF_SLOT_SHEEN, 3 * sizeof(float));
     }
 }
 
@@ -1381,6 +1403,10 @@ static void setting_from_material(brdf_setting *st, const brdf_model *model, con
         st->v[BRDF_SLOT_PARAMS + 3] = m->ior;
         memcpy(st->v + BRDF_SLOT_EXTRA, &m->specular_color.x, 3 * sizeof(float));
         st->v[BRDF_SLOT_EXTRA + 3] = m->transmission;
+        st->v[BRDF_SLOT_LAYER] = m->clearcoat;
+        st->v[BRDF_SLOT_LAYER + 1] = m->clearcoat_roughness;
+        st->v[BRDF_SLOT_LAYER + 2] = m->sheen_roughness;
+        memcpy(st->v + BRDF_SLOT_SHEEN, &m->sheen_color.x, 3 * sizeof(float));
     }
 }
 

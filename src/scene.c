@@ -149,6 +149,9 @@ void scene_material_default(GnMaterial *m)
     m->tex_base = m->tex_mr = m->tex_normal = m->tex_emissive = m->tex_occlusion = GN_INVALID;
     m->attenuation_color = (vec3){1, 1, 1}; /* KHR_materials_volume: no absorption */
     m->attenuation_distance = INFINITY;
+    m->tex_clearcoat = m->tex_clearcoat_roughness = m->tex_clearcoat_normal = GN_INVALID;
+    m->tex_sheen_color = m->tex_sheen_roughness = GN_INVALID;
+    m->clearcoat_normal_scale = 1;
     scene_phong_from_pbr(m);
 }
 

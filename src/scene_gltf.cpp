@@ -54,7 +54,7 @@ const char *const SUPPORTED_EXTENSIONS[] = {
     "KHR_materials_transmission", "KHR_materials_ior",               "KHR_materials_unlit",
     "KHR_texture_transform",      "KHR_mesh_quantization",           "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",    "KHR_materials_variants",          "KHR_materials_volume",
-    "KHR_materials_dispersion"};
+    "KHR_materials_dispersion",   "KHR_materials_clearcoat",         "KHR_materials_sheen"};
 
 using Json = nlohmann::json;
 
@@ -1091,6 +1091,33 @@ void read_normals(Ctx &c, const std::string &what, int acc, Prim &out)
     out.nrm = to_float(d);
 }
 
+const tinygltf::Value *extension(const tinygltf::Material &mat, const char *name)
+{
+    auto it = mat.extensions.find(name);
+    return it == mat.extensions.end() ? nullptr : &it->second;
+}
+
+/* A textureInfo of a material extension (e may be null) as tinygltf's own TextureInfo, so
+ * texture_slot reads both alike; index -1 when absent. Doc::check_material has checked its
+ * form (an index of an existing texture, texCoord an integer). */
+tinygltf::TextureInfo ext_texture(const tinygltf::Value *e, const char *key, double *scale = nullptr)
+{
+    tinygltf::TextureInfo t;
+    if (!e || !e->IsObject() || !e->Has(key) || !e->Get(key).IsObject())
+        return t;
+    const tinygltf::Value &v = e->Get(key);
+    if (v.Has("index") && v.Get("index").IsInt())
+        t.index = v.Get("index").GetNumberAsInt();
+    if (v.Has("texCoord") && v.Get("texCoord").IsInt())
+        t.texCoord = v.Get("texCoord").GetNumberAsInt();
+    if (scale && v.Has("scale") && v.Get("scale").IsNumber())
+        *scale = v.Get("scale").GetNumberAsDouble();
+    if (v.Has("extensions") && v.Get("extensions").IsObject())
+        for (const std::string &k : v.Get("extensions").Keys())
+            t.extensions[k] = v.Get("extensions").Get(k);
+    return t;
+}
+
 void read_tangents(Ctx &c, const std::string &what, int acc, Prim &out)
 {
     std::vector<double> d = read_accessor(c, acc);
@@ -1316,8 +1343,15 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
             xf->second.Get("texCoord").IsInt())
             nset = xf->second.Get("texCoord").GetNumberAsInt();
     }
+    /* a clearcoat normal map needs them too (the set of the base's normal map, if any) */
+    bool coat_normal = false;
+    if (mat && mat->normalTexture.index < 0) {
+        tinygltf::TextureInfo ct = ext_texture(extension(*mat, "KHR_materials_clearcoat"), "clearcoatNormalTexture");
+        coat_normal = ct.index >= 0;
+        nset = ct.texCoord;
+    }
     const std::vector<float> &tuv = nset == 1 ? out.uv1 : out.uv;
-    if (out.tan.empty() && !tuv.empty() && mat && mat->normalTexture.index >= 0)
+    if (out.tan.empty() && !tuv.empty() && mat && (mat->normalTexture.index >= 0 || coat_normal))
         generate_tangents(out, tuv);
     return true;
 }
@@ -1696,7 +1730,7 @@ void load_images_and_textures(Ctx &c, scene *out)
     for (const auto &alias : c.image_alias)
         c.image_map[size_t(alias.first)] = c.image_map[size_t(alias.second)];
     /* room for texture_slot's variants too: one per texture slot of a material at most */
-    c.textures_room = m.textures.size() + 5 * m.materials.size();
+    c.textures_room = m.textures.size() + 10 * m.materials.size();
     out->textures = static_cast<scene_texture *>(util_calloc(c.textures_room, sizeof(scene_texture)));
     c.textures_out = out;
     c.texture_map.assign(m.textures.size(), GN_INVALID);
@@ -1740,11 +1774,6 @@ double ext_number(Ctx &c, const tinygltf::Value &ext, const char *key, double de
     return def;
 }
 
-const tinygltf::Value *extension(const tinygltf::Material &mat, const char *name)
-{
-    auto it = mat.extensions.find(name);
-    return it == mat.extensions.end() ? nullptr : &it->second;
-}
 
 /* A number pair of an extension object (KHR_texture_transform's offset and scale); false
  * (with a warning) when it is there but not two finite numbers. */
@@ -1949,6 +1978,33 @@ void convert_material(Ctx &c, int mi, GnMaterial &g, scene_material_extras &x, c
     }
     if (const tinygltf::Value *e = extension(mat, "KHR_materials_dispersion"))
         g.dispersion = ranged(c, ext_number(c, *e, "dispersion", 0, what), 0, INFINITY, what, "dispersion");
+    if (const tinygltf::Value *e = extension(mat, "KHR_materials_clearcoat")) {
+        double scale = 1;
+        g.clearcoat = ranged(c, ext_number(c, *e, "clearcoatFactor", 0, what), 0, 1, what, "clearcoatFactor");
+        g.clearcoat_roughness = ranged(c, ext_number(c, *e, "clearcoatRoughnessFactor", 0, what), 0, 1, what,
+                                       "clearcoatRoughnessFactor");
+        g.tex_clearcoat = texture_slot(c, ext_texture(e, "clearcoatTexture"), what, "clearcoatTexture");
+        g.tex_clearcoat_roughness =
+            texture_slot(c, ext_texture(e, "clearcoatRoughnessTexture"), what, "clearcoatRoughnessTexture");
+        g.tex_clearcoat_normal =
+            texture_slot(c, ext_texture(e, "clearcoatNormalTexture", &scale), what, "clearcoatNormalTexture");
+        g.clearcoat_normal_scale = float(scale);
+    }
+    if (const tinygltf::Value *e = extension(mat, "KHR_materials_sheen")) {
+        float t[3];
+        if (e->IsObject() && e->Has("sheenColorFactor")) {
+            if (number_triple(e->Get("sheenColorFactor"), t))
+                g.sheen_color = vec3{ranged(c, t[0], 0, 1, what, "sheenColorFactor"),
+                                     ranged(c, t[1], 0, 1, what, "sheenColorFactor"),
+                                     ranged(c, t[2], 0, 1, what, "sheenColorFactor")};
+            else
+                warn(c, "%s: sheenColorFactor must be 3 numbers (ignored)", what.c_str());
+        }
+        g.sheen_roughness = ranged(c, ext_number(c, *e, "sheenRoughnessFactor", 0, what), 0, 1, what,
+                                   "sheenRoughnessFactor");
+        g.tex_sheen_color = texture_slot(c, ext_texture(e, "sheenColorTexture"), what, "sheenColorTexture");
+        g.tex_sheen_roughness = texture_slot(c, ext_texture(e, "sheenRoughnessTexture"), what, "sheenRoughnessTexture");
+    }
     if (extension(mat, "KHR_materials_unlit"))
         g.flags |= GN_MAT_UNLIT;
     if (mat.doubleSided)
@@ -2436,6 +2492,24 @@ void Doc::check_material(const Json &m, const std::string &p)
     }
     texture_info(m, "normalTexture", p);
     texture_info(m, "occlusionTexture", p);
+    if (const Json *ex = object(m, "extensions", p)) {
+        std::string pe = at(p, "extensions");
+        if (const Json *cc = object(*ex, "KHR_materials_clearcoat", pe)) {
+            std::string pc = at(pe, "KHR_materials_clearcoat");
+            number(*cc, "clearcoatFactor", pc);
+            number(*cc, "clearcoatRoughnessFactor", pc);
+            texture_info(*cc, "clearcoatTexture", pc);
+            texture_info(*cc, "clearcoatRoughnessTexture", pc);
+            texture_info(*cc, "clearcoatNormalTexture", pc);
+        }
+        if (const Json *sh = object(*ex, "KHR_materials_sheen", pe)) {
+            std::string ps = at(pe, "KHR_materials_sheen");
+            numbers(*sh, "sheenColorFactor", ps, 3);
+            number(*sh, "sheenRoughnessFactor", ps);
+            texture_info(*sh, "sheenColorTexture", ps);
+            texture_info(*sh, "sheenRoughnessTexture", ps);
+        }
+    }
     texture_info(m, "emissiveTexture", p);
     numbers(m, "emissiveFactor", p, 3);
     enum_str(m, "alphaMode", p, {"OPAQUE", "MASK", "BLEND"});

@@ -39,7 +39,9 @@ same_as_unspecialised() { same_pixels "specialised = unspecialised" GONIO_ALL_FE
 same_as_unspecialised "Cornell box" $C
 for model in lambert mirror phong blinn-phong torrance-sparrow beckmann ggx conductor \
     conductor:alpha=0 dielectric dielectric:alpha=0.3 \
-    gltf:metallic=0.5:roughness=0.02 gltf:transmission=1:roughness=0.4; do
+    gltf:metallic=0.5:roughness=0.02 gltf:transmission=1:roughness=0.4 \
+    gltf:roughness=0.4:clearcoat=1:clearcoat-roughness=0.2:sheen-color=0.6,0.4,0.2:sheen-roughness=0.5 \
+    gltf:roughness=0:metallic=1:clearcoat=0.7; do
     same_as_unspecialised "--brdf $model" $C --brdf "$model" --env 0.2
 done
 same_as_unspecialised "light sampling only" $C --estimator light

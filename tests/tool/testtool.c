@@ -395,8 +395,13 @@ done:
 /* compress.cpp: IN.gltf encoded with Draco or meshoptimizer, losslessly, into OUT.gltf. */
 int tool_compress(const char *how, const char *in, const char *out);
 
+/* sheen_table.c: glsl/sheen_albedo.h on stdout. */
+int sheen_table(void);
+
 int main(int argc, char **argv)
 {
+    if (argc == 2 && !strcmp(argv[1], "sheen-table"))
+        return sheen_table();
     if (argc == 4 && !strcmp(argv[1], "same"))
         return same_bits(argv[2], argv[3]);
     if (argc == 3 && !strcmp(argv[1], "stats"))
@@ -418,6 +423,7 @@ int main(int argc, char **argv)
                          argc == 8 ? atof(argv[7]) : 0.0);
     fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool compress draco|meshopt IN.gltf OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n"
                     "       testtool png depth|normal PNG REF.exr | testtool pick IN.exr CHANNEL OUT.exr\n"
-                    "       testtool at IN.exr CHANNEL X Y | testtool same WHOLE.exr PART.exr | testtool rgb IN.exr\n");
+                    "       testtool at IN.exr CHANNEL X Y | testtool same WHOLE.exr PART.exr | testtool rgb IN.exr\n"
+                    "       testtool sheen-table\n");
     return 2;
 }

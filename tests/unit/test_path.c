@@ -97,6 +97,12 @@ TEST(path, furnace)
         {"{\"gonio\":{\"brdf\":\"ggx\",\"diffuse\":0.5,\"specular\":0.5,\"alpha\":0.5}}", -1},
         {"{\"gonio\":{\"brdf\":\"torrance-sparrow\",\"diffuse\":0.5,\"specular\":0.5}}", -1},
         {"{\"gonio\":{\"brdf\":\"phong\",\"diffuse\":0.5,\"specular\":0.5}}", -1},
+        /* glTF layers over a white base: a smooth and a rough coat, a sheen, all three */
+        {"{\"gonio\":{\"brdf\":\"gltf\",\"base-color\":1,\"clearcoat\":1}}", -1},
+        {"{\"gonio\":{\"brdf\":\"gltf\",\"base-color\":1,\"clearcoat\":1,\"clearcoat-roughness\":0.4}}", -1},
+        {"{\"gonio\":{\"brdf\":\"gltf\",\"base-color\":1,\"sheen-color\":1,\"sheen-roughness\":0.3}}", -1},
+        {"{\"gonio\":{\"brdf\":\"gltf\",\"base-color\":1,\"metallic\":1,\"roughness\":0.2,\"clearcoat\":1,"
+         "\"clearcoat-roughness\":0.1,\"sheen-color\":1}}", -1},
     };
     char path[256];
     gpu g = {0};
@@ -126,6 +132,42 @@ TEST(path, furnace)
                        "case %zu (%s): lossy furnace gives %.5f +- %.5f, expected (0.1, 1]", i,
                        cases[i].extras, mean, se);
         }
+        image_destroy(&img);
+    }
+    unlink(path);
+    gpu_destroy(&g);
+}
+
+/* KHR_materials_unlit: the base colour is the radiance the surface sends, whatever lights
+ * it, and it reflects nothing: an unlit sphere seen by camera rays under no, a unit and a
+ * bright (20) environment shows exactly its base colour in every pixel it covers. */
+TEST(path, unlit)
+{
+    const float base[3] = {0.2f, 0.5f, 0.8f};
+    char path[256];
+    gpu g = {0};
+    if (!test_open_gpu(&g))
+        return;
+    tmp_file(path, sizeof path, "unlit.gltf");
+    gltf_write_material mat = {.base_color = {base[0], base[1], base[2], 1}, .roughness = 0.5f, .unlit = true};
+    write_sphere(path, &mat);
+    const float envs[3] = {0, 1, 20};
+    for (int e = 0; e < 3; e++) {
+        render_settings s = {.width = 24, .height = 24, .spp = 8, .camera = 0,
+                             .env = {envs[e], envs[e], envs[e]}, .seed = 3};
+        image img = {0};
+        if (!render_file(&g, path, NULL, s, &img))
+            continue;
+        int a = image_channel(&img, "A"), covered = 0, bad = 0;
+        for (int p = 0; p < img.width * img.height; p++) {
+            if (img.planes[a][p] != 1.0f)
+                continue;
+            covered++;
+            for (int c = 0; c < 3; c++)
+                bad += fabsf(img.planes[c][p] - base[c]) > 1e-6f;
+        }
+        CHECKF(covered > 100, "env %g: only %d covered pixels", envs[e], covered);
+        CHECKF(bad == 0, "env %g: %d pixel values differ from the base colour", envs[e], bad);
         image_destroy(&img);
     }
     unlink(path);
@@ -209,38 +251,44 @@ static double max_block_z(const image *a, const image *b, int bs)
     return zmax;
 }
 
-/* The Cornell box with glossy (GGX) walls: MIS, light sampling only and BSDF sampling only
- * converge to the same image; and the test notices a missing bounce. 256 spp: BSDF sampling
- * finds the small light rarely, and below that its variance estimates run low (at 128 spp
- * the z of a correct render reaches 9). */
+/* The Cornell box with glossy (GGX) walls, and again with layered glTF walls (a rough coat
+ * and a sheen: KHR_materials_clearcoat, _sheen): MIS, light sampling only and BSDF sampling
+ * only converge to the same image; and the test notices a missing bounce. 256 spp: BSDF
+ * sampling finds the small light rarely, and below that its variance estimates run low (at
+ * 128 spp the z of a correct render reaches 9). */
 TEST(path, estimators)
 {
     static const uint32_t strategies[] = {0, GN_FRAME_LIGHT_ONLY, GN_FRAME_BSDF_ONLY};
-    const char *brdf = "ggx:alpha=0.25:specular=0.3";
+    static const char *brdfs[] = {"ggx:alpha=0.25:specular=0.3",
+                                  "gltf:roughness=0.6:clearcoat=1:clearcoat-roughness=0.3:sheen-color=0.8,0.5,0.3:"
+                                  "sheen-roughness=0.5"};
     gpu g = {0};
-    image img[3] = {{0}}, direct = {0};
-    render_settings s = {.width = 32, .height = 32, .spp = 256, .camera = 0};
     if (!test_open_gpu(&g))
         return;
-    for (int i = 0; i < 3; i++) {
-        s.strategy = strategies[i];
-        s.seed = 10 + (uint32_t)i;
-        render_file(&g, "scenes/cornell.gltf", brdf, s, &img[i]);
+    for (int k = 0; k < 2; k++) {
+        const char *brdf = brdfs[k];
+        image img[3] = {{0}}, direct = {0};
+        render_settings s = {.width = 32, .height = 32, .spp = 256, .camera = 0};
+        for (int i = 0; i < 3; i++) {
+            s.strategy = strategies[i];
+            s.seed = 10 + (uint32_t)i;
+            render_file(&g, "scenes/cornell.gltf", brdf, s, &img[i]);
+        }
+        s.strategy = 0;
+        s.max_depth = 1;
+        render_file(&g, "scenes/cornell.gltf", brdf, s, &direct);
+        if (img[0].planes[0] && img[1].planes[0] && img[2].planes[0] && direct.planes[0]) {
+            double z01 = max_block_z(&img[0], &img[1], 4), z02 = max_block_z(&img[0], &img[2], 4);
+            double z12 = max_block_z(&img[1], &img[2], 4), zd = max_block_z(&img[0], &direct, 4);
+            CHECKF(z01 < Z_MAX, "%s: MIS vs light sampling: max block |z| = %.2f", brdf, z01);
+            CHECKF(z02 < Z_MAX, "%s: MIS vs BSDF sampling: max block |z| = %.2f", brdf, z02);
+            CHECKF(z12 < Z_MAX, "%s: light vs BSDF sampling: max block |z| = %.2f", brdf, z12);
+            CHECKF(zd > 2 * Z_MAX, "%s: the test cannot tell direct light only from MIS: |z| = %.2f", brdf, zd);
+        }
+        for (int i = 0; i < 3; i++)
+            image_destroy(&img[i]);
+        image_destroy(&direct);
     }
-    s.strategy = 0;
-    s.max_depth = 1;
-    render_file(&g, "scenes/cornell.gltf", brdf, s, &direct);
-    if (img[0].planes[0] && img[1].planes[0] && img[2].planes[0] && direct.planes[0]) {
-        double z01 = max_block_z(&img[0], &img[1], 4), z02 = max_block_z(&img[0], &img[2], 4);
-        double z12 = max_block_z(&img[1], &img[2], 4), zd = max_block_z(&img[0], &direct, 4);
-        CHECKF(z01 < Z_MAX, "MIS vs light sampling: max block |z| = %.2f", z01);
-        CHECKF(z02 < Z_MAX, "MIS vs BSDF sampling: max block |z| = %.2f", z02);
-        CHECKF(z12 < Z_MAX, "light vs BSDF sampling: max block |z| = %.2f", z12);
-        CHECKF(zd > 2 * Z_MAX, "the test cannot tell direct light only from MIS: |z| = %.2f", zd);
-    }
-    for (int i = 0; i < 3; i++)
-        image_destroy(&img[i]);
-    image_destroy(&direct);
     gpu_destroy(&g);
 }
 

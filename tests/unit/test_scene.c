@@ -1211,3 +1211,50 @@ TEST(scene, materials_lights_cameras)
                               "\"extensionsRequired\":[\"EXT_gonio_unknown\"]") &&
           strstr(load_log, "requires unsupported extension EXT_gonio_unknown"));
 }
+
+/* KHR_materials_clearcoat and _sheen: factors, textures (one through KHR_texture_transform,
+ * one through TEXCOORD_1), the coat's normal scale; out-of-range factors clamped with a
+ * warning; a texture index that names no texture, or a factor that is no number, is an
+ * error with its JSON path. */
+TEST(scene, layers)
+{
+    char body[8192];
+    const char *tex = "\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],\"textures\":[{\"source\":0},{\"source\":0}],";
+    char head[1024];
+    snprintf(head, sizeof head, tex, png_ga8);
+    snprintf(body, sizeof body,
+             "\"extensionsUsed\":[\"KHR_materials_clearcoat\",\"KHR_materials_sheen\",\"KHR_texture_transform\"],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TANGENT\":2},\"indices\":3,\"material\":0}]}],"
+             "%s\"materials\":[{\"extensions\":{"
+             "\"KHR_materials_clearcoat\":{\"clearcoatFactor\":0.75,\"clearcoatRoughnessFactor\":1.5,"
+             "\"clearcoatTexture\":{\"index\":0},\"clearcoatRoughnessTexture\":{\"index\":1,\"texCoord\":1},"
+             "\"clearcoatNormalTexture\":{\"index\":1,\"scale\":0.5}},"
+             "\"KHR_materials_sheen\":{\"sheenColorFactor\":[1,0.5,0.25],\"sheenRoughnessFactor\":0.3,"
+             "\"sheenColorTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":{\"scale\":[2,2]}}},"
+             "\"sheenRoughnessTexture\":{\"index\":1}}}}],\"nodes\":[{\"mesh\":0}]",
+             head);
+    scene s;
+    int w0 = util_warning_count();
+    CHECKF(load_tri_scene(&s, body), "%s", load_log);
+    CHECKF(util_warning_count() - w0 == 1 && strstr(load_log, "clearcoatRoughnessFactor"), "warnings:\n%s", load_log);
+    CHECK(!strstr(load_log, "unsupported extension"));
+    CHECK(s.num_materials == 1 && s.num_textures == 4);
+    if (s.num_materials == 1 && s.num_textures == 4) {
+        const GnMaterial *m = &s.materials[0];
+        CHECK(m->clearcoat == 0.75f && m->clearcoat_roughness == 1 && m->clearcoat_normal_scale == 0.5f);
+        CHECK(m->tex_clearcoat == 0 && m->tex_clearcoat_normal == 1 && m->tex_sheen_roughness == 1);
+        CHECK(m->tex_clearcoat_roughness >= 2 && s.textures[m->tex_clearcoat_roughness].flags == GN_TEX_UV1);
+        CHECK(m->tex_sheen_color >= 2 && s.textures[m->tex_sheen_color].transform[0] == 2);
+        CHECK(near3(m->sheen_color, 1, 0.5f, 0.25f, 0) && m->sheen_roughness == 0.3f);
+    }
+    scene_destroy(&s);
+    snprintf(body, sizeof body,
+             TRI_MESH ",%s\"materials\":[{\"extensions\":{\"KHR_materials_sheen\":{\"sheenColorTexture\":{\"index\":7}}}}],"
+             "\"nodes\":[{\"mesh\":0}]", head);
+    CHECK(!load_tri_scene(&s, body) &&
+          strstr(load_log, "materials[0].extensions.KHR_materials_sheen.sheenColorTexture.index: 7 does not exist"));
+    snprintf(body, sizeof body,
+             TRI_MESH ",\"materials\":[{\"extensions\":{\"KHR_materials_clearcoat\":{\"clearcoatFactor\":\"high\"}}}],"
+             "\"nodes\":[{\"mesh\":0}]");
+    CHECK(!load_tri_scene(&s, body) && strstr(load_log, "materials[0].extensions.KHR_materials_clearcoat.clearcoatFactor"));
+}
