@@ -7,7 +7,7 @@
 // llvmpipe ends an invocation's loops silently after 65,535 iterations in total (the count
 // is per SIMD group of 8 invocations: docs/architecture.md, The loop cap). A walk is bounded
 // by a budget of node visits and, in a kernel specialised with LOOP_CAP > 0 (the path
-// tracer on llvmpipe), by the loop passes its SIMD group has left; a walk stopped by either
+// tracer on llvmpipe), by its lane's share of the loop passes; a walk stopped by either
 // reports `truncated` and keeps its whole state, so the caller can resume it later.
 #ifndef GONIO_BVH_GLSL
 #define GONIO_BVH_GLSL
