@@ -726,7 +726,7 @@ static void loop_setup(renderer *r, GnFrame *frame)
     frame->loop_overhead = overhead;
     frame->state_stride = r->state_stride = state_stride(r, GN_MODE_PATH);
     /* One value for every render of the process, so the cached kernel stays valid. */
-    r->loop_cap = r->state_stride && !getenv("XX_NOCAP") ? 65535u - 4096u - 4 * 134u : 0;
+    r->loop_cap = r->state_stride ? 65535u - 4096u - 4 * 134u : 0;
     if (r->loop_cap && forced && atol(forced) > 0 && (uint32_t)atol(forced) < r->loop_cap) {
         /* each lane's share (of up to 8) at least two vertices' overhead and then a node
          * visit or a leaf: progress */
