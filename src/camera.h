@@ -40,13 +40,13 @@ typedef struct camera_option {
      "node order, the default); frame: frame the bounds from a raised\n"                       \
      "three-quarter view (the default without a camera); FILE.exr: the\n"                      \
      "view recorded by gonio render or preview",                                               \
-     CLI_CALL, (cam), 0, 0, NULL, camera_take_option},                                         \
+     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, camera_take_option},                                         \
     {"--look-at", "E,T[,U]",                                                                   \
      "place a camera: eye EX,EY,EZ, target TX,TY,TZ, up UX,UY,UZ\n"                            \
      "(default 0,1,0), world coordinates",                                                     \
-     CLI_CALL, (cam), 0, 0, NULL, camera_take_option},                                         \
+     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, camera_take_option},                                         \
     {"--fov", "DEGREES", "vertical field of view (default: the camera's own, else 45)",        \
-     CLI_CALL, (cam), 0, 0, NULL, camera_take_option}
+     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, camera_take_option}
 
 /* Takes opt (with its value val) when it is a camera option: returns 1 when taken, 0 when
  * opt is not a camera option, 2 after printing a usage error for command cmd. */

@@ -108,8 +108,10 @@ int cli_parse(const cli_command *c, int argc, char **argv, cli_args *out)
             return 0;
         }
         int k = find_option(c, a, len);
+        if (k < 0 && eq && len == 6 && !strncmp(a, "--help", 6))
+            return cli_usage_error(c->name, "--help takes no value");
         if (k < 0)
-            return cli_usage_error(c->name, "unknown option '%.*s'", (int)len, a);
+            return cli_usage_error(c->name, "unknown option '%.*s'%s", (int)len, a, c->unknown_hint ? c->unknown_hint : "");
         const cli_option *o = &c->options[k];
         char opt[64];
         snprintf(opt, sizeof opt, "%.*s", (int)len, a);

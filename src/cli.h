@@ -68,9 +68,11 @@ typedef struct cli_command {
     const char *epilog; /* paragraphs after the options; or NULL */
     int min_args, max_args; /* positional arguments; max_args -1: any number */
     const char *missing;    /* the usage error when fewer than min_args: "no scene given" */
+    const char *unknown_hint; /* appended to "unknown option": where the options are listed */
 } cli_command;
 /* A destination of the type its kind writes, or a compile error (the table's void * would
- * take any pointer): CLI_AS(float, &x). */
+ * take any pointer): CLI_AS(float, &x). The typed kinds' tables and the shared option
+ * macros use it; a CLI_CALL's destination is its parser's to check. */
 #define CLI_AS(type, p) _Generic((p), type *: (p))
 #define CLI_OPTIONS(table) .options = (table), .num_options = (int)(sizeof(table) / sizeof *(table))
 
@@ -115,7 +117,7 @@ bool cli_take_exr_compression(const char *cmd, const char *opt, const char *valu
     {"--half", NULL, "EXR: 16-bit half channels (default 32-bit float)", CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL}
 #define CLI_OPT_EXR_COMPRESSION(dest)                                                         \
     {"--compression", "C", "EXR: none, rle, zips, zip (default), piz, pxr24, b44, b44a",      \
-     CLI_CALL, (dest), 0, 0, "none, rle, zips, zip, piz, pxr24, b44 or b44a",                 \
+     CLI_CALL, CLI_AS(int, dest), 0, 0, "none, rle, zips, zip, piz, pxr24, b44 or b44a",       \
      cli_take_exr_compression}
 
 /* "gonio CMD: MESSAGE" and the hint to use --help; returns 2. */

@@ -416,12 +416,16 @@ int cmd_brdf(int argc, char **argv)
         CLI_OPT_DEVICE(&device),
         CLI_OPT_VALIDATE(&validate),
     };
-    char names[BRDF_MAX_PARAMS][48], help[BRDF_MAX_PARAMS][64];
+    char names[BRDF_MAX_PARAMS][48], help[BRDF_MAX_PARAMS][128];
     int n = BRDF_FIXED_OPTIONS;
     for (int i = 0; m && i < m->num_params; i++) { /* the model's parameters */
         const brdf_param *p = &m->params[i];
         snprintf(names[i], sizeof names[i], "--%s", p->name);
-        snprintf(help[i], sizeof help[i], "%s: in [%g, %g] (default %g)", m->name, p->min, p->max, p->def[0]);
+        if (p->count == 3 && (p->def[1] != p->def[0] || p->def[2] != p->def[0]))
+            snprintf(help[i], sizeof help[i], "%s: in [%g, %g] (default %g,%g,%g)", m->name, p->min, p->max,
+                     p->def[0], p->def[1], p->def[2]);
+        else
+            snprintf(help[i], sizeof help[i], "%s: in [%g, %g] (default %g)", m->name, p->min, p->max, p->def[0]);
         options[n++] = (cli_option){names[i], p->count == 3 ? "R,G,B" : "V", help[i], CLI_CALL, &s, 0, 0, NULL,
                                     take_param};
     }
@@ -432,7 +436,8 @@ int cmd_brdf(int argc, char **argv)
                     "       gonio brdf MODEL [--PARAM VALUE ...] --albedo\n"
                     "       gonio brdf MODEL [--PARAM VALUE ...] --sphere -o BALL.exr|BALL.png [--png BALL.png]\n"
                     "                  [--size WxH] [--spp N]",
-        .options = options, .num_options = n, .max_args = m ? 1 : 0};
+        .options = options, .num_options = n, .max_args = m ? 1 : 0,
+        .unknown_hint = " (gonio brdf --list: the models' parameters)"};
     cli_args args;
     if ((rc = cli_parse(&command, argc, argv, &args)) >= 0)
         return rc;

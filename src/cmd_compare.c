@@ -546,7 +546,7 @@ int cmd_compare(int argc, char **argv)
         {"--sweep", "LEVELS", "the teapot at these tessellation levels (see above)", CLI_CALL, &sweep_levels,
          0, 0, "up to 16 increasing levels 1..256, e.g. 1,2,4,8", take_levels},
         {"--modes", "LIST", "any of flat,gouraud,phong,path (default all four; phong and path\n"
-                            "are the references); path is skipped when not available",
+                            "are the references)",
          CLI_CALL, &o, 0, 0, "a list of flat, gouraud, phong, path (each once)", take_modes},
         {"--spp", "N", "path tracer samples per pixel (default 64); the local modes take\n"
                        "min(N, 16), which only anti-aliases them",
@@ -570,6 +570,8 @@ int cmd_compare(int argc, char **argv)
     rc = 1;
     input = args.num_args ? args.arg[0] : NULL;
     sweep = cli_given(&command, &args, "--sweep") ? "" : NULL;
+    if (sweep && (cli_given(&command, &args, "--scene") || outside))
+        return cli_usage_error("compare", "--sweep renders gonio's teapot: --scene and --allow-outside-files do not apply");
     scene_allow_outside_files(outside);
     if (!input)
         return cli_usage_error("compare", sweep ? "--sweep: no scene generator given (teapot)" : "no scene given");

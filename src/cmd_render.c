@@ -286,10 +286,10 @@ static int render_run(const render_job *job);
 static int render_frames(const render_job *job)
 {
     long a, b;
-    char range[64], *dash, names[2][4096];
+    char range[64] = "", *dash, names[2][4096];
     int rc = 0;
     snprintf(range, sizeof range, "%s", job->frames);
-    dash = strchr(range + 1, '-');
+    dash = range[0] ? strchr(range + 1, '-') : NULL;
     if (dash)
         *dash = 0;
     if (!dash || !util_parse_int(range, 0, 1 << 24, &a) || !util_parse_int(dash + 1, 0, 1 << 24, &b) || b < a)

@@ -29,16 +29,16 @@ typedef struct env_option {
     {"--env", "R,G,B | V",                                                                     \
      "constant environment radiance; 0: black (default: the scene's own\n"                     \
      "lights, or gonio's studio environment when it has none)",                                \
-     CLI_CALL, (env), 0, 0, NULL, env_take_option},                                            \
+     CLI_CALL, CLI_AS(env_option, env), 0, 0, NULL, env_take_option},                                            \
     {NULL, NULL,                                                                               \
      "  --env FILE          a lat-long HDR environment map, OpenEXR (.exr) or Radiance (.hdr),\n" \
      "                      +Y up; importance sampled by the path tracer, its mean radiance is\n" \
      "                      the local modes' ambient light\n",                                 \
      CLI_TEXT, NULL, 0, 0, NULL, NULL},                                                        \
     {"--env-rotate", "DEG", "turn the environment about +Y (right-handed, default 0)",        \
-     CLI_CALL, (env), 0, 0, NULL, env_take_option},                                            \
+     CLI_CALL, CLI_AS(env_option, env), 0, 0, NULL, env_take_option},                                            \
     {"--env-intensity", "X", "scale the environment's radiance (default 1)",                  \
-     CLI_CALL, (env), 0, 0, NULL, env_take_option}
+     CLI_CALL, CLI_AS(env_option, env), 0, 0, NULL, env_take_option}
 
 /* Takes opt (and its value) when it is an environment option: 1 taken, 0 not one, 2 after a
  * usage error printed for command cmd. */

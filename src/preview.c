@@ -835,7 +835,7 @@ int cmd_preview(int argc, char **argv)
         }
         vkDeviceWaitIdle(p->g.device);
         if (p->save)
-            ok = save_accumulated(p);
+            ok = save_accumulated(p) && ok;
         if (screenshot)
             ok = save_screenshot(p, screenshot) && ok;
         util_info("preview: %d frame(s), %s, %d spp, %dx%d", frames, render_mode_name(p->s.mode),
