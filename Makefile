@@ -165,14 +165,14 @@ unit: $(UNIT)
 bench: all
 	@tests/bench.sh $(GONIO)
 
-# gonio beside Mitsuba 3 on scenes it did not shape (bench/peer, docs/performance.md):
-# Mitsuba, Dr.Jit and a libLLVM for it come from PyPI into build/peer/venv (bench/peer/env.sh);
+# gonio beside Mitsuba 3 on scenes it did not shape (tests/peer, docs/performance.md):
+# Mitsuba, Dr.Jit and a libLLVM for it come from PyPI into build/peer/venv (tests/peer/env.sh);
 # python3-venv makes the venv. It skips, saying why, where they cannot be installed.
 DEB_PEER := python3-venv
 PEER_DEPS_CHECK = { python3 -c 'import ensurepip, venv'; } >/dev/null 2>&1
 bench-peer: all
 	@if ! $(PEER_DEPS_CHECK); then ( $(call apt_install,$(DEB_PEER)) ) || true; fi
-	@bench/peer/run.sh $(GONIO) $(PEER_ARGS)
+	@tests/peer/run.sh $(GONIO) $(PEER_ARGS)
 
 # libFuzzer targets over scene_load and image_read_exr (tests/fuzz); fuzz-run runs each for
 # FUZZ_TIME seconds from seeds of ../shared/assets and EXRs gonio writes (tests/fuzz/run.sh).

@@ -1,4 +1,4 @@
-# env.sh: sourced by bench/peer/run.sh and tests/regress/peer.sh. peer_env [install]: sets
+# env.sh: sourced by tests/peer/run.sh and tests/regress/peer.sh. peer_env [install]: sets
 # PEER_PY (the venv's python) and DRJIT_LIBLLVM_PATH when build/peer/venv holds a Mitsuba 3
 # whose LLVM backend runs; with `install`, makes that venv first where it is missing.
 # Dr.Jit's LLVM backend aborts with Debian 12's libLLVM (14 and 15) and needs a newer one:

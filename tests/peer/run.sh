@@ -4,11 +4,11 @@
 # exits 0.
 set -u
 cd "$(dirname "$0")/../.."
-. bench/peer/env.sh
+. tests/peer/env.sh
 G=${1:-build/gonio}
 shift
 if ! peer_env install; then
     echo "bench-peer: skipped: $PEER_WHY"
     exit 0
 fi
-exec "$PEER_PY" bench/peer/peer.py --gonio "$G" "$@"
+exec "$PEER_PY" tests/peer/peer.py --gonio "$G" "$@"

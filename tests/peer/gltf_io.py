@@ -162,7 +162,7 @@ def write(path, meshes, materials, camera=None, extensions=()):
         idx = add(np.asarray(I, np.uint32).reshape(-1), 5125, "SCALAR", 34963)
         gmeshes.append({"name": name, "primitives": [{"attributes": attrs, "indices": idx, "material": mat}]})
         nodes.append({"name": name, "mesh": len(gmeshes) - 1})
-    doc = {"asset": {"version": "2.0", "generator": "gonio bench/peer"}, "scene": 0,
+    doc = {"asset": {"version": "2.0", "generator": "gonio tests/peer"}, "scene": 0,
            "materials": materials, "meshes": gmeshes, "accessors": accessors, "bufferViews": views,
            "buffers": [{"byteLength": len(blob), "uri": os.path.basename(path)[:-5] + ".bin"}]}
     if extensions:
