@@ -302,7 +302,7 @@ typedef struct builder {
     uint32_t num_tris, num_recs, threads;
     uint32_t *rec;         /* record (the build's primitive) -> A's triangle | BVH_REC_PAIR */
     uint32_t *chunk_first; /* setup chunk -> its first record */
-    uint8_t *pair_at;      /* triangle -> 1: it and the next one are a record (count_worker) */
+    uint32_t *mate;        /* triangle -> the other triangle of its pair, GN_INVALID: single */
     prim *prims;
     GnBvhNode *nodes;
     GnTriPair *pairs;
@@ -341,20 +341,16 @@ static const float *vertex(const builder *bd, uint32_t tri, int k)
     return bd->positions + (size_t)bd->indices[3 * (size_t)tri + k] * bd->stride;
 }
 
-/* Triangles t and t + 1 of the index buffer make one GnTriPair when they share exactly one
+/* Triangles t and u make one GnTriPair when they share exactly one
  * edge (by vertex index; neither repeats an index), are wound alike (so that GnPrim can
  * list B's corners in the test's order by a rotation, keeping its winding), and the pair's
  * box is no larger (in surface area) than the two boxes together: the SAH's view, since a
  * pair costs the walk about what one triangle does (three texel fetches) and is entered
  * whenever a ray enters its box. (Without that test, the few folded pairs of the 250k bench
- * mesh made its rays 15% slower.) Only neighbours in the index buffer are paired: meshes
- * built from quads list a quad's two triangles together (Embree's triangle pairing makes
- * the same assumption), so one pass finds them with no search. */
-static bool pairs_with_next(const builder *bd, uint32_t t)
+ * mesh made its rays 15% slower.) */
+static bool pairs_with(const builder *bd, uint32_t t, uint32_t u)
 {
-    if ((uint64_t)t + 1 >= bd->num_tris)
-        return false;
-    const uint32_t *a = bd->indices + 3 * (size_t)t, *b = a + 3;
+    const uint32_t *a = bd->indices + 3 * (size_t)t, *b = bd->indices + 3 * (size_t)u;
     if (a[0] == a[1] || a[1] == a[2] || a[2] == a[0] || b[0] == b[1] || b[1] == b[2] || b[2] == b[0])
         return false;
     int shared = 0;
@@ -372,7 +368,7 @@ static bool pairs_with_next(const builder *bd, uint32_t t)
         return false;
     aabb ba = empty_box, bb = empty_box, bu;
     for (int k = 0; k < 3; k++) {
-        const float *x = vertex(bd, t, k), *y = vertex(bd, t + 1, k);
+        const float *x = vertex(bd, t, k), *y = vertex(bd, u, k);
         v4f vx = {x[0], x[1], x[2], 0}, vy = {y[0], y[1], y[2], 0};
         grow_box(&ba, vx, vx);
         grow_box(&bb, vy, vy);
@@ -382,10 +378,13 @@ static bool pairs_with_next(const builder *bd, uint32_t t)
     return half_area(&bu) <= half_area(&ba) + half_area(&bb);
 }
 
-/* Setup, BVH_SETUP_CHUNK triangles at a time: first each chunk's pairs and record count
- * (count_worker), then, from each chunk's first record, the records and their boxes
- * (setup_worker). Within a chunk the pairing is greedy from its first triangle (a pair,
- * else a single), so it depends on the chunk boundaries only, not on the threads. */
+/* Pairing, in two passes. First, BVH_SETUP_CHUNK triangles at a time in parallel, each with
+ * the next one in the index buffer: meshes built from quads list a quad's two triangles
+ * together, so this finds most pairs with no search (pair_worker; greedy from a chunk's first
+ * triangle, so it depends on the chunk boundaries only, not on the threads). Then the
+ * triangles left single meet the others of their edges (pair_by_edges), so that a mesh's
+ * pairs do not depend on the order of its index buffer. Setup then makes, from each chunk's
+ * first record, the records and their boxes (setup_worker). */
 static uint32_t chunk_range(builder *bd, uint32_t *begin, uint32_t *end)
 {
     uint64_t c = atomic_fetch_add(&bd->next_work, 1), b = c * BVH_SETUP_CHUNK;
@@ -396,20 +395,134 @@ static uint32_t chunk_range(builder *bd, uint32_t *begin, uint32_t *end)
     return (uint32_t)c;
 }
 
-static void *count_worker(void *arg)
+static void *pair_worker(void *arg)
 {
     builder *bd = ((worker *)arg)->bd;
-    uint32_t begin, end, c;
-    while ((c = chunk_range(bd, &begin, &end)) != GN_INVALID) {
-        uint32_t n = 0;
-        for (uint32_t t = begin; t < end; n++) {
-            bool pair = t + 1 < end && pairs_with_next(bd, t);
-            bd->pair_at[t] = pair;
+    uint32_t begin, end;
+    while (chunk_range(bd, &begin, &end) != GN_INVALID)
+        for (uint32_t t = begin; t < end;) {
+            bool pair = t + 1 < end && pairs_with(bd, t, t + 1);
+            bd->mate[t] = pair ? t + 1 : GN_INVALID;
+            if (pair)
+                bd->mate[t + 1] = t;
             t += pair ? 2 : 1;
         }
-        bd->chunk_first[c] = n;
-    }
     return NULL;
+}
+
+/* An edge of a single triangle: its two vertex indices, the smaller first, and the triangle. */
+typedef struct edge_ref {
+    uint64_t key;
+    uint32_t tri;
+} edge_ref;
+
+static int edge_order(const void *pa, const void *pb)
+{
+    const edge_ref *a = pa, *b = pb;
+    return a->key != b->key ? (a->key < b->key ? -1 : 1) : (a->tri > b->tri) - (a->tri < b->tri);
+}
+
+static uint64_t edge_key(uint32_t x, uint32_t y)
+{
+    return x < y ? (uint64_t)x << 32 | y : (uint64_t)y << 32 | x;
+}
+
+/* The single triangles' edges, sorted, give each single triangle the (at most three) others
+ * pairs_with accepts; then a greedy matching of fewest options first (a triangle with one
+ * candidate takes it before a neighbour with three can), each taking its candidate with the
+ * fewest options left: on the shuffled bench mesh this pairs as well as index order does,
+ * where plain first-come pairing lost one pair in seven. Deterministic: ties go by index. */
+typedef struct single_tri {
+    uint32_t tri, degree;
+} single_tri;
+
+static int by_degree(const void *pa, const void *pb)
+{
+    const single_tri *a = pa, *b = pb;
+    return a->degree != b->degree ? (a->degree < b->degree ? -1 : 1) : (a->tri > b->tri) - (a->tri < b->tri);
+}
+
+static void pair_by_edges(builder *bd)
+{
+    size_t n = 0;
+    for (uint32_t t = 0; t < bd->num_tris; t++)
+        n += bd->mate[t] == GN_INVALID;
+    if (n < 2)
+        return;
+    edge_ref *e = util_malloc(3 * n * sizeof *e);
+    size_t m = 0;
+    for (uint32_t t = 0; t < bd->num_tris; t++)
+        if (bd->mate[t] == GN_INVALID)
+            for (int k = 0; k < 3; k++) {
+                const uint32_t *v = bd->indices + 3 * (size_t)t;
+                e[m++] = (edge_ref){edge_key(v[k], v[(k + 1) % 3]), t};
+            }
+    qsort(e, m, sizeof *e, edge_order);
+    /* candidates: for each single triangle (in order), up to 3 others */
+    uint32_t *slot = util_malloc(bd->num_tris * sizeof *slot), *cand = util_malloc(3 * n * sizeof *cand);
+    uint32_t *degree = util_calloc(n, sizeof *degree);
+    single_tri *order = util_malloc(n * sizeof *order);
+    for (uint32_t t = 0, i = 0; t < bd->num_tris; t++)
+        slot[t] = bd->mate[t] == GN_INVALID ? i++ : GN_INVALID;
+    for (size_t lo = 0, hi; lo < m; lo = hi) {
+        for (hi = lo + 1; hi < m && e[hi].key == e[lo].key; hi++)
+            ;
+        for (size_t i = lo; i < hi; i++)
+            for (size_t j = lo; j < hi; j++) {
+                uint32_t t = e[i].tri, u = e[j].tri, st = slot[t];
+                if (t != u && degree[st] < 3 && pairs_with(bd, t, u))
+                    cand[3 * (size_t)st + degree[st]++] = u;
+            }
+    }
+    for (uint32_t t = 0; t < bd->num_tris; t++)
+        if (slot[t] != GN_INVALID)
+            order[slot[t]] = (single_tri){t, degree[slot[t]]};
+    qsort(order, n, sizeof *order, by_degree);
+    /* Karp-Sipser: a triangle left with one candidate takes it at once (a stack of them),
+     * else the next of fewest options takes its candidate with the fewest left. live: the
+     * candidates still single. */
+    uint32_t *live = util_malloc(n * sizeof *live), *stack = util_malloc(n * sizeof *stack), sp = 0;
+    memcpy(live, degree, n * sizeof *live);
+    for (size_t i = 0; i < n || sp;) {
+        uint32_t t;
+        if (sp) {
+            t = stack[--sp];
+        } else {
+            t = order[i++].tri;
+        }
+        uint32_t st = slot[t], best = GN_INVALID, best_left = UINT32_MAX;
+        if (bd->mate[t] != GN_INVALID || live[st] == 0)
+            continue;
+        for (uint32_t k = 0; k < degree[st]; k++) {
+            uint32_t u = cand[3 * (size_t)st + k];
+            if (bd->mate[u] == GN_INVALID && (live[slot[u]] < best_left || (live[slot[u]] == best_left && u < best)))
+                best = u, best_left = live[slot[u]];
+        }
+        if (best == GN_INVALID)
+            continue;
+        bd->mate[t] = best;
+        bd->mate[best] = t;
+        uint32_t ends[2] = {t, best};
+        for (int w = 0; w < 2; w++) /* the partners' other candidates lose an option */
+            for (uint32_t k = 0; k < degree[slot[ends[w]]]; k++) {
+                uint32_t v = cand[3 * (size_t)slot[ends[w]] + k];
+                if (bd->mate[v] == GN_INVALID && live[slot[v]] > 0 && --live[slot[v]] == 1)
+                    stack[sp++] = v;
+            }
+    }
+    free(stack);
+    free(live);
+    free(order);
+    free(degree);
+    free(cand);
+    free(slot);
+    free(e);
+}
+
+/* Does triangle t begin a record (a single, or the first of its pair in index order)? */
+static bool record_start(const builder *bd, uint32_t t)
+{
+    return bd->mate[t] == GN_INVALID || bd->mate[t] > t;
 }
 
 static void *setup_worker(void *arg)
@@ -419,15 +532,18 @@ static void *setup_worker(void *arg)
     uint32_t begin, end, c;
     while ((c = chunk_range(bd, &begin, &end)) != GN_INVALID) {
         uint32_t r = bd->chunk_first[c];
-        for (uint32_t t = begin; t < end; r++) {
-            bool pair = bd->pair_at[t];
+        for (uint32_t t = begin; t < end; t++) {
+            if (!record_start(bd, t))
+                continue;
+            uint32_t u = bd->mate[t];
+            bool pair = u != GN_INVALID;
             prim *p = &bd->prims[r];
             bd->rec[r] = t | (pair ? BVH_REC_PAIR : 0u);
             for (int a = 0; a < 3; a++)
                 p->lo3[a] = INFINITY, p->hi3[a] = -INFINITY;
-            for (uint32_t k = t; k <= t + pair; k++)
+            for (uint32_t j = 0; j <= (uint32_t)pair; j++)
                 for (int v = 0; v < 3; v++) {
-                    const float *x = vertex(bd, k, v);
+                    const float *x = vertex(bd, j ? u : t, v);
                     for (int a = 0; a < 3; a++) {
                         p->lo3[a] = minf(p->lo3[a], x[a]);
                         p->hi3[a] = maxf(p->hi3[a], x[a]);
@@ -438,7 +554,7 @@ static void *setup_worker(void *arg)
             v4f c4 = centroid(p);
             grow_box(&w->box, prim_lo(p), p->hi);
             grow_box(&w->cbox, c4, c4);
-            t += pair ? 2 : 1;
+            r++;
         }
     }
     return NULL;
@@ -451,9 +567,10 @@ static void write_pair(const builder *bd, uint32_t rec, uint32_t i, GnTriPair *q
                        uint32_t *tri_index, uint8_t *tri_rotation)
 {
     uint32_t ta = rec & ~BVH_REC_PAIR;
-    const uint32_t *a = bd->indices + 3 * (size_t)ta, *b = a + 3;
-    uint32_t rot = 0, rot_b = 0, idx[4];
     bool pair = (rec & BVH_REC_PAIR) != 0;
+    uint32_t tb = pair ? bd->mate[ta] : GN_INVALID;
+    const uint32_t *a = bd->indices + 3 * (size_t)ta, *b = pair ? bd->indices + 3 * (size_t)tb : a;
+    uint32_t rot = 0, rot_b = 0, idx[4];
     if (pair) /* the edge (a[k], a[k + 1]) that B has: rotate it to (p2, p0) */
         for (uint32_t k = 0; k < 3; k++) {
             uint32_t x = a[k], y = a[(k + 1) % 3];
@@ -477,7 +594,7 @@ static void write_pair(const builder *bd, uint32_t rec, uint32_t i, GnTriPair *q
     }
     tri_index[2 * (size_t)i] = ta;
     tri_rotation[2 * (size_t)i] = (uint8_t)rot;
-    tri_index[2 * (size_t)i + 1] = pair ? ta + 1 : GN_INVALID;
+    tri_index[2 * (size_t)i + 1] = tb;
     tri_rotation[2 * (size_t)i + 1] = (uint8_t)rot_b;
 }
 
@@ -720,13 +837,15 @@ bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
                                                               : (uint32_t)cpus;
     uint32_t chunks = (uint32_t)(((uint64_t)num_triangles + BVH_SETUP_CHUNK - 1) / BVH_SETUP_CHUNK);
     bd.chunk_first = util_malloc(chunks * sizeof *bd.chunk_first);
-    bd.pair_at = util_malloc(num_triangles);
+    bd.mate = util_malloc(num_triangles * sizeof *bd.mate);
     atomic_init(&bd.next_work, 0);
-    run_workers(&bd, count_worker, w);
+    run_workers(&bd, pair_worker, w);
+    pair_by_edges(&bd);
     for (uint32_t c = 0; c < chunks; c++) {
-        uint32_t n = bd.chunk_first[c];
+        uint32_t end = c + 1 < chunks ? (c + 1) * BVH_SETUP_CHUNK : num_triangles;
         bd.chunk_first[c] = bd.num_recs;
-        bd.num_recs += n;
+        for (uint32_t t = c * BVH_SETUP_CHUNK; t < end; t++)
+            bd.num_recs += record_start(&bd, t);
     }
     bd.rec = util_malloc(bd.num_recs * sizeof *bd.rec);
     bd.prims = util_malloc(bd.num_recs * sizeof *bd.prims);
@@ -756,7 +875,7 @@ bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
     free(bd.prims);
     free(bd.rec);
     free(bd.chunk_first);
-    free(bd.pair_at);
+    free(bd.mate);
     measure(out);
     out->build_seconds = util_now() - t0;
     return true;

@@ -35,7 +35,8 @@ typedef struct bvh_hit {
 } bvh_hit;
 
 /* Builds over num_triangles triangles given by positions (xyz floats) and indices (3 per
- * triangle); neighbours in the index buffer that share an edge may become one GnTriPair. Triangles must have finite vertices (scene_load guarantees it). Returns false
+ * triangle); two triangles that share an edge may become one GnTriPair, whatever their
+ * order in the index buffer. Triangles must have finite vertices (scene_load guarantees it). Returns false
  * only when num_triangles == 0. Deterministic: the same input gives the same tree. */
 bool bvh_build(bvh *out, const float *positions, size_t position_stride_floats,
                const uint32_t *indices, uint32_t num_triangles);
