@@ -71,6 +71,30 @@ struct BsdfSample {
     uint flags;  // BRDF_FLAG_*; 0 when no direction was sampled (weight 0)
 };
 
+// No direction sampled (weight 0).
+BsdfSample brdf_no_sample()
+{
+    BsdfSample s;
+    s.wi = vec3(0.0, 0.0, 1.0);
+    s.weight = vec3(0.0);
+    s.pdf = 0.0;
+    s.flags = 0u;
+    return s;
+}
+
+// A sampled non-Dirac direction wi with its f and whole-mixture pdf (none if pdf is 0).
+BsdfSample brdf_sample_from(vec3 wi, vec3 f, float pdf, uint flags)
+{
+    BsdfSample s = brdf_no_sample();
+    if (!(pdf > 0.0))
+        return s;
+    s.wi = wi;
+    s.pdf = pdf;
+    s.weight = f * abs(wi.z) / pdf;
+    s.flags = flags;
+    return s;
+}
+
 // ---- Fresnel --------------------------------------------------------------------------
 
 // The lecture's dielectric Fresnel: r_par, r_perp and F_r = (r_par^2 + r_perp^2) / 2 for
@@ -418,11 +442,7 @@ void brdf_base_eval_pdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
 // MIS over the parts), so weight = eval * |cos| / pdf exactly.
 BsdfSample brdf_base_sample(Bsdf b, vec3 wo, vec3 u)
 {
-    BsdfSample s;
-    s.wi = vec3(0.0, 0.0, 1.0);
-    s.weight = vec3(0.0);
-    s.pdf = 0.0;
-    s.flags = 0u;
+    BsdfSample s = brdf_no_sample();
     vec3 p = brdf_part_probs(b, wo);
     vec3 wi;
     bool reflect = true; // the side the chosen part sends wi to: a part's direction that
@@ -471,13 +491,7 @@ BsdfSample brdf_base_sample(Bsdf b, vec3 wo, vec3 u)
     vec3 f;
     float pdf;
     brdf_base_eval_pdf(b, wo, wi, f, pdf);
-    if (!(pdf > 0.0))
-        return s;
-    s.wi = wi;
-    s.pdf = pdf;
-    s.weight = f * abs(wi.z) / pdf;
-    s.flags = reflect ? BRDF_FLAG_REFLECTION : BRDF_FLAG_TRANSMISSION;
-    return s;
+    return brdf_sample_from(wi, f, pdf, reflect ? BRDF_FLAG_REFLECTION : BRDF_FLAG_TRANSMISSION);
 }
 
 // ---- the layers: KHR_materials_clearcoat and _sheen over the base ---------------------------
@@ -669,11 +683,7 @@ BsdfSample bsdf_sample(Bsdf b, vec3 wo, vec3 u)
 {
     if (!GN_HAS(GN_FEAT_LAYERS) || !brdf_has_layers(b))
         return brdf_base_sample(b, wo, u);
-    BsdfSample s;
-    s.wi = vec3(0.0, 0.0, 1.0);
-    s.weight = vec3(0.0);
-    s.pdf = 0.0;
-    s.flags = 0u;
+    BsdfSample s = brdf_no_sample();
     vec3 p = brdf_layer_probs(b, wo);
     vec3 wi;
     uint flags = BRDF_FLAG_REFLECTION;
@@ -721,13 +731,7 @@ BsdfSample bsdf_sample(Bsdf b, vec3 wo, vec3 u)
     vec3 f;
     float pdf;
     bsdf_eval_pdf(b, wo, wi, f, pdf);
-    if (!(pdf > 0.0))
-        return s;
-    s.wi = wi;
-    s.pdf = pdf;
-    s.weight = f * abs(wi.z) / pdf;
-    s.flags = flags;
-    return s;
+    return brdf_sample_from(wi, f, pdf, flags);
 }
 
 // The layers on a base Bsdf: coat weight c, roughness cr, normal cn (local frame); sheen
