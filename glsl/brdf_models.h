@@ -54,7 +54,7 @@
  * params = (metallic, roughness, specular, ior), extra = (specular colour, transmission),
  * layer = (clearcoat, clearcoat roughness, sheen roughness, the coat normal's tilt from +z
  * toward +x in radians: a test-only stand-in for a clearcoat normal map), sheen.rgb = sheen
- * colour (bsdf_layers).
+ * colour (bsdf_layers); aniso, irid and dt as their comments say.
  * Otherwise color and params are those of bsdf_from_model and extra is unused.
  * BRDF_OP_FRESNEL: params.x = eta (dielectric), color = eta and extra.xyz = k (conductor),
  * params.y = F0 and params.z = F90 (Schlick), params.w = sheen roughness (the sheen's table). */
@@ -67,7 +67,10 @@ GN_STRUCT(BrdfQuery) {
     vec3 u; float pad1;  /* the sample's random numbers in [0, 1) */
     vec4 layer;
     vec4 sheen;
-} GN_END(BrdfQuery); /* 128 bytes */
+    vec4 aniso; /* KHR_materials_anisotropy: strength, rotation (radians), 0, 0 */
+    vec4 irid;  /* KHR_materials_iridescence: factor, film ior, film thickness (nm), 0 */
+    vec4 dt;    /* KHR_materials_diffuse_transmission: colour.rgb, factor */
+} GN_END(BrdfQuery); /* 176 bytes */
 
 /* BRDF_OP_EVAL: f, pdf. BRDF_OP_SAMPLE: s_* (s_f, s_pdf_eval: eval and pdf at s_wi).
  * BRDF_OP_FRESNEL: f = (dielectric, Schlick, the sheen's albedo E from its table), s_f =
@@ -91,11 +94,14 @@ GN_STRUCT(BrdfSphere) {
     vec3 env; uint max_depth;          /* environment radiance; path length limit */
     vec4 layer;
     vec4 sheen;
-} GN_END(BrdfSphere); /* 128 bytes */
+    vec4 aniso; /* as BrdfQuery's */
+    vec4 irid;
+    vec4 dt;
+} GN_END(BrdfSphere); /* 176 bytes */
 
 #ifndef VULKAN
-GN_STATIC_ASSERT(sizeof(BrdfSphere) == 128, "BrdfSphere layout");
-GN_STATIC_ASSERT(sizeof(BrdfQuery) == 128, "BrdfQuery layout");
+GN_STATIC_ASSERT(sizeof(BrdfSphere) == 176, "BrdfSphere layout");
+GN_STATIC_ASSERT(sizeof(BrdfQuery) == 176, "BrdfQuery layout");
 GN_STATIC_ASSERT(offsetof(BrdfQuery, wo) == 48, "BrdfQuery layout");
 GN_STATIC_ASSERT(sizeof(BrdfResult) == 64, "BrdfResult layout");
 #endif

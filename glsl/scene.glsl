@@ -64,7 +64,7 @@ bool vertex_colors() { return GN_HAS(GN_FEAT_VERTEX_COLOR) && (frame.flags & GN_
 // Fields a kernel does not read are never fetched: the compiler drops unused texel loads.
 GnMaterial material_at(uint i)
 {
-    uint k = 17u * i;
+    uint k = 21u * i;
     vec4 t0 = texel_f(material_texels, k), t1 = texel_f(material_texels, k + 1u);
     vec4 t2 = texel_f(material_texels, k + 2u), t3 = texel_f(material_texels, k + 3u);
     uvec4 t4 = texelFetch(material_texels, int(k + 4u)), t5 = texelFetch(material_texels, int(k + 5u));
@@ -75,6 +75,8 @@ GnMaterial material_at(uint i)
     uvec4 t13 = texelFetch(material_texels, int(k + 13u));
     uvec4 t14 = texelFetch(material_texels, int(k + 14u)), t15 = texelFetch(material_texels, int(k + 15u));
     vec4 t16 = texel_f(material_texels, k + 16u);
+    uvec4 t17 = texelFetch(material_texels, int(k + 17u)), t18 = texelFetch(material_texels, int(k + 18u));
+    uvec4 t19 = texelFetch(material_texels, int(k + 19u)), t20 = texelFetch(material_texels, int(k + 20u));
     return GnMaterial(t0, t1.xyz, t1.w, t2.xyz, t2.w, t3.x, t3.y, t3.z, t3.w,
                       uintBitsToFloat(t4.x), uintBitsToFloat(t4.y), t4.z, t4.w,
                       t5.x, t5.y, t5.z, t5.w, t6.x, t6.y, t6.z, t6.w,
@@ -82,7 +84,11 @@ GnMaterial material_at(uint i)
                       t12.xyz, t12.w, uintBitsToFloat(t13.x), uintBitsToFloat(t13.y), t13.z,
                       uintBitsToFloat(t13.w),
                       uintBitsToFloat(t14.x), uintBitsToFloat(t14.y), t14.z, t14.w,
-                      t15.x, uintBitsToFloat(t15.y), t15.z, t15.w, t16.xyz, t16.w);
+                      t15.x, uintBitsToFloat(t15.y), t15.z, t15.w, t16.xyz, t16.w,
+                      uintBitsToFloat(t17.x), uintBitsToFloat(t17.y), t17.z, uintBitsToFloat(t17.w),
+                      uintBitsToFloat(t18.x), uintBitsToFloat(t18.y), uintBitsToFloat(t18.z),
+                      uintBitsToFloat(t18.w), t19.x, t19.y, uintBitsToFloat(t19.z), t19.w,
+                      uintBitsToFloat(t20.xyz), t20.w);
 }
 
 // ---- random numbers that depend only on (pixel, sample, dimension, seed) ---------------

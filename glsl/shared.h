@@ -148,12 +148,13 @@ typedef uint32_t uint;
 #define GN_FEAT_VARIANCE (1u << 26)     /* sums of squares (--aov variance) */
 #define GN_FEAT_TEX_TRANSFORM (1u << 27) /* KHR_texture_transform (GnTexture.transform) */
 #define GN_FEAT_UV1 (1u << 28)          /* textures reading TEXCOORD_1 (GN_TEX_UV1) */
-#define GN_FEAT_LAYERS (1u << 29)       /* KHR_materials_clearcoat and _sheen (brdf.glsl: bsdf_layers) */
+#define GN_FEAT_LAYERS (1u << 29)       /* KHR_materials_clearcoat, _sheen, _iridescence, _diffuse_transmission (brdf.glsl: bsdf_layers) */
 #define GN_FEAT_VOLUME (1u << 30)       /* KHR_materials_volume media, _dispersion */
+#define GN_FEAT_ANISO (1u << 31)        /* KHR_materials_anisotropy */
 #define GN_FEAT_LOBES (GN_FEAT_MIRROR | GN_FEAT_PHONG | GN_FEAT_BLINN | GN_FEAT_TS | \
                        GN_FEAT_BECKMANN | GN_FEAT_GGX)
 #define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
-#define GN_FEAT_ALL 0x7fffffffu
+#define GN_FEAT_ALL 0xffffffffu
 
 /* ---- BVH: both children's boxes in one 64-byte node (Aila & Laine 2009, "Understanding
  * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only
@@ -245,7 +246,16 @@ GN_STRUCT(GnMaterial) {
     float clearcoat; float clearcoat_roughness; uint tex_clearcoat; uint tex_clearcoat_roughness;
     uint tex_clearcoat_normal; float clearcoat_normal_scale; uint tex_sheen_color; uint tex_sheen_roughness;
     vec3 sheen_color; float sheen_roughness; /* KHR_materials_sheen factors (textures: RGB, A) */
-} GN_END(GnMaterial); /* 272 bytes */
+    /* KHR_materials_anisotropy: strength, rotation (radians, from the tangent toward the
+     * bitangent) and the direction/strength texture (RG: direction, B: strength) */
+    float anisotropy_strength; float anisotropy_rotation; uint tex_anisotropy; float anisotropy_pad0;
+    /* KHR_materials_iridescence: factor, the film's ior, its thickness range in nm and the
+     * factor (R) and thickness (G) textures */
+    float iridescence; float iridescence_ior; float iridescence_thickness_min; float iridescence_thickness_max;
+    uint tex_iridescence; uint tex_iridescence_thickness; float diffuse_transmission; uint tex_diffuse_transmission;
+    /* KHR_materials_diffuse_transmission: factor (above, texture A) and colour (texture RGB) */
+    vec3 diffuse_transmission_color; uint tex_diffuse_transmission_color;
+} GN_END(GnMaterial); /* 336 bytes */
 
 /* glTF KHR_lights_punctual light in world space. color = colour * intensity (W/sr for point
  * and spot, W/m^2 for directional: gonio reads photometric units as radiometric). direction
@@ -353,7 +363,7 @@ GN_STATIC_ASSERT(sizeof(GnTriPair) == 48, "GnTriPair layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");
 GN_STATIC_ASSERT(sizeof(GnVertex) == 80, "GnVertex layout");
 GN_STATIC_ASSERT(offsetof(GnVertex, u1) == 64, "GnVertex layout");
-GN_STATIC_ASSERT(sizeof(GnMaterial) == 272, "GnMaterial layout");
+GN_STATIC_ASSERT(sizeof(GnMaterial) == 336, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, attenuation_color) == 192, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, clearcoat) == 224, "GnMaterial layout");
 GN_STATIC_ASSERT(offsetof(GnMaterial, sheen_color) == 256, "GnMaterial layout");

@@ -41,14 +41,19 @@ const brdf_model brdf_models[] = {
      {COLOR("tint", BRDF_SLOT_COLOR, 1, 1, 1, 0, 1),
       SCALAR("ior", P(BRDF_P_DIELECTRIC_IOR), 1.5f, 1.01f, 4),
       SCALAR("alpha", P(BRDF_P_DIELECTRIC_ALPHA), 0, 0, 1)}},
-    {"gltf", BRDF_GLTF, "glTF metallic-roughness + KHR_materials_specular/transmission/ior/clearcoat/sheen", 11,
+    {"gltf", BRDF_GLTF, "glTF metallic-roughness + KHR_materials_specular/transmission/ior/clearcoat/sheen/anisotropy/iridescence/diffuse_transmission", 18,
      {COLOR("base-color", BRDF_SLOT_COLOR, 0.8f, 0.8f, 0.8f, 0, 1),
       SCALAR("metallic", P(0), 0, 0, 1), SCALAR("roughness", P(1), 0.5f, 0, 1),
       SCALAR("specular", P(2), 1, 0, 1), SCALAR("ior", P(3), 1.5f, 1, 4),
       COLOR("specular-color", BRDF_SLOT_EXTRA, 1, 1, 1, 0, 100),
       SCALAR("transmission", BRDF_SLOT_EXTRA + 3, 0, 0, 1),
       SCALAR("clearcoat", BRDF_SLOT_LAYER, 0, 0, 1), SCALAR("clearcoat-roughness", BRDF_SLOT_LAYER + 1, 0, 0, 1),
-      COLOR("sheen-color", BRDF_SLOT_SHEEN, 0, 0, 0, 0, 1), SCALAR("sheen-roughness", BRDF_SLOT_LAYER + 2, 0, 0, 1)}},
+      COLOR("sheen-color", BRDF_SLOT_SHEEN, 0, 0, 0, 0, 1), SCALAR("sheen-roughness", BRDF_SLOT_LAYER + 2, 0, 0, 1),
+      SCALAR("anisotropy", BRDF_SLOT_ANISO, 0, 0, 1), SCALAR("anisotropy-rotation", BRDF_SLOT_ANISO + 1, 0, -6.2832f, 6.2832f),
+      SCALAR("iridescence", BRDF_SLOT_IRID, 0, 0, 1), SCALAR("iridescence-ior", BRDF_SLOT_IRID + 1, 1.3f, 1, 4),
+      SCALAR("iridescence-thickness", BRDF_SLOT_IRID + 2, 400, 0, 2000),
+      SCALAR("diffuse-transmission", BRDF_SLOT_DT + 3, 0, 0, 1),
+      COLOR("diffuse-transmission-color", BRDF_SLOT_DT, 1, 1, 1, 0, 1)}},
 };
 const int brdf_num_models = (int)(sizeof brdf_models / sizeof *brdf_models);
 
@@ -224,6 +229,9 @@ void brdf_setting_to_query(const brdf_setting *s, BrdfQuery *q)
     q->extra = (vec4){v[7], v[8], v[9], v[10]};
     q->layer = (vec4){v[11], v[12], v[13], v[BRDF_SLOT_COAT_TILT]};
     q->sheen = (vec4){v[14], v[15], v[16], 0};
+    q->aniso = (vec4){v[BRDF_SLOT_ANISO], v[BRDF_SLOT_ANISO + 1], 0, 0};
+    q->irid = (vec4){v[BRDF_SLOT_IRID], v[BRDF_SLOT_IRID + 1], v[BRDF_SLOT_IRID + 2], 0};
+    q->dt = (vec4){v[BRDF_SLOT_DT], v[BRDF_SLOT_DT + 1], v[BRDF_SLOT_DT + 2], v[BRDF_SLOT_DT + 3]};
 }
 
 void brdf_format_setting(char *out, size_t cap, const brdf_setting *s)

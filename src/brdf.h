@@ -14,15 +14,19 @@
 
 /* Where a setting's values go: v[0..2] the colour, v[3..6] the four scalars (brdf_params),
  * v[7..10] glTF's extra (specular colour, transmission), v[11..13] glTF's layers (clearcoat,
- * clearcoat roughness, sheen roughness), v[14..16] the sheen colour (BrdfQuery.layer, .sheen). */
+ * clearcoat roughness, sheen roughness), v[14..16] the sheen colour (BrdfQuery.layer, .sheen),
+ * then the slots below. */
 #define BRDF_SLOT_COLOR 0
 #define BRDF_SLOT_PARAMS 3
 #define BRDF_SLOT_EXTRA 7
 #define BRDF_SLOT_LAYER 11
 #define BRDF_SLOT_SHEEN 14
 #define BRDF_SLOT_COAT_TILT 17 /* the coat normal's tilt (BrdfQuery.layer.w): no parameter, tests only */
-#define BRDF_NUM_SLOTS 18
-#define BRDF_MAX_PARAMS 12
+#define BRDF_SLOT_ANISO 18 /* anisotropy strength, rotation (BrdfQuery.aniso) */
+#define BRDF_SLOT_IRID 20  /* iridescence factor, film ior, thickness in nm (BrdfQuery.irid) */
+#define BRDF_SLOT_DT 23    /* diffuse transmission colour (3), factor (BrdfQuery.dt) */
+#define BRDF_NUM_SLOTS 27
+#define BRDF_MAX_PARAMS 18
 
 typedef struct brdf_param {
     const char *name; /* option name without the leading "--" */

@@ -316,6 +316,9 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
     scene.extra = q.extra;
     scene.layer = q.layer;
     scene.sheen = q.sheen;
+    scene.aniso = q.aniso;
+    scene.irid = q.irid;
+    scene.dt = q.dt;
     scene.light_dir = (vec3){-0.5f / 0.9718f, 0.6f / 0.9718f, 0.55f / 0.9718f}; /* upper left, front */
     scene.light_irradiance = (vec3){2.5f, 2.5f, 2.5f};
     scene.env = (vec3){0.3f, 0.3f, 0.3f};

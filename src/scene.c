@@ -151,7 +151,13 @@ void scene_material_default(GnMaterial *m)
     m->attenuation_distance = INFINITY;
     m->tex_clearcoat = m->tex_clearcoat_roughness = m->tex_clearcoat_normal = GN_INVALID;
     m->tex_sheen_color = m->tex_sheen_roughness = GN_INVALID;
+    m->tex_anisotropy = m->tex_iridescence = m->tex_iridescence_thickness = GN_INVALID;
+    m->tex_diffuse_transmission = m->tex_diffuse_transmission_color = GN_INVALID;
     m->clearcoat_normal_scale = 1;
+    m->iridescence_ior = 1.3f; /* KHR_materials_iridescence's defaults */
+    m->iridescence_thickness_min = 100;
+    m->iridescence_thickness_max = 400;
+    m->diffuse_transmission_color = (vec3){1, 1, 1};
     scene_phong_from_pbr(m);
 }
 
