@@ -81,8 +81,7 @@ void main()
         else if (MODE == GN_MODE_GOURAUD) color = gouraud_color(h, d);
         else if (MODE == GN_MODE_FLAT) color = flat_color(h, d);
     } else {
-        bool lit = MODE == GN_MODE_PHONG || MODE == GN_MODE_GOURAUD || MODE == GN_MODE_FLAT;
-        color = lit ? frame.env_color : vec3(0.0);
+        color = (mode_flags(MODE) & GN_MODEF_LIT) != 0u ? frame.env_color : vec3(0.0);
     }
     if (MODE == GN_MODE_COST) color = vec3(float(h.steps));
     accum[slot] += vec4(color, h.tri != GN_INVALID ? 1.0 : 0.0); // w: coverage

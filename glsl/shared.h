@@ -73,16 +73,37 @@ typedef uint32_t uint;
 #define GN_TILE_X 8u
 #define GN_TILE_Y 8u
 
-/* ---- integrator modes ----------------------------------------------------------------- */
-#define GN_MODE_PATH 0u
-#define GN_MODE_PHONG 1u
-#define GN_MODE_GOURAUD 2u
-#define GN_MODE_FLAT 3u
-#define GN_MODE_NORMAL 4u
-#define GN_MODE_ALBEDO 5u
-#define GN_MODE_DEPTH 6u
-#define GN_MODE_COST 7u /* BVH nodes visited per primary ray */
-#define GN_MODE_COUNT 8u
+/* ---- render modes: the one list -------------------------------------------------------
+ * X(ID, value, kernel, flags, name, help): mode GN_MODE_<ID> = value (0, 1, ... in list
+ * order: --mode's list, the help and the preview's number keys follow it), the kernel that
+ * renders it, its GN_MODEF_* and, for the host only (src/render.c's registry; glslang drops
+ * the unexpanded strings), its --mode name and its line of help. A mode of the local kernel
+ * is one branch of glsl/local.comp's local_color: a new mode is an entry here and that branch
+ * (docs/architecture.md, "Adding a render mode"). */
+#define GN_KERNEL_PATH 0u  /* glsl/path.comp: GN_PATH_SAMPLES samples a dispatch, resumed past the loop cap */
+#define GN_KERNEL_LOCAL 1u /* glsl/local.comp, specialised on the mode: one camera ray a sample */
+#define GN_MODEF_LIT 1u          /* the Phong model's lights: ambient, shadows; a miss shows the environment */
+#define GN_MODEF_VERTEX_LIGHT 2u /* the vertices are lit before the first dispatch (glsl/vertex.comp) */
+#define GN_MODES(X) \
+    X(PATH, 0u, GN_KERNEL_PATH, 0u, "path", "Monte Carlo path tracing of the rendering equation (default)") \
+    X(PHONG, 1u, GN_KERNEL_LOCAL, GN_MODEF_LIT, "phong", "the Phong reflection model, shaded per pixel") \
+    X(GOURAUD, 2u, GN_KERNEL_LOCAL, GN_MODEF_LIT | GN_MODEF_VERTEX_LIGHT, "gouraud", \
+      "the Phong reflection model at the vertices, interpolated") \
+    X(FLAT, 3u, GN_KERNEL_LOCAL, GN_MODEF_LIT, "flat", "the Phong reflection model, one colour a triangle") \
+    X(NORMAL, 4u, GN_KERNEL_LOCAL, 0u, "normal", "the shading normal (PNG: 0.5 + 0.5 n)") \
+    X(ALBEDO, 5u, GN_KERNEL_LOCAL, 0u, "albedo", "the surface's colour (base colour, or --brdf's)") \
+    X(DEPTH, 6u, GN_KERNEL_LOCAL, 0u, "depth", "distance along the camera axis, 0 where nothing is hit") \
+    X(COST, 7u, GN_KERNEL_LOCAL, 0u, "cost", "BVH nodes visited per primary ray (PNG: a colour map)")
+#ifdef VULKAN
+#define GN_MODE_ID(id, value, kernel, flags, name, help) const uint GN_MODE_##id = value;
+GN_MODES(GN_MODE_ID)
+#define GN_MODE_FLAGS(id, value, kernel, flags, name, help) if (mode == value) return flags;
+uint mode_flags(uint mode) { GN_MODES(GN_MODE_FLAGS) return 0u; }
+#else
+#define GN_MODE_ID(id, value, kernel, flags, name, help) GN_MODE_##id = value,
+enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
+#endif
+#undef GN_MODE_ID
 
 #define GN_LIGHT_POINT 0u
 #define GN_LIGHT_SPOT 1u

@@ -448,7 +448,7 @@ static bool parse_modes(const char *list, compare_opts *o)
     strcpy(buf, list);
     for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         int m = render_mode_from_name(tok);
-        if (m != GN_MODE_FLAT && m != GN_MODE_GOURAUD && m != GN_MODE_PHONG && m != GN_MODE_PATH)
+        if (m < 0 || !(render_modes[m].kernel == GN_KERNEL_PATH || render_modes[m].flags & GN_MODEF_LIT))
             return false;
         for (int i = 0; i < o->num_modes; i++)
             if (o->modes[i] == (uint32_t)m)

@@ -346,10 +346,7 @@ int cmd_render(int argc, char **argv)
                           "map up to the image's maximum (misses too: they walk the tree);\n"
                           "the background of depth and normals black",
          CLI_STRING, CLI_AS(const char *, &j.png_path), 0, 0, NULL, NULL},
-        {"--mode", "M", "path (default: Monte Carlo path tracing), phong, gouraud, flat,\n"
-                        "normal, albedo, depth, cost (depth: along the camera axis, 0 where\n"
-                        "nothing is hit, in the EXR as in the depth AOV)",
-         CLI_CALL, &j.s.mode, 0, 0, NULL, cli_take_mode},
+        {"--mode", "M", render_mode_help(), CLI_CALL, &j.s.mode, 0, 0, NULL, cli_take_mode},
         {"--spp", "N", "samples per pixel (default 16)", CLI_INT, CLI_AS(int, &j.s.spp), 1, 1 << 24,
          "an integer 1..16777216", NULL},
         {"--time", "SECONDS", "render for this long instead of --spp", CLI_DOUBLE, CLI_AS(double, &j.s.time_limit), FLT_MIN,

@@ -30,9 +30,8 @@ _Static_assert(IMAGE_TONEMAP_CLAMP == GN_TONEMAP_CLAMP && IMAGE_TONEMAP_ACES == 
 #define PREVIEW_MAX_BATCH 64             /* passes per frame at most */
 #define PREVIEW_IDLE_SECONDS 0.05        /* event wait once converged: repaints, not spins */
 
-static const char keys_help[] =
-    "gonio preview keys:\n"
-    "  1..8                mode: path, phong, gouraud, flat, normal, albedo, depth, cost\n"
+GN_STATIC_ASSERT(GN_MODE_COUNT <= 9, "a number key per mode");
+static const char keys_help_rest[] =
     "  left mouse          orbit around the target\n"
     "  right/middle mouse  pan\n"
     "  wheel               zoom (towards the target)\n"
@@ -45,9 +44,15 @@ static const char keys_help[] =
     "  H                   this help\n"
     "  Esc                 quit\n";
 
-static const uint32_t mode_keys[8] = {GN_MODE_PATH,   GN_MODE_PHONG,  GN_MODE_GOURAUD,
-                                      GN_MODE_FLAT,   GN_MODE_NORMAL, GN_MODE_ALBEDO,
-                                      GN_MODE_DEPTH,  GN_MODE_COST};
+/* The keys' help: the number keys are the modes in GN_MODES order. */
+static const char *keys_help(void)
+{
+    static char help[2048];
+    if (!help[0])
+        snprintf(help, sizeof help, "gonio preview keys:\n  1..%u                mode: %s\n%s", (unsigned)GN_MODE_COUNT,
+                 render_mode_list(), keys_help_rest);
+    return help;
+}
 
 typedef struct preview {
     scene sc;
@@ -211,8 +216,8 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     (void)mods;
     if (action == GLFW_RELEASE)
         return;
-    if (key >= GLFW_KEY_1 && key <= GLFW_KEY_8) {
-        uint32_t m = mode_keys[key - GLFW_KEY_1];
+    if (key >= GLFW_KEY_1 && key < GLFW_KEY_1 + (int)GN_MODE_COUNT) {
+        uint32_t m = (uint32_t)(key - GLFW_KEY_1);
         if (m != p->s.mode) {
             p->s.mode = m;
             p->restart = true;
@@ -241,7 +246,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT: p->exposure -= 0.5f; p->redraw = true; break;
     case GLFW_KEY_T: p->tonemap = (image_tonemap)((p->tonemap + 1) % 3); p->redraw = true; break;
     case GLFW_KEY_P: p->save = true; break;
-    case GLFW_KEY_H: fputs(keys_help, stdout); fflush(stdout); break;
+    case GLFW_KEY_H: fputs(keys_help(), stdout); fflush(stdout); break;
     default: break;
     }
 }
@@ -724,8 +729,7 @@ int cmd_preview(int argc, char **argv)
     bool no_shadows = false, quiet = false, outside = false;
     int scene_index = -1;
     const cli_option options[] = {
-        {"--mode", "M", "path (default), phong, gouraud, flat, normal, albedo, depth, cost", CLI_CALL,
-         &p->s.mode, 0, 0, NULL, cli_take_mode},
+        {"--mode", "M", render_mode_help(), CLI_CALL, &p->s.mode, 0, 0, NULL, cli_take_mode},
         {"--spp", "N", "stop accumulating at N samples per pixel (default: never)", CLI_INT, CLI_AS(int, &p->max_spp), 1,
          1 << 24, "an integer 1..16777216", NULL},
         {"--size", "WxH", "initial window size (default 640 wide, the camera's aspect)", CLI_CALL, size, 0, 0,
@@ -757,7 +761,7 @@ int cmd_preview(int argc, char **argv)
     };
     const cli_command command = {.name = "preview", .synopsis = "SCENE.gltf|.glb [options]",
                                  .intro = "Opens a window and shows the render converging; press H in it for the keys.\n",
-                                 CLI_OPTIONS(options), .epilog = keys_help, .min_args = 1, .max_args = 1,
+                                 CLI_OPTIONS(options), .epilog = keys_help(), .min_args = 1, .max_args = 1,
                                  .missing = "no scene given"};
     cli_args args;
     int rc = cli_parse(&command, argc, argv, &args);

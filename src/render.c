@@ -14,23 +14,62 @@
 #include "vertex.h" /* spv_vertex: glsl/vertex.comp */
 #include "util.h"
 
-static const char *const mode_names[GN_MODE_COUNT] = {
-    [GN_MODE_PATH] = "path",       [GN_MODE_PHONG] = "phong",   [GN_MODE_GOURAUD] = "gouraud",
-    [GN_MODE_FLAT] = "flat",       [GN_MODE_NORMAL] = "normal", [GN_MODE_ALBEDO] = "albedo",
-    [GN_MODE_DEPTH] = "depth",     [GN_MODE_COST] = "cost",
+/* ---- the registry of modes and kernels ---------------------------------------------------- */
+
+#define MODE_ENTRY(id, value, kernel, flags, name, help) [value] = {name, help, kernel, flags},
+const render_mode_info render_modes[GN_MODE_COUNT] = {GN_MODES(MODE_ENTRY)};
+#undef MODE_ENTRY
+
+/* The kernels the modes name. specialised: the GN_FEAT_* the kernel is built for as the
+ * scene needs them (the others compiled in); the path kernel is specialised on all, the
+ * local one only on what its lookups test per pixel (surfaces cut away: glsl/bvh.glsl;
+ * texture transforms and TEXCOORD_1: glsl/scene.glsl). batched: it takes up to
+ * renderer.path_samples samples a dispatch and is resumed past llvmpipe's loop cap (the
+ * GN_SPEC_LOOP_CAP constant, renderer_finish); otherwise one sample a dispatch. */
+typedef struct render_kernel {
+    const char *name;
+    const uint32_t *code;
+    size_t code_size;
+    uint32_t specialised;
+    bool batched;
+} render_kernel;
+
+static const render_kernel kernels[] = {
+    [GN_KERNEL_PATH] = {"path", spv_path, sizeof spv_path, GN_FEAT_ALL, true},
+    [GN_KERNEL_LOCAL] = {"local", spv_local, sizeof spv_local, GN_FEAT_ALPHA | GN_FEAT_TEX_TRANSFORM | GN_FEAT_UV1,
+                         false},
 };
+
+static const render_kernel *mode_kernel(uint32_t mode) { return &kernels[render_modes[mode].kernel]; }
 
 int render_mode_from_name(const char *name)
 {
     for (int i = 0; i < (int)GN_MODE_COUNT; i++)
-        if (strcmp(name, mode_names[i]) == 0)
+        if (strcmp(name, render_modes[i].name) == 0)
             return i;
     return -1;
 }
 
-const char *render_mode_name(uint32_t mode) { return mode < GN_MODE_COUNT ? mode_names[mode] : "?"; }
+const char *render_mode_name(uint32_t mode) { return mode < GN_MODE_COUNT ? render_modes[mode].name : "?"; }
 
-const char *render_mode_list(void) { return "path, phong, gouraud, flat, normal, albedo, depth, cost"; }
+const char *render_mode_list(void)
+{
+    static char list[256];
+    if (!list[0])
+        for (uint32_t i = 0; i < GN_MODE_COUNT; i++)
+            snprintf(list + strlen(list), sizeof list - strlen(list), "%s%s", i ? ", " : "", render_modes[i].name);
+    return list;
+}
+
+const char *render_mode_help(void)
+{
+    static char help[2048];
+    if (!help[0])
+        for (uint32_t i = 0; i < GN_MODE_COUNT; i++)
+            snprintf(help + strlen(help), sizeof help - strlen(help), "%s%-8s %s", i ? "\n" : "",
+                     render_modes[i].name, render_modes[i].help);
+    return help;
+}
 
 /* Emissive geometry as lights for the local modes when a scene has no punctual light (the
  * Cornell box): one light per emissive material at the power-weighted centroid. A flat
@@ -973,17 +1012,15 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     gpu_buffer_fill_zero(g, &r->squares);
     gpu_buffer_fill_zero(g, &r->pstate);
     gpu_buffer_fill_zero(g, &r->status);
-    return s->mode != GN_MODE_GOURAUD || light_vertices(r);
+    return !(render_modes[s->mode].flags & GN_MODEF_VERTEX_LIGHT) || light_vertices(r);
 }
 
-/* The GN_FEAT_* a mode's kernel is built for: the path kernel is specialised on all of
- * them, the local kernels only on GN_FEAT_ALPHA (surfaces cut away, glsl/bvh.glsl) and the
- * texture lookups' GN_FEAT_TEX_TRANSFORM and GN_FEAT_UV1 (glsl/scene.glsl). */
+/* The GN_FEAT_* a mode's kernel is built for: those it is specialised on as the scene and
+ * settings need them, every other one compiled in. */
 static uint32_t kernel_features(const renderer *r, uint32_t mode)
 {
-    const uint32_t local = GN_FEAT_ALPHA | GN_FEAT_TEX_TRANSFORM | GN_FEAT_UV1;
-    return mode == GN_MODE_PATH ? r->path_features
-                                : (GN_FEAT_ALL & ~local) | (r->material_features & local);
+    const uint32_t spec = mode_kernel(mode)->specialised;
+    return (GN_FEAT_ALL & ~spec) | (r->path_features & spec);
 }
 
 /* The walk's stack in registers for trees of at most GN_WALK_REGS_MAX levels (a walk puts
@@ -1021,13 +1058,12 @@ gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
         gpu_binding b[GN_BIND_COUNT];
         renderer_spec spec;
         gpu_pipeline_desc pd = {
-            .name = mode == GN_MODE_PATH ? "path" : "local",
-            .code = mode == GN_MODE_PATH ? spv_path : spv_local,
-            .code_size = mode == GN_MODE_PATH ? sizeof spv_path : sizeof spv_local,
+            .name = mode_kernel(mode)->name, .code = mode_kernel(mode)->code,
+            .code_size = mode_kernel(mode)->code_size,
             .local_size = {GN_TILE_X, GN_TILE_Y, 1}, .push_size = sizeof(GnPush),
             .bindings = b, .num_bindings = renderer_bindings(r, b),
             .specialization = renderer_specialize(r, mode, &spec)};
-        spec.values[3] = mode == GN_MODE_PATH ? r->loop_cap : 0u;
+        spec.values[3] = mode_kernel(mode)->batched ? r->loop_cap : 0u;
         gpu_pipeline_create(r->g, p, &pd);
     }
     return p;
@@ -1036,9 +1072,9 @@ gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,
                              uint32_t count)
 {
-    /* The path kernel takes up to GN_PATH_SAMPLES samples per dispatch (glsl/path.comp:
-     * a lane whose path ends starts its next one); the others one. */
-    uint32_t per = mode == GN_MODE_PATH ? r->path_samples : 1u;
+    /* A batched kernel takes up to path_samples samples per dispatch (glsl/path.comp: a lane
+     * whose path ends starts its next one); the others one. */
+    uint32_t per = mode_kernel(mode)->batched ? r->path_samples : 1u;
     for (uint32_t i = 0; i < count; i += per) {
         GnPush push = {first + i, 0, count - i < per ? count - i : per, 0};
         gpu_dispatch(cmd, renderer_pipeline(r, mode), &push, (uint32_t)r->width, (uint32_t)r->height, 1);
@@ -1052,7 +1088,7 @@ uint32_t renderer_finish(renderer *r, uint32_t mode, uint32_t next)
     /* status[1]: the pixels pending after the last dispatch. Each dispatch that takes no new
      * samples gives every pending pixel one more invocation's worth of loop passes. */
     volatile const uint32_t *pending = (const uint32_t *)r->status.mapped + 1;
-    while (mode == GN_MODE_PATH && r->loop_cap && *pending) {
+    while (mode_kernel(mode)->batched && r->loop_cap && *pending) {
         VkCommandBuffer cmd = gpu_begin(r->g);
         GnPush push = {next, 0, 0, 0};
         gpu_dispatch(cmd, renderer_pipeline(r, mode), &push, (uint32_t)r->width, (uint32_t)r->height, 1);
@@ -1236,7 +1272,7 @@ static bool begin_bands(renderer *r, const render_settings *s, const int region[
         r->band_squares = util_calloc(4 * pixels, sizeof(float));
     r->region_width = rw;
     r->region_height = rh;
-    return s->mode != GN_MODE_GOURAUD || light_vertices(r);
+    return !(render_modes[s->mode].flags & GN_MODEF_VERTEX_LIGHT) || light_vertices(r);
 }
 
 /* Band b's frame uploaded and its sums (host) copied into the buffers (load), or the
@@ -1268,7 +1304,7 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
     GnFrame frame;
     double t0;
     int done = 0, batch = 1, region[4], rows, bands;
-    const int per = s->mode == GN_MODE_PATH ? (int)r->path_samples : 1;
+    const int per = mode_kernel(s->mode)->batched ? (int)r->path_samples : 1;
     progress prog = {.tty = isatty(2), .tenth = -1};
     char why[256];
 

@@ -136,7 +136,6 @@ const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode
 
 /* The kernel of a mode (created on first use, kept until renderer_destroy). */
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode);
-bool renderer_mode_available(uint32_t mode);
 /* Records one sample pass (sample `sample_index` in every pixel) and a barrier. Call
  * renderer_begin first. */
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,
@@ -168,10 +167,21 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
  * extras). False with an error naming the scene and material on a bad name or value. */
 bool render_material_overrides(scene *sc, const char *brdf);
 
+/* The render modes (glsl/shared.h: GN_MODES) as the host reads them, indexed by GN_MODE_*. */
+typedef struct render_mode_info {
+    const char *name; /* --mode's */
+    const char *help; /* a line */
+    uint32_t kernel;  /* GN_KERNEL_* */
+    uint32_t flags;   /* GN_MODEF_* */
+} render_mode_info;
+extern const render_mode_info render_modes[GN_MODE_COUNT];
+
 /* Name <-> GN_MODE_* ("path", "phong", ...); -1 when unknown. */
 int render_mode_from_name(const char *name);
 const char *render_mode_name(uint32_t mode);
 /* Comma-separated list of every mode name, for messages. */
 const char *render_mode_list(void);
+/* A line per mode, "name  help", for --mode's help. */
+const char *render_mode_help(void);
 
 #endif

@@ -72,7 +72,7 @@ static void add_attr(render_header *h, image_attr a)
 void render_header_build(render_header *h, const renderer *r, const render_settings *s,
                          const render_stats *st, const char *brdf)
 {
-    const bool lit = s->mode == GN_MODE_PHONG || s->mode == GN_MODE_GOURAUD || s->mode == GN_MODE_FLAT;
+    const bool lit = render_modes[s->mode].flags & GN_MODEF_LIT;
     GnCamera cam;
     memset(h, 0, sizeof *h);
     if (!renderer_camera(r, s, &cam)) /* cannot fail: the render just used it */
