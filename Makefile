@@ -22,7 +22,12 @@ PKGS := vulkan glfw3 OpenEXR tinygltf nlohmann_json libpng zlib stb draco
 # meshoptimizer ships no pkg-config file (Debian 12): linked by name.
 LIBS_EXTRA := -lmeshoptimizer
 WARN := -Wall -Wextra -Wshadow -Werror
-CPPFLAGS += -Isrc -Iglsl -I$(BUILD)/spv -MMD -MP
+# The folders of the architecture (docs/architecture.md): core (errors, images, Vulkan, plots),
+# scene (glTF, meshes, camera, environment), accel (the BVH), render (the renderer, BRDFs,
+# outputs), cli (the commands); glsl/lib holds what kernels include, glsl/kernels the
+# program's kernels, tests/kernels the unit tests' own.
+SRC_DIRS := src/core src/scene src/accel src/render src/cli
+CPPFLAGS += $(SRC_DIRS:%=-I%) -Iglsl/lib -I$(BUILD)/spv -MMD -MP
 CFLAGS += -std=c11 -D_DEFAULT_SOURCE -pthread $(WARN)
 CXXFLAGS += -std=c++14 -pthread -Wall -Wextra -Werror
 LDFLAGS += -pthread
@@ -51,16 +56,17 @@ CXXFLAGS += $(OPT)
 PKG_CFLAGS = $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS = $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 
-SRC_C := $(filter-out src/main.c,$(wildcard src/*.c))
-SRC_CXX := $(wildcard src/*.cpp)
+SRC_C := $(filter-out src/cli/main.c,$(wildcard $(SRC_DIRS:%=%/*.c)))
+SRC_CXX := $(wildcard $(SRC_DIRS:%=%/*.cpp))
 LIB_OBJ := $(SRC_C:%.c=$(BUILD)/%.o) $(SRC_CXX:%.cpp=$(BUILD)/%.o)
-MAIN_OBJ := $(BUILD)/src/main.o
+MAIN_OBJ := $(BUILD)/src/cli/main.o
 TEST_SRC := $(wildcard tests/unit/*.c)
 TEST_OBJ := $(TEST_SRC:%.c=$(BUILD)/%.o)
 TOOL_OBJ := $(patsubst %.c,$(BUILD)/%.o,$(wildcard tests/tool/*.c)) \
 	$(patsubst %.cpp,$(BUILD)/%.o,$(wildcard tests/tool/*.cpp))
-SHADERS := $(wildcard glsl/*.comp)
-SPV_HDR := $(SHADERS:glsl/%.comp=$(BUILD)/spv/%.h)
+SHADERS := $(wildcard glsl/kernels/*.comp tests/kernels/*.comp)
+SPV_HDR := $(patsubst %.comp,$(BUILD)/spv/%.h,$(notdir $(SHADERS)))
+vpath %.comp glsl/kernels tests/kernels
 
 GONIO := $(BUILD)/gonio
 UNIT := $(BUILD)/unit_tests
@@ -136,11 +142,11 @@ $(BUILD)/%.o: %.cpp | deps
 	$(CXX) $(CPPFLAGS) $(PKG_CFLAGS) $(CXXFLAGS) -c -o $@ $<
 
 # Shaders: GLSL -> SPIR-V (checked by spirv-val) -> C array in a generated header.
-$(BUILD)/spv/%.h: glsl/%.comp | deps
+$(BUILD)/spv/%.h: %.comp | deps
 	@mkdir -p $(dir $@)
-	glslangValidator -V --target-env vulkan1.1 -Iglsl --depfile $(BUILD)/spv/$*.d -o $(BUILD)/spv/$*.spv $< >/dev/null || { glslangValidator -V --target-env vulkan1.1 -Iglsl -o /dev/null $<; exit 1; }
+	glslangValidator -V --target-env vulkan1.1 -Iglsl/lib --depfile $(BUILD)/spv/$*.d -o $(BUILD)/spv/$*.spv $< >/dev/null || { glslangValidator -V --target-env vulkan1.1 -Iglsl/lib -o /dev/null $<; exit 1; }
 	spirv-val --target-env vulkan1.1 $(BUILD)/spv/$*.spv
-	glslangValidator -V --target-env vulkan1.1 -Iglsl --vn spv_$(subst -,_,$*) -o $@ $< >/dev/null
+	glslangValidator -V --target-env vulkan1.1 -Iglsl/lib --vn spv_$(subst -,_,$*) -o $@ $< >/dev/null
 	@sed -i 's|\.spv:|.h:|' $(BUILD)/spv/$*.d
 shaders: $(SPV_HDR)
 

@@ -2,7 +2,7 @@
 # assets.sh: files the project did not write, rendered as a new user would, with no flags
 # but the output: every Khronos sample model and every glTF Asset Generator model must
 # render (exit 0) and show itself lit: the pixels it covers are not black. A scene without
-# lights of its own gets the studio environment (src/environment.h); one with them keeps
+# lights of its own gets the studio environment (src/scene/environment.h); one with them keeps
 # them. Skips when the third-party assets are absent.
 . "$(dirname "$0")/../lib.sh"
 G=$GONIO

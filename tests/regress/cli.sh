@@ -70,7 +70,7 @@ check "options that apply: no warning" test ! -s "$tmp/w.err"
 check "albedo with --brdf, --ambient, --no-shadows: no warning about --brdf" sh -c "! grep -q brdf '$tmp/w.err'"
 
 # ---- gonio info: emitters and cameras ---------------------------------------------------
-# The Cornell box's light is one quad (src/cmd_scene.c); its camera stands at (0, 0.273,
+# The Cornell box's light is one quad (src/cli/cmd_scene.c); its camera stands at (0, 0.273,
 # 0.8) looking down -Z with the published 39.3 degrees.
 "$G" info $C >"$tmp/info.txt"
 check "info: the Cornell box's light, 2 triangles" grep -q '^emissive  *2 triangles in 1 material(s): light (2)$' "$tmp/info.txt"

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # hostile.sh: inputs that try to make gonio read what it should not or misread what it
-# reads. A scene reads only regular files under its own folder (src/scene.h); errors name
+# reads. A scene reads only regular files under its own folder (src/scene/scene.h); errors name
 # the URI and reveal nothing about the file refused. Scenes are glTF JSON written by Python.
-# Also: command-line values parsed strictly, and what an output path may be (src/util.h).
+# Also: command-line values parsed strictly, and what an output path may be (src/core/util.h).
 . "$(dirname "$0")/../lib.sh"
 G=$GONIO
 command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
@@ -198,7 +198,7 @@ check "... (--alpha)" grep -q -- "--alpha 5 is out of range" "$tmp/last"
 # before LeakSanitizer could name its allocations).
 check_fails "--device 63 is refused cleanly" 1 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --device 63 --quiet
 check "... naming the devices" grep -q "only .* device(s)" "$tmp/last"
-# ---- Outputs: a new name or a writable regular file, nothing else (src/util.h) ------------
+# ---- Outputs: a new name or a writable regular file, nothing else (src/core/util.h) ------------
 O=$tmp/outputs
 mkdir -p "$O"
 R="--size 8x8 --spp 1 --quiet"

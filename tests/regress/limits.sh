@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# limits.sh: the device's limits (src/gpu.c: gpu_storage_limit, gpu_max_texels,
+# limits.sh: the device's limits (src/core/gpu.c: gpu_storage_limit, gpu_max_texels,
 # gpu_max_groups). A render above the storage-buffer range is rendered in bands, bit for bit
 # the render in one piece (or in other bands); the AOV and squares buffers exist only when
 # asked for; Gouraud's vertex pass dispatches in rows of work groups; what cannot be done at

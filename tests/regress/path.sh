@@ -30,7 +30,7 @@ same_pixels() {
     fi
 }
 
-# The path kernel is specialised on what the scene needs (GN_FEAT_* in glsl/shared.h):
+# The path kernel is specialised on what the scene needs (GN_FEAT_* in glsl/lib/shared.h):
 # removing code must not change a single pixel. Each case renders specialised and with
 # every feature (GONIO_ALL_FEATURES) and demands the same image, for every BRDF model, each
 # estimator, the AOVs, both kinds of environment, and sample models with textures, normal
@@ -57,7 +57,7 @@ f=${GONIO_ASSETS:-}/asset-generator/Material_MetallicRoughness/Material_Metallic
 [ -f "$f" ] && same_as_unspecialised "vertex colours (Asset Generator)" "$f" --env 0.5
 
 # The walk keeps its stack in registers for trees of up to GN_WALK_REGS_MAX levels
-# (glsl/bvh.glsl): every pixel must be what the stack in memory gives (GONIO_WALK_ARRAY=1),
+# (glsl/lib/bvh.glsl): every pixel must be what the stack in memory gives (GONIO_WALK_ARRAY=1),
 # in the path kernel and the local modes.
 same_as_stack_array() { same_pixels "stack in registers = in memory" GONIO_WALK_ARRAY=1 "$@"; }
 d=$("$G" info $C | awk '$1 == "bvh" && $2 == "depth" {print $3}')

@@ -1,11 +1,11 @@
-/* sheen_table.c (testtool sheen-table): writes glsl/sheen_albedo.h, the directional albedo
- * E(cos theta, r) of the sheen lobe of glsl/brdf.glsl (Charlie distribution and the
+/* sheen_table.c (testtool sheen-table): writes glsl/lib/sheen_albedo.h, the directional albedo
+ * E(cos theta, r) of the sheen lobe of glsl/lib/brdf.glsl (Charlie distribution and the
  * visibility of Estevez & Kulla 2017 that KHR_materials_sheen gives, unit colour) on a
  * SHEEN_N x SHEEN_N grid (rows at cos theta = (i / (SHEEN_N - 1))^2), by midpoint quadrature
  * over the hemisphere in double precision. KHR_materials_sheen scales the layers below by
  * 1 - max(colour) E, which needs E at every path vertex: a table read is cheap, the integral
  * is not. Regenerate (about a minute):
- *   make build/release/testtool && build/release/testtool sheen-table > glsl/sheen_albedo.h
+ *   make build/release/testtool && build/release/testtool sheen-table > glsl/lib/sheen_albedo.h
  * test_brdf.c (sheen_albedo) checks the table against Monte Carlo of the same formulas and
  * quadrature of the shader's own eval. */
 #include <math.h>
@@ -63,7 +63,7 @@ int sheen_table(void)
            " * Directional albedo E of the sheen lobe (brdf.glsl: brdf_sheen, before its division by\n"
            " * max(1, E)) at cos theta = (i / %d)^2 (rows: E rises from 0 within a few degrees of\n"
            " * grazing) and sheen roughness r = j / %d (columns; r below %g is taken as %g). The host\n"
-           " * hands the values to the kernels in a texel buffer (src/brdf.c: brdf_sheen_table). */\n"
+           " * hands the values to the kernels in a texel buffer (src/render/brdf.c: brdf_sheen_table). */\n"
            "#define SHEEN_N %d\n"
            "#define SHEEN_ALBEDO_VALUES \\\n", SHEEN_N - 1, SHEEN_N - 1, R_MIN, R_MIN, SHEEN_N);
     for (int i = 0; i < SHEEN_N; i++) {

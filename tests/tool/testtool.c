@@ -395,7 +395,7 @@ done:
 /* compress.cpp: IN.gltf encoded with Draco or meshoptimizer, losslessly, into OUT.gltf. */
 int tool_compress(const char *how, const char *in, const char *out);
 
-/* sheen_table.c: glsl/sheen_albedo.h on stdout. */
+/* sheen_table.c: glsl/lib/sheen_albedo.h on stdout. */
 int sheen_table(void);
 
 int main(int argc, char **argv)

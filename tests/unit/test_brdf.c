@@ -1,5 +1,5 @@
-/* test_brdf.c: the BRDF library (glsl/brdf.glsl) proven physical on the GPU through
- * glsl/brdf_test.comp: finiteness and positivity everywhere, Helmholtz reciprocity, energy
+/* test_brdf.c: the BRDF library (glsl/lib/brdf.glsl) proven physical on the GPU through
+ * glsl/kernels/brdf_test.comp: finiteness and positivity everywhere, Helmholtz reciprocity, energy
  * conservation (white-furnace albedo <= 1, = albedo for Lambert), sampling against the pdf
  * by a chi-square test (as pbrt-v4 and Mitsuba 3 do), pdf normalisation, weight = f cos/pdf,
  * the Fresnel equations against analytic values and a complex-arithmetic reference, the
@@ -884,7 +884,7 @@ TEST(brdf, layers_limit)
     close_runner();
 }
 
-/* The sheen's albedo table (glsl/sheen_albedo.h) against an independent integral: Monte Carlo
+/* The sheen's albedo table (glsl/lib/sheen_albedo.h) against an independent integral: Monte Carlo
  * over the hemisphere (uniform directions) of the README's Charlie D and Estevez & Kulla's
  * visibility, at points between the table's rows and columns. And the shader's sheen lobe
  * integrates to the table: quadrature of eval for a sheen over a black base at roughness

@@ -1,4 +1,4 @@
-/* test_gpu.c: the GLSL traversal (glsl/bvh.glsl, run by glsl/trace_test.comp on the
+/* test_gpu.c: the GLSL traversal (glsl/lib/bvh.glsl, run by tests/kernels/trace_test.comp on the
  * Vulkan device) against the C traversal of the same GnBvhNode layout and against brute
  * force, on random, degenerate, edge-on and deep meshes; and the renderer end to end on a
  * scene with an analytic answer. */
@@ -14,8 +14,8 @@
 #include "render.h"
 #include "scene_mesh.h"
 #include "test.h"
-#include "trace_test.h" /* spv_trace_test: glsl/trace_test.comp compiled by the build */
-#include "wrap_test.h"  /* spv_wrap_test: glsl/wrap_test.comp */
+#include "trace_test.h" /* spv_trace_test: tests/kernels/trace_test.comp compiled by the build */
+#include "wrap_test.h"  /* spv_wrap_test: tests/kernels/wrap_test.comp */
 
 typedef struct ray {
     float o[3], tmin, d[3], tmax;
@@ -381,7 +381,7 @@ TEST(gpu, traversal_deep)
     gpu_destroy(&g);
 }
 
-/* Texture wrapping (glsl/wrap.glsl computes the modulo through a float quotient) against
+/* Texture wrapping (glsl/lib/wrap.glsl computes the modulo through a float quotient) against
  * integer arithmetic: every mode, texture sizes from 1 to 2^13 + 1, indices around multiples
  * of the period, negative ones and ones near 2^24 (the function's exact range). */
 static int wrap_reference(int i, int n, int mode)

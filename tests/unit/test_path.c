@@ -1,4 +1,4 @@
-/* test_path.c: the path tracer (glsl/path.comp) against answers it does not compute itself:
+/* test_path.c: the path tracer (glsl/kernels/path.comp) against answers it does not compute itself:
  * furnaces (a closed convex object of albedo a under a constant environment of radiance 1
  * shows a), the three estimators (MIS, light only, BSDF only) against each other, the error
  * falling as 1/sqrt(spp), the Cornell box against a brute-force CPU path tracer written
@@ -658,7 +658,7 @@ TEST(path, merge_checks)
 }
 
 /* A path longer than one invocation may run: camera rays down the axis of the comb (50,000
- * teeth whose boxes all hold the axis, src/meshgen.c) visit every node before they reach the
+ * teeth whose boxes all hold the axis, src/scene/meshgen.c) visit every node before they reach the
  * triangle across its far end, far more loop iterations than llvmpipe lets an invocation
  * run. Every surface emits radiance 1 (both sides) and reflects nothing (black, no specular),
  * so each sample is exactly 1 whatever happens after the first hit: the image must be 1

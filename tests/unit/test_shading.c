@@ -1,5 +1,5 @@
 /* test_shading.c: the three shading algorithms of the lecture on the Vulkan device (glsl/
- * local.comp, glsl/vertex.comp) against the Phong reflection model written out again here in
+ * local.comp, glsl/kernels/vertex.comp) against the Phong reflection model written out again here in
  * C: Gouraud's vertex colours and their barycentric interpolation, flat shading's one colour
  * per triangle, per-pixel Phong shading converging to the analytic sphere, and the highlight
  * inside a triangle that Gouraud shading misses. */

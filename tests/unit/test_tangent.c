@@ -1,4 +1,4 @@
-/* test_tangent.c: src/tangent.c on meshes whose tangents follow from the glTF convention by
+/* test_tangent.c: src/scene/tangent.c on meshes whose tangents follow from the glTF convention by
  * hand: bitangent = cross(normal, tangent.xyz) * w must point toward decreasing v (glTF's
  * uv origin is the image's top left, and a normal map's +Y is up in the image). */
 #include <math.h>

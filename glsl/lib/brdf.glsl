@@ -1,0 +1,862 @@
+// brdf.glsl: the BSDFs of the lecture (materials-lecture.txt) with eval, pdf and importance
+// sampling in the local shading frame, used by every integrator and by brdf_test.comp.
+// Lambert f = C = albedo/pi; the mirror f = delta(wi - r(wo)) / (n.wi); normalised Phong
+// (Lafortune & Willems 1994) and Blinn-Phong; Torrance-Sparrow f = F D G / (4 (n.wo)(n.wi))
+// with Blinn's D = (e+2)/(2pi) (n.wh)^e and the V-cavity G (Cook & Torrance 1982); Beckmann
+// and GGX with height-correlated Smith G (Heitz 2014), GGX sampled by visible normals (Heitz
+// 2018); rough dielectrics after Walter et al. 2007 as written in pbrt-v4; the exact
+// dielectric and conductor Fresnel equations and Schlick's approximation. docs/brdf.md
+// derives each one and names the test that checks it.
+//
+// Conventions: normal = +z; wo points to the viewer, wi to the light, both away from the
+// surface. bsdf_eval returns f (no cosine); bsdf_pdf is the solid-angle density with which
+// bsdf_sample picks wi; Dirac lobes are not in eval/pdf, only in sample (BRDF_FLAG_DELTA).
+// Transmission transports importance (flux): the 1/eta^2 radiance scale is left out, so
+// R + T = 1 at a smooth interface; it cancels on closed objects.
+#ifndef BRDF_GLSL
+#define BRDF_GLSL
+
+#include "brdf_models.h"
+#include "sampling.glsl"
+#include "sheen_albedo.h"
+// The sheen's table (sheen_albedo.h) comes in a texel buffer of float bits (src/render/brdf.c:
+// brdf_sheen_table): as a constant array llvmpipe took minutes to compile the kernel. A kernel
+// that has the table elsewhere defines BRDF_SHEEN_FETCH before including this file.
+#ifndef BRDF_SHEEN_FETCH
+layout(binding = BRDF_BIND_SHEEN) uniform usamplerBuffer sheen_table;
+#define BRDF_SHEEN_FETCH(i) uintBitsToFloat(texelFetch(sheen_table, (i)).x)
+#endif
+
+#define BRDF_PI 3.14159265358979
+// Below this GGX/Beckmann alpha a lobe is treated as smooth (a Dirac lobe): a narrower
+// lobe is under a tenth of a degree wide, which float directions cannot resolve.
+#define BRDF_ALPHA_MIN 1e-3
+
+// Bsdf.lobe: the one specular lobe
+#define BRDF_LOBE_NONE 0u
+#define BRDF_LOBE_MIRROR 1u
+#define BRDF_LOBE_PHONG 2u
+#define BRDF_LOBE_BLINN 3u
+#define BRDF_LOBE_TS 4u // Torrance-Sparrow: Blinn's D, V-cavity G
+#define BRDF_LOBE_BECKMANN 5u
+#define BRDF_LOBE_GGX 6u
+
+// Bsdf.fresnel: the Fresnel factor of the lobe
+#define BRDF_FRESNEL_NONE 0u       // the lobe's weight only
+#define BRDF_FRESNEL_DIELECTRIC 1u // exact, index ior
+#define BRDF_FRESNEL_CONDUCTOR 2u  // exact, complex index eta + i k
+#define BRDF_FRESNEL_SCHLICK 3u    // F0 = specular, F90 = f90
+
+// A sum of BRDFs (the lecture's "adding BRDFs"): a Lambert layer, one specular lobe and a
+// dielectric interface (reflection + refraction), each with its weight.
+struct Bsdf {
+    vec3 diffuse; uint lobe;          // Lambert weight kd; the lobe's kind
+    vec3 specular; uint fresnel;      // lobe weight ks (Schlick: F0); the lobe's Fresnel
+    vec3 eta; float shape;            // conductor index; exponent (Phong, Blinn) or alpha
+    vec3 k; float ior;                // conductor extinction; dielectric index (in / out)
+    vec3 tint; float dielectric;      // dielectric part: transmission tint, weight (0: none)
+    vec3 couple_f0; float couple_f90; // Schlick of the layer over the diffuse (0, 0: none)
+    float f90;                        // Schlick F90 of the lobe
+    // The layers over all of the above (bsdf_layers; GN_FEAT_LAYERS): a clear coat, a GGX
+    // dielectric of index 1.5 with its own normal, and a sheen (Charlie distribution).
+    float coat;                       // the coat's weight (0: none)
+    vec3 coat_n; float coat_alpha;    // the coat's normal (unit, local frame); its GGX alpha
+    vec3 sheen; float sheen_r;        // the sheen's colour (0: none); its roughness
+};
+
+struct BsdfSample {
+    vec3 wi;
+    vec3 weight; // f |n.wi| / pdf; for a Dirac lobe its reflectance over its probability
+    float pdf;   // solid-angle pdf; for a Dirac lobe the probability of choosing it
+    uint flags;  // BRDF_FLAG_*; 0 when no direction was sampled (weight 0)
+};
+
+// No direction sampled (weight 0).
+BsdfSample brdf_no_sample()
+{
+    BsdfSample s;
+    s.wi = vec3(0.0, 0.0, 1.0);
+    s.weight = vec3(0.0);
+    s.pdf = 0.0;
+    s.flags = 0u;
+    return s;
+}
+
+// A sampled non-Dirac direction wi with its f and whole-mixture pdf (none if pdf is 0).
+BsdfSample brdf_sample_from(vec3 wi, vec3 f, float pdf, uint flags)
+{
+    BsdfSample s = brdf_no_sample();
+    if (!(pdf > 0.0))
+        return s;
+    s.wi = wi;
+    s.pdf = pdf;
+    s.weight = f * abs(wi.z) / pdf;
+    s.flags = flags;
+    return s;
+}
+
+// ---- Fresnel --------------------------------------------------------------------------
+
+// The lecture's dielectric Fresnel: r_par, r_perp and F_r = (r_par^2 + r_perp^2) / 2 for
+// unpolarised light (F_t = 1 - F_r). eta = eta_inside / eta_outside with the normal on the
+// outside; cos_i < 0 means light arrives from inside. 1 under total internal reflection.
+float brdf_fresnel_dielectric(float cos_i, float eta)
+{
+    cos_i = clamp(cos_i, -1.0, 1.0);
+    if (cos_i < 0.0) {
+        eta = 1.0 / eta;
+        cos_i = -cos_i;
+    }
+    float sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if (sin2_t >= 1.0)
+        return 1.0;
+    float cos_t = sqrt(1.0 - sin2_t);
+    float r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5 * (r_par * r_par + r_perp * r_perp);
+}
+
+// Unpolarised reflectance of a conductor with complex index eta + i k seen from a medium of
+// index 1 (the closed form of the Fresnel equations with a complex cos_t, as in pbrt).
+vec3 brdf_fresnel_conductor(float cos_i, vec3 eta, vec3 k)
+{
+    float c = clamp(cos_i, 0.0, 1.0), c2 = c * c, s2 = 1.0 - c2;
+    vec3 eta2 = eta * eta, k2 = k * k;
+    vec3 t0 = eta2 - k2 - s2;
+    vec3 a2b2 = sqrt(t0 * t0 + 4.0 * eta2 * k2);
+    vec3 t1 = a2b2 + c2;
+    vec3 a = sqrt(max(0.5 * (a2b2 + t0), 0.0));
+    vec3 t2 = 2.0 * c * a;
+    vec3 rs = (t1 - t2) / (t1 + t2);
+    vec3 t3 = c2 * a2b2 + s2 * s2;
+    vec3 t4 = t2 * s2;
+    vec3 rp = rs * (t3 - t4) / (t3 + t4);
+    return 0.5 * (rp + rs);
+}
+
+// Schlick's approximation F = F0 + (F90 - F0)(1 - cos)^5 (the lecture has F90 = 1).
+vec3 brdf_fresnel_schlick(float cos_i, vec3 f0, float f90)
+{
+    float m = clamp(1.0 - cos_i, 0.0, 1.0), m2 = m * m;
+    return f0 + (f90 - f0) * (m2 * m2 * m);
+}
+
+// F0 = ((eta_t - eta_i) / (eta_t + eta_i))^2 with eta_i = 1.
+float brdf_schlick_f0(float ior)
+{
+    float r = (ior - 1.0) / (ior + 1.0);
+    return r * r;
+}
+
+// ---- microfacet distributions and masking ----------------------------------------------
+
+// GLSL leaves pow(0, 0) undefined; a cosine <= 0 is outside every lobe here.
+float brdf_pow(float x, float e)
+{
+    return x > 0.0 ? pow(x, e) : 0.0;
+}
+
+// Blinn's distribution as the lecture writes it: D = (e + 2) / (2 pi) (wh.n)^e.
+float brdf_d_blinn(float cos_h, float e)
+{
+    return (e + 2.0) / (2.0 * BRDF_PI) * brdf_pow(cos_h, e);
+}
+
+float brdf_d_beckmann(vec3 h, float a)
+{
+    float c2 = h.z * h.z;
+    if (h.z <= 0.0)
+        return 0.0;
+    return exp(-dot(h.xy, h.xy) / (c2 * a * a)) / (BRDF_PI * a * a * c2 * c2);
+}
+
+// Trowbridge-Reitz: D = a^2 / (pi (cos^2 (a^2 - 1) + 1)^2), with sin^2 taken from x, y so
+// the peak keeps its precision when alpha is small.
+float brdf_d_ggx(vec3 h, float a)
+{
+    if (h.z <= 0.0)
+        return 0.0;
+    float d = dot(h.xy, h.xy) + h.z * h.z * a * a;
+    return a * a / (BRDF_PI * d * d);
+}
+
+// Smith G1 of GGX, 2 |c| / (|c| + sqrt(c^2 + a^2 s^2)): no division by a small cosine.
+float brdf_g1_ggx(vec3 w, float a)
+{
+    float c = abs(w.z);
+    return 2.0 * c / (c + sqrt(w.z * w.z + a * a * dot(w.xy, w.xy)));
+}
+
+// Height-correlated Smith G2 / (4 |n.wo| |n.wi|) of GGX (Heitz 2014, eq. 99), finite at
+// grazing angles.
+float brdf_v_ggx(vec3 wo, vec3 wi, float a)
+{
+    float lo = abs(wi.z) * sqrt(wo.z * wo.z + a * a * dot(wo.xy, wo.xy));
+    float li = abs(wo.z) * sqrt(wi.z * wi.z + a * a * dot(wi.xy, wi.xy));
+    return 0.5 / (lo + li);
+}
+
+// Smith Lambda of Beckmann: (erf(m) - 1)/2 + exp(-m^2) / (2 m sqrt(pi)), m = cot / alpha;
+// erfc by Numerical Recipes' Chebyshev fit (relative error < 1.2e-7).
+float brdf_lambda_beckmann(vec3 w, float a)
+{
+    float s = length(w.xy);
+    if (s == 0.0)
+        return 0.0;
+    float m = max(abs(w.z) / (a * s), 1e-7);
+    float t = 1.0 / (1.0 + 0.5 * m);
+    float erfc = t * exp(-m * m - 1.26551223 + t * (1.00002368 + t * (0.37409196 + t * (0.09678418 +
+                 t * (-0.18628806 + t * (0.27886807 + t * (-1.13520398 + t * (1.48851587 +
+                 t * (-0.82215223 + t * 0.17087277)))))))));
+    return max(0.0, 0.5 * (exp(-m * m) / (m * 1.7724538509) - erfc));
+}
+
+// Visible normal of GGX seen from w (w.z > 0), Heitz 2018 (JCGT 7(4)): pdf of the normal is
+// G1(w) max(0, w.h) D(h) / w.z.
+vec3 brdf_ggx_sample_vndf(vec3 w, float a, vec2 u)
+{
+    vec3 vh = normalize(vec3(a * w.x, a * w.y, w.z));
+    float len2 = dot(vh.xy, vh.xy);
+    vec3 t1 = len2 > 0.0 ? vec3(-vh.y, vh.x, 0.0) * inversesqrt(len2) : vec3(1.0, 0.0, 0.0);
+    vec3 t2 = cross(vh, t1);
+    float r = sqrt(u.x), phi = 2.0 * BRDF_PI * u.y;
+    float p1 = r * cos(phi), p2 = r * sin(phi);
+    float s = 0.5 * (1.0 + vh.z);
+    p2 = (1.0 - s) * sqrt(max(0.0, 1.0 - p1 * p1)) + s * p2;
+    vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
+    return normalize(vec3(a * nh.x, a * nh.y, max(0.0, nh.z)));
+}
+
+// wo refracted through the interface with normal n and eta = eta_inside / eta_outside
+// (n on the outside); false under total internal reflection.
+bool brdf_refract(vec3 wo, vec3 n, float eta, out vec3 wt)
+{
+    float ci = dot(n, wo);
+    if (ci < 0.0) {
+        eta = 1.0 / eta;
+        ci = -ci;
+        n = -n;
+    }
+    float s2t = max(0.0, 1.0 - ci * ci) / (eta * eta);
+    wt = vec3(0.0);
+    if (s2t >= 1.0)
+        return false;
+    wt = -wo / eta + (ci / eta - sqrt(1.0 - s2t)) * n;
+    return true;
+}
+
+// ---- the parts of a Bsdf -----------------------------------------------------------------
+
+// The lobe's Fresnel factor times its weight, at cos = wo.wh.
+vec3 brdf_lobe_fresnel(Bsdf b, float c)
+{
+    if (GN_HAS(GN_FEAT_FRESNEL_DIELECTRIC) && b.fresnel == BRDF_FRESNEL_DIELECTRIC)
+        return b.specular * brdf_fresnel_dielectric(c, b.ior);
+    if (GN_HAS(GN_FEAT_FRESNEL_CONDUCTOR) && b.fresnel == BRDF_FRESNEL_CONDUCTOR)
+        return b.specular * brdf_fresnel_conductor(c, b.eta, b.k);
+    if (GN_HAS(GN_FEAT_FRESNEL_SCHLICK) && b.fresnel == BRDF_FRESNEL_SCHLICK)
+        return brdf_fresnel_schlick(c, b.specular, b.f90);
+    return b.specular;
+}
+
+// Lambert under a Fresnel layer: kd/pi (1 - F(wo))(1 - F(wi)) / (1 - F_avg), with
+// F_avg = F0 + (F90 - F0)/21 the cosine-weighted mean of Schlick's F. Its albedo is
+// kd (1 - F(wo)) (Shirley et al. 1997), it is reciprocal, and with couple_f0 = f90 = 0 it is
+// the plain Lambert kd/pi.
+vec3 brdf_diffuse(Bsdf b, float co, float ci)
+{
+    if (!GN_HAS(GN_FEAT_COUPLED)) // couple_f0 = couple_f90 = 0: exactly the plain Lambert
+        return b.diffuse / BRDF_PI;
+    vec3 fo = brdf_fresnel_schlick(co, b.couple_f0, b.couple_f90);
+    vec3 fi = brdf_fresnel_schlick(ci, b.couple_f0, b.couple_f90);
+    vec3 avg = b.couple_f0 + (b.couple_f90 - b.couple_f0) / 21.0;
+    return b.diffuse / BRDF_PI * (1.0 - fo) * (1.0 - fi) / max(1.0 - avg, vec3(1e-6));
+}
+
+// f and pdf of the specular lobe for wo, wi above the surface.
+void brdf_lobe(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
+{
+    f = vec3(0.0);
+    pdf = 0.0;
+    float n = b.shape;
+    if (b.lobe == BRDF_LOBE_NONE || b.lobe == BRDF_LOBE_MIRROR)
+        return;
+    if (GN_HAS(GN_FEAT_PHONG) && b.lobe == BRDF_LOBE_PHONG) {
+        // (n+2)/(2 pi) cos^n of the angle between r(wi) and wo: albedo ks at normal
+        // incidence and less elsewhere; sampled about r(wo) with (n+1)/(2 pi) cos^n.
+        float v = brdf_pow(dot(vec3(-wi.xy, wi.z), wo), n);
+        f = b.specular * ((n + 2.0) / (2.0 * BRDF_PI) * v);
+        pdf = (n + 1.0) / (2.0 * BRDF_PI) * v;
+        return;
+    }
+    if (!GN_HAS(GN_FEAT_BLINN | GN_FEAT_TS | GN_FEAT_BECKMANN | GN_FEAT_GGX))
+        return;
+    vec3 h = normalize(wo + wi);
+    float oh = dot(wo, h);
+    if (GN_HAS(GN_FEAT_BLINN) && b.lobe == BRDF_LOBE_BLINN) {
+        // Normalised so the albedo at normal incidence is exactly ks (docs/brdf.md): the
+        // usual (n+8)/(8 pi) exceeds 1 by up to 7%.
+        float v = brdf_pow(h.z, n);
+        float norm = (n + 2.0) * (n + 4.0) / (8.0 * BRDF_PI * (n + exp2(-0.5 * n)));
+        f = b.specular * (norm * v);
+        pdf = (n + 1.0) / (2.0 * BRDF_PI) * v / (4.0 * oh);
+        return;
+    }
+    if (!GN_HAS(GN_FEAT_TS | GN_FEAT_BECKMANN | GN_FEAT_GGX))
+        return;
+    vec3 fr = brdf_lobe_fresnel(b, oh);
+    float dv = 0.0, pdf_h = 0.0; // D G / (4 cos_o cos_i); pdf of the normal h
+    if (GN_HAS(GN_FEAT_TS) && b.lobe == BRDF_LOBE_TS) {
+        float d = brdf_d_blinn(h.z, n);
+        float g = min(1.0, 2.0 * h.z * min(wo.z, wi.z) / oh);
+        dv = d * g / (4.0 * wo.z * wi.z);
+        pdf_h = d * h.z;
+    } else if (GN_HAS(GN_FEAT_BECKMANN) && b.lobe == BRDF_LOBE_BECKMANN) {
+        float d = brdf_d_beckmann(h, n);
+        float g = 1.0 / (1.0 + brdf_lambda_beckmann(wo, n) + brdf_lambda_beckmann(wi, n));
+        dv = d * g / (4.0 * wo.z * wi.z);
+        pdf_h = d * h.z;
+    } else if (GN_HAS(GN_FEAT_GGX) && b.lobe == BRDF_LOBE_GGX) {
+        float d = brdf_d_ggx(h, n);
+        dv = d * brdf_v_ggx(wo, wi, n);
+        pdf_h = brdf_g1_ggx(wo, n) * oh * d / wo.z;
+    }
+    f = fr * dv;
+    pdf = pdf_h / (4.0 * oh);
+}
+
+// A direction from the specular lobe's sampling density (may lie below the surface).
+vec3 brdf_lobe_sample(Bsdf b, vec3 wo, vec2 u)
+{
+    float n = b.shape, phi = 2.0 * BRDF_PI * u.y;
+    if (GN_HAS(GN_FEAT_PHONG) && b.lobe == BRDF_LOBE_PHONG) {
+        vec3 r = vec3(-wo.xy, wo.z), t, bt;
+        sampling_basis(r, t, bt);
+        float c = pow(u.x, 1.0 / (n + 1.0)), s = sqrt(max(0.0, 1.0 - c * c));
+        return (t * cos(phi) + bt * sin(phi)) * s + r * c;
+    }
+    vec3 h = vec3(0.0, 0.0, 1.0);
+    if (GN_HAS(GN_FEAT_GGX) && b.lobe == BRDF_LOBE_GGX) {
+        h = brdf_ggx_sample_vndf(wo, n, u);
+    } else if (GN_HAS(GN_FEAT_BLINN | GN_FEAT_TS | GN_FEAT_BECKMANN)) {
+        float c; // cos of the normal: density (n+1)/(2pi) c^n, D c for TS and Beckmann
+        if (GN_HAS(GN_FEAT_BLINN) && b.lobe == BRDF_LOBE_BLINN)
+            c = pow(u.x, 1.0 / (n + 1.0));
+        else if (GN_HAS(GN_FEAT_TS) && b.lobe == BRDF_LOBE_TS)
+            c = pow(u.x, 1.0 / (n + 2.0));
+        else
+            c = inversesqrt(1.0 - n * n * log(1.0 - u.x));
+        float s = sqrt(max(0.0, 1.0 - c * c));
+        h = vec3(s * cos(phi), s * sin(phi), c);
+    }
+    return 2.0 * dot(wo, h) * h - wo;
+}
+
+// f and pdf of the rough dielectric (GGX, alpha = shape), either side, reflection and
+// refraction, each chosen with its Fresnel probability. The generalised half vector
+// wm ~ eta wi + wo (Walter et al. 2007, eqs. 16, 21; pbrt-v4's DielectricBxDF).
+void brdf_rough_dielectric(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
+{
+    f = vec3(0.0);
+    pdf = 0.0;
+    float co = wo.z, ci = wi.z, a = b.shape;
+    if (co == 0.0 || ci == 0.0)
+        return;
+    bool reflect = co * ci > 0.0;
+    float etap = reflect ? 1.0 : (co > 0.0 ? b.ior : 1.0 / b.ior);
+    vec3 wm = wi * etap + wo;
+    if (dot(wm, wm) < 1e-20)
+        return;
+    wm = normalize(wm);
+    if (wm.z < 0.0)
+        wm = -wm;
+    float mo = dot(wm, wo), mi = dot(wm, wi);
+    if (mo * co <= 0.0 || mi * ci <= 0.0)
+        return; // the microfacet faces away from one of the directions
+    float fr = brdf_fresnel_dielectric(mo, b.ior);
+    float d = brdf_d_ggx(wm, a);
+    float v = brdf_v_ggx(wo, wi, a);
+    float pdf_m = brdf_g1_ggx(wo, a) * abs(mo) * d / abs(co);
+    if (reflect) {
+        f = vec3(fr * d * v);
+        pdf = fr * pdf_m / (4.0 * abs(mo));
+    } else {
+        float denom = mi + mo / etap;
+        denom *= denom;
+        f = b.tint * ((1.0 - fr) * d * 4.0 * v * abs(mi * mo) / denom);
+        pdf = (1.0 - fr) * pdf_m * abs(mi) / denom;
+    }
+}
+
+// Probabilities of sampling the diffuse layer, the lobe and the dielectric from wo: their
+// albedo estimates at wo, normalised.
+vec3 brdf_part_weights(Bsdf b, vec3 wo)
+{
+    vec3 p = vec3(0.0);
+    if (wo.z > 0.0) {
+        vec3 d = b.diffuse * (1.0 - brdf_fresnel_schlick(wo.z, b.couple_f0, b.couple_f90));
+        p.x = (d.r + d.g + d.b) / 3.0;
+        if (GN_HAS(GN_FEAT_LOBES) && b.lobe != BRDF_LOBE_NONE) {
+            vec3 s = brdf_lobe_fresnel(b, wo.z);
+            p.y = (s.r + s.g + s.b) / 3.0;
+        }
+    }
+    if (GN_HAS(GN_FEAT_GLASS) && wo.z != 0.0)
+        p.z = b.dielectric;
+    return p;
+}
+
+vec3 brdf_part_probs(Bsdf b, vec3 wo)
+{
+    vec3 p = brdf_part_weights(b, wo);
+    float sum = p.x + p.y + p.z;
+    return sum > 0.0 ? p / sum : vec3(0.0);
+}
+
+// ---- the base: the sum of the parts ------------------------------------------------------
+
+// f(wo, wi) and pdf(wo, wi) of the base's non-Dirac parts.
+void brdf_base_eval_pdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
+{
+    vec3 p = brdf_part_probs(b, wo);
+    f = vec3(0.0);
+    pdf = 0.0;
+    if (wo.z > 0.0 && wi.z > 0.0) {
+        vec3 fl;
+        float pl;
+        brdf_lobe(b, wo, wi, fl, pl);
+        f = brdf_diffuse(b, wo.z, wi.z) + fl;
+        pdf = p.x * wi.z / BRDF_PI + p.y * pl;
+    }
+    if (GN_HAS(GN_FEAT_ROUGH_GLASS) && b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN) {
+        vec3 ft;
+        float pt;
+        brdf_rough_dielectric(b, wo, wi, ft, pt);
+        f += b.dielectric * ft;
+        pdf += p.z * pt;
+    }
+}
+
+// Picks a part with u.x (then reuses u.x, rescaled, for reflect-or-refract) and a direction
+// from it with u.yz. A non-Dirac direction gets the pdf of the whole mixture (one-sample
+// MIS over the parts), so weight = eval * |cos| / pdf exactly.
+BsdfSample brdf_base_sample(Bsdf b, vec3 wo, vec3 u)
+{
+    BsdfSample s = brdf_no_sample();
+    vec3 p = brdf_part_probs(b, wo);
+    vec3 wi;
+    bool reflect = true; // the side the chosen part sends wi to: a part's direction that
+                         // lands on the other side is no sample of it (pbrt-v4 does the same)
+    if (u.x < p.x) {
+        wi = sampling_cosine_hemisphere(u.yz);
+    } else if (GN_HAS(GN_FEAT_LOBES) && u.x < p.x + p.y) {
+        if (GN_HAS(GN_FEAT_MIRROR) && b.lobe == BRDF_LOBE_MIRROR) {
+            s.wi = vec3(-wo.xy, wo.z);
+            s.pdf = p.y;
+            s.weight = brdf_lobe_fresnel(b, wo.z) / p.y;
+            s.flags = BRDF_FLAG_REFLECTION | BRDF_FLAG_DELTA;
+            return s;
+        }
+        wi = brdf_lobe_sample(b, wo, u.yz);
+    } else if (GN_HAS(GN_FEAT_GLASS) && p.z > 0.0) {
+        float x = min((u.x - p.x - p.y) / p.z, 1.0);
+        if (GN_HAS(GN_FEAT_SMOOTH_GLASS) && b.shape < BRDF_ALPHA_MIN) {
+            float fr = brdf_fresnel_dielectric(wo.z, b.ior);
+            if (x < fr) {
+                s.wi = vec3(-wo.xy, wo.z);
+                s.pdf = p.z * fr;
+                s.weight = vec3(b.dielectric / p.z);
+                s.flags = BRDF_FLAG_REFLECTION | BRDF_FLAG_DELTA;
+            } else if (brdf_refract(wo, vec3(0.0, 0.0, 1.0), b.ior, s.wi)) {
+                s.pdf = p.z * (1.0 - fr);
+                s.weight = b.dielectric * b.tint / p.z;
+                s.flags = BRDF_FLAG_TRANSMISSION | BRDF_FLAG_DELTA;
+            }
+            return s;
+        }
+        if (!GN_HAS(GN_FEAT_ROUGH_GLASS))
+            return s;
+        vec3 wm = brdf_ggx_sample_vndf(wo.z >= 0.0 ? wo : -wo, b.shape, u.yz);
+        float mo = dot(wo, wm);
+        reflect = x < brdf_fresnel_dielectric(mo, b.ior);
+        if (reflect)
+            wi = 2.0 * mo * wm - wo;
+        else if (!brdf_refract(wo, wm, b.ior, wi))
+            return s;
+    } else {
+        return s;
+    }
+    if ((wi.z * wo.z > 0.0) != reflect)
+        return s;
+    vec3 f;
+    float pdf;
+    brdf_base_eval_pdf(b, wo, wi, f, pdf);
+    return brdf_sample_from(wi, f, pdf, reflect ? BRDF_FLAG_REFLECTION : BRDF_FLAG_TRANSMISSION);
+}
+
+// ---- the layers: KHR_materials_clearcoat and _sheen over the base ---------------------------
+// f = coat + (1 - c F(min)) (sheen + (1 - s E(max)) base), docs/brdf.md:
+// - coat: c F(max(n_c.wo, n_c.wi)) D V of GGX (alpha_c) about the coat's normal n_c, with
+//   Schlick's F of F0 = 0.04 (index 1.5); the extension's README takes both Fresnel weights
+//   at n_c.wo, which is not reciprocal; at the mirror direction the two agree. F(max) <= F(wo)
+//   keeps the coat's albedo below c F(n_c.wo), and the base's weight 1 - c F(min) below
+//   1 - c F(n_c.wo): the sum never exceeds 1;
+// - sheen: colour D_Charlie V (Estevez & Kulla 2017) / max(1, E(wo), E(wi)), E the lobe's
+//   directional albedo (sheen_albedo.h), which exceeds 1 within a few degrees of grazing
+//   (up to 1.5 at low roughness): the division keeps the albedo <= 1 and the lobe
+//   reciprocal, and changes nothing elsewhere; the base scaled by
+//   1 - max(colour) max(min(E, 1)(wo), min(E, 1)(wi)), the README's min of its two scalings;
+// - light through the base (transmission) crosses the layers once, on the side it is outside.
+#define BRDF_COAT_F0 0.04
+#define BRDF_SHEEN_R_MIN 0.07 // tests/tool/sheen_table.c: a narrower sheen is too grazing to tabulate
+// Below this cosine (0.06 degrees from grazing, under the table's first row but 0) the sheen
+// is 0: its albedo there climbs to 3 before it falls to 0 at grazing, which no table row
+// could follow.
+#define BRDF_SHEEN_COS_MIN 0.001
+
+bool brdf_has_layers(Bsdf b)
+{
+    return b.coat > 0.0 || any(greaterThan(b.sheen, vec3(0.0)));
+}
+
+float brdf_coat_fresnel(float c)
+{
+    return brdf_fresnel_schlick(c, vec3(BRDF_COAT_F0), 1.0).x;
+}
+
+// w in the coat's frame (normal b.coat_n).
+vec3 brdf_to_coat(Bsdf b, vec3 w)
+{
+    vec3 t, bt;
+    sampling_basis(b.coat_n, t, bt);
+    return vec3(dot(w, t), dot(w, bt), dot(w, b.coat_n));
+}
+
+vec3 brdf_from_coat(Bsdf b, vec3 w)
+{
+    vec3 t, bt;
+    sampling_basis(b.coat_n, t, bt);
+    return w.x * t + w.y * bt + w.z * b.coat_n;
+}
+
+float brdf_max3(vec3 v) { return max(v.r, max(v.g, v.b)); }
+
+// E(cos theta, roughness) of the sheen lobe before its normalisation: bilinear in the table
+// (rows at cos = (i / (N - 1))^2).
+float brdf_sheen_table(float c, float r)
+{
+    vec2 x = vec2(sqrt(clamp(c, 0.0, 1.0)), clamp(r, 0.0, 1.0)) * float(SHEEN_N - 1);
+    ivec2 i = min(ivec2(x), ivec2(SHEEN_N - 2));
+    vec2 f = x - vec2(i);
+    int k = i.x * SHEEN_N + i.y;
+    return mix(mix(BRDF_SHEEN_FETCH(k), BRDF_SHEEN_FETCH(k + 1), f.y),
+               mix(BRDF_SHEEN_FETCH(k + SHEEN_N), BRDF_SHEEN_FETCH(k + SHEEN_N + 1), f.y), f.x);
+}
+
+// The directional albedo of the (normalised) sheen lobe is at most min(E, 1).
+float brdf_sheen_albedo(float c, float r)
+{
+    return min(brdf_sheen_table(c, r), 1.0);
+}
+
+float brdf_sheen_alpha(float r)
+{
+    r = max(r, BRDF_SHEEN_R_MIN);
+    return r * r;
+}
+
+// Charlie: D = (2 + 1/alpha) sin^(1/alpha) / (2 pi) (Estevez & Kulla 2017); h unit, h.z > 0.
+float brdf_d_charlie(vec3 h, float a)
+{
+    return (2.0 + 1.0 / a) * pow(max(dot(h.xy, h.xy), 0.0), 0.5 / a) / (2.0 * BRDF_PI);
+}
+
+// Estevez & Kulla's fit of Lambda for Charlie, as KHR_materials_sheen gives it.
+float brdf_sheen_l(float x, float a)
+{
+    float t = (1.0 - a) * (1.0 - a);
+    return mix(21.5473, 25.3245, t) / (1.0 + mix(3.82987, 3.32435, t) * pow(x, mix(0.19823, 0.16801, t))) +
+           mix(-1.97760, -1.27393, t) * x + mix(-4.32054, -4.85967, t);
+}
+
+float brdf_sheen_lambda(float c, float a)
+{
+    return c < 0.5 ? exp(brdf_sheen_l(c, a)) : exp(2.0 * brdf_sheen_l(0.5, a) - brdf_sheen_l(1.0 - c, a));
+}
+
+// The sheen's f (colour 1) and the pdf of its half-vector sampling, both above the surface.
+void brdf_sheen(Bsdf b, vec3 wo, vec3 wi, out float f, out float pdf)
+{
+    float a = brdf_sheen_alpha(b.sheen_r);
+    vec3 h = normalize(wo + wi);
+    float d = brdf_d_charlie(h, a);
+    float norm = max(1.0, max(brdf_sheen_table(wo.z, b.sheen_r), brdf_sheen_table(wi.z, b.sheen_r)));
+    f = d / ((1.0 + brdf_sheen_lambda(wo.z, a) + brdf_sheen_lambda(wi.z, a)) * 4.0 * wo.z * wi.z * norm);
+    if (min(wo.z, wi.z) < BRDF_SHEEN_COS_MIN)
+        f = 0.0;
+    pdf = d * h.z / (4.0 * dot(wo, h));
+}
+
+// The weights of the coat, the sheen and the base (the layers below the sheen) at wo, before
+// normalisation: their albedo estimates.
+vec3 brdf_layer_weights(Bsdf b, vec3 wo)
+{
+    float co = brdf_to_coat(b, wo).z;
+    float c = wo.z > 0.0 && co > 0.0 ? b.coat * brdf_coat_fresnel(co) : 0.0;
+    float e = wo.z > 0.0 ? brdf_sheen_albedo(wo.z, b.sheen_r) : 0.0;
+    vec3 pb = brdf_part_weights(b, wo);
+    return vec3(c, (1.0 - c) * e * (b.sheen.r + b.sheen.g + b.sheen.b) / 3.0,
+                (1.0 - c) * (1.0 - brdf_max3(b.sheen) * e) * (pb.x + pb.y + pb.z));
+}
+
+vec3 brdf_layer_probs(Bsdf b, vec3 wo)
+{
+    vec3 p = brdf_layer_weights(b, wo);
+    float sum = p.x + p.y + p.z;
+    return sum > 0.0 ? p / sum : vec3(0.0);
+}
+
+// What the layers leave of the layers below them between wo and wi (symmetric in the two):
+// x what the coat leaves of the sheen and the base, y what the sheen leaves of the base.
+vec2 brdf_layer_scale(Bsdf b, vec3 wo, vec3 wi)
+{
+    if (wo.z <= 0.0 && wi.z <= 0.0)
+        return vec2(1.0);
+    float co = clamp(brdf_to_coat(b, wo).z, 0.0, 1.0), ci = clamp(brdf_to_coat(b, wi).z, 0.0, 1.0);
+    float so = max(wo.z, 0.0), si = max(wi.z, 0.0), c, e;
+    if (wo.z > 0.0 && wi.z > 0.0) {
+        c = min(co, ci);
+        e = max(brdf_sheen_albedo(so, b.sheen_r), brdf_sheen_albedo(si, b.sheen_r));
+    } else { // through the base: the layers once, at the outside direction
+        c = wo.z > 0.0 ? co : ci;
+        e = brdf_sheen_albedo(max(so, si), b.sheen_r);
+    }
+    return vec2(1.0 - b.coat * brdf_coat_fresnel(c), 1.0 - brdf_max3(b.sheen) * e);
+}
+
+// f and pdf of the coat's and the sheen's lobes (non-Dirac), each pdf that of its own sampling.
+void brdf_layer_lobes(Bsdf b, vec3 wo, vec3 wi, out vec3 fc, out float pc, out vec3 fs, out float ps)
+{
+    fc = vec3(0.0);
+    pc = 0.0;
+    fs = vec3(0.0);
+    ps = 0.0;
+    if (wo.z <= 0.0 || wi.z <= 0.0)
+        return;
+    if (b.coat > 0.0 && b.coat_alpha >= BRDF_ALPHA_MIN) {
+        vec3 o = brdf_to_coat(b, wo), i = brdf_to_coat(b, wi);
+        if (o.z > 0.0 && i.z > 0.0) {
+            float a = b.coat_alpha;
+            vec3 h = normalize(o + i);
+            float d = brdf_d_ggx(h, a);
+            fc = vec3(b.coat * brdf_coat_fresnel(max(o.z, i.z)) * d * brdf_v_ggx(o, i, a));
+            pc = brdf_g1_ggx(o, a) * d / (4.0 * o.z);
+        }
+    }
+    if (any(greaterThan(b.sheen, vec3(0.0)))) {
+        float f;
+        brdf_sheen(b, wo, wi, f, ps);
+        fs = b.sheen * f;
+    }
+}
+
+// ---- the public BSDF API ------------------------------------------------------------------
+
+// f(wo, wi) and pdf(wo, wi) of the non-Dirac parts, in one pass (light sampling with MIS
+// needs both). Without layers exactly the base's.
+void bsdf_eval_pdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
+{
+    brdf_base_eval_pdf(b, wo, wi, f, pdf);
+    if (GN_HAS(GN_FEAT_LAYERS) && brdf_has_layers(b)) {
+        vec3 p = brdf_layer_probs(b, wo), fc, fs;
+        float pc, ps;
+        brdf_layer_lobes(b, wo, wi, fc, pc, fs, ps);
+        vec2 k = brdf_layer_scale(b, wo, wi);
+        f = fc + k.x * (fs + f * k.y);
+        pdf = p.x * pc + p.y * ps + p.z * pdf;
+    }
+}
+
+// The layers' own sampling: u.x picks the coat, the sheen or the base (then u.x rescaled for
+// the base's own choice); a Dirac coat or base lobe keeps its one strategy.
+BsdfSample bsdf_sample(Bsdf b, vec3 wo, vec3 u)
+{
+    if (!GN_HAS(GN_FEAT_LAYERS) || !brdf_has_layers(b))
+        return brdf_base_sample(b, wo, u);
+    BsdfSample s = brdf_no_sample();
+    vec3 p = brdf_layer_probs(b, wo);
+    vec3 wi;
+    uint flags = BRDF_FLAG_REFLECTION;
+    if (u.x < p.x) {
+        vec3 o = brdf_to_coat(b, wo);
+        if (b.coat_alpha < BRDF_ALPHA_MIN) {
+            s.wi = brdf_from_coat(b, vec3(-o.xy, o.z));
+            if (s.wi.z <= 0.0)
+                return s;
+            s.pdf = p.x;
+            s.weight = vec3(b.coat * brdf_coat_fresnel(o.z) / p.x);
+            s.flags = BRDF_FLAG_REFLECTION | BRDF_FLAG_DELTA;
+            return s;
+        }
+        vec3 h = brdf_ggx_sample_vndf(o, b.coat_alpha, u.yz), i = 2.0 * dot(o, h) * h - o;
+        if (i.z <= 0.0)
+            return s; // below the coat: outside the coat's pdf (brdf_layer_lobes)
+        wi = brdf_from_coat(b, i);
+    } else if (u.x < p.x + p.y) {
+        // Charlie's normal with density D cos: sin = u^(alpha / (2 alpha + 1))
+        float a = brdf_sheen_alpha(b.sheen_r), st = pow(u.y, a / (2.0 * a + 1.0)), phi = 2.0 * BRDF_PI * u.z;
+        vec3 h = vec3(st * cos(phi), st * sin(phi), sqrt(max(0.0, 1.0 - st * st)));
+        float oh = dot(wo, h);
+        if (oh <= 0.0)
+            return s; // the other half vector -h would be below: no sample of the sheen
+        wi = 2.0 * oh * h - wo;
+    } else if (p.z > 0.0) {
+        float x = min((u.x - p.x - p.y) / p.z, 0.99999994);
+        BsdfSample bs = brdf_base_sample(b, wo, vec3(x, u.yz));
+        if (bs.flags == 0u)
+            return bs;
+        if ((bs.flags & BRDF_FLAG_DELTA) != 0u) {
+            vec2 k = brdf_layer_scale(b, wo, bs.wi);
+            bs.weight *= k.x * k.y / p.z;
+            bs.pdf *= p.z;
+            return bs;
+        }
+        wi = bs.wi;
+        flags = bs.flags;
+    } else {
+        return s;
+    }
+    if ((wi.z * wo.z > 0.0) != (flags == BRDF_FLAG_REFLECTION))
+        return s;
+    vec3 f;
+    float pdf;
+    bsdf_eval_pdf(b, wo, wi, f, pdf);
+    return brdf_sample_from(wi, f, pdf, flags);
+}
+
+// The layers on a base Bsdf: coat weight c, roughness cr, normal cn (local frame); sheen
+// colour sc, roughness sr. c = 0 and sc = 0 leave b exactly as it is.
+Bsdf bsdf_layers(Bsdf b, float c, float cr, vec3 cn, vec3 sc, float sr)
+{
+    b.coat = clamp(c, 0.0, 1.0);
+    float a = clamp(cr, 0.0, 1.0);
+    b.coat_alpha = a * a;
+    b.coat_n = cn;
+    b.sheen = clamp(sc, vec3(0.0), vec3(1.0));
+    b.sheen_r = clamp(sr, 0.0, 1.0);
+    return b;
+}
+
+vec3 bsdf_eval(Bsdf b, vec3 wo, vec3 wi)
+{
+    vec3 f;
+    float pdf;
+    bsdf_eval_pdf(b, wo, wi, f, pdf);
+    return f;
+}
+
+float bsdf_pdf(Bsdf b, vec3 wo, vec3 wi)
+{
+    vec3 f;
+    float pdf;
+    bsdf_eval_pdf(b, wo, wi, f, pdf);
+    return pdf;
+}
+
+// ---- construction ---------------------------------------------------------------------------
+
+Bsdf brdf_empty()
+{
+    Bsdf b;
+    b.diffuse = vec3(0.0);
+    b.lobe = BRDF_LOBE_NONE;
+    b.specular = vec3(0.0);
+    b.fresnel = BRDF_FRESNEL_NONE;
+    b.eta = vec3(1.0);
+    b.shape = 0.0;
+    b.k = vec3(0.0);
+    b.ior = 1.5;
+    b.tint = vec3(1.0);
+    b.dielectric = 0.0;
+    b.couple_f0 = vec3(0.0);
+    b.couple_f90 = 0.0;
+    b.f90 = 1.0;
+    b.coat = 0.0;
+    b.coat_n = vec3(0.0, 0.0, 1.0);
+    b.coat_alpha = 0.0;
+    b.sheen = vec3(0.0);
+    b.sheen_r = 0.0;
+    return b;
+}
+
+// The models of brdf_models.h (ids from 1) from a colour and four scalars (the slots there).
+Bsdf bsdf_from_model(uint model, vec3 color, vec4 params)
+{
+    Bsdf b = brdf_empty();
+    if (model == BRDF_LAMBERT) {
+        b.diffuse = color;
+    } else if (model == BRDF_MIRROR) {
+        b.lobe = BRDF_LOBE_MIRROR;
+        b.specular = color;
+    } else if (model >= BRDF_PHONG && model <= BRDF_GGX) {
+        b.diffuse = color;
+        b.specular = vec3(params[BRDF_P_SPECULAR]);
+        b.shape = params[BRDF_P_SHAPE];
+        b.ior = params[BRDF_P_IOR];
+        b.lobe = model == BRDF_PHONG ? BRDF_LOBE_PHONG
+               : model == BRDF_BLINN_PHONG ? BRDF_LOBE_BLINN
+               : model == BRDF_TORRANCE_SPARROW ? BRDF_LOBE_TS
+               : model == BRDF_BECKMANN ? BRDF_LOBE_BECKMANN : BRDF_LOBE_GGX;
+        if (model >= BRDF_TORRANCE_SPARROW)
+            b.fresnel = BRDF_FRESNEL_DIELECTRIC;
+        if (model >= BRDF_BECKMANN && b.shape < BRDF_ALPHA_MIN)
+            b.lobe = BRDF_LOBE_MIRROR;
+    } else if (model == BRDF_CONDUCTOR) {
+        b.lobe = params[BRDF_P_ALPHA] < BRDF_ALPHA_MIN ? BRDF_LOBE_MIRROR : BRDF_LOBE_GGX;
+        b.fresnel = BRDF_FRESNEL_CONDUCTOR;
+        b.specular = vec3(1.0);
+        b.eta = color;
+        b.k = params.xyz;
+        b.shape = params[BRDF_P_ALPHA];
+    } else if (model == BRDF_DIELECTRIC) {
+        b.dielectric = 1.0;
+        b.tint = color;
+        b.ior = params[BRDF_P_DIELECTRIC_IOR];
+        b.shape = params[BRDF_P_DIELECTRIC_ALPHA];
+    }
+    return b;
+}
+
+// glTF 2.0 metallic-roughness with KHR_materials_specular, _transmission and _ior, as a sum
+// weighted (1-m)(1-t) dielectric-over-diffuse + m metal + (1-m) t rough glass:
+// - one GGX lobe (alpha = roughness^2) with Schlick's F whose F0, F90 mix the dielectric's
+//   (F0 = min(((ior-1)/(ior+1))^2 specular_color, 1) specular, F90 = specular) and the
+//   metal's (F0 = base colour, F90 = 1); Schlick is linear in F0, F90, so the mix is exact;
+// - the diffuse base colour coupled to the dielectric's Fresnel (brdf_diffuse), not the
+//   spec's fresnel_mix (1 - F(v.h)), which is not energy conserving: 1.3 at 80 degrees for
+//   a white base (docs/brdf.md);
+// - transmission as the rough (or smooth) dielectric of index ior, tinted by base colour.
+Bsdf bsdf_gltf(vec3 base_color, float metallic, float roughness, float specular,
+               vec3 specular_color, float ior, float transmission)
+{
+    Bsdf b = brdf_empty();
+    float m = clamp(metallic, 0.0, 1.0), t = clamp(transmission, 0.0, 1.0);
+    float alpha = clamp(roughness, 0.0, 1.0);
+    alpha *= alpha;
+    vec3 f0 = min(vec3(brdf_schlick_f0(ior)) * specular_color, vec3(1.0)) * specular;
+    float wd = (1.0 - m) * (1.0 - t);
+    b.diffuse = wd * base_color;
+    b.couple_f0 = f0;
+    b.couple_f90 = specular;
+    b.lobe = alpha < BRDF_ALPHA_MIN ? BRDF_LOBE_MIRROR : BRDF_LOBE_GGX;
+    b.shape = alpha;
+    b.fresnel = BRDF_FRESNEL_SCHLICK;
+    b.specular = wd * f0 + m * base_color;
+    b.f90 = wd * specular + m;
+    b.dielectric = (1.0 - m) * t;
+    b.tint = base_color;
+    b.ior = max(ior, 1.01); // at 1 the rough BTDF collapses to a Dirac along -wo
+    return b;
+}
+
+#endif

@@ -1,0 +1,119 @@
+/* cmd_info.c: `gonio info`, a scene's contents and BVH statistics. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "bvh.h"
+#include "cli.h"
+#include "scene.h"
+#include "util.h"
+
+/* The area lights as the path tracer sees them (render.c: build_emitters): triangles of
+ * non-zero area whose material emits and is not unlit; prints the materials by name. */
+static void print_emitters(const scene *sc)
+{
+    uint32_t tris = 0, mats = 0;
+    uint32_t *count = util_calloc(sc->num_materials, sizeof *count);
+    for (uint32_t t = 0; t < sc->num_triangles; t++) {
+        const GnMaterial *m = &sc->materials[sc->tri_material[t]];
+        double c[3];
+        if (!(m->emissive.x > 0 || m->emissive.y > 0 || m->emissive.z > 0) || (m->flags & GN_MAT_UNLIT))
+            continue;
+        scene_triangle_cross(sc, t, c);
+        if (!(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > 0))
+            continue;
+        tris++;
+        mats += count[sc->tri_material[t]]++ == 0;
+    }
+    printf("emissive       %u triangles in %u material(s)", tris, mats);
+    for (uint32_t m = 0, n = 0; m < sc->num_materials; m++)
+        if (count[m])
+            printf("%s%s (%u)", n++ ? ", " : ": ", sc->material_names[m][0] ? sc->material_names[m] : "(unnamed)",
+                   count[m]);
+    printf("\n");
+    free(count);
+}
+
+/* The materials with a medium or dispersion, as the path tracer reads them (glsl/kernels/path.comp:
+ * sigma_a = -ln(attenuation colour) / attenuation distance). */
+static void print_media(const scene *sc)
+{
+    for (uint32_t i = 0; i < sc->num_materials; i++) {
+        const GnMaterial *m = &sc->materials[i];
+        const float *c = &m->attenuation_color.x;
+        double sigma[3];
+        if (!m->volume && !(m->dispersion > 0))
+            continue;
+        for (int k = 0; k < 3; k++)
+            sigma[k] = c[k] >= 1 ? 0 : -log(c[k] > 1e-30f ? c[k] : 1e-30f) / m->attenuation_distance;
+        printf("medium %-7u \"%s\" %s attenuation (%g, %g, %g) distance %g (sigma_a %g, %g, %g), "
+               "thickness %g, ior %g, dispersion %g\n", i, sc->material_names[i][0] ? sc->material_names[i] : "(unnamed)",
+               m->volume ? "volume" : "thin-walled", c[0], c[1], c[2], m->attenuation_distance, sigma[0], sigma[1],
+               sigma[2], m->thickness, m->ior, m->dispersion);
+    }
+}
+
+int cmd_info(int argc, char **argv)
+{
+    bool outside = false;
+    const cli_option options[] = {CLI_OPT_ALLOW_OUTSIDE_FILES(&outside)};
+    const cli_command cmd = {
+        .name = "info", .synopsis = "SCENE.gltf|.glb [--allow-outside-files]",
+        .intro = "Prints the scene's contents and its BVH statistics: the emissive triangles (the path\n"
+                 "tracer's area lights) and the materials that emit, and one line per camera (index, name,\n"
+                 "position, forward direction, vertical field of view or orthographic width x height;\n"
+                 "the first is the one gonio render uses by default), the KHR_materials_variants\n"
+                 "variants by index and name (for --variant), and one line per material that bounds a\n"
+                 "medium (KHR_materials_volume) or disperses (KHR_materials_dispersion): attenuation\n"
+                 "colour and distance, the absorption coefficient they give, thickness (unused by the\n"
+                 "path tracer), IOR and dispersion.\n",
+        CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given"};
+    cli_args args;
+    scene sc = {0};
+    bvh b = {0};
+    int rc = cli_parse(&cmd, argc, argv, &args);
+    if (rc >= 0)
+        return rc;
+    const char *path = args.arg[0];
+    scene_allow_outside_files(outside);
+    if (!scene_load(&sc, path))
+        return 1;
+    bvh_build(&b, &sc.vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc.indices,
+              sc.num_triangles);
+    printf("scene          %s\n", path);
+    printf("triangles      %u\n", sc.num_triangles);
+    printf("vertices       %u\n", sc.num_vertices);
+    printf("meshes         %u (primitive instances; %u glTF meshes, %u nodes)\n", sc.num_meshes,
+           sc.num_gltf_meshes, sc.num_nodes);
+    printf("materials      %u\n", sc.num_materials);
+    printf("variants       %u\n", sc.num_variants);
+    for (uint32_t i = 0; i < sc.num_variants; i++)
+        printf("variant %-6u \"%s\"\n", i, sc.variant_names[i]);
+    printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
+    printf("lights         %u\n", sc.num_lights);
+    print_emitters(&sc);
+    print_media(&sc);
+    printf("cameras        %u\n", sc.num_cameras);
+    for (uint32_t i = 0; i < sc.num_cameras; i++) {
+        const scene_camera *c = &sc.cameras[i];
+        printf("camera %-7u \"%s\" position (%g, %g, %g) forward (%g, %g, %g) ", i, c->name, c->position[0],
+               c->position[1], c->position[2], c->forward[0], c->forward[1], c->forward[2]);
+        if (c->ortho_half_height > 0)
+            printf("orthographic %g x %g\n", 2 * c->ortho_half_height * c->aspect, 2 * c->ortho_half_height);
+        else
+            printf("yfov %.4g deg\n", c->yfov * 180 / M_PI);
+    }
+    printf("bounds         (%g, %g, %g) - (%g, %g, %g)\n", sc.bounds_min[0], sc.bounds_min[1],
+           sc.bounds_min[2], sc.bounds_max[0], sc.bounds_max[1], sc.bounds_max[2]);
+    printf("bvh nodes      %u (%zu bytes each)\n", b.num_nodes, sizeof(GnBvhNode));
+    printf("bvh leaf prims %u (%u triangle pairs sharing an edge, %u single triangles)\n",
+           b.num_pairs, b.num_tris - b.num_pairs, 2 * b.num_pairs - b.num_tris);
+    printf("bvh depth      %u\n", b.depth);
+    printf("bvh max leaf   %u triangle pairs\n", b.max_leaf_size);
+    printf("bvh sah cost   %.2f\n", b.sah_cost);
+    printf("bvh build      %.2f ms (%.2f M triangles/s)\n", b.build_seconds * 1e3,
+           b.build_seconds > 0 ? sc.num_triangles / b.build_seconds * 1e-6 : 0.0);
+    bvh_destroy(&b);
+    scene_destroy(&sc);
+    return 0;
+}

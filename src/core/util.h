@@ -1,0 +1,77 @@
+/* util.h: error reporting, timing and small parsing helpers shared by every module.
+ *
+ * Three kinds of failure, three treatments: a Vulkan/driver failure stops in GPU_CHECK
+ * (src/core/gpu.h) with the call, file, line and VkResult name; bad user input is reported with
+ * util_error (naming the file and the problem) and returned as `false` up to main, which
+ * exits 1; a programmer's mistake is an assert. */
+#ifndef GONIO_UTIL_H
+#define GONIO_UTIL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#if defined(__GNUC__)
+#define UTIL_PRINTF(a, b) __attribute__((format(printf, a, b)))
+#else
+#define UTIL_PRINTF(a, b)
+#endif
+
+/* "gonio: error: ..." on stderr. Messages about a file start with the file's path. */
+void util_error(const char *fmt, ...) UTIL_PRINTF(1, 2);
+/* "gonio: warning: ..." on stderr. */
+void util_warn(const char *fmt, ...) UTIL_PRINTF(1, 2);
+/* Informational line on stderr, silenced by util_set_quiet(true). */
+void util_info(const char *fmt, ...) UTIL_PRINTF(1, 2);
+void util_set_quiet(bool quiet);
+/* No errors or warnings either (warnings still counted): for the fuzz targets only, where
+ * printing them is most of the time spent. */
+void util_set_silent(bool silent);
+bool util_quiet(void);
+/* Number of warnings printed so far (tests and the CLI summary use it). */
+int util_warning_count(void);
+
+/* Monotonic seconds. */
+double util_now(void);
+
+/* malloc/calloc/realloc that stop the program with a message when memory runs out. */
+void *util_malloc(size_t size);
+void *util_calloc(size_t count, size_t size);
+void *util_realloc(void *ptr, size_t size);
+
+/* Strict number parsing: the whole string must be a decimal number in range, as typed: no
+ * leading space, no '+', no hexadecimal; false otherwise. */
+bool util_parse_int(const char *s, long min, long max, long *out);
+bool util_parse_float(const char *s, float *out);
+/* "R,G,B" or one value V (= V,V,V), each finite and >= 0: a colour or a radiance. */
+bool util_parse_rgb(const char *s, float out[3]);
+/* "WxH" -> width, height (each 1..16384). */
+bool util_parse_size(const char *s, int *w, int *h);
+
+/* Reads a whole file; NULL (and util_error naming the file) on failure. */
+void *util_read_file(const char *path, size_t *size);
+
+/* Writing an output file safely: util_tmp_path gives "DIR/.NAME.tmp-PID" beside the
+ * destination; util_commit_file renames it into place (or removes it when ok is false).
+ * A failed or interrupted write therefore never leaves a half-written output.
+ *
+ * What an output path may be (every command checks with util_check_output before any work,
+ * and util_commit_file checks again): a new name, or a regular file that may be written,
+ * which is replaced and keeps its mode (and owner, where the writer may give it). Refused
+ * with an error naming the path: an empty name, a path too long for its temporary name, a
+ * missing or unwritable folder, a directory, a symbolic link, a device (/dev/null), FIFO or
+ * socket, a read-only file (for root too). util_check_output also removes the temporary
+ * files of this name that a killed gonio left behind (their process no longer exists). */
+bool util_check_output(const char *path);
+void util_tmp_path(char *out, size_t cap, const char *final_path);
+/* Whether s ends in suffix, ignoring case (file extensions). */
+bool util_has_suffix(const char *s, const char *suffix);
+bool util_commit_file(const char *tmp_path, const char *final_path, bool ok);
+/* Removes the temporary file of a write under way (async-signal-safe: for a handler that
+ * ends the program at once). */
+void util_remove_pending_tmp(void);
+/* util_tmp_path, then fopen(tmp, mode); NULL with an error naming final_path on failure. */
+FILE *util_tmp_open(char *tmp, size_t cap, const char *final_path, const char *mode);
+
+#endif

@@ -1,0 +1,295 @@
+/* brdf.c: the table of BRDF models (the lecture's, glsl/lib/brdf.glsl) with their parameters,
+ * strict `--PARAM VALUE` parsing, and the runner of the BRDF test kernel. */
+#include "brdf.h"
+
+#include <assert.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "brdf_test.h" /* spv_brdf_test, generated from glsl/kernels/brdf_test.comp */
+#include "util.h"
+
+#define P(slot) (BRDF_SLOT_PARAMS + (slot))
+#define COLOR(name, slot, d0, d1, d2, lo, hi) {name, slot, 3, {d0, d1, d2}, lo, hi}
+#define SCALAR(name, slot, d, lo, hi) {name, slot, 1, {d, 0, 0}, lo, hi}
+/* The diffuse + one-lobe models share their layout (brdf_models.h). */
+#define LAYERED(shape_name, shape_def, shape_max)                                       \
+    COLOR("diffuse", BRDF_SLOT_COLOR, 0, 0, 0, 0, 1), SCALAR("specular", P(BRDF_P_SPECULAR), 1, 0, 1), \
+        SCALAR(shape_name, P(BRDF_P_SHAPE), shape_def, 0, shape_max)
+
+const brdf_model brdf_models[] = {
+    {"lambert", BRDF_LAMBERT, "Lambertian diffuse, f = albedo / pi", 1,
+     {COLOR("diffuse", BRDF_SLOT_COLOR, 0.8f, 0.8f, 0.8f, 0, 1)}},
+    {"mirror", BRDF_MIRROR, "perfect mirror, Lo = R Li(r(wo)) (a Dirac lobe)", 1,
+     {COLOR("reflectance", BRDF_SLOT_COLOR, 1, 1, 1, 0, 1)}},
+    {"phong", BRDF_PHONG, "diffuse + normalised Phong, ks (n+2)/(2 pi) cos^n(r(wi), wo)", 3,
+     {LAYERED("exponent", 32, 100000)}},
+    {"blinn-phong", BRDF_BLINN_PHONG, "diffuse + normalised Blinn-Phong, ks N(n) (n.h)^n", 3,
+     {LAYERED("exponent", 32, 100000)}},
+    {"torrance-sparrow", BRDF_TORRANCE_SPARROW,
+     "diffuse + Torrance-Sparrow: Blinn D, V-cavity G, dielectric Fresnel", 4,
+     {LAYERED("exponent", 100, 100000), SCALAR("ior", P(BRDF_P_IOR), 1.5f, 1, 4)}},
+    {"beckmann", BRDF_BECKMANN, "diffuse + Beckmann microfacet, Smith G, dielectric Fresnel", 4,
+     {LAYERED("alpha", 0.2f, 1), SCALAR("ior", P(BRDF_P_IOR), 1.5f, 1, 4)}},
+    {"ggx", BRDF_GGX, "diffuse + GGX microfacet, Smith G, dielectric Fresnel", 4,
+     {LAYERED("alpha", 0.2f, 1), SCALAR("ior", P(BRDF_P_IOR), 1.5f, 1, 4)}},
+    {"conductor", BRDF_CONDUCTOR, "GGX metal, complex index eta + i k (default: gold)", 3,
+     {COLOR("eta", BRDF_SLOT_COLOR, 0.143f, 0.374f, 1.442f, 0.01f, 10),
+      COLOR("k", P(BRDF_P_K), 3.983f, 2.385f, 1.603f, 0, 20),
+      SCALAR("alpha", P(BRDF_P_ALPHA), 0.1f, 0, 1)}},
+    {"dielectric", BRDF_DIELECTRIC, "glass: Fresnel reflection + refraction, smooth or GGX", 3,
+     {COLOR("tint", BRDF_SLOT_COLOR, 1, 1, 1, 0, 1),
+      SCALAR("ior", P(BRDF_P_DIELECTRIC_IOR), 1.5f, 1.01f, 4),
+      SCALAR("alpha", P(BRDF_P_DIELECTRIC_ALPHA), 0, 0, 1)}},
+    {"gltf", BRDF_GLTF, "glTF metallic-roughness + KHR_materials_specular/transmission/ior/clearcoat/sheen/anisotropy/iridescence/diffuse_transmission", 18,
+     {COLOR("base-color", BRDF_SLOT_COLOR, 0.8f, 0.8f, 0.8f, 0, 1),
+      SCALAR("metallic", P(0), 0, 0, 1), SCALAR("roughness", P(1), 0.5f, 0, 1),
+      SCALAR("specular", P(2), 1, 0, 1), SCALAR("ior", P(3), 1.5f, 1, 4),
+      COLOR("specular-color", BRDF_SLOT_EXTRA, 1, 1, 1, 0, 100),
+      SCALAR("transmission", BRDF_SLOT_EXTRA + 3, 0, 0, 1),
+      SCALAR("clearcoat", BRDF_SLOT_LAYER, 0, 0, 1), SCALAR("clearcoat-roughness", BRDF_SLOT_LAYER + 1, 0, 0, 1),
+      COLOR("sheen-color", BRDF_SLOT_SHEEN, 0, 0, 0, 0, 1), SCALAR("sheen-roughness", BRDF_SLOT_LAYER + 2, 0, 0, 1),
+      SCALAR("anisotropy", BRDF_SLOT_ANISO, 0, 0, 1), SCALAR("anisotropy-rotation", BRDF_SLOT_ANISO + 1, 0, -6.2832f, 6.2832f),
+      SCALAR("iridescence", BRDF_SLOT_IRID, 0, 0, 1), SCALAR("iridescence-ior", BRDF_SLOT_IRID + 1, 1.3f, 1, 4),
+      SCALAR("iridescence-thickness", BRDF_SLOT_IRID + 2, 400, 0, 2000),
+      SCALAR("diffuse-transmission", BRDF_SLOT_DT + 3, 0, 0, 1),
+      COLOR("diffuse-transmission-color", BRDF_SLOT_DT, 1, 1, 1, 0, 1)}},
+};
+const int brdf_num_models = (int)(sizeof brdf_models / sizeof *brdf_models);
+
+const float brdf_sheen_table[BRDF_SHEEN_TABLE_SIZE] = {SHEEN_ALBEDO_VALUES};
+
+const brdf_model *brdf_model_find(const char *name)
+{
+    char list[512] = "";
+    for (int i = 0; i < brdf_num_models; i++)
+        if (strcmp(brdf_models[i].name, name) == 0)
+            return &brdf_models[i];
+    for (int i = 0; i < brdf_num_models; i++)
+        strcat(strcat(list, i ? ", " : ""), brdf_models[i].name);
+    util_error("unknown BRDF model '%s'; the models are: %s", name, list);
+    return NULL;
+}
+
+const brdf_model *brdf_model_by_id(uint32_t id)
+{
+    for (int i = 0; i < brdf_num_models; i++)
+        if (brdf_models[i].id == id)
+            return &brdf_models[i];
+    assert(!"no BRDF model with that id");
+    return NULL;
+}
+
+void brdf_setting_init(brdf_setting *s, const brdf_model *m)
+{
+    memset(s, 0, sizeof *s);
+    s->model = m;
+    for (int i = 0; i < m->num_params; i++)
+        memcpy(&s->v[m->params[i].slot], m->params[i].def, sizeof(float) * (size_t)m->params[i].count);
+}
+
+const brdf_param *brdf_param_find(const brdf_model *m, const char *name)
+{
+    for (int i = 0; i < m->num_params; i++)
+        if (strcmp(m->params[i].name, name) == 0)
+            return &m->params[i];
+    return NULL;
+}
+
+/* "--a X, --b R,G,B" (options of gonio brdf) or "a=X, b=R,G,B" (a --brdf spec) */
+static void param_list(const brdf_model *m, bool spec, char *out, size_t cap)
+{
+    size_t len = 0;
+    out[0] = 0;
+    for (int i = 0; i < m->num_params && len < cap; i++)
+        len += (size_t)snprintf(out + len, cap - len, "%s%s%s%s", i ? ", " : "", spec ? "" : "--",
+                                m->params[i].name, m->params[i].count == 3 ? (spec ? "=R,G,B" : " R,G,B")
+                                                                           : (spec ? "=X" : " X"));
+}
+
+/* "X" or "R,G,B" -> the number of values (at most 3), 0 when malformed. */
+static int parse_values(const char *text, float v[3])
+{
+    int n = 0;
+    for (const char *c = text;; c++) {
+        size_t len = strcspn(c, ",");
+        char num[64];
+        if (n == 3 || len >= sizeof num)
+            return 0;
+        memcpy(num, c, len);
+        num[len] = 0;
+        if (!util_parse_float(num, &v[n++]))
+            return 0;
+        c += len;
+        if (!*c)
+            return n;
+    }
+}
+
+/* Errors name the parameter as the user wrote it: "--alpha" (an option of gonio brdf) or
+ * "parameter alpha" (a PARAM=VALUE of a --brdf spec). */
+static bool setting_set(brdf_setting *s, const char *name, const char *value, bool spec)
+{
+    const brdf_param *p = brdf_param_find(s->model, name);
+    const char *pre = spec ? "parameter " : "--";
+    float v[3];
+    int n;
+    if (!p) {
+        char list[512];
+        param_list(s->model, spec, list, sizeof list);
+        util_error("BRDF model %s has no %s%s; it accepts %s", s->model->name, pre, name, list);
+        return false;
+    }
+    n = parse_values(value, v);
+    if (n == 1 && p->count == 3) {
+        v[1] = v[2] = v[0];
+        n = 3;
+    }
+    if (n != p->count) {
+        util_error("BRDF model %s: %s%s needs %s, not '%s'", s->model->name, pre, name,
+                   p->count == 3 ? "a colour R,G,B or one number" : "one number", value);
+        return false;
+    }
+    for (int i = 0; i < n; i++) {
+        if (!(v[i] >= p->min && v[i] <= p->max)) {
+            util_error("BRDF model %s: %s%s%s%s is out of range [%g, %g]", s->model->name, pre, name,
+                       spec ? "=" : " ", value, p->min, p->max);
+            return false;
+        }
+    }
+    memcpy(&s->v[p->slot], v, sizeof(float) * (size_t)n);
+    return true;
+}
+
+bool brdf_setting_set(brdf_setting *s, const char *name, const char *value)
+{
+    return setting_set(s, name, value, false);
+}
+
+/* The spec's text up to the first ':' is the model name. */
+const brdf_model *brdf_spec_model(const char *spec)
+{
+    char name[64];
+    size_t len = strcspn(spec, ":");
+    if (len == 0 || len >= sizeof name) {
+        util_error("--brdf '%s': expected MODEL[:PARAM=VALUE...]", spec);
+        return NULL;
+    }
+    memcpy(name, spec, len);
+    name[len] = 0;
+    return brdf_model_find(name);
+}
+
+bool brdf_spec_apply(brdf_setting *s, const char *spec)
+{
+    const char *c = spec + strcspn(spec, ":");
+    /* Every ':' starts one PARAM=VALUE: "ggx:" and "ggx:::" are mistakes, not defaults. */
+    while (*c == ':') {
+        char kv[128], *eq;
+        size_t len = strcspn(++c, ":");
+        if (len >= sizeof kv) {
+            util_error("--brdf '%s': a PARAM=VALUE is too long", spec);
+            return false;
+        }
+        memcpy(kv, c, len);
+        kv[len] = 0;
+        c += len;
+        if (!(eq = strchr(kv, '=')) || eq == kv) {
+            util_error("--brdf '%s': expected MODEL[:PARAM=VALUE...], not '%s'", spec, kv);
+            return false;
+        }
+        *eq = 0;
+        if (!setting_set(s, kv, eq + 1, true))
+            return false;
+    }
+    return true;
+}
+
+bool brdf_spec_check(const char *spec)
+{
+    const brdf_model *m = brdf_spec_model(spec);
+    brdf_setting st;
+    if (!m)
+        return false;
+    brdf_setting_init(&st, m);
+    return brdf_spec_apply(&st, spec);
+}
+
+bool brdf_setting_two_sided(const brdf_setting *s)
+{
+    return s->model->id == BRDF_DIELECTRIC || (s->model->id == BRDF_GLTF && s->v[BRDF_SLOT_EXTRA + 3] > 0);
+}
+
+void brdf_setting_to_query(const brdf_setting *s, BrdfQuery *q)
+{
+    const float *v = s->v;
+    q->model = s->model->id;
+    q->color = (vec3){v[0], v[1], v[2]};
+    q->params = (vec4){v[3], v[4], v[5], v[6]};
+    q->extra = (vec4){v[7], v[8], v[9], v[10]};
+    q->layer = (vec4){v[11], v[12], v[13], v[BRDF_SLOT_COAT_TILT]};
+    q->sheen = (vec4){v[14], v[15], v[16], 0};
+    q->aniso = (vec4){v[BRDF_SLOT_ANISO], v[BRDF_SLOT_ANISO + 1], 0, 0};
+    q->irid = (vec4){v[BRDF_SLOT_IRID], v[BRDF_SLOT_IRID + 1], v[BRDF_SLOT_IRID + 2], 0};
+    q->dt = (vec4){v[BRDF_SLOT_DT], v[BRDF_SLOT_DT + 1], v[BRDF_SLOT_DT + 2], v[BRDF_SLOT_DT + 3]};
+}
+
+void brdf_format_setting(char *out, size_t cap, const brdf_setting *s)
+{
+    const brdf_model *m = s->model;
+    size_t len = (size_t)snprintf(out, cap, "%s", m->name);
+    for (int i = 0; i < m->num_params && len < cap; i++) {
+        const float *v = &s->v[m->params[i].slot];
+        if (m->params[i].count == 3 && (v[0] != v[1] || v[1] != v[2]))
+            len += (size_t)snprintf(out + len, cap - len, " %s=%g,%g,%g", m->params[i].name, v[0], v[1], v[2]);
+        else
+            len += (size_t)snprintf(out + len, cap - len, " %s=%g", m->params[i].name, v[0]);
+    }
+}
+
+void brdf_runner_create(brdf_runner *r, gpu *g, uint32_t capacity)
+{
+    assert(capacity > 0);
+    memset(r, 0, sizeof *r);
+    r->g = g;
+    r->capacity = capacity;
+    gpu_buffer_create(g, &r->queries, sizeof(BrdfQuery) * (VkDeviceSize)capacity,
+                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+    gpu_buffer_create(g, &r->results, sizeof(BrdfResult) * (VkDeviceSize)capacity,
+                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+    gpu_buffer_create_texels_as(g, &r->sheen, brdf_sheen_table, sizeof(float) * BRDF_SHEEN_TABLE_SIZE,
+                                VK_FORMAT_R32_UINT);
+    const gpu_binding bind[] = {
+        {0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->queries},
+        {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->results},
+        {BRDF_BIND_SHEEN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->sheen},
+    };
+    gpu_pipeline_desc pd = {.name = "brdf_test", .code = spv_brdf_test, .code_size = sizeof spv_brdf_test,
+                            .local_size = {64, 1, 1}, .push_size = 4, .bindings = bind, .num_bindings = 3};
+    gpu_pipeline_create(g, &r->pipeline, &pd);
+}
+
+void brdf_runner_destroy(brdf_runner *r)
+{
+    if (!r->g)
+        return;
+    gpu_pipeline_destroy(r->g, &r->pipeline);
+    gpu_buffer_destroy(r->g, &r->sheen);
+    gpu_buffer_destroy(r->g, &r->results);
+    gpu_buffer_destroy(r->g, &r->queries);
+    memset(r, 0, sizeof *r);
+}
+
+void brdf_runner_run(brdf_runner *r, const BrdfQuery *q, BrdfResult *out, size_t n)
+{
+    for (size_t done = 0; done < n;) {
+        uint32_t count = (uint32_t)(n - done < r->capacity ? n - done : r->capacity);
+        VkCommandBuffer cmd;
+        gpu_buffer_upload(r->g, &r->queries, q + done, sizeof *q * count, 0);
+        cmd = gpu_begin(r->g);
+        gpu_dispatch(cmd, &r->pipeline, &count, count, 1, 1);
+        gpu_submit_wait(r->g, cmd);
+        gpu_buffer_download(r->g, &r->results, out + done, sizeof *out * count, 0);
+        done += count;
+    }
+}

@@ -1,0 +1,100 @@
+/* brdf.h: the BRDF model table (names, parameters, defaults and ranges of the models in
+ * glsl/lib/brdf_models.h) with strict parsing of `--PARAM VALUE` settings, and a runner that
+ * batches queries through glsl/kernels/brdf_test.comp, i.e. through the renderer's own brdf.glsl. */
+#ifndef GONIO_BRDF_H
+#define GONIO_BRDF_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "brdf_models.h"
+#include "gpu.h"
+#include "sheen_albedo.h"
+
+/* Where a setting's values go: v[0..2] the colour, v[3..6] the four scalars (brdf_params),
+ * v[7..10] glTF's extra (specular colour, transmission), v[11..13] glTF's layers (clearcoat,
+ * clearcoat roughness, sheen roughness), v[14..16] the sheen colour (BrdfQuery.layer, .sheen),
+ * then the slots below. */
+#define BRDF_SLOT_COLOR 0
+#define BRDF_SLOT_PARAMS 3
+#define BRDF_SLOT_EXTRA 7
+#define BRDF_SLOT_LAYER 11
+#define BRDF_SLOT_SHEEN 14
+#define BRDF_SLOT_COAT_TILT 17 /* the coat normal's tilt (BrdfQuery.layer.w): no parameter, tests only */
+#define BRDF_SLOT_ANISO 18 /* anisotropy strength, rotation (BrdfQuery.aniso) */
+#define BRDF_SLOT_IRID 20  /* iridescence factor, film ior, thickness in nm (BrdfQuery.irid) */
+#define BRDF_SLOT_DT 23    /* diffuse transmission colour (3), factor (BrdfQuery.dt) */
+#define BRDF_NUM_SLOTS 27
+#define BRDF_MAX_PARAMS 18
+
+typedef struct brdf_param {
+    const char *name; /* option name without the leading "--" */
+    int slot;         /* first value in brdf_setting.v */
+    int count;        /* 1: a scalar; 3: a colour ("R,G,B" or one value for all three) */
+    float def[3];
+    float min, max;   /* accepted range of every component */
+} brdf_param;
+
+typedef struct brdf_model {
+    const char *name; /* lower case, e.g. "torrance-sparrow" */
+    uint32_t id;      /* BRDF_* of brdf_models.h */
+    const char *summary;
+    int num_params;
+    brdf_param params[BRDF_MAX_PARAMS];
+} brdf_model;
+
+typedef struct brdf_setting {
+    const brdf_model *model;
+    float v[BRDF_NUM_SLOTS];
+} brdf_setting;
+
+/* The sheen's directional albedo (glsl/lib/sheen_albedo.h), SHEEN_N x SHEEN_N floats, which every
+ * kernel that builds a sheen reads from a texel buffer (brdf.glsl: brdf_sheen_table). */
+extern const float brdf_sheen_table[];
+#define BRDF_SHEEN_TABLE_SIZE (SHEEN_N * SHEEN_N)
+
+extern const brdf_model brdf_models[];
+extern const int brdf_num_models;
+
+/* The model of that name; NULL with an error listing the accepted names otherwise. */
+const brdf_model *brdf_model_find(const char *name);
+/* The model with that id (programmer error if none). */
+const brdf_model *brdf_model_by_id(uint32_t id);
+/* A setting of m with every parameter at its default. */
+void brdf_setting_init(brdf_setting *s, const brdf_model *m);
+/* Sets parameter `name` (without "--") from text; false with an error naming the model and
+ * listing its parameters (unknown name), or giving the accepted form and range (bad value). */
+bool brdf_setting_set(brdf_setting *s, const char *name, const char *value);
+/* A `--brdf MODEL[:PARAM=VALUE...]` spec (gonio render). brdf_spec_model: its model, NULL
+ * with an error otherwise; brdf_spec_apply: sets its parameters on s (of that model), false
+ * with an error naming the spec or "parameter NAME" (an empty PARAM=VALUE is an error);
+ * brdf_spec_check: both, on a default setting, for checking a command line before work. */
+const brdf_model *brdf_spec_model(const char *spec);
+bool brdf_spec_apply(brdf_setting *s, const char *spec);
+bool brdf_spec_check(const char *spec);
+/* The first parameter named `name`, or NULL. */
+const brdf_param *brdf_param_find(const brdf_model *m, const char *name);
+/* Does the setting transmit (a dielectric interface: light below the surface matters)? */
+bool brdf_setting_two_sided(const brdf_setting *s);
+/* Fills the material fields (model, color, params, extra) of a test-kernel query. */
+void brdf_setting_to_query(const brdf_setting *s, BrdfQuery *q);
+/* "name param=value ..." (colours as one value when grey, else R,G,B): the `gonio brdf
+ * --list` line of a default setting. */
+void brdf_format_setting(char *out, size_t cap, const brdf_setting *s);
+
+/* Batches BrdfQuery records through brdf_test.comp. */
+typedef struct brdf_runner {
+    gpu *g;
+    gpu_buffer queries, results, sheen;
+    gpu_pipeline pipeline;
+    uint32_t capacity;
+} brdf_runner;
+
+/* capacity: queries per dispatch (buffers of 96 and 64 bytes per query). */
+void brdf_runner_create(brdf_runner *r, gpu *g, uint32_t capacity);
+void brdf_runner_destroy(brdf_runner *r); /* accepts a zeroed struct */
+/* Runs n queries (in batches of the capacity) and writes their n results. */
+void brdf_runner_run(brdf_runner *r, const BrdfQuery *q, BrdfResult *out, size_t n);
+
+#endif

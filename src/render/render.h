@@ -1,0 +1,187 @@
+/* render.h: a scene on the GPU and the progressive sample passes that render it.
+ *
+ * Work is submitted as short dispatches of a few samples per pixel each (keeps a window
+ * responsive, GPU watchdogs quiet, and lets an interrupted render write what it has; the
+ * path kernel finishes in a later dispatch what llvmpipe's loop cap interrupts:
+ * docs/architecture.md). Samples depend only on (pixel, sample, dimension, seed). */
+#ifndef GONIO_RENDER_H
+#define GONIO_RENDER_H
+
+#include <signal.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "bvh.h"
+#include "gpu.h"
+#include "image.h"
+#include "scene.h"
+
+typedef struct render_settings {
+    uint32_t mode;          /* GN_MODE_* */
+    int width, height;
+    int spp;                /* samples per pixel */
+    double time_limit;      /* > 0: stop after this many seconds (at least one pass) */
+    uint32_t seed;
+    int camera;             /* glTF camera index, -1 = frame the scene */
+    uint32_t aov;           /* RENDER_AOV_* set: the extra channels to add */
+    bool shadows;           /* ray-traced shadows in the local modes (default on) */
+    int max_depth;          /* path tracer: 0 = unbounded (roulette only) */
+    float env[3];           /* constant environment radiance */
+    bool ambient_set;       /* local modes: ambient replaces the scene's global ambient light */
+    float ambient[3];
+    bool progress;          /* progress bar on stderr */
+    volatile sig_atomic_t *stop; /* set asynchronously to end after the current pass */
+    const GnCamera *camera_override; /* non-NULL: this camera (aspect from the image), not `camera` */
+    const scene_camera *view; /* non-NULL: this camera (aspect from the image), not `camera`
+                               * (camera_resolve, src/scene/camera.h, makes it) */
+    const char *camera_label; /* for headers: which camera, e.g. "camera 0 'Camera'" */
+    const char *env_label;    /* for headers: "studio", a map's path, "constant" */
+    const image *env_map;   /* path: lat-long radiance map (R, G, B or Y), replaces env */
+    float env_rotation;     /* path: the map turned about +Y, degrees (right-handed) */
+    uint32_t strategy;      /* path: 0 = MIS, GN_FRAME_LIGHT_ONLY or GN_FRAME_BSDF_ONLY */
+    /* The region rendered: pixels [crop_x0, crop_x1) x [crop_y0, crop_y1) of the
+     * width x height image, each exactly as the whole render has it; crop_x1 = 0: all. */
+    int crop_x0, crop_y0, crop_x1, crop_y1;
+    /* Non-NULL: go on from an earlier render of these settings: its sums (channels
+     * RENDER_SUM_*, as renderer_sums writes them) of resume_spp samples are loaded and the
+     * render takes samples resume_spp to spp - 1, so the result is that of one render of spp. */
+    const image *resume;
+    int resume_spp;
+} render_settings;
+
+/* The region s renders, {x0, y0, x1, y1}. */
+void render_region(const render_settings *s, int region[4]);
+
+/* The AOVs (extra EXR channels) a render can add. Normal, albedo and depth come from one
+ * GPU pass (GN_FRAME_AOV) whichever of them is asked for; none asked costs nothing. */
+#define RENDER_AOV_NORMAL 1u   /* normal.X/Y/Z: world-space shading normal */
+#define RENDER_AOV_ALBEDO 2u   /* albedo.R/G/B: base colour */
+#define RENDER_AOV_DEPTH 4u    /* depth.Z: distance along the camera axis, 0 on a miss */
+#define RENDER_AOV_VARIANCE 8u /* variance.R/G/B: the estimated variance of each pixel's mean */
+#define RENDER_AOV_GPU (RENDER_AOV_NORMAL | RENDER_AOV_ALBEDO | RENDER_AOV_DEPTH)
+/* "normal", "albedo", "depth", "variance" -> RENDER_AOV_*; 0 when unknown. */
+uint32_t render_aov_from_name(const char *name);
+
+typedef struct render_stats {
+    int spp;                /* samples per pixel actually taken */
+    double seconds;         /* rendering time (passes only) */
+    double first_pass_seconds;
+    double setup_seconds;   /* BVH build and upload */
+    uint64_t rays;          /* camera rays traced (pixels * spp) */
+    uint32_t truncated;     /* rays cut short by the traversal budget (path: 0, or a bug) */
+    uint32_t resumes;       /* path: dispatches that only finished paths the loop cap interrupted */
+    int bands;              /* horizontal bands the region was rendered in (1: one piece) */
+} render_stats;
+
+typedef struct renderer {
+    gpu *g;
+    const scene *sc;
+    bvh tree;
+    uint32_t num_lights, num_emitters;
+    uint32_t num_area_emitters; /* the emitter table's triangles, before its punctual lights */
+    gpu_buffer frame, nodes, tris, prims, vertices, materials, lights, texels, textures,
+        emitters, vcolor, status;
+    gpu_buffer accum, aov;  /* sized for the current image */
+    gpu_pipeline pipelines[GN_MODE_COUNT]; /* created on first use */
+    gpu_pipeline vertex_pass; /* Gouraud's per-vertex lighting (glsl/kernels/vertex.comp) */
+    gpu_buffer squares, env; /* path: per-pixel sums of squares; the environment map */
+    gpu_buffer pstate;        /* path under a loop cap: the paths left pending (GN_BIND_PSTATE) */
+    uint32_t loop_cap;        /* path: the kernel's LOOP_CAP (glsl/lib/bvh.glsl), 0 without a cap */
+    uint32_t state_stride;    /* words a pixel of pstate (frame_setup), 0 without a cap */
+    GnEmitter *emitter_table; /* path: lights, then a slot for the environment */
+    double *emitter_weight;   /* their selection weights (flux / pi) */
+    const image *env_source;  /* the map now in `env` */
+    double env_weight;        /* its selection weight */
+    int width, height;
+    double setup_seconds;
+    uint32_t material_features; /* GN_FEAT_* the materials need (renderer_create) */
+    uint32_t path_features;     /* ... and the current path render (renderer_begin) */
+    uint32_t pipeline_features[GN_MODE_COUNT]; /* what each cached kernel was built for */
+    uint32_t path_samples;      /* samples per path dispatch (1..GN_PATH_SAMPLES) */
+    bool failed;                /* renderer_create refused the scene: nothing renders */
+    VkDeviceSize vcolor_bytes;  /* Gouraud's colours: more than a storage buffer holds when
+                                 * vcolor is a dummy (then --mode gouraud is refused) */
+    /* A render in bands (renderer_render): the whole region's sums on the host, which
+     * renderer_resolve and renderer_sums read instead of the buffers; NULL otherwise. */
+    float *band_accum, *band_aov, *band_squares;
+    int region_width, region_height;
+} renderer;
+
+/* Builds the BVH and uploads the scene. False (with an error naming the scene, the limit
+ * and the numbers) when the scene's buffers exceed the device's limits; the renderer is then
+ * marked failed, so that renderer_begin and renderer_render return false too. */
+bool renderer_create(renderer *r, gpu *g, const scene *sc);
+void renderer_destroy(renderer *r); /* accepts a zeroed struct */
+
+/* The camera for settings->camera (or the framing one) as the GPU wants it. Returns false
+ * (with an error) if the index is out of range. */
+bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out);
+
+/* Fills and uploads the frame constants for s; (re)allocates and clears the accumulation,
+ * AOV and status buffers for s's region (the AOV and squares buffers only when s->aov asks
+ * for them; 16-byte dummies otherwise). False (with an error) when the region needs more
+ * than one buffer may hold: only renderer_render renders such a region, in bands. */
+bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame);
+/* The descriptor bindings of every render kernel (up to GN_BIND_COUNT entries). */
+uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
+
+/* Specialization constants of the render kernels: constant 0 = mode (or a kernel's own
+ * variant); constant 1 = the GN_FEAT_* set (the path kernel reads it; others ignore it). */
+typedef struct renderer_spec {
+    uint32_t values[4];
+    VkSpecializationMapEntry entries[4];
+    VkSpecializationInfo info;
+} renderer_spec;
+const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec);
+
+/* The kernel of a mode (created on first use, kept until renderer_destroy). */
+gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode);
+/* Records one sample pass (sample `sample_index` in every pixel) and a barrier. Call
+ * renderer_begin first. */
+void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,
+                             uint32_t count);
+/* After the submission of renderer_record_samples(..., first, count) has completed: the path
+ * kernel's pixels left pending by llvmpipe's loop cap (glsl/kernels/path.comp) finished, by further
+ * dispatches that take no new samples, so every pixel has all first + count samples. */
+uint32_t renderer_finish(renderer *r, uint32_t mode, uint32_t next); /* returns the dispatches */
+/* The accumulated image divided by spp: R, G, B, A and the AOV channels of the set aov
+ * (RENDER_AOV_*; the GPU ones need a render with them, variance any). */
+void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out);
+/* Appends the exact accumulation sums to out, the state --resume goes on from: sum.R/G/B/A
+ * always, sum.normal.X/Y/Z, sum.albedo.R/G/B, sum.depth.Z with the GPU AOVs of aov, and
+ * sum2.R/G/B (the squares) with variance. The EXR keeps them as 32-bit floats. */
+void renderer_sums(const renderer *r, uint32_t aov, image *out);
+
+/* Renders and fills `out` with R, G, B, A (A = coverage) and the channels of the AOVs in
+ * s->aov, in the order normal.X/Y/Z, albedo.R/G/B, depth.Z, variance.R/G/B. Each is the
+ * mean over the pixel's samples, a miss counting 0 (so depth is 0 where nothing is hit).
+ * A region whose accumulation buffers exceed the device's limits (gpu_storage_limit, half
+ * the host heap, maxComputeWorkGroupCount[1]) is rendered in horizontal bands, each a crop
+ * with the same bits: every batch of samples goes through all bands in turn (their sums
+ * kept on the host), so --time, a stop and the progress act on whole rounds of bands. */
+bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats);
+
+/* Applies BRDF-model overrides to the scene's materials (GnMaterial.brdf, brdf_params and
+ * the model's colour): each material's extras {"gonio": {"brdf": NAME, PARAM: VALUE...}}
+ * and, when brdf is not NULL, "NAME[:PARAM=VALUE...]" for every material (winning over
+ * extras). False with an error naming the scene and material on a bad name or value. */
+bool render_material_overrides(scene *sc, const char *brdf);
+
+/* The render modes (glsl/lib/shared.h: GN_MODES) as the host reads them, indexed by GN_MODE_*. */
+typedef struct render_mode_info {
+    const char *name; /* --mode's */
+    const char *help; /* a line */
+    uint32_t kernel;  /* GN_KERNEL_* */
+    uint32_t flags;   /* GN_MODEF_* */
+} render_mode_info;
+extern const render_mode_info render_modes[GN_MODE_COUNT];
+
+/* Name <-> GN_MODE_* ("path", "phong", ...); -1 when unknown. */
+int render_mode_from_name(const char *name);
+const char *render_mode_name(uint32_t mode);
+/* Comma-separated list of every mode name, for messages. */
+const char *render_mode_list(void);
+/* A line per mode, "name  help", for --mode's help. */
+const char *render_mode_help(void);
+
+#endif

@@ -1,0 +1,172 @@
+/* scene.h: a renderable scene in world space, loaded from glTF 2.0 (.gltf or .glb).
+ *
+ * The loader (scene_gltf.cpp) hides tinygltf behind scene_load. It walks the node
+ * hierarchy (matrix and TRS), bakes every mesh primitive instance into world space and
+ * merges them into one triangle list; per-vertex data stays indexed. Materials and lights
+ * are stored directly in their GPU form (glsl/lib/shared.h). */
+#ifndef GONIO_SCENE_H
+#define GONIO_SCENE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "shared.h"
+
+typedef struct scene_camera {
+    char name[64];
+    float position[3];
+    float right[3], up[3], forward[3]; /* orthonormal, world space (forward = node -Z) */
+    float yfov;                        /* radians (perspective) */
+    float ortho_half_height;           /* > 0: orthographic, half the view's height (ymag) */
+    float aspect;                      /* 0 when the glTF camera gives none (ortho: xmag / ymag) */
+    float znear, zfar;                 /* zfar 0 = infinite */
+} scene_camera;
+
+typedef struct scene_image {
+    uint32_t width, height;
+    uint8_t *rgba8; /* width * height * 4 bytes, rows top to bottom, as stored in the file */
+} scene_image;
+
+/* A material's use of an image (GnTexture): one per glTF texture, plus one per texture
+ * reference with its own texCoord or KHR_texture_transform. */
+typedef struct scene_texture {
+    uint32_t image; /* index into images */
+    uint32_t flags; /* GnTexture flags: wrap S/T, GN_TEX_NEAREST, GN_TEX_UV1 */
+    float transform[6]; /* the rows of KHR_texture_transform's matrix (GnTexture.row0, row1) */
+} scene_texture;
+
+/* Raw `extras: {"gonio": {...}}` of a material, kept for the integrators that read them. */
+typedef struct scene_material_extras {
+    char brdf[32];              /* "" when absent */
+    int num_params;
+    char param_names[8][24];
+    float param_values[8];
+    bool has_phong;             /* "phong": {...} was present; fields already in GnMaterial */
+} scene_material_extras;
+
+typedef struct scene {
+    char path[1024];
+
+    uint32_t num_vertices;
+    GnVertex *vertices;         /* world space; normals normalised; tangents zero if absent
+                                   and not generated (src/scene/tangent.c: for normal maps) */
+
+    uint32_t num_triangles;
+    uint32_t *indices;          /* 3 per triangle, into vertices */
+    uint32_t *tri_material;     /* per triangle, into materials */
+
+    uint32_t num_meshes;        /* glTF mesh primitives drawn (after instancing by nodes) */
+    uint32_t num_gltf_meshes;   /* glTF meshes in the file */
+    uint32_t num_nodes;         /* glTF nodes in the file */
+
+    uint32_t num_materials;     /* >= 1: a default material is appended when needed */
+    GnMaterial *materials;
+    scene_material_extras *material_extras;
+    char (*material_names)[64];
+    uint32_t num_variants;      /* KHR_materials_variants of the file (any one selected or not) */
+    char (*variant_names)[64];
+
+    uint32_t num_lights;
+    GnLight *lights;
+
+    uint32_t num_images;
+    scene_image *images;
+    uint32_t num_textures;
+    scene_texture *textures;
+
+    uint32_t num_cameras;       /* in node-traversal order (depth-first, children in order) */
+    scene_camera *cameras;
+
+    float bounds_min[3], bounds_max[3]; /* of all triangles; min > max when empty */
+    float ambient[3];           /* global ambient light of the Phong model (default 0) */
+    bool vertex_colors;         /* some mesh has COLOR_0 (GnVertex.color; 1 elsewhere) */
+} scene;
+
+/* Loads a .gltf or .glb file (GLB chosen by its magic, or by the extension). Every buffer,
+ * view, accessor and reference is validated before use; structural errors (anything that
+ * could make a read go out of bounds, unresolved references, node loops, non-finite
+ * transforms, required extensions other than KHR_lights_punctual, KHR_materials_{unlit,
+ * specular, transmission, ior, emissive_strength, variants, volume, dispersion},
+ * KHR_draco_mesh_compression and
+ * EXT_meshopt_compression, compressed data its decoder rejects) print an error naming the file and the
+ * problem and return false with *out zeroed. What can be skipped or repaired safely prints a
+ * warning naming the file and the feature: points/lines primitives (strips and fans become
+ * triangles), orthographic or invalid cameras, invalid lights, unknown optional extensions (one warning each),
+ * unknown alpha modes (rendered opaque), texCoord > 1 and missing or undecodable images (texture
+ * slot GN_INVALID; PNG and JPEG only), out-of-range material values (clamped), non-unit
+ * normals (renormalised), skins, morph targets, COLOR_0. Primitives without NORMAL get flat
+ * normals (de-indexed). Triangles with non-finite or absurdly large (|x| > 1e15) vertices
+ * are dropped with one warning. A scene without any triangle is an error ("no triangles"). */
+bool scene_load(scene *out, const char *path);
+
+/* Limits of a decoded scene, checked before anything is allocated, with the numbers in the
+ * error: triangles and vertices after instancing (about 300 bytes each through loading and
+ * the BVH build: 5 GB at the limit), and texels of all images together (RGBA8; images with
+ * the same bytes are decoded once and count once). */
+#define SCENE_MAX_TRIANGLES (1u << 24)
+#define SCENE_MAX_TEXELS (1ull << 28)
+/* The same for the glTF scene of index scene_index (-1: the file's default scene, else its
+ * first, else every node without a parent); an index the file lacks is an error. */
+bool scene_load_scene(scene *out, const char *path, int scene_index);
+/* By default a scene reads only regular files under its own folder (URIs resolved, `..`,
+ * percent-escapes and symlinks included; never the working directory): anything else is an
+ * error naming the URI. True lets a scene read any file (--allow-outside-files). */
+void scene_allow_outside_files(bool allow);
+/* Loads that follow apply the KHR_materials_variants variant of this name: each primitive's
+ * mapping that lists it replaces the primitive's material (primitives without one keep
+ * theirs); a file without a variant of that name is an error listing the variants it has.
+ * NULL or "" (the default): the files' own materials. */
+void scene_select_variant(const char *name);
+/* Loads that follow see the file's animations at this time in seconds: every animation's
+ * translation, rotation and scale channels (STEP, LINEAR with slerp for rotations,
+ * CUBICSPLINE as glTF 2.0 defines them) replace the nodes' own, so meshes, cameras and
+ * lights move; morph-target weights are not animated (a warning). Negative (the default):
+ * the nodes' own transforms. */
+void scene_animation_time(double seconds);
+
+/* Frees everything; accepts a zeroed struct. */
+void scene_destroy(scene *s);
+
+/* A camera that frames the whole scene: a raised three-quarter view of the centre of the
+ * bounds (from the +Z side, turned SCENE_FRAME_AZIMUTH degrees toward +X and raised
+ * SCENE_FRAME_ELEVATION degrees, level horizon) from a distance at which the bounding sphere
+ * fits in the vertical and horizontal field of view (yfov 45 degrees) for the given image
+ * aspect (width / height, > 0); znear and zfar enclose the sphere with a factor of 2 to
+ * spare. Empty or single-point bounds still give a valid camera (a tiny sphere around the
+ * point, or the unit sphere at the origin). */
+#define SCENE_FRAME_AZIMUTH 35.0
+#define SCENE_FRAME_ELEVATION 25.0
+void scene_default_camera(const scene *s, float aspect, scene_camera *out);
+/* The same with another vertical field of view (radians, in (0, pi)). */
+void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *out);
+
+/* Triangle t's edge cross product (p1 - p0) x (p2 - p0), in double: twice its area along
+ * its normal. */
+void scene_triangle_cross(const scene *s, uint32_t t, double out[3]);
+
+/* Recomputes bounds_min/bounds_max from the triangles. */
+void scene_compute_bounds(scene *s);
+
+/* Removes every triangle with a corner whose position is not finite or has a coordinate
+ * beyond 1e15 in magnitude (such values overflow ray-box tests in float), compacting indices
+ * and tri_material, and zeroes those vertices (no triangle refers to them any more). Returns
+ * the number of triangles removed; prints nothing (the caller warns once). */
+uint32_t scene_drop_invalid_triangles(scene *s);
+
+/* Default material, as glTF 2.0 specifies for primitives without one (white, metallic 1,
+ * roughness 1), with the Phong parameters derived as scene_phong_from_pbr does. */
+void scene_material_default(GnMaterial *m);
+
+/* Classic (OpenGL 1.x) Phong parameters from the metallic-roughness ones:
+ *   diffuse   = base_color.rgb * (1 - metallic) * (1 - transmission)
+ *   specular  = mix(0.04 * specular_color * specular, base_color.rgb, metallic)
+ *               (the glTF dielectric F0 of 0.04, tinted by KHR_materials_specular; metals
+ *               reflect their base colour)
+ *   shininess = clamp(2 / alpha^2 - 2, 1, 10000), alpha = roughness^2 (the Blinn-Phong
+ *               exponent matching a Beckmann lobe of roughness alpha, Walter et al. 2007)
+ *   ambient   = diffuse (OpenGL's convention that ambient tracks the diffuse colour; the
+ *               scene's ambient light is 0 by default, so it only shows under one)
+ *   emission  = emissive */
+void scene_phong_from_pbr(GnMaterial *m);
+
+#endif
