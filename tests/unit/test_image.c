@@ -418,67 +418,53 @@ TEST(image, exr_bad_files)
     remove_dir(dir);
 }
 
+/* Writing img to path (PNG or EXR) fails with a message naming path and leaves `files`
+ * entries in dir (the temporary file gone). */
+static bool write_fails(const image *img, const char *path, bool png, const char *dir, int files)
+{
+    char msg[1024];
+    capture cap;
+    capture_begin(&cap, stderr);
+    bool ok = png ? image_write_png_from(img, path, 0, IMAGE_TONEMAP_CLAMP) : image_write_exr(img, path, NULL, 0);
+    capture_end(&cap, msg, sizeof msg);
+    return !ok && strstr(msg, path) && dir_count(dir) == files;
+}
+
 TEST(image, exr_write_fails)
 {
     static const char *const names[1] = {"Y"};
-    char dir[64], path[256], ro[128], msg[1024];
-    capture cap;
+    char dir[64], path[256], ro[128];
     image img;
-    bool ok;
 
     make_dir(dir);
     image_create(&img, 3, 3, 1, names);
 
     snprintf(path, sizeof path, "%s/missing/out.exr", dir);
-    capture_begin(&cap, stderr);
-    ok = image_write_exr(&img, path, NULL, 0);
-    capture_end(&cap, msg, sizeof msg);
-    CHECK(!ok && strstr(msg, path));
-    CHECK(dir_count(dir) == 0);
+    CHECK(write_fails(&img, path, false, dir, 0));
 
     /* The parent is a regular file: fails even for root. */
     snprintf(path, sizeof path, "%s/file", dir);
     write_bytes(path, "x", 1);
     snprintf(path, sizeof path, "%s/file/out.exr", dir);
-    capture_begin(&cap, stderr);
-    ok = image_write_exr(&img, path, NULL, 0);
-    capture_end(&cap, msg, sizeof msg);
-    CHECK(!ok && strstr(msg, path));
-    CHECK(dir_count(dir) == 1);
+    CHECK(write_fails(&img, path, false, dir, 1));
 
     /* The destination is a directory: the rename fails and the temporary file goes. */
     snprintf(path, sizeof path, "%s/isdir.exr", dir);
     CHECK(mkdir(path, 0755) == 0);
-    capture_begin(&cap, stderr);
-    ok = image_write_exr(&img, path, NULL, 0);
-    capture_end(&cap, msg, sizeof msg);
-    CHECK(!ok && strstr(msg, path));
-    CHECK(dir_count(dir) == 2);
+    CHECK(write_fails(&img, path, false, dir, 2));
 
     /* A read-only directory (root writes anyway, so only checked for other users). */
     snprintf(ro, sizeof ro, "%s/ro", dir);
     CHECK(mkdir(ro, 0555) == 0);
     if (geteuid() != 0) {
         snprintf(path, sizeof path, "%s/out.exr", ro);
-        capture_begin(&cap, stderr);
-        ok = image_write_exr(&img, path, NULL, 0);
-        capture_end(&cap, msg, sizeof msg);
-        CHECK(!ok && strstr(msg, path));
-        CHECK(dir_count(ro) == 0);
+        CHECK(write_fails(&img, path, false, ro, 0));
         snprintf(path, sizeof path, "%s/out.png", ro);
-        capture_begin(&cap, stderr);
-        ok = image_write_png_from(&img, path, 0, IMAGE_TONEMAP_CLAMP);
-        capture_end(&cap, msg, sizeof msg);
-        CHECK(!ok && strstr(msg, path));
-        CHECK(dir_count(ro) == 0);
+        CHECK(write_fails(&img, path, true, ro, 0));
     }
 
     snprintf(path, sizeof path, "%s/missing/out.png", dir);
-    capture_begin(&cap, stderr);
-    ok = image_write_png_from(&img, path, 0, IMAGE_TONEMAP_CLAMP);
-    capture_end(&cap, msg, sizeof msg);
-    CHECK(!ok && strstr(msg, path));
-    CHECK(dir_count(dir) == 3);
+    CHECK(write_fails(&img, path, true, dir, 3));
 
     image_destroy(&img);
     image_destroy(&img); /* destroy of a zeroed image is fine */
