@@ -262,7 +262,7 @@ int cmd_bench(int argc, char **argv)
     s.width = w;
     s.height = h;
     s.camera = sc.num_cameras ? 0 : -1;
-    s.shadows = false;
+    s.no_shadows = true;
     if (paths) {
         bool ok;
         s.mode = GN_MODE_PATH;

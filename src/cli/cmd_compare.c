@@ -63,7 +63,7 @@ static bool render_one(renderer *r, const compare_opts *o, uint32_t mode, image 
     render_stats st;
     render_settings s = {.mode = mode, .width = o->width, .height = o->height,
                          .spp = mode == GN_MODE_PATH || o->spp < COMPARE_LOCAL_SPP ? o->spp : COMPARE_LOCAL_SPP,
-                         .view = &o->view, .shadows = true, .progress = !o->quiet};
+                         .view = &o->view, .progress = !o->quiet};
     return renderer_render(r, &s, out, &st);
 }
 

@@ -330,7 +330,7 @@ static int render_frames(const render_job *job)
 
 int cmd_render(int argc, char **argv)
 {
-    render_job j = {.s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .shadows = true, .progress = true,
+    render_job j = {.s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .progress = true,
                           .stop = &stop_requested},
                     .frame = -1, .fps = 24, .at = -1, .device = -1, .scene_index = -1,
                     .tm = IMAGE_TONEMAP_CLAMP, .exr = IMAGE_EXR_DEFAULTS};
@@ -415,7 +415,7 @@ int cmd_render(int argc, char **argv)
     if (rc >= 0)
         return rc;
     j.scene_path = args.arg[0];
-    j.s.shadows = !no_shadows;
+    j.s.no_shadows = no_shadows;
     const char *out_path = j.out_path, *png_path = j.png_path, *exr_path = NULL;
     warn_inapplicable(&command, &args, &j.s, png_path, out_path);
     if (!out_path && !png_path)

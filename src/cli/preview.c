@@ -276,7 +276,7 @@ static bool save_accumulated(preview *p)
     ok = image_write_exr(&img, exr, h.attrs, h.count) &&
          render_write_png(&img, p->s.mode, png, p->exposure, p->tonemap); /* as gonio render's */
     if (ok) {
-        printf("gonio preview: wrote %s and %s (%s, %d spp)\n", exr, png,
+        printf("gonio: wrote %s and %s (%s, %d spp)\n", exr, png,
                render_mode_name(p->s.mode), p->spp);
         fflush(stdout);
     }
@@ -313,7 +313,7 @@ static bool save_screenshot(preview *p, const char *path)
 static void glfw_error(int code, const char *msg)
 {
     (void)code;
-    fprintf(stderr, "gonio preview: GLFW: %s\n", msg);
+    util_warn("GLFW: %s", msg);
 }
 
 /* An 8-bit RGBA or BGRA format: the display kernel writes the bytes and a buffer-to-image
@@ -723,7 +723,7 @@ int cmd_preview(int argc, char **argv)
     bool studio;
 
     memset(p, 0, sizeof *p);
-    p->s = (render_settings){.mode = GN_MODE_PATH, .camera = -1, .shadows = true};
+    p->s = (render_settings){.mode = GN_MODE_PATH, .camera = -1};
     p->prefix = "gonio-preview";
     p->batch = 1;
     bool no_shadows = false, quiet = false, outside = false;
@@ -771,7 +771,7 @@ int cmd_preview(int argc, char **argv)
     width = size[0];
     height = size[1];
     size_given = cli_given(&command, &args, "--size");
-    p->s.shadows = !no_shadows;
+    p->s.no_shadows = no_shadows;
     util_set_quiet(quiet);
     scene_allow_outside_files(outside);
     if (screenshot && image_format_of(screenshot) != IMAGE_FORMAT_PNG)

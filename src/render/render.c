@@ -359,9 +359,18 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
     memset(r, 0, sizeof *r);
     r->g = g;
     r->sc = sc;
-    bvh_build(&r->tree, &sc->vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc->indices,
-              sc->num_triangles);
-    assert(r->tree.num_tris < (1u << 27)); /* glsl/lib/bvh.glsl packs leaves' first triangles in 27 bits */
+    if (!bvh_build(&r->tree, &sc->vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc->indices,
+                   sc->num_triangles)) {
+        util_error("%s: no triangles to render", sc->path);
+        r->failed = true;
+        return false;
+    }
+    if (r->tree.num_tris > GN_BVH_FIRST) { /* leaves index their first triangle in 27 bits */
+        util_error("%s: %u triangles, more than the %u a BVH leaf can index", sc->path, sc->num_triangles,
+                   GN_BVH_FIRST);
+        r->failed = true;
+        return false;
+    }
     for (uint32_t i = 0; i < sc->num_materials; i++)
         r->material_features |= material_features(&sc->materials[i]);
     if (!scene_fits(r)) {
@@ -852,7 +861,7 @@ static bool frame_setup(renderer *r, const render_settings *s, const int region[
     frame->mode = s->mode;
     frame->max_depth = (uint32_t)s->max_depth;
     frame->num_lights = r->num_lights;
-    frame->flags = (s->aov & RENDER_AOV_GPU ? GN_FRAME_AOV : 0u) | (s->shadows ? GN_FRAME_SHADOWS : 0u) |
+    frame->flags = (s->aov & RENDER_AOV_GPU ? GN_FRAME_AOV : 0u) | (!s->no_shadows ? GN_FRAME_SHADOWS : 0u) |
                    (s->aov & RENDER_AOV_VARIANCE ? GN_FRAME_VARIANCE : 0u) |
                    (r->sc->vertex_colors ? GN_FRAME_VERTEX_COLOR : 0u) |
                    (r->material_features & GN_FEAT_ALPHA ? GN_FRAME_ALPHA : 0u);
@@ -863,7 +872,7 @@ static bool frame_setup(renderer *r, const render_settings *s, const int region[
     frame->bounds_min = v3(r->sc->bounds_min);
     frame->bounds_max = v3(r->sc->bounds_max);
     frame->ambient = v3(s->ambient_set ? s->ambient : r->sc->ambient);
-    frame->traversal_budget = traversal_budget(r->g, 1 + (s->shadows ? r->num_lights : 0));
+    frame->traversal_budget = traversal_budget(r->g, 1 + (!s->no_shadows ? r->num_lights : 0));
     r->state_stride = 0; /* path_begin sets it, and the loop cap, for the path kernel */
     return s->mode != GN_MODE_PATH || path_begin(r, s, frame);
 }

@@ -16,6 +16,9 @@
 #include "image.h"
 #include "scene.h"
 
+/* What to render. A zero field is the default where one exists (mode path, seed 0, no AOVs,
+ * shadows on, unbounded depth, a black environment, MIS, the whole image, no resume, no
+ * progress); width, height and spp must be given, and camera (-1: frame the scene). */
 typedef struct render_settings {
     uint32_t mode;          /* GN_MODE_* */
     int width, height;
@@ -24,7 +27,7 @@ typedef struct render_settings {
     uint32_t seed;
     int camera;             /* glTF camera index, -1 = frame the scene */
     uint32_t aov;           /* RENDER_AOV_* set: the extra channels to add */
-    bool shadows;           /* ray-traced shadows in the local modes (default on) */
+    bool no_shadows;        /* local modes: no ray-traced shadows (false, the default: shadows) */
     int max_depth;          /* path tracer: 0 = unbounded (roulette only) */
     float env[3];           /* constant environment radiance */
     bool ambient_set;       /* local modes: ambient replaces the scene's global ambient light */

@@ -96,7 +96,7 @@ void render_header_build(render_header *h, const renderer *r, const render_setti
         add_string(h, "gonio:env", "%.9g,%.9g,%.9g", s->env[0], s->env[1], s->env[2]);
     if (lit) {
         const float *a = s->ambient_set ? s->ambient : r->sc->ambient;
-        add_string(h, "gonio:shadows", "%s", s->shadows ? "on" : "off");
+        add_string(h, "gonio:shadows", "%s", s->no_shadows ? "off" : "on");
         add_string(h, "gonio:ambient", "%.9g,%.9g,%.9g", a[0], a[1], a[2]);
     }
     add_attr(h, (image_attr){"gonio:spp", IMAGE_ATTR_INT, NULL, st->spp, 0, NULL});

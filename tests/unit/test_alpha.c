@@ -105,7 +105,7 @@ static bool render_mean(gpu *g, const char *path, uint32_t mode, double *mean)
     render_stats st;
     image img = {0};
     render_settings s = {.mode = mode, .width = SIZE, .height = SIZE, .spp = SPP, .camera = 0, .seed = 7,
-                         .shadows = true, .ambient_set = true};
+                         .ambient_set = true};
     bool ok = scene_load(&sc, path);
     if (ok) {
         renderer_create(&r, g, &sc);

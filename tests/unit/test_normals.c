@@ -30,7 +30,7 @@ static bool render_asset(gpu *g, const char *rel, uint32_t mode, int size, int s
     renderer r = {0};
     render_stats st;
     render_settings s = {.mode = mode, .width = size, .height = size, .spp = spp, .camera = -1,
-                         .shadows = true, .env = {1, 1, 1}, .seed = 1, .camera_override = cam};
+                         .env = {1, 1, 1}, .seed = 1, .camera_override = cam};
     snprintf(path, sizeof path, "%s/%s", dir, rel);
     bool ok = scene_load(&sc, path);
     CHECKF(ok, "cannot load %s", path);

@@ -111,7 +111,7 @@ static bool render_scene(const scene *sc, uint32_t mode, int w, int h, bool want
     scene_camera view;
     straight_down_z(sc, (float)w / (float)h, &view);
     render_settings s = {.mode = mode, .width = w, .height = h, .spp = 1, .camera = -1,
-                         .shadows = true, .view = &view};
+                         .view = &view};
     render_stats st;
     renderer r;
     gpu g;
