@@ -1353,7 +1353,12 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
      * bands split the samples: the same command gives the same bits, and so do a render
      * resumed from its sums (s->resume), a crop of it (GnFrame) and one in bands. A batch
      * goes through every band before the next, so all pixels always have the same samples:
-     * a stop or --time ends the render after a whole round. */
+     * a stop or --time ends the render after a whole round. The kernel is compiled first,
+     * so that --time, the progress and the rates count rendering, not the driver's compiler
+     * (the setup time includes it). */
+    t0 = util_now();
+    renderer_pipeline(r, s->mode);
+    double compile_seconds = util_now() - t0;
     t0 = util_now();
     while (s->time_limit > 0 || done < s->spp) {
         double tb = util_now();
@@ -1396,7 +1401,7 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
     }
     stats->spp = done;
     stats->rays = (uint64_t)pixels * (uint64_t)(done - (s->resume ? s->resume_spp : 0));
-    stats->setup_seconds = r->setup_seconds;
+    stats->setup_seconds = r->setup_seconds + compile_seconds;
     stats->truncated = ((const uint32_t *)r->status.mapped)[0];
     if (getenv("GONIO_DEBUG_RESUMES")) /* tests/regress/path.sh: the interrupted paths were there */
         fprintf(stderr, "gonio: debug: %u dispatch(es) finished paths the loop cap interrupted\n",
