@@ -1,4 +1,4 @@
-// brdf.glsl: the BSDFs of the lecture (materials-lecture.txt) with eval, pdf and importance
+// brdf.glsl: the BSDFs of docs/brdf.md with eval, pdf and importance
 // sampling in the local shading frame, used by every integrator and by brdf_test.comp.
 // Lambert f = C = albedo/pi; the mirror f = delta(wi - r(wo)) / (n.wi); normalised Phong
 // (Lafortune & Willems 1994) and Blinn-Phong; Torrance-Sparrow f = F D G / (4 (n.wo)(n.wi))
