@@ -181,7 +181,7 @@ bench-peer: all
 	@tests/peer/run.sh $(GONIO) $(PEER_ARGS)
 
 # libFuzzer targets over scene_load and image_read_exr (tests/fuzz); fuzz-run runs each for
-# FUZZ_TIME seconds from seeds of ../shared/assets and EXRs gonio writes (tests/fuzz/run.sh).
+# FUZZ_TIME seconds from seeds of $GONIO_ASSETS and EXRs gonio writes (tests/fuzz/run.sh).
 FUZZ_TARGETS := build/fuzz/fuzz_scene build/fuzz/fuzz_exr
 FUZZ_TIME ?= 60
 fuzz: fuzz-deps

@@ -2,7 +2,7 @@
 # make-images.sh: regenerates every figure in docs/img (make docs-images): the BRDF lobe
 # plots and material balls of docs/brdf.md section 6, the shading comparison and sweep of
 # docs/shading.md, and the path-traced scenes of docs/path-tracing.md (the glTF sample
-# models are skipped when ../shared/assets is absent). Environment: GONIO (the program;
+# models are skipped when $GONIO_ASSETS is absent). Environment: GONIO (the program;
 # default build/gonio), GONIO_ASSETS (default ../shared/assets).
 set -eu
 cd "$(dirname "$0")/.."
@@ -36,7 +36,7 @@ ball dielectric dielectric --tint 0.5,0.8,1 --alpha 0.05
 ball gltf gltf --base-color 0.8,0.3,0.1 --roughness 0.4 --metallic 0.5
 
 # ---- docs/shading.md ----------------------------------------------------------------------
-# The lecture's teapot in all four modes (path is skipped while unavailable), 320x240.
+# The OpenGL 1.x teapot in all four modes (path is skipped while unavailable), 320x240.
 "$G" compare scenes/teapot.gltf -o "$tmp/teapot" --spp 256 --quiet
 cp "$tmp/teapot/side-by-side.png" $img/shading-teapot.png
 rm -f $img/shading-diff-*.png

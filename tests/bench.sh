@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # bench.sh GONIO: make bench. BVH build rate, ray throughput and time to first pixel on the
-# Cornell box, the largest glTF sample model in ../shared/assets (when present), and a
+# Cornell box, the largest glTF sample model in $GONIO_ASSETS (when present), and a
 # generated mesh of about 250k triangles; then the path tracer (bench --paths: paths/s at
 # 256x256, first pixel, time to an RMSE) on the Cornell box and a textured sample model.
 set -u

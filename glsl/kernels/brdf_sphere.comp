@@ -1,6 +1,6 @@
 #version 450
 // brdf_sphere.comp: the material ball of `gonio brdf --sphere`: a unit sphere lit by a
-// directional light (evaluated directly: Lo += f E cos, the lecture's point-light integral)
+// directional light (evaluated directly: Lo += f E cos, the point-light integral)
 // and a constant environment (reached by BSDF sampling, bounces through glass included),
 // one path per pixel per dispatch, accumulated. Uses the renderer's brdf.glsl.
 #extension GL_GOOGLE_include_directive : require

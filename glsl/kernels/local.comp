@@ -1,6 +1,6 @@
 #version 450
 // local.comp: one sample per pixel per dispatch of the non-path-traced modes: the Phong
-// reflection model of the lecture (glsl/lib/phong.glsl) evaluated once per triangle (flat),
+// reflection model of OpenGL 1.x (glsl/lib/phong.glsl) evaluated once per triangle (flat),
 // per vertex and interpolated (Gouraud) or per pixel (Phong shading), and the debug images
 // normal, albedo, depth and BVH cost. The mode is a specialization constant, so each mode
 // compiles to its own lean kernel.

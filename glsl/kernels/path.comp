@@ -1,6 +1,6 @@
 #version 450
-// path.comp: Monte Carlo path tracing of the lecture's rendering equation
-// L_o = L_e + integral f L_i cos, one path sample per pixel per dispatch. At every vertex:
+// path.comp: Monte Carlo path tracing of the rendering equation (docs/path-tracing.md)
+// L_o = L_e + integral f L_i cos, several path samples a pixel per dispatch. At every vertex:
 // next-event estimation (one light from the power-proportional table, area sampling on
 // triangles, the lat-long environment map by its luminance) and a BSDF sample from
 // brdf.glsl, combined by multiple importance sampling with the power heuristic (Veach &
@@ -622,7 +622,7 @@ void main()
             loop_left -= min(loop_left, frame.loop_overhead);
         // One vertex, in a loop of one iteration: a path's end is a `break` out of it.
         // (llvmpipe masks lanes for a break cheaply; a continue or an early return masks
-        // every later statement again and cost a third of the speed.)
+        // every later statement again, which is slower: docs/performance.md.)
         do {
             if (phase == PHASE_RAY) {
             Hit h = trace_resume(true, o, d, tmin, false, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);

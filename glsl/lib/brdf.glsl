@@ -1,4 +1,4 @@
-// brdf.glsl: the BSDFs of the lecture (materials-lecture.txt) with eval, pdf and importance
+// brdf.glsl: the BSDFs of docs/brdf.md with eval, pdf and importance
 // sampling in the local shading frame, used by every integrator and by brdf_test.comp.
 // Lambert f = C = albedo/pi; the mirror f = delta(wi - r(wo)) / (n.wi); normalised Phong
 // (Lafortune & Willems 1994) and Blinn-Phong; Torrance-Sparrow f = F D G / (4 (n.wo)(n.wi))
@@ -47,7 +47,7 @@ layout(binding = BRDF_BIND_SHEEN) uniform usamplerBuffer sheen_table;
 #define BRDF_FRESNEL_CONDUCTOR 2u  // exact, complex index eta + i k
 #define BRDF_FRESNEL_SCHLICK 3u    // F0 = specular, F90 = f90
 
-// A sum of BRDFs (the lecture's "adding BRDFs"): a Lambert layer, one specular lobe and a
+// A sum of BRDFs (docs/brdf.md, section 2): a Lambert layer, one specular lobe and a
 // dielectric interface (reflection + refraction), each with its weight.
 struct Bsdf {
     vec3 diffuse; uint lobe;          // Lambert weight kd; the lobe's kind
@@ -97,7 +97,7 @@ BsdfSample brdf_sample_from(vec3 wi, vec3 f, float pdf, uint flags)
 
 // ---- Fresnel --------------------------------------------------------------------------
 
-// The lecture's dielectric Fresnel: r_par, r_perp and F_r = (r_par^2 + r_perp^2) / 2 for
+// The exact dielectric Fresnel: r_par, r_perp and F_r = (r_par^2 + r_perp^2) / 2 for
 // unpolarised light (F_t = 1 - F_r). eta = eta_inside / eta_outside with the normal on the
 // outside; cos_i < 0 means light arrives from inside. 1 under total internal reflection.
 float brdf_fresnel_dielectric(float cos_i, float eta)
@@ -134,7 +134,7 @@ vec3 brdf_fresnel_conductor(float cos_i, vec3 eta, vec3 k)
     return 0.5 * (rp + rs);
 }
 
-// Schlick's approximation F = F0 + (F90 - F0)(1 - cos)^5 (the lecture has F90 = 1).
+// Schlick's approximation F = F0 + (F90 - F0)(1 - cos)^5 (F90 = 1 for a plain dielectric).
 vec3 brdf_fresnel_schlick(float cos_i, vec3 f0, float f90)
 {
     float m = clamp(1.0 - cos_i, 0.0, 1.0), m2 = m * m;
@@ -156,7 +156,7 @@ float brdf_pow(float x, float e)
     return x > 0.0 ? pow(x, e) : 0.0;
 }
 
-// Blinn's distribution as the lecture writes it: D = (e + 2) / (2 pi) (wh.n)^e.
+// Blinn's distribution in its classic form: D = (e + 2) / (2 pi) (wh.n)^e.
 float brdf_d_blinn(float cos_h, float e)
 {
     return (e + 2.0) / (2.0 * BRDF_PI) * brdf_pow(cos_h, e);

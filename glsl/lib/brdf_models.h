@@ -1,6 +1,6 @@
 /* brdf_models.h: the BRDF model ids, their parameter slots and the records of the BRDF test
  * kernel, shared by C (src/render/brdf.c, the tests) and GLSL (brdf.glsl, brdf_test.comp). The
- * models are the lecture's (materials-lecture.txt); docs/brdf.md has their equations.
+ * models and their equations are docs/brdf.md's.
  *
  * A model is a colour plus four scalars: GnMaterial.brdf (the id) with base_color.rgb as the
  * colour and brdf_params as the scalars; bsdf_from_model() in brdf.glsl reads them. The
@@ -13,7 +13,7 @@
 /* ---- model ids (GnMaterial.brdf) ------------------------------------------------------ */
 #define BRDF_GLTF 0u             /* glTF metallic-roughness (+ specular, transmission, ior, clearcoat, sheen) */
 #define BRDF_LAMBERT 1u          /* colour = albedo */
-#define BRDF_MIRROR 2u           /* colour = reflectance; the lecture's delta BRDF */
+#define BRDF_MIRROR 2u           /* colour = reflectance; the ideal mirror's delta BRDF */
 #define BRDF_PHONG 3u            /* colour = diffuse; specular, exponent */
 #define BRDF_BLINN_PHONG 4u      /* colour = diffuse; specular, exponent */
 #define BRDF_TORRANCE_SPARROW 5u /* colour = diffuse; specular, exponent e of Blinn's D, ior */

@@ -18,7 +18,7 @@
 // registers, for trees of at most K levels (the host sets it from the tree: src/render/render.c).
 // llvmpipe keeps a private array that is indexed per lane in memory and reads and writes it
 // one lane at a time with a branch on each lane's mask; a shift register of K values costs
-// it 2K vector selects a node visit instead (Cornell box paths: +6%).
+// it 2K vector selects a node visit instead (the gain: docs/performance.md).
 layout(constant_id = GN_SPEC_WALK_REGS) const uint WALK_REGS = 0u;
 
 // LOOP_CAP > 0: the loop passes a SIMD group may run (src/render/render.c sets it below llvmpipe's

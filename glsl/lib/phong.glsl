@@ -1,4 +1,4 @@
-// phong.glsl: the Phong reflection model of the lecture (Phong 1975; OpenGL 1.x's lighting
+// phong.glsl: the Phong reflection model (Phong 1975; OpenGL 1.x's lighting
 // equation): L = emission + ambient_light * ka + sum over lights of E (kd (n.l) + ks (r.v)^s),
 // r = 2 (n.l) n - l, with ray-traced shadows. One function serves the three shading
 // algorithms, which differ only in where they call it: once per triangle (flat), once per
@@ -77,7 +77,7 @@ vec3 phong_shade(vec3 p, vec3 n, vec3 ng, vec4 uv, vec3 vcolor, uint material, v
             continue;
         if (shadowed(p, ng, wi, dist, DIM_ALPHA + DIM_ALPHA_RAY * (1u + i)))
             continue;
-        vec3 r = 2.0 * ndl * n - wi; // the lecture's r(w_i)
+        vec3 r = 2.0 * ndl * n - wi; // the mirror direction r(w_i)
         // OpenGL's 0^0 = 1; GLSL leaves pow(0, 0) undefined.
         float spec = m.phong_shininess > 0.0 ? pow(max(dot(r, v), 0.0), m.phong_shininess) : 1.0;
         c += E * (kd * ndl + ks * spec);

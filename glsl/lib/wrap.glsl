@@ -5,8 +5,8 @@
 #define GONIO_WRAP_GLSL
 
 // i modulo n in [0, n) for 0 < n and |i| < 2^24 (beyond, still in [0, n)). x86 has no
-// vector integer division, so llvmpipe runs `%` one lane at a time (it made textured
-// scenes a third slower). In that range floor(float(i) / float(n)) is exact: a quotient
+// vector integer division, so llvmpipe runs `%` one lane at a time (what that cost
+// textured scenes: docs/performance.md). In that range floor(float(i) / float(n)) is exact: a quotient
 // that is not an integer is at least 1/n from one, more than its rounding error, |i/n|
 // 2^-24. The selects and the clamp keep larger |i| in range.
 int mod_floor(int i, int n)

@@ -346,8 +346,7 @@ static const float *vertex(const builder *bd, uint32_t tri, int k)
  * list B's corners in the test's order by a rotation, keeping its winding), and the pair's
  * box is no larger (in surface area) than the two boxes together: the SAH's view, since a
  * pair costs the walk about what one triangle does (three texel fetches) and is entered
- * whenever a ray enters its box. (Without that test, the few folded pairs of the 250k bench
- * mesh made its rays 15% slower.) */
+ * whenever a ray enters its box (docs/performance.md: what folded pairs cost). */
 static bool pairs_with(const builder *bd, uint32_t t, uint32_t u)
 {
     const uint32_t *a = bd->indices + 3 * (size_t)t, *b = bd->indices + 3 * (size_t)u;

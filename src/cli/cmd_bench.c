@@ -212,7 +212,7 @@ int cmd_bench(int argc, char **argv)
     const cli_command command = {
         .name = "bench", .synopsis = "[SCENE.gltf | --generate N] [options]",
         .intro =
-            "Prints the BVH build time (best of 3), the time from start to the first finished\n"
+            "Prints the BVH build time (best of 7), the time from start to the first finished\n"
             "pixel (load, build, upload, shader compile, one pass), and the throughput of\n"
             "primary (camera) rays and diffuse bounce rays (cosine-distributed from the primary\n"
             "hits) through the GPU traversal. Default scene: the Cornell box (gonio scene cornell).\n"

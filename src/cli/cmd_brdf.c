@@ -1,7 +1,7 @@
 /* cmd_brdf.c: `gonio brdf`, a virtual goniophotometer over the shader BRDF library: the
- * model list, polar plots of a lobe in the plane of incidence (the lecture's "Visualizing
- * BRDFs": Lambertian, specular, combined), the directional albedo against incident angle
- * (the lecture's energy-conservation integral), and a material ball under a directional light
+ * model list, polar plots of a lobe in the plane of incidence (Lambertian, specular,
+ * combined), the directional albedo against incident angle (the energy-conservation
+ * integral), and a material ball under a directional light
  * and a constant environment. Every number comes from glsl/lib/brdf.glsl run on the GPU. */
 #include <math.h>
 #include <stdio.h>
@@ -243,7 +243,7 @@ static int run_plot(brdf_runner *r, const brdf_setting *s, double theta_deg, con
     brdf_format_setting(title, sizeof title, s);
     curves[n] = (plot_curve){layered ? "combined: f = diffuse + specular" : "f", 0x1f4e9affu, {0}};
     plot_eval(r, s, theta, curves[n++].f);
-    if (layered) { /* the lecture's Lambertian, specular, combined */
+    if (layered) { /* Lambertian, specular, combined */
         brdf_setting part = *s;
         part.v[ks->slot] = 0;
         curves[n] = (plot_curve){"Lambertian (diffuse) part", 0x2ca02cffu, {0}};
@@ -265,7 +265,7 @@ static int run_plot(brdf_runner *r, const brdf_setting *s, double theta_deg, con
 
 /* ---- directional albedo ----------------------------------------------------------------- */
 
-/* The white-furnace integral of the lecture, int f cos dwi, as the mean sample weight over a
+/* The white-furnace integral, int f cos dwi, as the mean sample weight over a
  * 3D low-discrepancy (Roberts' R3) sequence: deterministic and accurate to ~1e-3. */
 static void run_albedo(brdf_runner *r, const brdf_setting *s)
 {

@@ -1,4 +1,4 @@
-/* cmd_compare.c: `gonio compare`: the lecture's three shading algorithms (flat, Gouraud, Phong
+/* cmd_compare.c: `gonio compare`: the three classic shading algorithms (flat, Gouraud, Phong
  * shading) and the path tracer rendered from one scene, side by side, with difference heat
  * maps and image metrics (image.h); and `--sweep`, the error of flat and Gouraud shading
  * against per-pixel Phong shading as the teapot's tessellation gets finer. */
@@ -496,7 +496,7 @@ static bool make_dir(const char *dir)
 
 #define COMPARE_INTRO                                                                          \
     "Renders a scene with flat, Gouraud and per-pixel Phong shading (the Phong reflection\n"   \
-    "model of the lecture) and path-traced, and writes into DIR:\n"                             \
+    "model of OpenGL 1.x) and path-traced, and writes into DIR:\n"                             \
     "  MODE.exr, MODE.png        each mode's image (linear float EXR; sRGB PNG, clamped)\n"     \
     "  side-by-side.png          the PNGs in a row, labelled with the mode and its RMSE\n"     \
     "  diff-A-vs-B.png           heat map of |A - B| (mean over R, G, B, viridis; the legend\n" \

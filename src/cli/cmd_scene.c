@@ -1,7 +1,7 @@
 /* cmd_scene.c: `gonio scene cornell|teapot` and `gonio teapot`: the project's own scenes as
  * glTF. The Cornell box follows the Cornell Program of Computer Graphics' published
  * measurements (graphics.cornell.edu/online/box/data.html); the teapot scene is the
- * lecture's OpenGL 1.x example (red diffuse, white specular, shininess 128, light from
+ * classic OpenGL 1.x example (red diffuse, white specular, shininess 128, light from
  * (1,1,1)). */
 #include <errno.h>
 #include <math.h>
@@ -199,7 +199,7 @@ static bool write_cornell(const char *path)
     return gltf_write_file(path, &desc);
 }
 
-/* ---- the lecture's teapot ----------------------------------------------------------------
+/* ---- the OpenGL 1.x teapot ---------------------------------------------------------------
  * glMaterial: diffuse (1,0,0), specular (1,1,1), shininess 128 (and OpenGL's default ambient
  * 0.2), kept verbatim in extras for the Phong modes. For the path tracer, the roughness
  * whose Phong-equivalent exponent 2/alpha^2 - 2 (Walter et al. 2007) is 128, alpha =
@@ -249,7 +249,7 @@ static int run(int argc, char **argv, bool teapot_command)
     int level = SCENE_TEAPOT_LEVEL;
     const cli_option options[] = {
         {NULL, NULL, "  cornell             the Cornell box (published measurements, metres, one area light)\n"
-                     "  teapot              the Utah teapot as in the lecture's OpenGL 1.x example\n",
+                     "  teapot              the Utah teapot as in the classic OpenGL 1.x example\n",
          CLI_TEXT, NULL, 0, 0, NULL, NULL},
         {"-o, --output", "FILE", "the file to write, in the format its name says: .gltf JSON with\n"
                                  "the buffer embedded, .glb binary glTF (any other name is a usage error)",

@@ -28,7 +28,7 @@ static void usage(FILE *f)
 {
     fprintf(f, "usage: gonio COMMAND [OPTIONS]   (gonio COMMAND --help for details)\n\n"
                "A physically based renderer: GLSL compute shaders on Vulkan ray-trace\n"
-               "triangle BVHs and shade with the BRDFs of the lecture.\n\ncommands:\n");
+               "triangle BVHs and shade with physically based BRDFs.\n\ncommands:\n");
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
         fprintf(f, "  %-9s %s\n", commands[i].name, commands[i].summary);
     fprintf(f, "\n  --version   print the version\n"

@@ -149,7 +149,7 @@ static bool loop_capped(const gpu *g)
 
 /* How many samples one invocation of the path kernel takes per dispatch, 1 to
  * GN_PATH_SAMPLES. More keep the SIMD lanes busier (glsl/kernels/path.comp): the Cornell box's
- * paths went 2.96 -> 3.03 M paths/s from 16 to 31 on lavapipe. Each path has its own
+ * paths run faster with 31 than 16 on lavapipe (docs/performance.md). Each path has its own
  * walk budget, but on llvmpipe all of them share the loop cap (65,535 iterations per SIMD
  * group), so the number is what fits half the cap for typical paths: 16 rays (8 vertices,
  * each with a shadow ray) of sah_cost node visits, about 3 loop iterations a visit, and 2

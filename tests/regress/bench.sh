@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # bench.sh: `gonio bench --generate` and `gonio bench --paths` run and prints every figure (first pixel, paths/s, the
 # reference and both RMSE thresholds) on the Cornell box at a tiny size, so the command
-# behind docs/path-tracing.md's performance figures cannot rot.
+# behind docs/performance.md's figures cannot rot.
 . "$(dirname "$0")/../lib.sh"
 G=$GONIO
 check "bench --paths on the Cornell box" "$G" bench scenes/cornell.gltf --paths --size 16x16 \

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# compare.sh: `gonio compare` on the lecture's teapot: every promised file with its size and
+# compare.sh: `gonio compare` on scenes/teapot.gltf: every promised file with its size and
 # labels, metrics that say the three shading algorithms differ, the sweep whose
 # Gouraud-vs-Phong error falls as the tessellation gets finer, and bad usage.
 . "$(dirname "$0")/../lib.sh"

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # invalid.sh: malformed glTF. First `gonio render` over every glTF-Validator test case in
-# ../shared/assets: a file whose validator report has an error in something gonio reads
+# $GONIO_ASSETS: a file whose validator report has an error in something gonio reads
 # (the REJECT codes below) must fail (exit 1) with an error, other than "no triangles", that
 # names the file, and write no output; one whose errors gonio degrades gracefully (the
 # DEGRADE codes) must render with a warning, or fail naming the file after a warning. The

@@ -31,8 +31,8 @@ extern int test_checks;
 /* Marks the running test skipped (with a reason printed once). */
 void test_skip(const char *why);
 
-/* Directory of the third-party test assets (../shared/assets relative to the repo root, or
- * $GONIO_ASSETS); NULL when absent, in which case tests that need it call test_skip. */
+/* Directory of the third-party test assets ($GONIO_ASSETS, which tests/run.sh sets; the
+ * fallback is test_main.c's); NULL when absent, in which case tests that need it call test_skip. */
 const char *test_assets_dir(void);
 
 /* The Vulkan device for GPU tests (validation on when GONIO_VALIDATE=1); a failed CHECK

@@ -703,7 +703,7 @@ TEST(brdf, broken_variants_fail)
 
 /* ---- Fresnel -------------------------------------------------------------------------------- */
 
-/* The lecture's r_par, r_perp with complex cos_t: an independent conductor reference. */
+/* Fresnel's r_par, r_perp with complex cos_t: an independent conductor reference. */
 static double fresnel_complex(double cos_i, double complex n)
 {
     double sin2 = 1 - cos_i * cos_i;
@@ -776,7 +776,7 @@ TEST(brdf, fresnel)
     close_runner();
 }
 
-/* Dirac lobes: the mirror returns r(wo) with weight R (the lecture's Lo = Li(r(wo))); the
+/* Dirac lobes: the mirror returns r(wo) with weight R (Lo = R Li(r(wo)), docs/brdf.md); the
  * smooth dielectric reflects with probability F and refracts by Snell's law otherwise (always
  * reflecting past the critical angle); polished conductors and glTF weight by their Fresnel. */
 TEST(brdf, delta_lobes)

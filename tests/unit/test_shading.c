@@ -1,5 +1,5 @@
-/* test_shading.c: the three shading algorithms of the lecture on the Vulkan device (glsl/
- * local.comp, glsl/kernels/vertex.comp) against the Phong reflection model written out again here in
+/* test_shading.c: the three shading algorithms of docs/shading.md on the Vulkan device
+ * (glsl/kernels/local.comp, glsl/kernels/vertex.comp) against the Phong reflection model written out again here in
  * C: Gouraud's vertex colours and their barycentric interpolation, flat shading's one colour
  * per triangle, per-pixel Phong shading converging to the analytic sphere, and the highlight
  * inside a triangle that Gouraud shading misses. */
@@ -47,7 +47,7 @@ static void normalize3(double v[3])
         v[k] /= l;
 }
 
-/* The Phong reflection model, from the lecture's formula: emission + ambient light * ka +
+/* The Phong reflection model, from its formula (docs/shading.md): emission + ambient light * ka +
  * E (kd (n.l) + ks (r.v)^s), r = 2 (n.l) n - l; a light behind the surface adds nothing.
  * Point lights fall off as 1/d^2. n, v unit. */
 static void phong_ref(const shade_params *p, const double pos[3], const double n[3],
