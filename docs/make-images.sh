@@ -24,6 +24,9 @@ mkdir -p $img
 "$G" brdf dielectric --theta 40 -o $img/brdf-glass.png
 "$G" brdf dielectric --alpha 0.2 --theta 40 -o $img/brdf-dielectric.png
 "$G" brdf gltf --roughness 0.4 --theta 45 -o $img/brdf-gltf.png
+"$G" brdf gltf --metallic 1 --roughness 0.3 --anisotropy 0.8 --theta 45 -o $img/brdf-gltf-aniso.png
+"$G" brdf gltf --metallic 1 --roughness 0.3 --anisotropy 0.8 --anisotropy-rotation 1.5708 --theta 45 \
+    -o $img/brdf-gltf-aniso-across.png
 ball() { # ball NAME MODEL [PARAMS...]
     local name=$1; shift
     "$G" brdf "$@" --sphere --size 128x128 --spp 256 -o "$tmp/ball.exr" --png $img/brdf-ball-$name.png
@@ -34,6 +37,8 @@ ball ggx ggx --diffuse 0.1,0.2,0.5 --specular 0.5 --alpha 0.1
 ball conductor conductor --alpha 0.2
 ball dielectric dielectric --tint 0.5,0.8,1 --alpha 0.05
 ball gltf gltf --base-color 0.8,0.3,0.1 --roughness 0.4 --metallic 0.5
+ball aniso gltf --base-color 0.9 --metallic 1 --roughness 0.3 --anisotropy 0.8
+ball aniso-across gltf --base-color 0.9 --metallic 1 --roughness 0.3 --anisotropy 0.8 --anisotropy-rotation 1.5708
 
 # ---- docs/shading.md ----------------------------------------------------------------------
 # The OpenGL 1.x teapot in all four modes (path is skipped while unavailable), 320x240.

@@ -40,6 +40,7 @@ void main()
         : bsdf_from_model(scene.model, scene.color, scene.params);
     if (scene.model == BRDF_GLTF)
         b = bsdf_layers(b, scene.layer.x, scene.layer.y, vec3(0.0, 0.0, 1.0), scene.sheen.rgb, scene.layer.z);
+    Bsdf b0 = b; // before the anisotropy, whose direction each hit sets
     vec4 jitter = rng_uniform4(pixel, push.sample_index, 0u, push.pad0);
     float aspect = float(scene.width) / float(scene.height);
     vec2 ndc = vec2(2.0 * (float(px.x) + jitter.x) / float(scene.width) - 1.0,
@@ -56,6 +57,14 @@ void main()
         vec3 p = o + t * d, n = normalize(p), tx, ty;
         sampling_basis(n, tx, ty);
         vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
+        if (scene.model == BRDF_GLTF && scene.aniso.x > 0.0) {
+            // The ball's tangent runs along its parallels (about the vertical axis), as on a
+            // lathe-brushed part; the rotation turns it toward the bitangent n x t.
+            vec3 t = cross(vec3(0.0, 1.0, 0.0), n);
+            t = dot(t, t) > 1e-12 ? normalize(t) : tx;
+            vec2 tl = vec2(dot(t, tx), dot(t, ty)), bl = vec2(-tl.y, tl.x);
+            b = bsdf_anisotropy(b0, scene.aniso.x, cos(scene.aniso.y) * tl + sin(scene.aniso.y) * bl);
+        }
         // The light reaches only the outside (the sphere is convex: no shadow ray needed).
         vec3 wl = vec3(dot(scene.light_dir, tx), dot(scene.light_dir, ty), dot(scene.light_dir, n));
         if (wo.z > 0.0 && wl.z > 0.0)

@@ -39,8 +39,16 @@ void main()
     Bsdf b = q.model == BRDF_GLTF
         ? bsdf_gltf(q.color, q.params.x, q.params.y, q.params.z, q.extra.xyz, q.params.w, q.extra.w)
         : bsdf_from_model(q.model, q.color, q.params);
-    if (q.model == BRDF_GLTF)
+    if (q.model == BRDF_GLTF) {
         b = bsdf_layers(b, q.layer.x, q.layer.y, vec3(sin(q.layer.w), 0.0, cos(q.layer.w)), q.sheen.rgb, q.layer.z);
+        // the tangent is +x: the anisotropy's direction is the rotation's
+        b = bsdf_anisotropy(b, q.aniso.x, vec2(cos(q.aniso.y), sin(q.aniso.y)));
+    }
+    if ((q.op & BRDF_OP_NDF) != 0u) {
+        r.f = vec3(brdf_base_d(b, q.wi), brdf_base_g1(b, q.wo), 0.0);
+        results[i] = r;
+        return;
+    }
     if ((q.op & BRDF_OP_EVAL) != 0u)
         bsdf_eval_pdf(b, q.wo, q.wi, r.f, r.pdf);
     if ((q.op & BRDF_OP_SAMPLE) != 0u) {

@@ -675,6 +675,8 @@ void main()
                 vec3 cn = flip ? -s.coat_n : s.coat_n;
                 b.coat_n = normalize(vec3(dot(cn, tx), dot(cn, ty), dot(cn, n)));
             }
+            if (GN_HAS(GN_FEAT_ANISO) && s.aniso > 0.0 && m.brdf == BRDF_GLTF) // the direction on the shading plane
+                b = bsdf_anisotropy(b, s.aniso, vec2(dot(s.aniso_t, tx), dot(s.aniso_t, ty)));
             vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
             uint far = GN_INVALID; // the medium beyond a transmitting surface
             if (GN_HAS(GN_FEAT_VOLUME))

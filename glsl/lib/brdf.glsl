@@ -62,6 +62,9 @@ struct Bsdf {
     float coat;                       // the coat's weight (0: none)
     vec3 coat_n; float coat_alpha;    // the coat's normal (unit, local frame); its GGX alpha
     vec3 sheen; float sheen_r;        // the sheen's colour (0: none); its roughness
+    // KHR_materials_anisotropy (bsdf_anisotropy; GN_FEAT_ANISO): the GGX of the lobe and the
+    // glass stretched to alpha aniso_at along aniso_dir (unit, local xy), shape across it.
+    vec2 aniso_dir; float aniso_at;   // aniso_at 0: isotropic
 };
 
 struct BsdfSample {
@@ -227,6 +230,101 @@ vec3 brdf_ggx_sample_vndf(vec3 w, float a, vec2 u)
     return normalize(vec3(a * nh.x, a * nh.y, max(0.0, nh.z)));
 }
 
+// ---- anisotropic GGX (KHR_materials_anisotropy) --------------------------------------------
+// Heitz 2014 (JCGT 3(2)), eqs. 85-86, and Heitz 2018's sampling with alpha = (a_t, a_b) on the
+// axes of the frame (x along the anisotropy direction): the isotropic formulas above are the
+// case a_t = a_b, kept apart so that a lobe without anisotropy keeps its exact values.
+
+// D = 1 / (pi a_t a_b (x^2/a_t^2 + y^2/a_b^2 + z^2)^2), h in the anisotropy frame.
+float brdf_ggx_aniso_d(vec3 h, vec2 a)
+{
+    if (h.z <= 0.0)
+        return 0.0;
+    vec3 s = vec3(h.x / a.x, h.y / a.y, h.z);
+    float d = dot(s, s);
+    return 1.0 / (BRDF_PI * a.x * a.y * d * d);
+}
+
+// G1 = 2 |c| / (|c| + sqrt(c^2 + a_t^2 x^2 + a_b^2 y^2)).
+float brdf_ggx_aniso_g1(vec3 w, vec2 a)
+{
+    vec2 s = a * w.xy;
+    float c = abs(w.z);
+    return 2.0 * c / (c + sqrt(w.z * w.z + dot(s, s)));
+}
+
+// Height-correlated G2 / (4 |n.wo| |n.wi|), as brdf_v_ggx.
+float brdf_ggx_aniso_v(vec3 wo, vec3 wi, vec2 a)
+{
+    vec2 so = a * wo.xy, si = a * wi.xy;
+    float lo = abs(wi.z) * sqrt(wo.z * wo.z + dot(so, so));
+    float li = abs(wo.z) * sqrt(wi.z * wi.z + dot(si, si));
+    return 0.5 / (lo + li);
+}
+
+// Visible normal seen from w (w.z > 0): brdf_ggx_sample_vndf with the view stretched by
+// (a_t, a_b) instead of a.
+vec3 brdf_ggx_aniso_vndf(vec3 w, vec2 a, vec2 u)
+{
+    vec3 vh = normalize(vec3(a * w.xy, w.z));
+    float len2 = dot(vh.xy, vh.xy);
+    vec3 t1 = len2 > 0.0 ? vec3(-vh.y, vh.x, 0.0) * inversesqrt(len2) : vec3(1.0, 0.0, 0.0);
+    vec3 t2 = cross(vh, t1);
+    float r = sqrt(u.x), phi = 2.0 * BRDF_PI * u.y;
+    float p1 = r * cos(phi), p2 = r * sin(phi);
+    float s = 0.5 * (1.0 + vh.z);
+    p2 = (1.0 - s) * sqrt(max(0.0, 1.0 - p1 * p1)) + s * p2;
+    vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
+    return normalize(vec3(a * nh.xy, max(0.0, nh.z)));
+}
+
+bool brdf_is_aniso(Bsdf b)
+{
+    return GN_HAS(GN_FEAT_ANISO) && b.aniso_at > 0.0;
+}
+
+// w from the local frame to the anisotropy frame (x along aniso_dir) and back.
+vec3 brdf_to_aniso(Bsdf b, vec3 w)
+{
+    vec2 t = b.aniso_dir;
+    return vec3(dot(w.xy, t), t.x * w.y - t.y * w.x, w.z);
+}
+
+vec3 brdf_from_aniso(Bsdf b, vec3 w)
+{
+    vec2 t = b.aniso_dir;
+    return vec3(t.x * w.x - t.y * w.y, t.y * w.x + t.x * w.y, w.z);
+}
+
+// The base's GGX (the lobe's and the glass's, alpha = shape): anisotropic where the Bsdf is.
+float brdf_base_d(Bsdf b, vec3 h)
+{
+    if (brdf_is_aniso(b))
+        return brdf_ggx_aniso_d(brdf_to_aniso(b, h), vec2(b.aniso_at, b.shape));
+    return brdf_d_ggx(h, b.shape);
+}
+
+float brdf_base_g1(Bsdf b, vec3 w)
+{
+    if (brdf_is_aniso(b))
+        return brdf_ggx_aniso_g1(brdf_to_aniso(b, w), vec2(b.aniso_at, b.shape));
+    return brdf_g1_ggx(w, b.shape);
+}
+
+float brdf_base_v(Bsdf b, vec3 wo, vec3 wi)
+{
+    if (brdf_is_aniso(b))
+        return brdf_ggx_aniso_v(brdf_to_aniso(b, wo), brdf_to_aniso(b, wi), vec2(b.aniso_at, b.shape));
+    return brdf_v_ggx(wo, wi, b.shape);
+}
+
+vec3 brdf_base_vndf(Bsdf b, vec3 w, vec2 u)
+{
+    if (brdf_is_aniso(b))
+        return brdf_from_aniso(b, brdf_ggx_aniso_vndf(brdf_to_aniso(b, w), vec2(b.aniso_at, b.shape), u));
+    return brdf_ggx_sample_vndf(w, b.shape, u);
+}
+
 // wo refracted through the interface with normal n and eta = eta_inside / eta_outside
 // (n on the outside); false under total internal reflection.
 bool brdf_refract(vec3 wo, vec3 n, float eta, out vec3 wt)
@@ -317,9 +415,9 @@ void brdf_lobe(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
         dv = d * g / (4.0 * wo.z * wi.z);
         pdf_h = d * h.z;
     } else if (GN_HAS(GN_FEAT_GGX) && b.lobe == BRDF_LOBE_GGX) {
-        float d = brdf_d_ggx(h, n);
-        dv = d * brdf_v_ggx(wo, wi, n);
-        pdf_h = brdf_g1_ggx(wo, n) * oh * d / wo.z;
+        float d = brdf_base_d(b, h);
+        dv = d * brdf_base_v(b, wo, wi);
+        pdf_h = brdf_base_g1(b, wo) * oh * d / wo.z;
     }
     f = fr * dv;
     pdf = pdf_h / (4.0 * oh);
@@ -337,7 +435,7 @@ vec3 brdf_lobe_sample(Bsdf b, vec3 wo, vec2 u)
     }
     vec3 h = vec3(0.0, 0.0, 1.0);
     if (GN_HAS(GN_FEAT_GGX) && b.lobe == BRDF_LOBE_GGX) {
-        h = brdf_ggx_sample_vndf(wo, n, u);
+        h = brdf_base_vndf(b, wo, u);
     } else if (GN_HAS(GN_FEAT_BLINN | GN_FEAT_TS | GN_FEAT_BECKMANN)) {
         float c; // cos of the normal: density (n+1)/(2pi) c^n, D c for TS and Beckmann
         if (GN_HAS(GN_FEAT_BLINN) && b.lobe == BRDF_LOBE_BLINN)
@@ -374,9 +472,9 @@ void brdf_rough_dielectric(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
     if (mo * co <= 0.0 || mi * ci <= 0.0)
         return; // the microfacet faces away from one of the directions
     float fr = brdf_fresnel_dielectric(mo, b.ior);
-    float d = brdf_d_ggx(wm, a);
-    float v = brdf_v_ggx(wo, wi, a);
-    float pdf_m = brdf_g1_ggx(wo, a) * abs(mo) * d / abs(co);
+    float d = brdf_base_d(b, wm);
+    float v = brdf_base_v(b, wo, wi);
+    float pdf_m = brdf_base_g1(b, wo) * abs(mo) * d / abs(co);
     if (reflect) {
         f = vec3(fr * d * v);
         pdf = fr * pdf_m / (4.0 * abs(mo));
@@ -476,7 +574,7 @@ BsdfSample brdf_base_sample(Bsdf b, vec3 wo, vec3 u)
         }
         if (!GN_HAS(GN_FEAT_ROUGH_GLASS))
             return s;
-        vec3 wm = brdf_ggx_sample_vndf(wo.z >= 0.0 ? wo : -wo, b.shape, u.yz);
+        vec3 wm = brdf_base_vndf(b, wo.z >= 0.0 ? wo : -wo, u.yz);
         float mo = dot(wo, wm);
         reflect = x < brdf_fresnel_dielectric(mo, b.ior);
         if (reflect)
@@ -786,6 +884,8 @@ Bsdf brdf_empty()
     b.coat_alpha = 0.0;
     b.sheen = vec3(0.0);
     b.sheen_r = 0.0;
+    b.aniso_dir = vec2(1.0, 0.0);
+    b.aniso_at = 0.0;
     return b;
 }
 
@@ -856,6 +956,24 @@ Bsdf bsdf_gltf(vec3 base_color, float metallic, float roughness, float specular,
     b.dielectric = (1.0 - m) * t;
     b.tint = base_color;
     b.ior = max(ior, 1.01); // at 1 the rough BTDF collapses to a Dirac along -wo
+    return b;
+}
+
+// KHR_materials_anisotropy on a glTF base (bsdf_gltf): strength s in [0, 1] along dir (local
+// xy, any length; none: the tangent) stretches the GGX of the specular, metal and
+// transmission lobes to alpha_t = mix(alpha, 1, s^2) along dir, alpha_b = alpha across it.
+// alpha_b is kept >= BRDF_ALPHA_MIN (a mirror across, rough along is still a GGX lobe); s = 0,
+// or a lobe still too narrow along dir, leaves b exactly as it is.
+Bsdf bsdf_anisotropy(Bsdf b, float strength, vec2 dir)
+{
+    float s = clamp(strength, 0.0, 1.0), at = mix(b.shape, 1.0, s * s);
+    if (!GN_HAS(GN_FEAT_ANISO) || !(s > 0.0) || at < BRDF_ALPHA_MIN)
+        return b;
+    if (b.lobe == BRDF_LOBE_MIRROR)
+        b.lobe = BRDF_LOBE_GGX;
+    b.shape = max(b.shape, BRDF_ALPHA_MIN);
+    b.aniso_at = at;
+    b.aniso_dir = dot(dir, dir) > 1e-20 ? normalize(dir) : vec2(1.0, 0.0);
     return b;
 }
 

@@ -49,6 +49,7 @@
 #define BRDF_OP_EVAL 1u    /* f and pdf at (wo, wi) */
 #define BRDF_OP_SAMPLE 2u  /* sample(wo, u), then f and pdf at the sampled direction */
 #define BRDF_OP_FRESNEL 4u /* Fresnel functions at cos = wo.z (see BrdfResult) */
+#define BRDF_OP_NDF 8u     /* the base's GGX: D at the half vector wi, G1(wo) (see BrdfResult) */
 
 /* A material and the directions to query it with. model BRDF_GLTF: color = base colour,
  * params = (metallic, roughness, specular, ior), extra = (specular colour, transmission),
@@ -74,7 +75,7 @@ GN_STRUCT(BrdfQuery) {
 
 /* BRDF_OP_EVAL: f, pdf. BRDF_OP_SAMPLE: s_* (s_f, s_pdf_eval: eval and pdf at s_wi).
  * BRDF_OP_FRESNEL: f = (dielectric, Schlick, the sheen's albedo E from its table), s_f =
- * conductor (RGB). */
+ * conductor (RGB). BRDF_OP_NDF (model BRDF_GLTF, roughness > 0): f = (D(wi), G1(wo), 0). */
 GN_STRUCT(BrdfResult) {
     vec3 f; float pdf;
     vec3 s_wi; float s_pdf;

@@ -237,6 +237,10 @@ struct Surface {
     vec3 coat_n;
     vec3 sheen;
     float sheen_roughness;
+    // KHR_materials_anisotropy (GN_FEAT_ANISO; else 0): the strength and the direction in
+    // world space (the tangent frame's, rotated; 0 where the mesh has no tangents)
+    float aniso;
+    vec3 aniso_t;
 };
 
 // tri: BVH-order triangle index; (u, v): barycentrics of v1 and v2; d: ray direction.
@@ -318,6 +322,27 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
             }
         }
         s.coat_n = shading_normal_valid(flip ? -s.coat_n : s.coat_n, ng, -d);
+    }
+    s.aniso = 0.0;
+    s.aniso_t = vec3(0.0);
+    if (GN_HAS(GN_FEAT_ANISO) && m.anisotropy_strength > 0.0) {
+        // The extension's direction: (1, 0) or the texture's RG in [-1, 1], rotated by the
+        // rotation from the tangent toward the bitangent; its B scales the strength.
+        vec2 dir = vec2(1.0, 0.0);
+        s.aniso = m.anisotropy_strength;
+        if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_anisotropy != GN_INVALID) {
+            vec3 ta = texture_sample(m.tex_anisotropy, s.uv, false).rgb;
+            dir = ta.rg * 2.0 - 1.0;
+            s.aniso *= ta.b;
+        }
+        float cr = cos(m.anisotropy_rotation), sr = sin(m.anisotropy_rotation);
+        dir = vec2(cr * dir.x - sr * dir.y, sr * dir.x + cr * dir.y);
+        vec3 tangent = tg.xyz - n * dot(n, tg.xyz);
+        if (dot(tangent, tangent) > 1e-20) {
+            tangent = normalize(tangent);
+            vec3 bitangent = (tg.w < 0.0 ? -1.0 : 1.0) * cross(n, tangent);
+            s.aniso_t = dir.x * tangent + dir.y * bitangent;
+        }
     }
     if (GN_HAS(GN_FEAT_NORMAL_MAP) && m.tex_normal != GN_INVALID) {
         // The vertex tangents: the mesh's TANGENT or the loader's MikkTSpace ones, which

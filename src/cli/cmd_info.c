@@ -53,6 +53,19 @@ static void print_media(const scene *sc)
     }
 }
 
+/* The materials with KHR_materials_anisotropy, as bsdf_anisotropy reads them. */
+static void print_anisotropy(const scene *sc)
+{
+    for (uint32_t i = 0; i < sc->num_materials; i++) {
+        const GnMaterial *m = &sc->materials[i];
+        if (!(m->anisotropy_strength > 0) && m->tex_anisotropy == GN_INVALID)
+            continue;
+        printf("anisotropy %-3u \"%s\" strength %g, rotation %g deg%s\n", i,
+               sc->material_names[i][0] ? sc->material_names[i] : "(unnamed)", m->anisotropy_strength,
+               m->anisotropy_rotation * 180 / M_PI, m->tex_anisotropy != GN_INVALID ? ", textured" : "");
+    }
+}
+
 int cmd_info(int argc, char **argv)
 {
     bool outside = false;
@@ -66,7 +79,8 @@ int cmd_info(int argc, char **argv)
                  "variants by index and name (for --variant), and one line per material that bounds a\n"
                  "medium (KHR_materials_volume) or disperses (KHR_materials_dispersion): attenuation\n"
                  "colour and distance, the absorption coefficient they give, thickness (unused by the\n"
-                 "path tracer), IOR and dispersion.\n",
+                 "path tracer), IOR and dispersion; one line per anisotropic material\n"
+                 "(KHR_materials_anisotropy): strength, rotation and whether a texture sets them.\n",
         CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given"};
     cli_args args;
     scene sc = {0};
@@ -93,6 +107,7 @@ int cmd_info(int argc, char **argv)
     printf("lights         %u\n", sc.num_lights);
     print_emitters(&sc);
     print_media(&sc);
+    print_anisotropy(&sc);
     printf("cameras        %u\n", sc.num_cameras);
     for (uint32_t i = 0; i < sc.num_cameras; i++) {
         const scene_camera *c = &sc.cameras[i];

@@ -217,6 +217,15 @@ static uint32_t material_features(const GnMaterial *m)
                 m->tex_sheen_roughness != GN_INVALID)
                 f |= GN_FEAT_TEXTURES;
         }
+        /* bsdf_anisotropy: the lobe and the glass stay GGX where roughness 0 would make them
+         * Dirac (the texture only scales the strength) */
+        if (m->anisotropy_strength > 0) {
+            f |= GN_FEAT_ANISO | (m->tex_anisotropy != GN_INVALID ? GN_FEAT_TEXTURES : 0u);
+            if (m->specular != 0 || metal_hi > 0)
+                f |= GN_FEAT_GGX;
+            if (t > 0 && metal_lo < 1)
+                f |= GN_FEAT_ROUGH_GLASS;
+        }
         break;
     }
     case BRDF_LAMBERT:
@@ -1436,6 +1445,8 @@ static void apply_setting(GnMaterial *m, const brdf_setting *st)
         m->clearcoat_roughness = st->v[BRDF_SLOT_LAYER + 1];
         m->sheen_roughness = st->v[BRDF_SLOT_LAYER + 2];
         memcpy(&m->sheen_color.x, st->v + BRDF_SLOT_SHEEN, 3 * sizeof(float));
+        m->anisotropy_strength = st->v[BRDF_SLOT_ANISO];
+        m->anisotropy_rotation = st->v[BRDF_SLOT_ANISO + 1];
     }
 }
 
@@ -1457,6 +1468,8 @@ static void setting_from_material(brdf_setting *st, const brdf_model *model, con
         st->v[BRDF_SLOT_LAYER + 1] = m->clearcoat_roughness;
         st->v[BRDF_SLOT_LAYER + 2] = m->sheen_roughness;
         memcpy(st->v + BRDF_SLOT_SHEEN, &m->sheen_color.x, 3 * sizeof(float));
+        st->v[BRDF_SLOT_ANISO] = m->anisotropy_strength;
+        st->v[BRDF_SLOT_ANISO + 1] = m->anisotropy_rotation;
     }
 }
 

@@ -54,7 +54,8 @@ const char *const SUPPORTED_EXTENSIONS[] = {
     "KHR_materials_transmission", "KHR_materials_ior",               "KHR_materials_unlit",
     "KHR_texture_transform",      "KHR_mesh_quantization",           "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",    "KHR_materials_variants",          "KHR_materials_volume",
-    "KHR_materials_dispersion",   "KHR_materials_clearcoat",         "KHR_materials_sheen"};
+    "KHR_materials_dispersion",   "KHR_materials_clearcoat",         "KHR_materials_sheen",
+    "KHR_materials_anisotropy"};
 
 using Json = nlohmann::json;
 
@@ -1350,8 +1351,20 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
         coat_normal = ct.index >= 0;
         nset = ct.texCoord;
     }
+    /* so does anisotropy: its direction is in the tangent frame (the set of its texture when
+     * no normal map chose one) */
+    bool aniso = false;
+    if (mat) {
+        const tinygltf::Value *ae = extension(*mat, "KHR_materials_anisotropy");
+        aniso = ae && ae->IsObject() && ae->Has("anisotropyStrength") && ae->Get("anisotropyStrength").IsNumber() &&
+                ae->Get("anisotropyStrength").GetNumberAsDouble() > 0;
+        if (aniso && mat->normalTexture.index < 0 && !coat_normal) {
+            tinygltf::TextureInfo at = ext_texture(ae, "anisotropyTexture");
+            nset = at.index >= 0 ? at.texCoord : 0;
+        }
+    }
     const std::vector<float> &tuv = nset == 1 ? out.uv1 : out.uv;
-    if (out.tan.empty() && !tuv.empty() && mat && (mat->normalTexture.index >= 0 || coat_normal))
+    if (out.tan.empty() && !tuv.empty() && mat && (mat->normalTexture.index >= 0 || coat_normal || aniso))
         generate_tangents(out, tuv);
     return true;
 }
@@ -2005,6 +2018,14 @@ void convert_material(Ctx &c, int mi, GnMaterial &g, scene_material_extras &x, c
         g.tex_sheen_color = texture_slot(c, ext_texture(e, "sheenColorTexture"), what, "sheenColorTexture");
         g.tex_sheen_roughness = texture_slot(c, ext_texture(e, "sheenRoughnessTexture"), what, "sheenRoughnessTexture");
     }
+    if (const tinygltf::Value *e = extension(mat, "KHR_materials_anisotropy")) {
+        double rot = ext_number(c, *e, "anisotropyRotation", 0, what);
+        g.anisotropy_strength = ranged(c, ext_number(c, *e, "anisotropyStrength", 0, what), 0, 1, what,
+                                       "anisotropyStrength");
+        /* any angle: reduced to [-pi, pi] so that float keeps its precision */
+        g.anisotropy_rotation = std::isfinite(rot) ? float(std::remainder(rot, 2 * M_PI)) : 0.0f;
+        g.tex_anisotropy = texture_slot(c, ext_texture(e, "anisotropyTexture"), what, "anisotropyTexture");
+    }
     if (extension(mat, "KHR_materials_unlit"))
         g.flags |= GN_MAT_UNLIT;
     if (mat.doubleSided)
@@ -2508,6 +2529,12 @@ void Doc::check_material(const Json &m, const std::string &p)
             number(*sh, "sheenRoughnessFactor", ps);
             texture_info(*sh, "sheenColorTexture", ps);
             texture_info(*sh, "sheenRoughnessTexture", ps);
+        }
+        if (const Json *an = object(*ex, "KHR_materials_anisotropy", pe)) {
+            std::string pa = at(pe, "KHR_materials_anisotropy");
+            number(*an, "anisotropyStrength", pa);
+            number(*an, "anisotropyRotation", pa);
+            texture_info(*an, "anisotropyTexture", pa);
         }
     }
     texture_info(m, "emissiveTexture", p);

@@ -346,6 +346,43 @@ static int rgb_stats(const char *path)
     return 0;
 }
 
+/* The spread of an image's light: the luminance-weighted second central moments of the
+ * pixel coordinates, `sxx syy sxy` (%.6g; x right, y down), for the anisotropy tests. */
+static int moments(const char *path)
+{
+    image img;
+    if (!image_read_exr(&img, path))
+        return 1;
+    int r = image_channel(&img, "R"), g = image_channel(&img, "G"), b = image_channel(&img, "B");
+    if (r < 0 || g < 0 || b < 0) {
+        fprintf(stderr, "testtool: %s has no R, G, B\n", path);
+        image_destroy(&img);
+        return 1;
+    }
+    double w = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+    for (int y = 0; y < img.height; y++)
+        for (int x = 0; x < img.width; x++) {
+            size_t i = (size_t)y * img.width + x;
+            double l = 0.2126 * img.planes[r][i] + 0.7152 * img.planes[g][i] + 0.0722 * img.planes[b][i];
+            if (!(l > 0))
+                continue;
+            w += l;
+            sx += l * x;
+            sy += l * y;
+            sxx += l * x * x;
+            syy += l * y * y;
+            sxy += l * x * y;
+        }
+    image_destroy(&img);
+    if (!(w > 0)) {
+        fprintf(stderr, "testtool: %s is black\n", path);
+        return 1;
+    }
+    double mx = sx / w, my = sy / w;
+    printf("%.6g %.6g %.6g\n", sxx / w - mx * mx, syy / w - my * my, sxy / w - mx * my);
+    return 0;
+}
+
 /* PART's pixels sit at (x0, y0) of the display window (image.h); so do WHOLE's. */
 static int same_bits(const char *whole, const char *part)
 {
@@ -408,6 +445,8 @@ int main(int argc, char **argv)
         return stats(argv[2]);
     if (argc == 3 && !strcmp(argv[1], "rgb"))
         return rgb_stats(argv[2]);
+    if (argc == 3 && !strcmp(argv[1], "moments"))
+        return moments(argv[2]);
     if (argc == 6 && !strcmp(argv[1], "at"))
         return print_value(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]));
     if (argc == 5 && !strcmp(argv[1], "png") && (!strcmp(argv[2], "depth") || !strcmp(argv[2], "normal")))
@@ -424,6 +463,7 @@ int main(int argc, char **argv)
     fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool compress draco|meshopt IN.gltf OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n"
                     "       testtool png depth|normal PNG REF.exr | testtool pick IN.exr CHANNEL OUT.exr\n"
                     "       testtool at IN.exr CHANNEL X Y | testtool same WHOLE.exr PART.exr | testtool rgb IN.exr\n"
+                    "       testtool moments IN.exr\n"
                     "       testtool sheen-table\n");
     return 2;
 }

@@ -61,6 +61,12 @@ static const config configs[] = {
     {"gltf", "sheen-color=0.9,0.4,0.2 sheen-roughness=1 clearcoat=0.5 clearcoat-roughness=0.2 base-color=0.9"},
     {"gltf", "clearcoat=1 clearcoat-roughness=0.2 sheen-color=0.5 transmission=1 roughness=0.3"},
     {"gltf", "clearcoat=0.8 transmission=1 roughness=0"},
+    /* KHR_materials_anisotropy: rotations in radians from the tangent (+x) */
+    {"gltf", "metallic=1 roughness=0.3 base-color=0.9,0.6,0.2 anisotropy=0.8"},
+    {"gltf", "roughness=0.5 anisotropy=1 anisotropy-rotation=0.7"},
+    {"gltf", "roughness=0.2 anisotropy=0.6 anisotropy-rotation=2 specular-color=1,0.5,0.5"},
+    {"gltf", "transmission=1 roughness=0.4 anisotropy=0.7 anisotropy-rotation=-1"},
+    {"gltf", "clearcoat=0.5 clearcoat-roughness=0.2 roughness=0.3 metallic=0.5 anisotropy=0.9 anisotropy-rotation=1"},
 };
 #define NUM_CONFIGS ((int)(sizeof configs / sizeof *configs))
 
@@ -950,6 +956,99 @@ TEST(brdf, sheen_albedo)
             CHECKF(fabs(m.albedo_quad[0] - er.f.z) < 0.01 * er.f.z + 1e-3, "sheen r %g at %g deg: eval integrates to %.4f, table %.4f",
                    rs[j], t * 25.0, m.albedo_quad[0], er.f.z);
         }
+    }
+    close_runner();
+}
+
+/* ---- KHR_materials_anisotropy ------------------------------------------------------------- */
+
+/* Strength 0 leaves the glTF base exactly as it is, whatever the rotation: eval, pdf and
+ * sample give the same bits as the setting without the extension. */
+TEST(brdf, anisotropy_limit)
+{
+    enum { N = 8192 };
+    static const char *bases[] = {"", "metallic=1 roughness=0.3 base-color=0.9,0.6,0.2", "roughness=0",
+                                  "transmission=1 roughness=0.4", "transmission=0.5 metallic=0.2 roughness=0",
+                                  "clearcoat=0.6 clearcoat-roughness=0.3 roughness=0.5 sheen-color=0.4"};
+    if (!open_runner())
+        return;
+    BrdfQuery *q = qbuf;
+    BrdfResult *r = rbuf;
+    rng_state = 9;
+    for (int k = 0; k < (int)(sizeof bases / sizeof *bases); k++) {
+        char with[256];
+        brdf_setting base, aniso;
+        snprintf(with, sizeof with, "%s anisotropy=0 anisotropy-rotation=1.3", bases[k]);
+        make_setting(&(config){"gltf", bases[k]}, &base);
+        make_setting(&(config){"gltf", with}, &aniso);
+        for (int i = 0; i < N / 2; i++) {
+            vec3 wo = polar(acos(1 - 2 * rnd()), 2 * PI * rnd()), wi = polar(acos(1 - 2 * rnd()), 2 * PI * rnd());
+            vec3 u = rnd_u();
+            q[2 * i] = query(&base, BRDF_OP_EVAL | BRDF_OP_SAMPLE, wo, wi, u);
+            q[2 * i + 1] = query(&aniso, BRDF_OP_EVAL | BRDF_OP_SAMPLE, wo, wi, u);
+        }
+        brdf_runner_run(&runner, q, r, N);
+        int differ = 0;
+        for (int i = 0; i < N / 2; i++)
+            differ += memcmp(&r[2 * i], &r[2 * i + 1], sizeof *r) != 0;
+        CHECKF(differ == 0, "gltf %s: %d of %d queries differ with anisotropy 0", bases[k], differ, N / 2);
+    }
+    close_runner();
+}
+
+/* The anisotropic GGX distribution by quadrature over the hemisphere of half vectors
+ * (theta = pi/2 x^2: dense at the pole, where the lobes are narrow): the projected area of
+ * the microfacets is the surface's, integral D(h) cos(h) dw = 1, and Smith's masking makes
+ * the visible projected area the surface's seen from wo, integral G1(wo) max(0, wo.h) D(h)
+ * dw = cos(wo) (Heitz 2014, eqs. 4 and 17). And the lobe is stretched along the rotation:
+ * D falls off slower toward (cos r, sin r) than across it. */
+TEST(brdf, anisotropy_ndf)
+{
+    enum { NT = 1600, NP = 720, N = NT * NP };
+    static const char *cases[] = {"roughness=0.2 anisotropy=0.9", "roughness=0.5 anisotropy=0.5 anisotropy-rotation=0.7",
+                                  "roughness=0.3 anisotropy=1 anisotropy-rotation=-2",
+                                  "roughness=0.1 anisotropy=0.7 anisotropy-rotation=1.5708"};
+    static const double wo_deg[] = {0, 45, 75};
+    if (!open_runner())
+        return;
+    BrdfQuery *q = qbuf;
+    BrdfResult *r = rbuf;
+    for (int k = 0; k < (int)(sizeof cases / sizeof *cases); k++) {
+        brdf_setting s;
+        make_setting(&(config){"gltf", cases[k]}, &s);
+        for (int t = 0; t < 3; t++) {
+            vec3 wo = polar(rad(wo_deg[t]), 0.4);
+            double area = 0, visible = 0;
+            for (int i0 = 0; i0 < N; i0 += CHUNK) {
+                int n = N - i0 < CHUNK ? N - i0 : CHUNK;
+                for (int i = 0; i < n; i++) {
+                    int it = (i0 + i) / NP, ip = (i0 + i) % NP;
+                    double x = (it + 0.5) / NT, th = PI / 2 * x * x, ph = 2 * PI * (ip + 0.5) / NP;
+                    q[i] = query(&s, BRDF_OP_NDF, wo, polar(th, ph), v3(0, 0, 0));
+                }
+                brdf_runner_run(&runner, q, r, (size_t)n);
+                for (int i = 0; i < n; i++) {
+                    int it = (i0 + i) / NP;
+                    double x = (it + 0.5) / NT, th = PI / 2 * x * x;
+                    double dw = sin(th) * (PI * x / NT) * (2 * PI / NP); /* dtheta = pi x dx */
+                    vec3 h = q[i].wi;
+                    double oh = (double)wo.x * h.x + (double)wo.y * h.y + (double)wo.z * h.z;
+                    area += r[i].f.x * cos(th) * dw;
+                    visible += r[i].f.y * fmax(0, oh) * r[i].f.x * dw;
+                }
+            }
+            if (t == 0)
+                CHECKF(fabs(area - 1) < 2e-3, "gltf %s: integral of D cos = %.5f, not 1", cases[k], area);
+            CHECKF(fabs(visible - wo.z) < 2e-3, "gltf %s wo %g deg: visible projected area %.5f, not cos %.5f",
+                   cases[k], wo_deg[t], visible, wo.z);
+        }
+        /* 20 degrees off the normal along the direction and across it */
+        double rot = s.v[BRDF_SLOT_ANISO + 1];
+        q[0] = query(&s, BRDF_OP_NDF, v3(0, 0, 1), polar(rad(20), rot), v3(0, 0, 0));
+        q[1] = query(&s, BRDF_OP_NDF, v3(0, 0, 1), polar(rad(20), rot + PI / 2), v3(0, 0, 0));
+        brdf_runner_run(&runner, q, r, 2);
+        CHECKF(r[0].f.x > 2 * r[1].f.x, "gltf %s: D along the direction %g, across it %g", cases[k], r[0].f.x,
+               r[1].f.x);
     }
     close_runner();
 }

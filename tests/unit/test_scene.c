@@ -1258,3 +1258,47 @@ TEST(scene, layers)
              "\"nodes\":[{\"mesh\":0}]");
     CHECK(!load_tri_scene(&s, body) && strstr(load_log, "materials[0].extensions.KHR_materials_clearcoat.clearcoatFactor"));
 }
+
+/* KHR_materials_anisotropy: strength, rotation (reduced to [-pi, pi]) and texture (through
+ * TEXCOORD_1); a strength out of [0, 1] clamped with a warning; a texture that names no
+ * texture, or a strength that is no number, is an error with its JSON path. */
+TEST(scene, anisotropy)
+{
+    char body[8192], head[1024];
+    snprintf(head, sizeof head, "\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],\"textures\":[{\"source\":0}],",
+             png_ga8);
+    snprintf(body, sizeof body,
+             "\"extensionsUsed\":[\"KHR_materials_anisotropy\"],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TANGENT\":2},\"indices\":3,\"material\":0},"
+             "{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TANGENT\":2},\"indices\":3,\"material\":1}]}],"
+             "%s\"materials\":[{\"extensions\":{\"KHR_materials_anisotropy\":{\"anisotropyStrength\":0.6,"
+             "\"anisotropyRotation\":7.5,\"anisotropyTexture\":{\"index\":0,\"texCoord\":1}}}},"
+             "{\"extensions\":{\"KHR_materials_anisotropy\":{\"anisotropyStrength\":1.25}}}],\"nodes\":[{\"mesh\":0}]",
+             head);
+    scene s;
+    int w0 = util_warning_count();
+    CHECKF(load_tri_scene(&s, body), "%s", load_log);
+    CHECKF(util_warning_count() - w0 == 1 && strstr(load_log, "anisotropyStrength 1.25 is out of range [0, 1] (clamped)"),
+           "warnings:\n%s", load_log);
+    CHECK(!strstr(load_log, "unsupported extension"));
+    CHECK(s.num_materials == 2);
+    if (s.num_materials == 2) {
+        const GnMaterial *m = &s.materials[0];
+        CHECK(m->anisotropy_strength == 0.6f && near(m->anisotropy_rotation, (float)(7.5 - 2 * M_PI), 1e-6f));
+        CHECK(m->tex_anisotropy != GN_INVALID && m->tex_anisotropy < s.num_textures &&
+              s.textures[m->tex_anisotropy].flags == GN_TEX_UV1);
+        CHECK(s.materials[1].anisotropy_strength == 1 && s.materials[1].anisotropy_rotation == 0 &&
+              s.materials[1].tex_anisotropy == GN_INVALID);
+    }
+    scene_destroy(&s);
+    snprintf(body, sizeof body,
+             TRI_MESH ",%s\"materials\":[{\"extensions\":{\"KHR_materials_anisotropy\":{\"anisotropyTexture\":{\"index\":3}}}}],"
+             "\"nodes\":[{\"mesh\":0}]", head);
+    CHECK(!load_tri_scene(&s, body) &&
+          strstr(load_log, "materials[0].extensions.KHR_materials_anisotropy.anisotropyTexture.index: 3 does not exist"));
+    snprintf(body, sizeof body,
+             TRI_MESH ",\"materials\":[{\"extensions\":{\"KHR_materials_anisotropy\":{\"anisotropyStrength\":\"high\"}}}],"
+             "\"nodes\":[{\"mesh\":0}]");
+    CHECK(!load_tri_scene(&s, body) &&
+          strstr(load_log, "materials[0].extensions.KHR_materials_anisotropy.anisotropyStrength"));
+}
