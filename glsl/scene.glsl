@@ -30,7 +30,7 @@ layout(std430, binding = GN_BIND_LIGHTS) readonly buffer LightBlock { GnLight li
 layout(binding = GN_BIND_TEXELS) uniform usamplerBuffer texels; // R32UI: one RGBA8 texel each
 layout(binding = GN_BIND_TEXTURES) uniform usamplerBuffer texture_texels; // GnTexture[]
 
-const float PI = 3.14159265358979323846;
+#define PI GN_PI // (the name path.comp and bench.comp use)
 
 vec4 texel_f(usamplerBuffer b, uint i) { return uintBitsToFloat(texelFetch(b, int(i))); }
 

@@ -28,6 +28,18 @@ typedef uint32_t uint;
 #define GN_END(name) name
 #endif
 
+/* ---- constants of the host and the kernels, each defined once --------------------------- */
+#define GN_PI 3.14159265358979323846 /* a double in C, a float in GLSL (the same float either way) */
+/* llvmpipe (lavapipe) ends an invocation's loops silently after this many iterations in
+ * total (docs/architecture.md: The loop cap): the walk budgets and the path kernel's cap. */
+#define GN_LLVMPIPE_LOOP_LIMIT 65535u
+/* The most triangle pairs in a BVH leaf (src/bvh.c splits a larger node even where the SAH
+ * prefers a leaf; GnBvhNode's count field has room for 8). */
+#define GN_BVH_MAX_LEAF 8
+/* Loop passes one node visit of a walk can cost: the visit, and the two leaves it may open,
+ * each one pass plus one a pair (src/render.c: traversal_budget). */
+#define GN_WALK_VISIT_PASSES (1u + 2u * (1u + GN_BVH_MAX_LEAF))
+
 /* ---- descriptor bindings (set 0) of the render kernels -------------------------------- */
 #define GN_BIND_FRAME 0u     /* GnFrame (a read-only storage buffer: see glsl/scene.glsl) */
 /* Bindings 1-5 are RGBA32UI uniform texel buffers (16 bytes a texel), read through
@@ -151,8 +163,7 @@ typedef uint32_t uint;
 #define GN_FEAT_LAYERS (1u << 29)       /* KHR_materials_clearcoat, _sheen, _iridescence, _diffuse_transmission (brdf.glsl: bsdf_layers) */
 #define GN_FEAT_VOLUME (1u << 30)       /* KHR_materials_volume media, _dispersion */
 #define GN_FEAT_ANISO (1u << 31)        /* KHR_materials_anisotropy */
-#define GN_FEAT_LOBES (GN_FEAT_MIRROR | GN_FEAT_PHONG | GN_FEAT_BLINN | GN_FEAT_TS | \
-                       GN_FEAT_BECKMANN | GN_FEAT_GGX)
+/* (GN_FEAT_LOBES, every lobe a BRDF model can build: brdf_models.h, from its table) */
 #define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
 #define GN_FEAT_ALL 0xffffffffu
 
@@ -168,8 +179,8 @@ typedef uint32_t uint;
  *   a_count == 0, a_index == INVALID  empty (only b, when the whole scene is one leaf); its
  *                                     box is inverted (min FLT_MAX, max -FLT_MAX), so the
  *                                     walk's slab test never enters it and needs no check
- * Leaves hold at most 8 pairs and scenes at most 2^26 triangles (src/scene_gltf.cpp), so
- * first fits in 27 bits. */
+ * Leaves hold at most GN_BVH_MAX_LEAF pairs and scenes at most 2^26 triangles
+ * (src/scene_gltf.cpp), so first fits in 27 bits. */
 #define GN_BVH_LEAF 0x80000000u
 #define GN_BVH_COUNT_SHIFT 27
 #define GN_BVH_FIRST 0x07ffffffu
@@ -177,6 +188,9 @@ typedef uint32_t uint;
  * test hits: 1 + 2 gamma(3) (Ize 2013; gamma(n) = n u / (1 - n u), u = 2^-24) is just above
  * 1 + 3 ulp, so 1 + 4 ulp (src/bvh.c and glsl/bvh.glsl, one value). */
 #define GN_BVH_TFAR_SCALE 1.00000048f
+/* A ray direction's component below this counts as parallel to its slabs (src/bvh.c:
+ * BVH_PARALLEL_DIR says why; glsl/bvh.glsl: ray_pre). */
+#define GN_BVH_PARALLEL_DIR 1e-30f
 GN_STRUCT(GnBvhNode) {
     vec3 a_min; uint a_index;
     vec3 a_max; uint a_count;
@@ -358,6 +372,8 @@ GN_STRUCT(GnDisplayPush) {
 #endif
 #include <stddef.h>
 GN_STATIC_ASSERT(sizeof(GnBvhNode) == 64, "GnBvhNode layout");
+GN_STATIC_ASSERT(((GN_BVH_MAX_LEAF - 1) << GN_BVH_COUNT_SHIFT & ~(GN_BVH_LEAF | GN_BVH_FIRST)) ==
+                     (GN_BVH_MAX_LEAF - 1) << GN_BVH_COUNT_SHIFT, "a leaf's count fits its bits");
 GN_STATIC_ASSERT(offsetof(GnBvhNode, b_min) == 32, "GnBvhNode layout");
 GN_STATIC_ASSERT(sizeof(GnTriPair) == 48, "GnTriPair layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");

@@ -135,7 +135,6 @@ static float clamp01(float x) { return x < 0 ? 0 : x > 1 ? 1 : x; }
  * metalness) every value it can reach counts. */
 static uint32_t material_features(const GnMaterial *m)
 {
-    const float alpha_min = 1e-3f; /* BRDF_ALPHA_MIN */
     uint32_t f = 0;
     bool textured = m->tex_base != GN_INVALID || m->tex_mr != GN_INVALID ||
                     m->tex_emissive != GN_INVALID || m->tex_occlusion != GN_INVALID;
@@ -151,14 +150,14 @@ static uint32_t material_features(const GnMaterial *m)
         f |= GN_FEAT_EMISSIVE;
     switch (m->brdf) {
     case BRDF_GLTF: {
-        /* bsdf_gltf: a GGX lobe (a mirror below alpha_min) with Schlick's F of weight
+        /* bsdf_gltf: a GGX lobe (a mirror below BRDF_ALPHA_MIN) with Schlick's F of weight
          * wd f0 + m base and F90 wd specular + m; the diffuse coupled to that layer when
          * specular > 0; glass of weight (1 - m) t. The texture scales roughness and
          * metalness by [0, 1]. */
         float metal_hi = clamp01(m->metallic), metal_lo = m->tex_mr != GN_INVALID ? 0 : metal_hi;
         float rough_hi = clamp01(m->roughness), rough_lo = m->tex_mr != GN_INVALID ? 0 : rough_hi;
         float t = clamp01(m->transmission);
-        bool smooth = rough_lo * rough_lo < alpha_min, rough = rough_hi * rough_hi >= alpha_min;
+        bool smooth = rough_lo * rough_lo < BRDF_ALPHA_MIN, rough = rough_hi * rough_hi >= BRDF_ALPHA_MIN;
         f |= GN_FEAT_GLTF;
         if (m->specular != 0 || metal_hi > 0) {
             f |= GN_FEAT_FRESNEL_SCHLICK | (smooth ? GN_FEAT_MIRROR : 0u) | (rough ? GN_FEAT_GGX : 0u);
@@ -180,37 +179,16 @@ static uint32_t material_features(const GnMaterial *m)
         }
         break;
     }
-    case BRDF_LAMBERT:
-        break;
-    case BRDF_MIRROR:
-        f |= GN_FEAT_MIRROR;
-        break;
-    case BRDF_PHONG:
-        f |= GN_FEAT_PHONG;
-        break;
-    case BRDF_BLINN_PHONG:
-        f |= GN_FEAT_BLINN;
-        break;
-    case BRDF_TORRANCE_SPARROW:
-        f |= GN_FEAT_TS | GN_FEAT_FRESNEL_DIELECTRIC;
-        break;
-    case BRDF_BECKMANN:
-        f |= GN_FEAT_BECKMANN | GN_FEAT_MIRROR | GN_FEAT_FRESNEL_DIELECTRIC;
-        break;
-    case BRDF_GGX:
-        f |= GN_FEAT_GGX | GN_FEAT_MIRROR | GN_FEAT_FRESNEL_DIELECTRIC;
-        break;
-    case BRDF_CONDUCTOR:
-        f |= GN_FEAT_GGX | GN_FEAT_MIRROR | GN_FEAT_FRESNEL_CONDUCTOR;
-        break;
-    case BRDF_DIELECTRIC:
-        f |= GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS;
-        break;
-    default:
-        f |= GN_FEAT_ALL; /* unknown to this table: keep every feature */
+    default: {
+        /* an override model: its row of the table (glsl/brdf_models.h); an id unknown to it
+         * keeps every feature */
+        uint32_t mf = GN_FEAT_ALL;
+        for (int i = 0; i < brdf_num_models; i++)
+            if (brdf_models[i].id == m->brdf)
+                mf = brdf_models[i].features;
+        f |= mf | GN_FEAT_MODELS;
     }
-    if (m->brdf != BRDF_GLTF)
-        f |= GN_FEAT_MODELS;
+    }
     return f;
 }
 
@@ -485,11 +463,10 @@ static uint32_t traversal_budget(const gpu *g, uint32_t rays_per_invocation)
 {
     if (!loop_capped(g))
         return 1u << 30;
-    /* A node visit costs one iteration and opens at most two leaves, each one more
-     * iteration plus max_leaf_size (8 at most, the builder's cap): 19. The count is shared
-     * by the 8 invocations of a SIMD group, so this keeps typical work well under the cap,
-     * not every case; a walk the cap stops says so (glsl/bvh.glsl) rather than lie. */
-    return 60000u / (rays_per_invocation * 19u);
+    /* A node visit costs at most GN_WALK_VISIT_PASSES iterations. The count is shared by
+     * the 8 invocations of a SIMD group, so this keeps typical work well under the cap, not
+     * every case; a walk the cap stops says so (glsl/bvh.glsl) rather than lie. */
+    return 60000u / (rays_per_invocation * GN_WALK_VISIT_PASSES);
 }
 
 /* Progress on stderr. On a terminal, a bar redrawn in place; otherwise (a log) plain lines,
@@ -726,7 +703,7 @@ static void loop_setup(renderer *r, GnFrame *frame)
     frame->loop_overhead = overhead;
     frame->state_stride = r->state_stride = state_stride(r, GN_MODE_PATH);
     /* One value for every render of the process, so the cached kernel stays valid. */
-    r->loop_cap = r->state_stride ? 65535u - 4096u - 4 * 134u : 0;
+    r->loop_cap = r->state_stride ? GN_LLVMPIPE_LOOP_LIMIT - 4096u - 4 * 134u : 0;
     if (r->loop_cap && forced && atol(forced) > 0 && (uint32_t)atol(forced) < r->loop_cap) {
         /* each lane's share (of up to 8) at least two vertices' overhead and then a node
          * visit or a leaf: progress */
