@@ -9,8 +9,8 @@
 // derives each one and names the test that checks it.
 //
 // Conventions: normal = +z; wo points to the viewer, wi to the light, both away from the
-// surface. bsdf_eval returns f (no cosine); bsdf_pdf is the solid-angle density with which
-// bsdf_sample picks wi; Dirac lobes are not in eval/pdf, only in sample (BRDF_FLAG_DELTA).
+// surface. bsdf_eval returns f (no cosine); bsdf_eval_pdf also the solid-angle density with
+// which bsdf_sample picks wi; Dirac lobes are not in eval/pdf, only in sample (BRDF_FLAG_DELTA).
 // Transmission transports importance (flux): the 1/eta^2 radiance scale is left out, so
 // R + T = 1 at a smooth interface; it cancels on closed objects.
 #ifndef BRDF_GLSL
@@ -750,14 +750,6 @@ vec3 bsdf_eval(Bsdf b, vec3 wo, vec3 wi)
     float pdf;
     bsdf_eval_pdf(b, wo, wi, f, pdf);
     return f;
-}
-
-float bsdf_pdf(Bsdf b, vec3 wo, vec3 wi)
-{
-    vec3 f;
-    float pdf;
-    bsdf_eval_pdf(b, wo, wi, f, pdf);
-    return pdf;
 }
 
 // ---- construction ---------------------------------------------------------------------------

@@ -328,27 +328,29 @@ GN_STRUCT(GnCamera) {
  * the accumulation buffers hold, so a crop renders exactly the pixels of the whole image. */
 GN_STRUCT(GnFrame) {
     GnCamera camera;
-    uint width; uint height; uint seed; uint mode;
-    uint max_depth; uint num_lights; uint num_emitters; uint flags;
+    uint width; uint height; uint seed; uint max_depth;
+    uint num_lights; uint num_emitters; uint flags;
+    uint traversal_budget;               /* max BVH steps per ray (docs/architecture.md: the loop cap) */
     vec3 ambient; float emitter_power;   /* ambient: global ambient light of the Phong model */
-    vec3 env_color; uint num_nodes;      /* constant environment radiance */
-    vec3 bounds_min; float depth_scale;
-    vec3 bounds_max; uint traversal_budget; /* max BVH steps per ray (docs/architecture.md: the loop cap) */
+    vec3 env_color; float env_select;    /* constant environment radiance; env's selection probability */
     uint env_width; uint env_height;     /* GN_FRAME_ENV_MAP: the lat-long map's size */
-    float env_select; float env_norm;    /* env's selection probability; 1 / mean map weight */
     float env_cos; float env_sin;        /* the map turned by a about +Y (right-handed): cos a, -sin a */
     uint crop_x; uint crop_y;            /* the region's top-left pixel in the whole image */
     uint crop_width; uint crop_height;   /* the region's size: the dispatch and the buffers */
     uint loop_overhead; uint state_stride; /* path, LOOP_CAP > 0: loop passes a vertex costs besides its walks; words per pixel of GN_BIND_PSTATE */
-} GN_END(GnFrame); /* 224 bytes */
+    uint pad0; uint pad1;                /* (std430 rounds the struct to 16 bytes) */
+} GN_END(GnFrame); /* 192 bytes */
 
 /* Per-dispatch values (push constants). */
 GN_STRUCT(GnPush) {
-    uint sample_index;   /* index of the (first) sample this pass takes in every pixel */
-    uint pass_flags;
-    uint pad0;           /* path.comp: how many samples, sample_index on (0..GN_PATH_SAMPLES; 0: only finish those pending) */
-    uint pad1;
+    uint sample_index;   /* index of the (first) sample this pass takes in every pixel;
+                            trace_test.comp: the number of rays */
+    uint pass_flags;     /* vertex.comp: the side (0 front, 1 back); trace_test.comp: GN_PASS_* */
+    uint samples;        /* path.comp: how many samples, sample_index on (0..GN_PATH_SAMPLES; 0: only finish those pending) */
+    uint seed;           /* brdf_sphere.comp: the random numbers' seed */
 } GN_END(GnPush);
+#define GN_PASS_RESUME 1u  /* trace_test.comp: resume the walks the last dispatch saved */
+#define GN_PASS_ANY_HIT 2u /* trace_test.comp: any hit ends a walk (shadow rays) */
 
 /* ---- display kernel (glsl/display.comp): accumulated radiance -> 8-bit sRGB texels ----- */
 #define GN_DISPLAY_BIND_ACCUM 0u /* vec4[] per pixel, as GN_BIND_ACCUM */
@@ -390,9 +392,9 @@ GN_STATIC_ASSERT(sizeof(GnEmitter) == 16, "GnEmitter layout");
 GN_STATIC_ASSERT(sizeof(GnTexture) == 48, "GnTexture layout");
 GN_STATIC_ASSERT(offsetof(GnTexture, row1) == 32, "GnTexture layout");
 GN_STATIC_ASSERT(sizeof(GnCamera) == 80, "GnCamera layout");
-GN_STATIC_ASSERT(sizeof(GnFrame) == 224, "GnFrame layout");
-GN_STATIC_ASSERT(offsetof(GnFrame, crop_x) == 200, "GnFrame layout");
-GN_STATIC_ASSERT(offsetof(GnFrame, env_width) == 176, "GnFrame layout");
+GN_STATIC_ASSERT(sizeof(GnFrame) == 192, "GnFrame layout");
+GN_STATIC_ASSERT(offsetof(GnFrame, crop_x) == 160, "GnFrame layout");
+GN_STATIC_ASSERT(offsetof(GnFrame, env_width) == 144, "GnFrame layout");
 GN_STATIC_ASSERT(offsetof(GnFrame, ambient) == 112, "GnFrame layout");
 GN_STATIC_ASSERT(sizeof(GnPush) == 16, "GnPush layout");
 GN_STATIC_ASSERT(sizeof(GnDisplayPush) == 32, "GnDisplayPush layout");

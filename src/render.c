@@ -787,7 +787,6 @@ static bool frame_setup(renderer *r, const render_settings *s, const int region[
     frame->crop_width = (uint32_t)(region[2] - region[0]);
     frame->crop_height = (uint32_t)(region[3] - region[1]);
     frame->seed = s->seed;
-    frame->mode = s->mode;
     frame->max_depth = (uint32_t)s->max_depth;
     frame->num_lights = r->num_lights;
     frame->flags = (s->aov & RENDER_AOV_GPU ? GN_FRAME_AOV : 0u) | (s->shadows ? GN_FRAME_SHADOWS : 0u) |
@@ -797,9 +796,6 @@ static bool frame_setup(renderer *r, const render_settings *s, const int region[
     frame->env_color = (vec3){s->env[0], s->env[1], s->env[2]};
     frame->env_cos = (float)cos(s->env_rotation * M_PI / 180);
     frame->env_sin = (float)-sin(s->env_rotation * M_PI / 180);
-    frame->num_nodes = r->tree.num_nodes;
-    frame->bounds_min = v3(r->sc->bounds_min);
-    frame->bounds_max = v3(r->sc->bounds_max);
     frame->ambient = v3(s->ambient_set ? s->ambient : r->sc->ambient);
     frame->traversal_budget = traversal_budget(r->g, 1 + (s->shadows ? r->num_lights : 0));
     r->state_stride = 0; /* path_begin sets it, and the loop cap, for the path kernel */
