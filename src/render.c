@@ -694,20 +694,22 @@ static uint32_t log2_up(uint32_t n)
  * more vertices once the walks stop and for saving and loading a path with its stack.
  * GONIO_LOOP_CAP=N lowers it (tests: paths interrupted and resumed many times). */
 static uint32_t state_stride(const renderer *r, uint32_t mode);
+/* The most loop_setup's overhead can be (log2_up is at most 32): the fixed cap leaves room
+ * for it. */
+#define PATH_OVERHEAD_MAX (32u + (32u + 2) + (32u + 32u + 4))
 static void loop_setup(renderer *r, GnFrame *frame)
 {
     const char *forced = getenv("GONIO_LOOP_CAP");
-    /* (at most 32 + 34 + 68: the overhead the fixed cap below leaves room for) */
     uint32_t overhead = 32 + (frame->num_emitters > 1 ? log2_up(frame->num_emitters) + 2 : 0) +
                         (frame->flags & GN_FRAME_ENV_MAP ? log2_up(frame->env_width) + log2_up(frame->env_height) + 4 : 0);
     frame->loop_overhead = overhead;
     frame->state_stride = r->state_stride = state_stride(r, GN_MODE_PATH);
     /* One value for every render of the process, so the cached kernel stays valid. */
-    r->loop_cap = r->state_stride ? GN_LLVMPIPE_LOOP_LIMIT - 4096u - 4 * 134u : 0;
+    r->loop_cap = r->state_stride ? GN_LLVMPIPE_LOOP_LIMIT - 4096u - 4 * PATH_OVERHEAD_MAX : 0;
     if (r->loop_cap && forced && atol(forced) > 0 && (uint32_t)atol(forced) < r->loop_cap) {
         /* each lane's share (of up to 8) at least two vertices' overhead and then a node
          * visit or a leaf: progress */
-        uint32_t least = 8 * (2 * 134u + 64);
+        uint32_t least = 8 * (2 * PATH_OVERHEAD_MAX + 64);
         r->loop_cap = (uint32_t)atol(forced) > least ? (uint32_t)atol(forced) : least;
     }
 }
