@@ -11,7 +11,7 @@ layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
 
 layout(std430, binding = 0) readonly buffer SceneBlock { BrdfSphere scene; };
 layout(std430, binding = 1) buffer AccumBlock { vec4 accum[]; };
-layout(push_constant) uniform PushBlock { GnPush push; }; // sample_index; pad0 = seed
+layout(push_constant) uniform PushBlock { GnPush push; }; // sample_index, seed
 
 #define SPHERE_CAMERA_Z 4.0
 #define SPHERE_TAN_HALF_FOV 0.3 // the ball fills ~80% of the frame height
@@ -41,7 +41,7 @@ void main()
     if (scene.model == BRDF_GLTF)
         b = bsdf_layers(b, scene.layer.x, scene.layer.y, vec3(0.0, 0.0, 1.0), scene.sheen.rgb, scene.layer.z);
     Bsdf b0 = b; // before the anisotropy, whose direction each hit sets
-    vec4 jitter = rng_uniform4(pixel, push.sample_index, 0u, push.pad0);
+    vec4 jitter = rng_uniform4(pixel, push.sample_index, 0u, push.seed);
     float aspect = float(scene.width) / float(scene.height);
     vec2 ndc = vec2(2.0 * (float(px.x) + jitter.x) / float(scene.width) - 1.0,
                     1.0 - 2.0 * (float(px.y) + jitter.y) / float(scene.height));
@@ -69,7 +69,7 @@ void main()
         vec3 wl = vec3(dot(scene.light_dir, tx), dot(scene.light_dir, ty), dot(scene.light_dir, n));
         if (wo.z > 0.0 && wl.z > 0.0)
             radiance += throughput * bsdf_eval(b, wo, wl) * scene.light_irradiance * wl.z;
-        BsdfSample s = bsdf_sample(b, wo, rng_uniform4(pixel, push.sample_index, depth + 1u, push.pad0).xyz);
+        BsdfSample s = bsdf_sample(b, wo, rng_uniform4(pixel, push.sample_index, depth + 1u, push.seed).xyz);
         if (s.flags == 0u)
             break;
         throughput *= s.weight;

@@ -429,7 +429,7 @@ vec3 offset_origin(vec3 p, vec3 ng, vec3 w)
 }
 
 // ---- the paths of an invocation --------------------------------------------------------------
-// An invocation takes push.pad0 samples of its pixel (sample indices push.sample_index on),
+// An invocation takes push.samples samples of its pixel (sample indices push.sample_index on),
 // starting the next path as soon as one ends ("regeneration"). The 8 lanes of a SIMD group
 // run in step until the longest of their paths ends, and roulette makes path lengths vary
 // a lot; a lane that starts its next path at once, instead of idling, keeps the group busy.
@@ -595,7 +595,7 @@ void main()
     ps_base = slot * frame.state_stride;
     if (LOOP_CAP > 0u)
         pstate_behind = pstate[ps_base];
-    samples = pstate_behind + push.pad0;
+    samples = pstate_behind + push.samples;
     taken = 0u;
     // The sums go on from the buffers, one sample at a time in sample order, so a pixel's
     // sum is the same float whichever dispatches (or runs: --resume) took its samples.

@@ -9,8 +9,8 @@
 // derives each one and names the test that checks it.
 //
 // Conventions: normal = +z; wo points to the viewer, wi to the light, both away from the
-// surface. bsdf_eval returns f (no cosine); bsdf_pdf is the solid-angle density with which
-// bsdf_sample picks wi; Dirac lobes are not in eval/pdf, only in sample (BRDF_FLAG_DELTA).
+// surface. bsdf_eval returns f (no cosine); bsdf_eval_pdf also the solid-angle density with
+// which bsdf_sample picks wi; Dirac lobes are not in eval/pdf, only in sample (BRDF_FLAG_DELTA).
 // Transmission transports importance (flux): the 1/eta^2 radiance scale is left out, so
 // R + T = 1 at a smooth interface; it cancels on closed objects.
 #ifndef BRDF_GLSL
@@ -27,10 +27,7 @@ layout(binding = BRDF_BIND_SHEEN) uniform usamplerBuffer sheen_table;
 #define BRDF_SHEEN_FETCH(i) uintBitsToFloat(texelFetch(sheen_table, (i)).x)
 #endif
 
-#define BRDF_PI 3.14159265358979
-// Below this GGX/Beckmann alpha a lobe is treated as smooth (a Dirac lobe): a narrower
-// lobe is under a tenth of a degree wide, which float directions cannot resolve.
-#define BRDF_ALPHA_MIN 1e-3
+#define BRDF_PI GN_PI
 
 // Bsdf.lobe: the one specular lobe
 #define BRDF_LOBE_NONE 0u
@@ -853,14 +850,6 @@ vec3 bsdf_eval(Bsdf b, vec3 wo, vec3 wi)
     return f;
 }
 
-float bsdf_pdf(Bsdf b, vec3 wo, vec3 wi)
-{
-    vec3 f;
-    float pdf;
-    bsdf_eval_pdf(b, wo, wi, f, pdf);
-    return pdf;
-}
-
 // ---- construction ---------------------------------------------------------------------------
 
 Bsdf brdf_empty()
@@ -889,41 +878,46 @@ Bsdf brdf_empty()
     return b;
 }
 
-// The models of brdf_models.h (ids from 1) from a colour and four scalars (the slots there).
+// A model of brdf_models.h's table but glTF from a colour and four scalars, placed as its
+// row's layout says; a microfacet lobe too narrow for float directions is the mirror.
 Bsdf bsdf_from_model(uint model, vec3 color, vec4 params)
 {
     Bsdf b = brdf_empty();
-    if (model == BRDF_LAMBERT) {
+    uint place = BRDF_LAYOUT_GLTF;
+// (the parameters are named apart from Bsdf's fields, which they would replace)
+#define BRDF_X_ROW(id, name_, summary_, lobe_, fresnel_, layout_, lobe_feats_, feats_, params_) \
+    if (model == id) {                                                                          \
+        b.lobe = lobe_;                                                                         \
+        b.fresnel = fresnel_;                                                                   \
+        place = layout_;                                                                        \
+    }
+    BRDF_MODELS(BRDF_X_ROW)
+#undef BRDF_X_ROW
+    if (place == BRDF_LAYOUT_DIFFUSE) {
         b.diffuse = color;
-    } else if (model == BRDF_MIRROR) {
-        b.lobe = BRDF_LOBE_MIRROR;
+    } else if (place == BRDF_LAYOUT_LOBE) {
         b.specular = color;
-    } else if (model >= BRDF_PHONG && model <= BRDF_GGX) {
+    } else if (place == BRDF_LAYOUT_LAYERED) {
         b.diffuse = color;
         b.specular = vec3(params[BRDF_P_SPECULAR]);
         b.shape = params[BRDF_P_SHAPE];
         b.ior = params[BRDF_P_IOR];
-        b.lobe = model == BRDF_PHONG ? BRDF_LOBE_PHONG
-               : model == BRDF_BLINN_PHONG ? BRDF_LOBE_BLINN
-               : model == BRDF_TORRANCE_SPARROW ? BRDF_LOBE_TS
-               : model == BRDF_BECKMANN ? BRDF_LOBE_BECKMANN : BRDF_LOBE_GGX;
-        if (model >= BRDF_TORRANCE_SPARROW)
-            b.fresnel = BRDF_FRESNEL_DIELECTRIC;
-        if (model >= BRDF_BECKMANN && b.shape < BRDF_ALPHA_MIN)
-            b.lobe = BRDF_LOBE_MIRROR;
-    } else if (model == BRDF_CONDUCTOR) {
-        b.lobe = params[BRDF_P_ALPHA] < BRDF_ALPHA_MIN ? BRDF_LOBE_MIRROR : BRDF_LOBE_GGX;
-        b.fresnel = BRDF_FRESNEL_CONDUCTOR;
+    } else if (place == BRDF_LAYOUT_CONDUCTOR) {
         b.specular = vec3(1.0);
         b.eta = color;
         b.k = params.xyz;
         b.shape = params[BRDF_P_ALPHA];
-    } else if (model == BRDF_DIELECTRIC) {
+    } else if (place == BRDF_LAYOUT_DIELECTRIC) {
         b.dielectric = 1.0;
         b.tint = color;
         b.ior = params[BRDF_P_DIELECTRIC_IOR];
         b.shape = params[BRDF_P_DIELECTRIC_ALPHA];
+    } else {
+        b.lobe = BRDF_LOBE_NONE; // glTF has its own constructor; an unknown id is black
+        b.fresnel = BRDF_FRESNEL_NONE;
     }
+    if ((b.lobe == BRDF_LOBE_BECKMANN || b.lobe == BRDF_LOBE_GGX) && b.shape < BRDF_ALPHA_MIN)
+        b.lobe = BRDF_LOBE_MIRROR;
     return b;
 }
 

@@ -1,6 +1,6 @@
-/* brdf_models.h: the BRDF model ids, their parameter slots and the records of the BRDF test
- * kernel, shared by C (src/render/brdf.c, the tests) and GLSL (brdf.glsl, brdf_test.comp). The
- * models and their equations are docs/brdf.md's.
+/* brdf_models.h: the table of BRDF models, their parameter slots and the records of the BRDF
+ * test kernel, shared by C (src/render/brdf.c, src/render/render.c, the tests) and GLSL (brdf.glsl,
+ * brdf_test.comp). docs/brdf.md has the models' equations.
  *
  * A model is a colour plus four scalars: GnMaterial.brdf (the id) with base_color.rgb as the
  * colour and brdf_params as the scalars; bsdf_from_model() in brdf.glsl reads them. The
@@ -10,29 +10,115 @@
 
 #include "shared.h"
 
-/* ---- model ids (GnMaterial.brdf) ------------------------------------------------------ */
-#define BRDF_GLTF 0u             /* glTF metallic-roughness (+ specular, transmission, ior, clearcoat, sheen) */
-#define BRDF_LAMBERT 1u          /* colour = albedo */
-#define BRDF_MIRROR 2u           /* colour = reflectance; the ideal mirror's delta BRDF */
-#define BRDF_PHONG 3u            /* colour = diffuse; specular, exponent */
-#define BRDF_BLINN_PHONG 4u      /* colour = diffuse; specular, exponent */
-#define BRDF_TORRANCE_SPARROW 5u /* colour = diffuse; specular, exponent e of Blinn's D, ior */
-#define BRDF_BECKMANN 6u         /* colour = diffuse; specular, alpha, ior */
-#define BRDF_GGX 7u              /* colour = diffuse; specular, alpha, ior */
-#define BRDF_CONDUCTOR 8u        /* colour = eta (real part of the index, RGB); k.rgb, alpha */
-#define BRDF_DIELECTRIC 9u       /* colour = transmission tint; ior, alpha */
-#define BRDF_MODEL_COUNT 10u
+/* ---- the models: one table, expanded by C (src/render/brdf.c: names, parameters, --list;
+ * src/render/render.c: material_features) and GLSL (brdf.glsl: bsdf_from_model). A row is
+ *   X(id, name, summary, lobe, fresnel, layout, lobe_feats, feats, params)
+ * - id: GnMaterial.brdf; unique (tests/unit/test_brdf.c checks), never reused. BRDF_GLTF is
+ *   built by bsdf_gltf from GnMaterial's own fields, the rest by bsdf_from_model from a
+ *   colour and the four scalars of brdf_params, placed as `layout` says;
+ * - name, summary, params: C only (glslang tokenises the strings but never expands them):
+ *   the `gonio brdf` / `--brdf` name, its --list line, and its parameters as
+ *   COLOR/SCALAR(name, slot, default(s), min, max) of src/render/brdf.c, slots of src/render/brdf.h;
+ * - lobe, fresnel: the Bsdf's specular lobe and its Fresnel factor (BRDF_LOBE_*,
+ *   BRDF_FRESNEL_* of brdf.glsl); a microfacet lobe (Beckmann, GGX) whose alpha is below
+ *   BRDF_ALPHA_MIN becomes the mirror;
+ * - lobe_feats: the GN_FEAT_* of the lobes the model can build (GN_FEAT_LOBES is their
+ *   union); feats: its other GN_FEAT_* (Fresnel, glass). The path kernel is specialised on
+ *   their union for a scene whose materials use the model (src/render/render.c: material_features;
+ *   glTF's bits depend on the material's values and are worked out there).
+ * Adding a model: a row here, its lobe in brdf.glsl if it has a new one, its section in
+ * docs/brdf.md (docs/architecture.md: Adding a BRDF model). */
+#define BRDF_GLTF 0u /* the ids that code names; a new model needs none */
+#define BRDF_LAMBERT 1u
+#define BRDF_MIRROR 2u
+#define BRDF_PHONG 3u
+#define BRDF_BLINN_PHONG 4u
+#define BRDF_TORRANCE_SPARROW 5u
+#define BRDF_BECKMANN 6u
+#define BRDF_GGX 7u
+#define BRDF_CONDUCTOR 8u
+#define BRDF_DIELECTRIC 9u
+
+/* layout: where bsdf_from_model puts the colour and the four scalars (slots below) */
+#define BRDF_LAYOUT_GLTF 0u       /* none: bsdf_gltf reads GnMaterial */
+#define BRDF_LAYOUT_DIFFUSE 1u    /* colour = Lambert albedo */
+#define BRDF_LAYOUT_LOBE 2u       /* colour = the lobe's weight */
+#define BRDF_LAYOUT_LAYERED 3u    /* colour = Lambert albedo; specular, shape, ior */
+#define BRDF_LAYOUT_CONDUCTOR 4u  /* colour = eta (real part of the index, RGB); k.rgb, alpha */
+#define BRDF_LAYOUT_DIELECTRIC 5u /* colour = transmission tint; ior, alpha */
+
+#define BRDF_GLTF_FEATS (GN_FEAT_MIRROR | GN_FEAT_GGX) /* bsdf_gltf: a GGX lobe, a mirror when smooth */
+#define BRDF_SMOOTH_FEATS(lobe) (lobe | GN_FEAT_MIRROR) /* a microfacet lobe: a mirror below BRDF_ALPHA_MIN */
+#define BRDF_LAYERED_PARAMS(shape, shape_def, shape_max) \
+    COLOR("diffuse", BRDF_SLOT_COLOR, 0, 0, 0, 0, 1), SCALAR("specular", P(BRDF_P_SPECULAR), 1, 0, 1), \
+        SCALAR(shape, P(BRDF_P_SHAPE), shape_def, 0, shape_max)
+
+#define BRDF_MODELS(X) \
+    X(BRDF_LAMBERT, "lambert", "Lambertian diffuse, f = albedo / pi", \
+      BRDF_LOBE_NONE, BRDF_FRESNEL_NONE, BRDF_LAYOUT_DIFFUSE, 0u, 0u, \
+      (COLOR("diffuse", BRDF_SLOT_COLOR, 0.8f, 0.8f, 0.8f, 0, 1))) \
+    X(BRDF_MIRROR, "mirror", "perfect mirror, Lo = R Li(r(wo)) (a Dirac lobe)", \
+      BRDF_LOBE_MIRROR, BRDF_FRESNEL_NONE, BRDF_LAYOUT_LOBE, GN_FEAT_MIRROR, 0u, \
+      (COLOR("reflectance", BRDF_SLOT_COLOR, 1, 1, 1, 0, 1))) \
+    X(BRDF_PHONG, "phong", "diffuse + normalised Phong, ks (n+2)/(2 pi) cos^n(r(wi), wo)", \
+      BRDF_LOBE_PHONG, BRDF_FRESNEL_NONE, BRDF_LAYOUT_LAYERED, GN_FEAT_PHONG, 0u, \
+      (BRDF_LAYERED_PARAMS("exponent", 32, 100000))) \
+    X(BRDF_BLINN_PHONG, "blinn-phong", "diffuse + normalised Blinn-Phong, ks N(n) (n.h)^n", \
+      BRDF_LOBE_BLINN, BRDF_FRESNEL_NONE, BRDF_LAYOUT_LAYERED, GN_FEAT_BLINN, 0u, \
+      (BRDF_LAYERED_PARAMS("exponent", 32, 100000))) \
+    X(BRDF_TORRANCE_SPARROW, "torrance-sparrow", "diffuse + Torrance-Sparrow: Blinn D, V-cavity G, dielectric Fresnel", \
+      BRDF_LOBE_TS, BRDF_FRESNEL_DIELECTRIC, BRDF_LAYOUT_LAYERED, GN_FEAT_TS, GN_FEAT_FRESNEL_DIELECTRIC, \
+      (BRDF_LAYERED_PARAMS("exponent", 100, 100000), SCALAR("ior", P(BRDF_P_IOR), 1.5f, 1, 4))) \
+    X(BRDF_BECKMANN, "beckmann", "diffuse + Beckmann microfacet, Smith G, dielectric Fresnel", \
+      BRDF_LOBE_BECKMANN, BRDF_FRESNEL_DIELECTRIC, BRDF_LAYOUT_LAYERED, BRDF_SMOOTH_FEATS(GN_FEAT_BECKMANN), \
+      GN_FEAT_FRESNEL_DIELECTRIC, (BRDF_LAYERED_PARAMS("alpha", 0.2f, 1), SCALAR("ior", P(BRDF_P_IOR), 1.5f, 1, 4))) \
+    X(BRDF_GGX, "ggx", "diffuse + GGX microfacet, Smith G, dielectric Fresnel", \
+      BRDF_LOBE_GGX, BRDF_FRESNEL_DIELECTRIC, BRDF_LAYOUT_LAYERED, BRDF_SMOOTH_FEATS(GN_FEAT_GGX), \
+      GN_FEAT_FRESNEL_DIELECTRIC, (BRDF_LAYERED_PARAMS("alpha", 0.2f, 1), SCALAR("ior", P(BRDF_P_IOR), 1.5f, 1, 4))) \
+    X(BRDF_CONDUCTOR, "conductor", "GGX metal, complex index eta + i k (default: gold)", \
+      BRDF_LOBE_GGX, BRDF_FRESNEL_CONDUCTOR, BRDF_LAYOUT_CONDUCTOR, BRDF_SMOOTH_FEATS(GN_FEAT_GGX), \
+      GN_FEAT_FRESNEL_CONDUCTOR, \
+      (COLOR("eta", BRDF_SLOT_COLOR, 0.143f, 0.374f, 1.442f, 0.01f, 10), \
+       COLOR("k", P(BRDF_P_K), 3.983f, 2.385f, 1.603f, 0, 20), SCALAR("alpha", P(BRDF_P_ALPHA), 0.1f, 0, 1))) \
+    X(BRDF_DIELECTRIC, "dielectric", "glass: Fresnel reflection + refraction, smooth or GGX", \
+      BRDF_LOBE_NONE, BRDF_FRESNEL_NONE, BRDF_LAYOUT_DIELECTRIC, 0u, GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS, \
+      (COLOR("tint", BRDF_SLOT_COLOR, 1, 1, 1, 0, 1), SCALAR("ior", P(BRDF_P_DIELECTRIC_IOR), 1.5f, 1.01f, 4), \
+       SCALAR("alpha", P(BRDF_P_DIELECTRIC_ALPHA), 0, 0, 1))) \
+    X(BRDF_GLTF, "gltf", \
+      "glTF metallic-roughness + KHR_materials_specular/transmission/ior/clearcoat/sheen/anisotropy/iridescence/diffuse_transmission", \
+      BRDF_LOBE_GGX, BRDF_FRESNEL_SCHLICK, BRDF_LAYOUT_GLTF, BRDF_GLTF_FEATS, GN_FEAT_GLTF, \
+      (COLOR("base-color", BRDF_SLOT_COLOR, 0.8f, 0.8f, 0.8f, 0, 1), \
+       SCALAR("metallic", P(0), 0, 0, 1), SCALAR("roughness", P(1), 0.5f, 0, 1), \
+       SCALAR("specular", P(2), 1, 0, 1), SCALAR("ior", P(3), 1.5f, 1, 4), \
+       COLOR("specular-color", BRDF_SLOT_EXTRA, 1, 1, 1, 0, 100), \
+       SCALAR("transmission", BRDF_SLOT_EXTRA + 3, 0, 0, 1), \
+       SCALAR("clearcoat", BRDF_SLOT_LAYER, 0, 0, 1), SCALAR("clearcoat-roughness", BRDF_SLOT_LAYER + 1, 0, 0, 1), \
+       COLOR("sheen-color", BRDF_SLOT_SHEEN, 0, 0, 0, 0, 1), SCALAR("sheen-roughness", BRDF_SLOT_LAYER + 2, 0, 0, 1), \
+       SCALAR("anisotropy", BRDF_SLOT_ANISO, 0, 0, 1), SCALAR("anisotropy-rotation", BRDF_SLOT_ANISO + 1, 0, -6.2832f, 6.2832f), \
+       SCALAR("iridescence", BRDF_SLOT_IRID, 0, 0, 1), SCALAR("iridescence-ior", BRDF_SLOT_IRID + 1, 1.3f, 1, 4), \
+       SCALAR("iridescence-thickness", BRDF_SLOT_IRID + 2, 400, 0, 2000), \
+       SCALAR("diffuse-transmission", BRDF_SLOT_DT + 3, 0, 0, 1), \
+       COLOR("diffuse-transmission-color", BRDF_SLOT_DT, 1, 1, 1, 0, 1)))
+
+/* Below this GGX/Beckmann alpha a lobe is treated as smooth (a Dirac lobe): a narrower lobe
+ * is under a tenth of a degree wide, which float directions cannot resolve (brdf.glsl's
+ * constructors; src/render/render.c: material_features, which must agree). */
+#define BRDF_ALPHA_MIN 1e-3f
+
+/* The union of every model's lobe features: may a kernel meet any specular lobe at all. */
+#define BRDF_X_LOBE_FEATS(id, name, summary, lobe, fresnel, layout, lobe_feats, feats, params) | (lobe_feats)
+#define GN_FEAT_LOBES (0u BRDF_MODELS(BRDF_X_LOBE_FEATS))
 
 /* ---- slots of the four scalars (indices into brdf_params) ------------------------------ */
-/* phong, blinn-phong, torrance-sparrow, beckmann, ggx: a Lambert layer (the colour) plus one
- * specular lobe; max(diffuse) + specular <= 1 keeps the sum energy conserving. */
+/* BRDF_LAYOUT_LAYERED: a Lambert layer (the colour) plus one specular lobe;
+ * max(diffuse) + specular <= 1 keeps the sum energy conserving. */
 #define BRDF_P_SPECULAR 0 /* lobe weight ks */
 #define BRDF_P_SHAPE 1    /* Phong/Blinn exponent, or microfacet alpha (Beckmann, GGX) */
 #define BRDF_P_IOR 2      /* index of the dielectric below the lobe (Fresnel) */
-/* conductor */
+/* BRDF_LAYOUT_CONDUCTOR */
 #define BRDF_P_K 0        /* k.r, k.g, k.b in slots 0, 1, 2 */
 #define BRDF_P_ALPHA 3    /* GGX alpha; 0 = polished (delta) */
-/* dielectric */
+/* BRDF_LAYOUT_DIELECTRIC */
 #define BRDF_P_DIELECTRIC_IOR 0
 #define BRDF_P_DIELECTRIC_ALPHA 1 /* GGX alpha; 0 = smooth glass (delta) */
 

@@ -80,8 +80,8 @@ RayPre ray_pre(vec3 o, vec3 d)
     r.sx = ex - Sx * ez;
     r.sy = ey - Sy * ez;
     r.sz = Sz * ez;
-    r.inv = vec3(1.0) / mix(d, sign(d) * 1e-30 + vec3(equal(d, vec3(0.0))) * 1e-30,
-                            lessThan(ad, vec3(1e-30)));
+    r.inv = vec3(1.0) / mix(d, sign(d) * GN_BVH_PARALLEL_DIR + vec3(equal(d, vec3(0.0))) * GN_BVH_PARALLEL_DIR,
+                            lessThan(ad, vec3(GN_BVH_PARALLEL_DIR)));
     r.neg = lessThan(r.inv, vec3(0.0));
     return r;
 }

@@ -6,7 +6,7 @@
 #ifndef SAMPLING_GLSL
 #define SAMPLING_GLSL
 
-#define SAMPLING_PI 3.14159265358979
+#include "shared.h"
 
 // [0,1)^2 -> unit disk, area preserving and with low distortion (stratification survives).
 vec2 sampling_concentric_disk(vec2 u)
@@ -17,10 +17,10 @@ vec2 sampling_concentric_disk(vec2 u)
     float r, phi;
     if (abs(o.x) > abs(o.y)) {
         r = o.x;
-        phi = 0.25 * SAMPLING_PI * (o.y / o.x);
+        phi = 0.25 * GN_PI * (o.y / o.x);
     } else {
         r = o.y;
-        phi = 0.5 * SAMPLING_PI - 0.25 * SAMPLING_PI * (o.x / o.y);
+        phi = 0.5 * GN_PI - 0.25 * GN_PI * (o.x / o.y);
     }
     return r * vec2(cos(phi), sin(phi));
 }
@@ -37,7 +37,7 @@ vec3 sampling_uniform_sphere(vec2 u)
 {
     float z = 1.0 - 2.0 * u.x;
     float r = sqrt(max(0.0, 1.0 - z * z));
-    float phi = 2.0 * SAMPLING_PI * u.y;
+    float phi = 2.0 * GN_PI * u.y;
     return vec3(r * cos(phi), r * sin(phi), z);
 }
 

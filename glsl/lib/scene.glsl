@@ -30,7 +30,7 @@ layout(std430, binding = GN_BIND_LIGHTS) readonly buffer LightBlock { GnLight li
 layout(binding = GN_BIND_TEXELS) uniform usamplerBuffer texels; // R32UI: one RGBA8 texel each
 layout(binding = GN_BIND_TEXTURES) uniform usamplerBuffer texture_texels; // GnTexture[]
 
-const float PI = 3.14159265358979323846;
+#define PI GN_PI // (the name path.comp and bench.comp use)
 
 vec4 texel_f(usamplerBuffer b, uint i) { return uintBitsToFloat(texelFetch(b, int(i))); }
 
@@ -222,11 +222,9 @@ struct Surface {
     vec4 uv;          // TEXCOORD_0 (xy) and TEXCOORD_1 (zw)
     vec3 base;        // linear base colour (factor * texture * vertex colour)
     vec3 vcolor;      // the interpolated vertex colour (1 without COLOR_0)
-    float alpha;
     float metallic;
     float roughness;
     vec3 emission;
-    float occlusion;
     uint material;
     bool front;       // the ray hit the side the triangle's winding calls front
     // KHR_materials_clearcoat and _sheen (GN_FEAT_LAYERS; else 0): the coat's weight,
@@ -276,7 +274,6 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     base *= vc;
     s.vcolor = vc.rgb;
     s.base = base.rgb;
-    s.alpha = base.a;
     s.metallic = m.metallic;
     s.roughness = m.roughness;
     if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_mr != GN_INVALID) {
@@ -287,9 +284,7 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     s.emission = m.emissive;
     if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_emissive != GN_INVALID)
         s.emission *= texture_sample(m.tex_emissive, s.uv, true).rgb;
-    s.occlusion = 1.0;
-    if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_occlusion != GN_INVALID)
-        s.occlusion = 1.0 + m.occlusion_strength * (texture_sample(m.tex_occlusion, s.uv, false).r - 1.0);
+    // (occlusion maps: the local modes' ambient term only, glsl/lib/phong.glsl)
     s.coat = 0.0;
     s.coat_roughness = 0.0;
     s.coat_n = n;

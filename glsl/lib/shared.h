@@ -28,6 +28,18 @@ typedef uint32_t uint;
 #define GN_END(name) name
 #endif
 
+/* ---- constants of the host and the kernels, each defined once --------------------------- */
+#define GN_PI 3.14159265358979323846 /* a double in C, a float in GLSL (the same float either way) */
+/* llvmpipe (lavapipe) ends an invocation's loops silently after this many iterations in
+ * total (docs/architecture.md: The loop cap): the walk budgets and the path kernel's cap. */
+#define GN_LLVMPIPE_LOOP_LIMIT 65535u
+/* The most triangle pairs in a BVH leaf (src/accel/bvh.c splits a larger node even where the SAH
+ * prefers a leaf; GnBvhNode's count field has room for 8). */
+#define GN_BVH_MAX_LEAF 8
+/* Loop passes one node visit of a walk can cost: the visit, and the two leaves it may open,
+ * each one pass plus one a pair (src/render/render.c: traversal_budget). */
+#define GN_WALK_VISIT_PASSES (1u + 2u * (1u + GN_BVH_MAX_LEAF))
+
 /* ---- descriptor bindings (set 0) of the render kernels -------------------------------- */
 #define GN_BIND_FRAME 0u     /* GnFrame (a read-only storage buffer: see glsl/lib/scene.glsl) */
 /* Bindings 1-5 are RGBA32UI uniform texel buffers (16 bytes a texel), read through
@@ -172,8 +184,7 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
 #define GN_FEAT_LAYERS (1u << 29)       /* KHR_materials_clearcoat, _sheen, _iridescence, _diffuse_transmission (brdf.glsl: bsdf_layers) */
 #define GN_FEAT_VOLUME (1u << 30)       /* KHR_materials_volume media, _dispersion */
 #define GN_FEAT_ANISO (1u << 31)        /* KHR_materials_anisotropy */
-#define GN_FEAT_LOBES (GN_FEAT_MIRROR | GN_FEAT_PHONG | GN_FEAT_BLINN | GN_FEAT_TS | \
-                       GN_FEAT_BECKMANN | GN_FEAT_GGX)
+/* (GN_FEAT_LOBES, every lobe a BRDF model can build: brdf_models.h, from its table) */
 #define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
 #define GN_FEAT_ALL 0xffffffffu
 
@@ -189,8 +200,8 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
  *   a_count == 0, a_index == INVALID  empty (only b, when the whole scene is one leaf); its
  *                                     box is inverted (min FLT_MAX, max -FLT_MAX), so the
  *                                     walk's slab test never enters it and needs no check
- * Leaves hold at most 8 pairs and scenes at most 2^26 triangles (src/scene/scene_gltf.cpp), so
- * first fits in 27 bits. */
+ * Leaves hold at most GN_BVH_MAX_LEAF pairs and scenes at most 2^26 triangles
+ * (src/scene/scene_gltf.cpp), so first fits in 27 bits. */
 #define GN_BVH_LEAF 0x80000000u
 #define GN_BVH_COUNT_SHIFT 27
 #define GN_BVH_FIRST 0x07ffffffu
@@ -198,6 +209,9 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
  * test hits: 1 + 2 gamma(3) (Ize 2013; gamma(n) = n u / (1 - n u), u = 2^-24) is just above
  * 1 + 3 ulp, so 1 + 4 ulp (src/accel/bvh.c and glsl/lib/bvh.glsl, one value). */
 #define GN_BVH_TFAR_SCALE 1.00000048f
+/* A ray direction's component below this counts as parallel to its slabs (src/accel/bvh.c:
+ * BVH_PARALLEL_DIR says why; glsl/lib/bvh.glsl: ray_pre). */
+#define GN_BVH_PARALLEL_DIR 1e-30f
 GN_STRUCT(GnBvhNode) {
     vec3 a_min; uint a_index;
     vec3 a_max; uint a_count;
@@ -335,27 +349,29 @@ GN_STRUCT(GnCamera) {
  * the accumulation buffers hold, so a crop renders exactly the pixels of the whole image. */
 GN_STRUCT(GnFrame) {
     GnCamera camera;
-    uint width; uint height; uint seed; uint mode;
-    uint max_depth; uint num_lights; uint num_emitters; uint flags;
+    uint width; uint height; uint seed; uint max_depth;
+    uint num_lights; uint num_emitters; uint flags;
+    uint traversal_budget;               /* max BVH steps per ray (docs/architecture.md: the loop cap) */
     vec3 ambient; float emitter_power;   /* ambient: global ambient light of the Phong model */
-    vec3 env_color; uint num_nodes;      /* constant environment radiance */
-    vec3 bounds_min; float depth_scale;
-    vec3 bounds_max; uint traversal_budget; /* max BVH steps per ray (docs/architecture.md: the loop cap) */
+    vec3 env_color; float env_select;    /* constant environment radiance; env's selection probability */
     uint env_width; uint env_height;     /* GN_FRAME_ENV_MAP: the lat-long map's size */
-    float env_select; float env_norm;    /* env's selection probability; 1 / mean map weight */
     float env_cos; float env_sin;        /* the map turned by a about +Y (right-handed): cos a, -sin a */
     uint crop_x; uint crop_y;            /* the region's top-left pixel in the whole image */
     uint crop_width; uint crop_height;   /* the region's size: the dispatch and the buffers */
     uint loop_overhead; uint state_stride; /* path, LOOP_CAP > 0: loop passes a vertex costs besides its walks; words per pixel of GN_BIND_PSTATE */
-} GN_END(GnFrame); /* 224 bytes */
+    uint pad0; uint pad1;                /* (std430 rounds the struct to 16 bytes) */
+} GN_END(GnFrame); /* 192 bytes */
 
 /* Per-dispatch values (push constants). */
 GN_STRUCT(GnPush) {
-    uint sample_index;   /* index of the (first) sample this pass takes in every pixel */
-    uint pass_flags;
-    uint pad0;           /* path.comp: how many samples, sample_index on (0..GN_PATH_SAMPLES; 0: only finish those pending) */
-    uint pad1;
+    uint sample_index;   /* index of the (first) sample this pass takes in every pixel;
+                            trace_test.comp: the number of rays */
+    uint pass_flags;     /* vertex.comp: the side (0 front, 1 back); trace_test.comp: GN_PASS_* */
+    uint samples;        /* path.comp: how many samples, sample_index on (0..GN_PATH_SAMPLES; 0: only finish those pending) */
+    uint seed;           /* brdf_sphere.comp: the random numbers' seed */
 } GN_END(GnPush);
+#define GN_PASS_RESUME 1u  /* trace_test.comp: resume the walks the last dispatch saved */
+#define GN_PASS_ANY_HIT 2u /* trace_test.comp: any hit ends a walk (shadow rays) */
 
 /* ---- display kernel (glsl/kernels/display.comp): accumulated radiance -> 8-bit sRGB texels ----- */
 #define GN_DISPLAY_BIND_ACCUM 0u /* vec4[] per pixel, as GN_BIND_ACCUM */
@@ -379,6 +395,8 @@ GN_STRUCT(GnDisplayPush) {
 #endif
 #include <stddef.h>
 GN_STATIC_ASSERT(sizeof(GnBvhNode) == 64, "GnBvhNode layout");
+GN_STATIC_ASSERT(((GN_BVH_MAX_LEAF - 1) << GN_BVH_COUNT_SHIFT & ~(GN_BVH_LEAF | GN_BVH_FIRST)) ==
+                     (GN_BVH_MAX_LEAF - 1) << GN_BVH_COUNT_SHIFT, "a leaf's count fits its bits");
 GN_STATIC_ASSERT(offsetof(GnBvhNode, b_min) == 32, "GnBvhNode layout");
 GN_STATIC_ASSERT(sizeof(GnTriPair) == 48, "GnTriPair layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");
@@ -395,9 +413,9 @@ GN_STATIC_ASSERT(sizeof(GnEmitter) == 16, "GnEmitter layout");
 GN_STATIC_ASSERT(sizeof(GnTexture) == 48, "GnTexture layout");
 GN_STATIC_ASSERT(offsetof(GnTexture, row1) == 32, "GnTexture layout");
 GN_STATIC_ASSERT(sizeof(GnCamera) == 80, "GnCamera layout");
-GN_STATIC_ASSERT(sizeof(GnFrame) == 224, "GnFrame layout");
-GN_STATIC_ASSERT(offsetof(GnFrame, crop_x) == 200, "GnFrame layout");
-GN_STATIC_ASSERT(offsetof(GnFrame, env_width) == 176, "GnFrame layout");
+GN_STATIC_ASSERT(sizeof(GnFrame) == 192, "GnFrame layout");
+GN_STATIC_ASSERT(offsetof(GnFrame, crop_x) == 160, "GnFrame layout");
+GN_STATIC_ASSERT(offsetof(GnFrame, env_width) == 144, "GnFrame layout");
 GN_STATIC_ASSERT(offsetof(GnFrame, ambient) == 112, "GnFrame layout");
 GN_STATIC_ASSERT(sizeof(GnPush) == 16, "GnPush layout");
 GN_STATIC_ASSERT(sizeof(GnDisplayPush) == 32, "GnDisplayPush layout");

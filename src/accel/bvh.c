@@ -30,8 +30,8 @@
 #define BVH_BINS 16      /* per axis; Wald 2007 finds 16 as good as a full sweep */
 #define BVH_MIN_LEAF 4   /* up to this many pairs always a leaf; above, the SAH decides
                             (4 rather than 2: a faster build, and lavapipe traces as fast) */
-#define BVH_MAX_LEAF 8   /* above this a node is split even when the SAH prefers a leaf */
-#define BVH_MAX_DEPTH 64 /* GnBvhNode levels; the traversal stack (64) never overflows */
+#define BVH_MAX_LEAF GN_BVH_MAX_LEAF /* above this a node is split even when the SAH prefers a leaf */
+#define BVH_MAX_DEPTH 64 /* GnBvhNode levels; also the host walk's stack, which never overflows */
 _Static_assert(GN_WALK_STACK - 2 >= BVH_MAX_DEPTH - 1, "glsl/lib/bvh.glsl's stack must hold a deepest walk");
 /* Threads: the top levels are built on one thread until there are a few subtrees per thread
  * (at most BVH_SUBTREES), which the threads then share; below BVH_PARALLEL_MIN triangles
@@ -43,14 +43,12 @@ _Static_assert(GN_WALK_STACK - 2 >= BVH_MAX_DEPTH - 1, "glsl/lib/bvh.glsl's stac
 /* builder.rec: the record holds triangles (index) and (index + 1) */
 #define BVH_REC_PAIR 0x80000000u
 
-/* Traversal constants, shared with glsl/lib/bvh.glsl. */
-#define BVH_STACK 64
-/* A direction component smaller than this is treated as parallel to its slabs: the inverse
- * becomes +-BVH_PARALLEL_INV (finite, so no 0 * inf NaN and no inf on GPUs that assume
- * none). Boxes are padded (see pad_up) so that a parallel ray lying exactly in a box face
+/* Traversal constants. A direction component smaller than BVH_PARALLEL_DIR is treated as
+ * parallel to its slabs: the inverse becomes +-BVH_PARALLEL_INV (finite, so no 0 * inf NaN
+ * and no inf on GPUs that assume none). Boxes are padded (see pad_up) so that a parallel ray lying exactly in a box face
  * still gets a slab interval of at least +-(0.5e-20 * 1e30) = +-5e9: hits farther than that
  * along a ray with a zero direction component are not guaranteed. */
-#define BVH_PARALLEL_DIR 1e-30f
+#define BVH_PARALLEL_DIR GN_BVH_PARALLEL_DIR
 #define BVH_PARALLEL_INV 1e30f
 #define BVH_BOX_PAD 1e-20f
 
@@ -778,7 +776,7 @@ static double box_area(const vec3 *lo, const vec3 *hi)
  * (padded) boxes. */
 static void measure(bvh *out)
 {
-    uint32_t stack[2 * BVH_STACK + 2], level[2 * BVH_STACK + 2], sp = 0;
+    uint32_t stack[2 * BVH_MAX_DEPTH + 2], level[2 * BVH_MAX_DEPTH + 2], sp = 0;
     double inner = 0, leaves = 0;
     stack[sp] = 0, level[sp++] = 1;
     out->depth = 0;
@@ -1047,8 +1045,8 @@ static bvh_hit traverse(const bvh *b, const float org[3], const float dir[3], fl
                         float tmax, bool any_hit, uint32_t *steps)
 {
     bvh_hit hit = {tmax, 0, 0, GN_INVALID};
-    uint32_t stack_node[BVH_STACK], sp = 0, node = 0, nsteps = 0;
-    float stack_t[BVH_STACK];
+    uint32_t stack_node[BVH_MAX_DEPTH], sp = 0, node = 0, nsteps = 0;
+    float stack_t[BVH_MAX_DEPTH];
     ray r;
     if (b->num_nodes == 0) /* the zeroed bvh of an empty scene */
         return hit;
@@ -1077,7 +1075,7 @@ static bvh_hit traverse(const bvh *b, const float org[3], const float dir[3], fl
         hb = hb && eb <= hit.t;
         if (ha && hb) {
             bool a_near = ea <= eb;
-            assert(sp < BVH_STACK); /* depth <= BVH_MAX_DEPTH keeps sp < depth */
+            assert(sp < BVH_MAX_DEPTH); /* depth <= BVH_MAX_DEPTH keeps sp < depth */
             stack_node[sp] = a_near ? n->b_index : n->a_index;
             stack_t[sp++] = a_near ? eb : ea;
             node = a_near ? n->a_index : n->b_index;

@@ -446,7 +446,7 @@ int cmd_brdf(int argc, char **argv)
         return rc;
     if (list) {
         for (int i = 0; i < brdf_num_models; i++) {
-            char line[256];
+            char line[1024]; /* the gltf model's line is over 300 characters */
             brdf_setting_init(&s, &brdf_models[i]);
             brdf_format_setting(line, sizeof line, &s);
             printf("%s\n", line);

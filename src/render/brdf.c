@@ -12,49 +12,13 @@
 #define P(slot) (BRDF_SLOT_PARAMS + (slot))
 #define COLOR(name, slot, d0, d1, d2, lo, hi) {name, slot, 3, {d0, d1, d2}, lo, hi}
 #define SCALAR(name, slot, d, lo, hi) {name, slot, 1, {d, 0, 0}, lo, hi}
-/* The diffuse + one-lobe models share their layout (brdf_models.h). */
-#define LAYERED(shape_name, shape_def, shape_max)                                       \
-    COLOR("diffuse", BRDF_SLOT_COLOR, 0, 0, 0, 0, 1), SCALAR("specular", P(BRDF_P_SPECULAR), 1, 0, 1), \
-        SCALAR(shape_name, P(BRDF_P_SHAPE), shape_def, 0, shape_max)
+#define UNPAREN(...) __VA_ARGS__
+/* The table of glsl/lib/brdf_models.h; the parameter count is that of its list. */
+#define MODEL(id, name, summary, lobe, fresnel, layout, lobe_feats, feats, params)                  \
+    {name, id, summary, (int)(sizeof((brdf_param[]){UNPAREN params}) / sizeof(brdf_param)),       \
+     {UNPAREN params}, (lobe_feats) | (feats)},
 
-const brdf_model brdf_models[] = {
-    {"lambert", BRDF_LAMBERT, "Lambertian diffuse, f = albedo / pi", 1,
-     {COLOR("diffuse", BRDF_SLOT_COLOR, 0.8f, 0.8f, 0.8f, 0, 1)}},
-    {"mirror", BRDF_MIRROR, "perfect mirror, Lo = R Li(r(wo)) (a Dirac lobe)", 1,
-     {COLOR("reflectance", BRDF_SLOT_COLOR, 1, 1, 1, 0, 1)}},
-    {"phong", BRDF_PHONG, "diffuse + normalised Phong, ks (n+2)/(2 pi) cos^n(r(wi), wo)", 3,
-     {LAYERED("exponent", 32, 100000)}},
-    {"blinn-phong", BRDF_BLINN_PHONG, "diffuse + normalised Blinn-Phong, ks N(n) (n.h)^n", 3,
-     {LAYERED("exponent", 32, 100000)}},
-    {"torrance-sparrow", BRDF_TORRANCE_SPARROW,
-     "diffuse + Torrance-Sparrow: Blinn D, V-cavity G, dielectric Fresnel", 4,
-     {LAYERED("exponent", 100, 100000), SCALAR("ior", P(BRDF_P_IOR), 1.5f, 1, 4)}},
-    {"beckmann", BRDF_BECKMANN, "diffuse + Beckmann microfacet, Smith G, dielectric Fresnel", 4,
-     {LAYERED("alpha", 0.2f, 1), SCALAR("ior", P(BRDF_P_IOR), 1.5f, 1, 4)}},
-    {"ggx", BRDF_GGX, "diffuse + GGX microfacet, Smith G, dielectric Fresnel", 4,
-     {LAYERED("alpha", 0.2f, 1), SCALAR("ior", P(BRDF_P_IOR), 1.5f, 1, 4)}},
-    {"conductor", BRDF_CONDUCTOR, "GGX metal, complex index eta + i k (default: gold)", 3,
-     {COLOR("eta", BRDF_SLOT_COLOR, 0.143f, 0.374f, 1.442f, 0.01f, 10),
-      COLOR("k", P(BRDF_P_K), 3.983f, 2.385f, 1.603f, 0, 20),
-      SCALAR("alpha", P(BRDF_P_ALPHA), 0.1f, 0, 1)}},
-    {"dielectric", BRDF_DIELECTRIC, "glass: Fresnel reflection + refraction, smooth or GGX", 3,
-     {COLOR("tint", BRDF_SLOT_COLOR, 1, 1, 1, 0, 1),
-      SCALAR("ior", P(BRDF_P_DIELECTRIC_IOR), 1.5f, 1.01f, 4),
-      SCALAR("alpha", P(BRDF_P_DIELECTRIC_ALPHA), 0, 0, 1)}},
-    {"gltf", BRDF_GLTF, "glTF metallic-roughness + KHR_materials_specular/transmission/ior/clearcoat/sheen/anisotropy/iridescence/diffuse_transmission", 18,
-     {COLOR("base-color", BRDF_SLOT_COLOR, 0.8f, 0.8f, 0.8f, 0, 1),
-      SCALAR("metallic", P(0), 0, 0, 1), SCALAR("roughness", P(1), 0.5f, 0, 1),
-      SCALAR("specular", P(2), 1, 0, 1), SCALAR("ior", P(3), 1.5f, 1, 4),
-      COLOR("specular-color", BRDF_SLOT_EXTRA, 1, 1, 1, 0, 100),
-      SCALAR("transmission", BRDF_SLOT_EXTRA + 3, 0, 0, 1),
-      SCALAR("clearcoat", BRDF_SLOT_LAYER, 0, 0, 1), SCALAR("clearcoat-roughness", BRDF_SLOT_LAYER + 1, 0, 0, 1),
-      COLOR("sheen-color", BRDF_SLOT_SHEEN, 0, 0, 0, 0, 1), SCALAR("sheen-roughness", BRDF_SLOT_LAYER + 2, 0, 0, 1),
-      SCALAR("anisotropy", BRDF_SLOT_ANISO, 0, 0, 1), SCALAR("anisotropy-rotation", BRDF_SLOT_ANISO + 1, 0, -6.2832f, 6.2832f),
-      SCALAR("iridescence", BRDF_SLOT_IRID, 0, 0, 1), SCALAR("iridescence-ior", BRDF_SLOT_IRID + 1, 1.3f, 1, 4),
-      SCALAR("iridescence-thickness", BRDF_SLOT_IRID + 2, 400, 0, 2000),
-      SCALAR("diffuse-transmission", BRDF_SLOT_DT + 3, 0, 0, 1),
-      COLOR("diffuse-transmission-color", BRDF_SLOT_DT, 1, 1, 1, 0, 1)}},
-};
+const brdf_model brdf_models[] = {BRDF_MODELS(MODEL)};
 const int brdf_num_models = (int)(sizeof brdf_models / sizeof *brdf_models);
 
 const float brdf_sheen_table[BRDF_SHEEN_TABLE_SIZE] = {SHEEN_ALBEDO_VALUES};
@@ -68,15 +32,6 @@ const brdf_model *brdf_model_find(const char *name)
     for (int i = 0; i < brdf_num_models; i++)
         strcat(strcat(list, i ? ", " : ""), brdf_models[i].name);
     util_error("unknown BRDF model '%s'; the models are: %s", name, list);
-    return NULL;
-}
-
-const brdf_model *brdf_model_by_id(uint32_t id)
-{
-    for (int i = 0; i < brdf_num_models; i++)
-        if (brdf_models[i].id == id)
-            return &brdf_models[i];
-    assert(!"no BRDF model with that id");
     return NULL;
 }
 

@@ -42,6 +42,7 @@ typedef struct brdf_model {
     const char *summary;
     int num_params;
     brdf_param params[BRDF_MAX_PARAMS];
+    uint32_t features; /* GN_FEAT_* its Bsdf can need (the table's lobe_feats | feats) */
 } brdf_model;
 
 typedef struct brdf_setting {
@@ -59,8 +60,6 @@ extern const int brdf_num_models;
 
 /* The model of that name; NULL with an error listing the accepted names otherwise. */
 const brdf_model *brdf_model_find(const char *name);
-/* The model with that id (programmer error if none). */
-const brdf_model *brdf_model_by_id(uint32_t id);
 /* A setting of m with every parameter at its default. */
 void brdf_setting_init(brdf_setting *s, const brdf_model *m);
 /* Sets parameter `name` (without "--") from text; false with an error naming the model and

@@ -174,7 +174,6 @@ static float clamp01(float x) { return x < 0 ? 0 : x > 1 ? 1 : x; }
  * metalness) every value it can reach counts. */
 static uint32_t material_features(const GnMaterial *m)
 {
-    const float alpha_min = 1e-3f; /* BRDF_ALPHA_MIN */
     uint32_t f = 0;
     bool textured = m->tex_base != GN_INVALID || m->tex_mr != GN_INVALID ||
                     m->tex_emissive != GN_INVALID || m->tex_occlusion != GN_INVALID;
@@ -190,14 +189,14 @@ static uint32_t material_features(const GnMaterial *m)
         f |= GN_FEAT_EMISSIVE;
     switch (m->brdf) {
     case BRDF_GLTF: {
-        /* bsdf_gltf: a GGX lobe (a mirror below alpha_min) with Schlick's F of weight
+        /* bsdf_gltf: a GGX lobe (a mirror below BRDF_ALPHA_MIN) with Schlick's F of weight
          * wd f0 + m base and F90 wd specular + m; the diffuse coupled to that layer when
          * specular > 0; glass of weight (1 - m) t. The texture scales roughness and
          * metalness by [0, 1]. */
         float metal_hi = clamp01(m->metallic), metal_lo = m->tex_mr != GN_INVALID ? 0 : metal_hi;
         float rough_hi = clamp01(m->roughness), rough_lo = m->tex_mr != GN_INVALID ? 0 : rough_hi;
         float t = clamp01(m->transmission);
-        bool smooth = rough_lo * rough_lo < alpha_min, rough = rough_hi * rough_hi >= alpha_min;
+        bool smooth = rough_lo * rough_lo < BRDF_ALPHA_MIN, rough = rough_hi * rough_hi >= BRDF_ALPHA_MIN;
         f |= GN_FEAT_GLTF;
         if (m->specular != 0 || metal_hi > 0) {
             f |= GN_FEAT_FRESNEL_SCHLICK | (smooth ? GN_FEAT_MIRROR : 0u) | (rough ? GN_FEAT_GGX : 0u);
@@ -228,37 +227,16 @@ static uint32_t material_features(const GnMaterial *m)
         }
         break;
     }
-    case BRDF_LAMBERT:
-        break;
-    case BRDF_MIRROR:
-        f |= GN_FEAT_MIRROR;
-        break;
-    case BRDF_PHONG:
-        f |= GN_FEAT_PHONG;
-        break;
-    case BRDF_BLINN_PHONG:
-        f |= GN_FEAT_BLINN;
-        break;
-    case BRDF_TORRANCE_SPARROW:
-        f |= GN_FEAT_TS | GN_FEAT_FRESNEL_DIELECTRIC;
-        break;
-    case BRDF_BECKMANN:
-        f |= GN_FEAT_BECKMANN | GN_FEAT_MIRROR | GN_FEAT_FRESNEL_DIELECTRIC;
-        break;
-    case BRDF_GGX:
-        f |= GN_FEAT_GGX | GN_FEAT_MIRROR | GN_FEAT_FRESNEL_DIELECTRIC;
-        break;
-    case BRDF_CONDUCTOR:
-        f |= GN_FEAT_GGX | GN_FEAT_MIRROR | GN_FEAT_FRESNEL_CONDUCTOR;
-        break;
-    case BRDF_DIELECTRIC:
-        f |= GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS;
-        break;
-    default:
-        f |= GN_FEAT_ALL; /* unknown to this table: keep every feature */
+    default: {
+        /* an override model: its row of the table (glsl/lib/brdf_models.h); an id unknown to it
+         * keeps every feature */
+        uint32_t mf = GN_FEAT_ALL;
+        for (int i = 0; i < brdf_num_models; i++)
+            if (brdf_models[i].id == m->brdf)
+                mf = brdf_models[i].features;
+        f |= mf | GN_FEAT_MODELS;
     }
-    if (m->brdf != BRDF_GLTF)
-        f |= GN_FEAT_MODELS;
+    }
     return f;
 }
 
@@ -542,11 +520,10 @@ static uint32_t traversal_budget(const gpu *g, uint32_t rays_per_invocation)
 {
     if (!loop_capped(g))
         return 1u << 30;
-    /* A node visit costs one iteration and opens at most two leaves, each one more
-     * iteration plus max_leaf_size (8 at most, the builder's cap): 19. The count is shared
-     * by the 8 invocations of a SIMD group, so this keeps typical work well under the cap,
-     * not every case; a walk the cap stops says so (glsl/lib/bvh.glsl) rather than lie. */
-    return 60000u / (rays_per_invocation * 19u);
+    /* A node visit costs at most GN_WALK_VISIT_PASSES iterations. The count is shared by
+     * the 8 invocations of a SIMD group, so this keeps typical work well under the cap, not
+     * every case; a walk the cap stops says so (glsl/lib/bvh.glsl) rather than lie. */
+    return 60000u / (rays_per_invocation * GN_WALK_VISIT_PASSES);
 }
 
 /* Progress on stderr. On a terminal, a bar redrawn in place; otherwise (a log) plain lines,
@@ -774,20 +751,22 @@ static uint32_t log2_up(uint32_t n)
  * more vertices once the walks stop and for saving and loading a path with its stack.
  * GONIO_LOOP_CAP=N lowers it (tests: paths interrupted and resumed many times). */
 static uint32_t state_stride(const renderer *r, uint32_t mode);
+/* The most loop_setup's overhead can be (log2_up is at most 32): the fixed cap leaves room
+ * for it. */
+#define PATH_OVERHEAD_MAX (32u + (32u + 2) + (32u + 32u + 4))
 static void loop_setup(renderer *r, GnFrame *frame)
 {
     const char *forced = getenv("GONIO_LOOP_CAP");
-    /* (at most 32 + 34 + 68: the overhead the fixed cap below leaves room for) */
     uint32_t overhead = 32 + (frame->num_emitters > 1 ? log2_up(frame->num_emitters) + 2 : 0) +
                         (frame->flags & GN_FRAME_ENV_MAP ? log2_up(frame->env_width) + log2_up(frame->env_height) + 4 : 0);
     frame->loop_overhead = overhead;
     frame->state_stride = r->state_stride = state_stride(r, GN_MODE_PATH);
     /* One value for every render of the process, so the cached kernel stays valid. */
-    r->loop_cap = r->state_stride ? 65535u - 4096u - 4 * 134u : 0;
+    r->loop_cap = r->state_stride ? GN_LLVMPIPE_LOOP_LIMIT - 4096u - 4 * PATH_OVERHEAD_MAX : 0;
     if (r->loop_cap && forced && atol(forced) > 0 && (uint32_t)atol(forced) < r->loop_cap) {
         /* each lane's share (of up to 8) at least two vertices' overhead and then a node
          * visit or a leaf: progress */
-        uint32_t least = 8 * (2 * 134u + 64);
+        uint32_t least = 8 * (2 * PATH_OVERHEAD_MAX + 64);
         r->loop_cap = (uint32_t)atol(forced) > least ? (uint32_t)atol(forced) : least;
     }
 }
@@ -867,7 +846,6 @@ static bool frame_setup(renderer *r, const render_settings *s, const int region[
     frame->crop_width = (uint32_t)(region[2] - region[0]);
     frame->crop_height = (uint32_t)(region[3] - region[1]);
     frame->seed = s->seed;
-    frame->mode = s->mode;
     frame->max_depth = (uint32_t)s->max_depth;
     frame->num_lights = r->num_lights;
     frame->flags = (s->aov & RENDER_AOV_GPU ? GN_FRAME_AOV : 0u) | (!s->no_shadows ? GN_FRAME_SHADOWS : 0u) |
@@ -877,9 +855,6 @@ static bool frame_setup(renderer *r, const render_settings *s, const int region[
     frame->env_color = (vec3){s->env[0], s->env[1], s->env[2]};
     frame->env_cos = (float)cos(s->env_rotation * M_PI / 180);
     frame->env_sin = (float)-sin(s->env_rotation * M_PI / 180);
-    frame->num_nodes = r->tree.num_nodes;
-    frame->bounds_min = v3(r->sc->bounds_min);
-    frame->bounds_max = v3(r->sc->bounds_max);
     frame->ambient = v3(s->ambient_set ? s->ambient : r->sc->ambient);
     frame->traversal_budget = traversal_budget(r->g, 1 + (!s->no_shadows ? r->num_lights : 0));
     r->state_stride = 0; /* path_begin sets it, and the loop cap, for the path kernel */

@@ -9,8 +9,6 @@
 
 #include "util.h"
 
-#define MESHGEN_PI 3.14159265358979323846
-
 static uint64_t splitmix64(uint64_t *state)
 {
     uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
@@ -49,10 +47,10 @@ static void sphere_into(meshgen_mesh *m, uint32_t vbase, uint32_t tbase, const f
 {
     uint32_t last = vbase + 1 + (stacks - 1) * slices; /* south pole */
     for (uint32_t j = 0; j <= stacks; j++) {
-        double theta = MESHGEN_PI * j / stacks;
+        double theta = M_PI * j / stacks;
         uint32_t ring = (j == 0 || j == stacks) ? 1 : slices;
         for (uint32_t i = 0; i < ring; i++) {
-            double phi = 2 * MESHGEN_PI * i / slices;
+            double phi = 2 * M_PI * i / slices;
             double n[3] = {sin(theta) * cos(phi), cos(theta), sin(theta) * sin(phi)};
             double r = radius;
             uint32_t vi = j == 0 ? vbase : j == stacks ? last : vbase + 1 + (j - 1) * slices + i;

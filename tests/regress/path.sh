@@ -37,8 +37,9 @@ same_pixels() {
 # maps, glass, punctual lights and vertex colours.
 same_as_unspecialised() { same_pixels "specialised = unspecialised" GONIO_ALL_FEATURES=1 "$@"; }
 same_as_unspecialised "Cornell box" $C
-for model in lambert mirror phong blinn-phong torrance-sparrow beckmann ggx conductor \
-    conductor:alpha=0 dielectric dielectric:alpha=0.3 \
+models=$("$G" brdf --list | cut -d' ' -f1) # every model of the table, at its defaults
+check "brdf --list names models" test -n "$models"
+for model in $models conductor:alpha=0 dielectric:alpha=0.3 \
     gltf:metallic=0.5:roughness=0.02 gltf:transmission=1:roughness=0.4 \
     gltf:roughness=0.4:clearcoat=1:clearcoat-roughness=0.2:sheen-color=0.6,0.4,0.2:sheen-roughness=0.5 \
     gltf:roughness=0:metallic=1:clearcoat=0.7; do

@@ -70,6 +70,27 @@ static const config configs[] = {
 };
 #define NUM_CONFIGS ((int)(sizeof configs / sizeof *configs))
 
+/* The settings the tests run over: configs, then every model of the table (brdf_models.h)
+ * that configs give no default setting of, at its defaults: a model added to the table is
+ * tested with no edit here. */
+static config cases[NUM_CONFIGS + 64];
+static int num_cases(void)
+{
+    static int n;
+    if (n)
+        return n;
+    for (; n < NUM_CONFIGS; n++)
+        cases[n] = configs[n];
+    for (int i = 0; i < brdf_num_models; i++) {
+        bool tested = false;
+        for (int k = 0; k < NUM_CONFIGS; k++)
+            tested |= !strcmp(configs[k].model, brdf_models[i].name) && !configs[k].params[0];
+        if (!tested && n < (int)(sizeof cases / sizeof *cases))
+            cases[n++] = (config){brdf_models[i].name, ""};
+    }
+    return n;
+}
+
 static bool make_setting(const config *c, brdf_setting *s)
 {
     char buf[256], *save = NULL;
@@ -449,8 +470,19 @@ TEST(brdf, model_table)
     brdf_setting_init(&s, brdf_model_find("gltf"));
     CHECK(brdf_setting_set(&s, "transmission", "0.5") && s.v[BRDF_SLOT_EXTRA + 3] == 0.5f);
     CHECK(brdf_setting_set(&s, "specular-color", "1,0.5,0.25") && s.v[BRDF_SLOT_EXTRA + 2] == 0.25f);
-    for (int i = 0; i < NUM_CONFIGS; i++)
-        CHECKF(make_setting(&configs[i], &s), "config %s", describe(&configs[i]));
+    for (int i = 0; i < num_cases(); i++)
+        CHECKF(make_setting(&cases[i], &s), "config %s", describe(&cases[i]));
+    /* the table: ids unique and glTF's the special one; every model tested (num_cases) */
+    for (int i = 0; i < brdf_num_models; i++) {
+        for (int k = 0; k < i; k++)
+            CHECKF(brdf_models[k].id != brdf_models[i].id, "models %s and %s share id %u", brdf_models[k].name,
+                   brdf_models[i].name, brdf_models[i].id);
+        CHECKF(brdf_models[i].num_params > 0 && brdf_models[i].num_params <= BRDF_MAX_PARAMS, "%s: %d parameters",
+               brdf_models[i].name, brdf_models[i].num_params);
+        CHECKF((brdf_models[i].id == BRDF_GLTF) == !strcmp(brdf_models[i].name, "gltf"), "%s: id %u",
+               brdf_models[i].name, brdf_models[i].id);
+    }
+    CHECK(num_cases() < (int)(sizeof cases / sizeof *cases)); /* (full: a model may be left out) */
 }
 
 /* No NaN or Inf anywhere, f >= 0, pdf >= 0, weight >= 0, sampled directions unit length,
@@ -464,10 +496,10 @@ TEST(brdf, finite_and_positive)
     BrdfQuery *q = qbuf;
     BrdfResult *r = rbuf;
     rng_state = 1;
-    for (int ci = 0; ci < NUM_CONFIGS; ci++) {
+    for (int ci = 0; ci < num_cases(); ci++) {
         brdf_setting s;
         int bad = 0, below = 0;
-        make_setting(&configs[ci], &s);
+        make_setting(&cases[ci], &s);
         for (int i = 0; i < N; i++) {
             vec3 wo = polar(acos(1 - 2 * rnd()), 2 * PI * rnd()), wi = polar(acos(1 - 2 * rnd()), 2 * PI * rnd());
             vec3 u = rnd_u();
@@ -498,7 +530,7 @@ TEST(brdf, finite_and_positive)
             }
             if (!ok && bad++ < 3)
                 fprintf(stderr, "  %s: wo (%g %g %g) wi (%g %g %g) u (%g %g %g): f %g pdf %g s_wi (%g %g %g) "
-                        "w %g pdf %g flags %u\n", describe(&configs[ci]), q[i].wo.x, q[i].wo.y, q[i].wo.z,
+                        "w %g pdf %g flags %u\n", describe(&cases[ci]), q[i].wo.x, q[i].wo.y, q[i].wo.z,
                         q[i].wi.x, q[i].wi.y, q[i].wi.z, q[i].u.x, q[i].u.y, q[i].u.z, x->f.x, x->pdf,
                         x->s_wi.x, x->s_wi.y, x->s_wi.z, x->s_weight.x, x->s_pdf, x->s_flags);
             if (!brdf_setting_two_sided(&s) && (q[i].wo.z <= 0 || q[i].wi.z <= 0) && (sum3(x->f) != 0 || x->pdf != 0))
@@ -506,8 +538,8 @@ TEST(brdf, finite_and_positive)
             if (!brdf_setting_two_sided(&s) && x->s_flags && (q[i].wo.z <= 0 || x->s_wi.z <= 0))
                 below++;
         }
-        CHECKF(bad == 0, "%s: %d queries with NaN/Inf or negative values", describe(&configs[ci]), bad);
-        CHECKF(below == 0, "%s: %d queries reflect light below an opaque surface", describe(&configs[ci]), below);
+        CHECKF(bad == 0, "%s: %d queries with NaN/Inf or negative values", describe(&cases[ci]), bad);
+        CHECKF(below == 0, "%s: %d queries reflect light below an opaque surface", describe(&cases[ci]), below);
     }
     close_runner();
 }
@@ -523,10 +555,10 @@ TEST(brdf, reciprocity)
     BrdfQuery *q = qbuf;
     BrdfResult *r = rbuf;
     rng_state = 2;
-    for (int ci = 0; ci < NUM_CONFIGS; ci++) {
+    for (int ci = 0; ci < num_cases(); ci++) {
         brdf_setting s;
         int bad = 0, nonzero = 0;
-        make_setting(&configs[ci], &s);
+        make_setting(&cases[ci], &s);
         bool sides = brdf_setting_two_sided(&s);
         double ior = s.model->id == BRDF_DIELECTRIC ? s.v[BRDF_SLOT_PARAMS + BRDF_P_DIELECTRIC_IOR]
                                                      : s.v[BRDF_SLOT_PARAMS + 3];
@@ -563,10 +595,10 @@ TEST(brdf, reciprocity)
                 nonzero += x > 0;
                 if (fabs(x - y) > 2e-4 * fmax(x, y) + 1e-7 && bad++ < 3)
                     fprintf(stderr, "  %s: f(wo,wi) = %g, f(wi,wo) * %g = %g (wo %.9g %.9g %.9g wi %.9g %.9g %.9g)\n",
-                            describe(&configs[ci]), x, scale, y, q[2 * i].wo.x, q[2 * i].wo.y, q[2 * i].wo.z, q[2 * i].wi.x, q[2 * i].wi.y, q[2 * i].wi.z);
+                            describe(&cases[ci]), x, scale, y, q[2 * i].wo.x, q[2 * i].wo.y, q[2 * i].wo.z, q[2 * i].wi.x, q[2 * i].wi.y, q[2 * i].wi.z);
             }
         }
-        CHECKF(bad == 0, "%s: %d pairs break reciprocity", describe(&configs[ci]), bad);
+        CHECKF(bad == 0, "%s: %d pairs break reciprocity", describe(&cases[ci]), bad);
         /* Dirac-only models have nothing to compare; the rest must have been exercised. */
         bool dirac = !strcmp(s.model->name, "mirror") ||
                      (s.model->id == BRDF_CONDUCTOR && s.v[BRDF_SLOT_PARAMS + BRDF_P_ALPHA] == 0) ||
@@ -574,7 +606,7 @@ TEST(brdf, reciprocity)
                      (s.model->id == BRDF_GLTF && s.v[BRDF_SLOT_PARAMS + 1] == 0 && s.v[BRDF_SLOT_EXTRA + 3] == 1 &&
                       s.v[BRDF_SLOT_LAYER + 1] == 0 && sum3((vec3){s.v[BRDF_SLOT_SHEEN], s.v[BRDF_SLOT_SHEEN + 1],
                                                                   s.v[BRDF_SLOT_SHEEN + 2]}) == 0); /* smooth glass, smooth coat */
-        CHECKF(dirac || nonzero > N / 4, "%s: only %d non-zero values", describe(&configs[ci]), nonzero);
+        CHECKF(dirac || nonzero > N / 4, "%s: only %d non-zero values", describe(&cases[ci]), nonzero);
     }
     close_runner();
 }
@@ -635,17 +667,17 @@ TEST(brdf, sampling_matches_pdf)
     int tests = 0;
     if (!open_runner())
         return;
-    for (int ci = 0; ci < NUM_CONFIGS; ci++) {
+    for (int ci = 0; ci < num_cases(); ci++) {
         brdf_setting s;
-        make_setting(&configs[ci], &s);
+        make_setting(&cases[ci], &s);
         tests += brdf_setting_two_sided(&s) ? 5 : 3;
     }
     rng_state = 4;
-    for (int ci = 0; ci < NUM_CONFIGS; ci++) {
+    for (int ci = 0; ci < num_cases(); ci++) {
         brdf_setting s;
-        make_setting(&configs[ci], &s);
+        make_setting(&cases[ci], &s);
         for (int t = 0; t < (brdf_setting_two_sided(&s) ? 5 : 3); t++) {
-            const char *what = describe(&configs[ci]);
+            const char *what = describe(&cases[ci]);
             char why[200];
             measure m;
             measure_case(&s, polar(rad(theta[t]), 1.0), true, 1, 1, &m);
@@ -668,15 +700,15 @@ TEST(brdf, energy)
     if (!open_runner())
         return;
     rng_state = 5;
-    for (int ci = 0; ci < NUM_CONFIGS; ci++) {
+    for (int ci = 0; ci < num_cases(); ci++) {
         brdf_setting s;
-        make_setting(&configs[ci], &s);
+        make_setting(&cases[ci], &s);
         for (int t = 0; t < (brdf_setting_two_sided(&s) ? 10 : 7); t++) {
             measure m;
             char why[200];
             measure_case(&s, polar(rad(theta[t]), 2.0), false, 1, 1, &m);
-            CHECKF(m.nonfinite == 0, "%s wo %.1f: %d NaN/Inf", describe(&configs[ci]), theta[t], m.nonfinite);
-            CHECKF(check_energy(&m, false, why, sizeof why), "%s wo %.1f deg: %s", describe(&configs[ci]), theta[t],
+            CHECKF(m.nonfinite == 0, "%s wo %.1f: %d NaN/Inf", describe(&cases[ci]), theta[t], m.nonfinite);
+            CHECKF(check_energy(&m, false, why, sizeof why), "%s wo %.1f deg: %s", describe(&cases[ci]), theta[t],
                    why);
         }
     }
@@ -1005,7 +1037,7 @@ TEST(brdf, anisotropy_limit)
 TEST(brdf, anisotropy_ndf)
 {
     enum { NT = 1600, NP = 720, N = NT * NP };
-    static const char *cases[] = {"roughness=0.2 anisotropy=0.9", "roughness=0.5 anisotropy=0.5 anisotropy-rotation=0.7",
+    static const char *ndf_cases[] = {"roughness=0.2 anisotropy=0.9", "roughness=0.5 anisotropy=0.5 anisotropy-rotation=0.7",
                                   "roughness=0.3 anisotropy=1 anisotropy-rotation=-2",
                                   "roughness=0.1 anisotropy=0.7 anisotropy-rotation=1.5708"};
     static const double wo_deg[] = {0, 45, 75};
@@ -1013,9 +1045,9 @@ TEST(brdf, anisotropy_ndf)
         return;
     BrdfQuery *q = qbuf;
     BrdfResult *r = rbuf;
-    for (int k = 0; k < (int)(sizeof cases / sizeof *cases); k++) {
+    for (int k = 0; k < (int)(sizeof ndf_cases / sizeof *ndf_cases); k++) {
         brdf_setting s;
-        make_setting(&(config){"gltf", cases[k]}, &s);
+        make_setting(&(config){"gltf", ndf_cases[k]}, &s);
         for (int t = 0; t < 3; t++) {
             vec3 wo = polar(rad(wo_deg[t]), 0.4);
             double area = 0, visible = 0;
@@ -1038,16 +1070,16 @@ TEST(brdf, anisotropy_ndf)
                 }
             }
             if (t == 0)
-                CHECKF(fabs(area - 1) < 2e-3, "gltf %s: integral of D cos = %.5f, not 1", cases[k], area);
+                CHECKF(fabs(area - 1) < 2e-3, "gltf %s: integral of D cos = %.5f, not 1", ndf_cases[k], area);
             CHECKF(fabs(visible - wo.z) < 2e-3, "gltf %s wo %g deg: visible projected area %.5f, not cos %.5f",
-                   cases[k], wo_deg[t], visible, wo.z);
+                   ndf_cases[k], wo_deg[t], visible, wo.z);
         }
         /* 20 degrees off the normal along the direction and across it */
         double rot = s.v[BRDF_SLOT_ANISO + 1];
         q[0] = query(&s, BRDF_OP_NDF, v3(0, 0, 1), polar(rad(20), rot), v3(0, 0, 0));
         q[1] = query(&s, BRDF_OP_NDF, v3(0, 0, 1), polar(rad(20), rot + PI / 2), v3(0, 0, 0));
         brdf_runner_run(&runner, q, r, 2);
-        CHECKF(r[0].f.x > 2 * r[1].f.x, "gltf %s: D along the direction %g, across it %g", cases[k], r[0].f.x,
+        CHECKF(r[0].f.x > 2 * r[1].f.x, "gltf %s: D along the direction %g, across it %g", ndf_cases[k], r[0].f.x,
                r[1].f.x);
     }
     close_runner();

@@ -81,7 +81,7 @@ static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any
         gpu_pipeline_create(g, &p, &pd);
     }
     for (;;) {
-        GnPush push = {n, dispatches > 0, any_hit, 0};
+        GnPush push = {n, (dispatches > 0 ? GN_PASS_RESUME : 0u) | (any_hit ? GN_PASS_ANY_HIT : 0u), 0, 0};
         VkCommandBuffer cmd;
         memset(status.mapped, 0, 16);
         cmd = gpu_begin(g);
