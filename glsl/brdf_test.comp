@@ -40,6 +40,8 @@ void main()
         ? bsdf_gltf(q.color, q.params.x, q.params.y, q.params.z, q.extra.xyz, q.params.w, q.extra.w)
         : bsdf_from_model(q.model, q.color, q.params);
     if (q.model == BRDF_GLTF)
+        b = bsdf_gltf_film(b, q.color, q.params.x, q.params.z, q.extra.xyz, q.params.w, q.extra.w, q.irid.xyz, q.dt);
+    if (q.model == BRDF_GLTF)
         b = bsdf_layers(b, q.layer.x, q.layer.y, vec3(sin(q.layer.w), 0.0, cos(q.layer.w)), q.sheen.rgb, q.layer.z);
     if ((q.op & BRDF_OP_EVAL) != 0u)
         bsdf_eval_pdf(b, q.wo, q.wi, r.f, r.pdf);

@@ -178,6 +178,14 @@ static uint32_t material_features(const GnMaterial *m)
                 m->tex_sheen_roughness != GN_INVALID)
                 f |= GN_FEAT_TEXTURES;
         }
+        /* bsdf_gltf_film: an iridescent film, a diffuse transmission (textures as above) */
+        if (m->iridescence > 0 || m->diffuse_transmission > 0) {
+            f |= GN_FEAT_LAYERS;
+            if ((m->iridescence > 0 && (m->tex_iridescence != GN_INVALID || m->tex_iridescence_thickness != GN_INVALID)) ||
+                (m->diffuse_transmission > 0 && (m->tex_diffuse_transmission != GN_INVALID ||
+                                                 m->tex_diffuse_transmission_color != GN_INVALID)))
+                f |= GN_FEAT_TEXTURES;
+        }
         break;
     }
     case BRDF_LAMBERT:
@@ -1386,6 +1394,11 @@ static void apply_setting(GnMaterial *m, const brdf_setting *st)
         m->clearcoat_roughness = st->v[BRDF_SLOT_LAYER + 1];
         m->sheen_roughness = st->v[BRDF_SLOT_LAYER + 2];
         memcpy(&m->sheen_color.x, st->v + BRDF_SLOT_SHEEN, 3 * sizeof(float));
+        m->iridescence = st->v[BRDF_SLOT_IRID];
+        m->iridescence_ior = st->v[BRDF_SLOT_IRID + 1];
+        m->iridescence_thickness_max = st->v[BRDF_SLOT_IRID + 2];
+        memcpy(&m->diffuse_transmission_color.x, st->v + BRDF_SLOT_DT, 3 * sizeof(float));
+        m->diffuse_transmission = st->v[BRDF_SLOT_DT + 3];
     }
 }
 
@@ -1407,6 +1420,11 @@ static void setting_from_material(brdf_setting *st, const brdf_model *model, con
         st->v[BRDF_SLOT_LAYER + 1] = m->clearcoat_roughness;
         st->v[BRDF_SLOT_LAYER + 2] = m->sheen_roughness;
         memcpy(st->v + BRDF_SLOT_SHEEN, &m->sheen_color.x, 3 * sizeof(float));
+        st->v[BRDF_SLOT_IRID] = m->iridescence;
+        st->v[BRDF_SLOT_IRID + 1] = m->iridescence_ior;
+        st->v[BRDF_SLOT_IRID + 2] = m->iridescence_thickness_max;
+        memcpy(st->v + BRDF_SLOT_DT, &m->diffuse_transmission_color.x, 3 * sizeof(float));
+        st->v[BRDF_SLOT_DT + 3] = m->diffuse_transmission;
     }
 }
 
