@@ -59,14 +59,14 @@ static void print_films(const scene *sc)
     for (uint32_t i = 0; i < sc->num_materials; i++) {
         const GnMaterial *m = &sc->materials[i];
         const char *name = sc->material_names[i][0] ? sc->material_names[i] : "(unnamed)";
-        if (m->iridescence > 0)
-            printf("iridescence %-3u \"%s\" factor %g%s, film ior %g, thickness %g nm%s\n", i, name, m->iridescence,
-                   m->tex_iridescence != GN_INVALID ? " x texture" : "", m->iridescence_ior,
-                   m->tex_iridescence_thickness != GN_INVALID ? m->iridescence_thickness_min : m->iridescence_thickness_max,
-                   m->tex_iridescence_thickness != GN_INVALID ? "" : " (no thickness texture: the maximum)");
         if (m->iridescence > 0 && m->tex_iridescence_thickness != GN_INVALID)
-            printf("iridescence %-3u \"%s\" thickness texture maps to %g - %g nm\n", i, name,
+            printf("iridescence %-3u \"%s\" factor %g%s, film ior %g, thickness %g - %g nm (texture G)\n", i, name,
+                   m->iridescence, m->tex_iridescence != GN_INVALID ? " x texture" : "", m->iridescence_ior,
                    m->iridescence_thickness_min, m->iridescence_thickness_max);
+        else if (m->iridescence > 0)
+            printf("iridescence %-3u \"%s\" factor %g%s, film ior %g, thickness %g nm\n", i, name, m->iridescence,
+                   m->tex_iridescence != GN_INVALID ? " x texture" : "", m->iridescence_ior,
+                   m->iridescence_thickness_max);
         if (m->diffuse_transmission > 0)
             printf("diffuse transmission %-3u \"%s\" factor %g%s, colour (%g, %g, %g)%s\n", i, name,
                    m->diffuse_transmission, m->tex_diffuse_transmission != GN_INVALID ? " x texture" : "",
