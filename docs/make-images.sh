@@ -27,6 +27,10 @@ mkdir -p $img
 "$G" brdf gltf --metallic 1 --roughness 0.3 --anisotropy 0.8 --theta 45 -o $img/brdf-gltf-aniso.png
 "$G" brdf gltf --metallic 1 --roughness 0.3 --anisotropy 0.8 --anisotropy-rotation 1.5708 --theta 45 \
     -o $img/brdf-gltf-aniso-across.png
+"$G" brdf gltf --roughness 0.3 --metallic 1 --base-color 0.5 --iridescence 1 --iridescence-thickness 400 --theta 45 \
+    -o $img/brdf-gltf-iridescence.png
+"$G" brdf gltf --roughness 0.5 --base-color 0.8 --diffuse-transmission 0.6 --diffuse-transmission-color 0.9,0.6,0.2 \
+    --theta 45 -o $img/brdf-gltf-diffuse-transmission.png
 ball() { # ball NAME MODEL [PARAMS...]
     local name=$1; shift
     "$G" brdf "$@" --sphere --size 128x128 --spp 256 -o "$tmp/ball.exr" --png $img/brdf-ball-$name.png
@@ -39,6 +43,10 @@ ball dielectric dielectric --tint 0.5,0.8,1 --alpha 0.05
 ball gltf gltf --base-color 0.8,0.3,0.1 --roughness 0.4 --metallic 0.5
 ball aniso gltf --base-color 0.9 --metallic 1 --roughness 0.3 --anisotropy 0.8
 ball aniso-across gltf --base-color 0.9 --metallic 1 --roughness 0.3 --anisotropy 0.8 --anisotropy-rotation 1.5708
+ball iridescence gltf --base-color 0.5 --metallic 1 --roughness 0.25 --iridescence 1 --iridescence-thickness 400 \
+    --iridescence-ior 1.33
+ball diffuse-transmission gltf --base-color 0.3,0.6,0.2 --roughness 0.5 --diffuse-transmission 0.8 \
+    --diffuse-transmission-color 0.9,0.8,0.3
 
 # ---- docs/shading.md ----------------------------------------------------------------------
 # The OpenGL 1.x teapot in all four modes (path is skipped while unavailable), 320x240.

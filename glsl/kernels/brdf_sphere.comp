@@ -39,6 +39,9 @@ void main()
                     scene.params.w, scene.extra.w)
         : bsdf_from_model(scene.model, scene.color, scene.params);
     if (scene.model == BRDF_GLTF)
+        b = bsdf_gltf_film(b, scene.color, scene.params.x, scene.params.z, scene.extra.xyz, scene.params.w,
+                           scene.extra.w, scene.irid.xyz, scene.dt);
+    if (scene.model == BRDF_GLTF)
         b = bsdf_layers(b, scene.layer.x, scene.layer.y, vec3(0.0, 0.0, 1.0), scene.sheen.rgb, scene.layer.z);
     Bsdf b0 = b; // before the anisotropy, whose direction each hit sets
     vec4 jitter = rng_uniform4(pixel, push.sample_index, 0u, push.seed);

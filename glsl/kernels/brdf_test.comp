@@ -40,6 +40,7 @@ void main()
         ? bsdf_gltf(q.color, q.params.x, q.params.y, q.params.z, q.extra.xyz, q.params.w, q.extra.w)
         : bsdf_from_model(q.model, q.color, q.params);
     if (q.model == BRDF_GLTF) {
+        b = bsdf_gltf_film(b, q.color, q.params.x, q.params.z, q.extra.xyz, q.params.w, q.extra.w, q.irid.xyz, q.dt);
         b = bsdf_layers(b, q.layer.x, q.layer.y, vec3(sin(q.layer.w), 0.0, cos(q.layer.w)), q.sheen.rgb, q.layer.z);
         // the tangent is +x: the anisotropy's direction is the rotation's
         b = bsdf_anisotropy(b, q.aniso.x, vec2(cos(q.aniso.y), sin(q.aniso.y)));

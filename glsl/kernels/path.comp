@@ -291,13 +291,15 @@ Bsdf material_bsdf(Surface s, GnMaterial m)
     Bsdf b = bsdf_gltf(s.base, s.metallic, s.roughness, m.specular, m.specular_color, m.ior, m.transmission);
     if (GN_HAS(GN_FEAT_LAYERS)) // the coat's normal in the local frame: main() sets it
         b = bsdf_layers(b, s.coat, s.coat_roughness, vec3(0.0, 0.0, 1.0), s.sheen, s.sheen_roughness);
+    if (GN_HAS(GN_FEAT_LAYERS)) // iridescence, diffuse transmission
+        b = bsdf_gltf_film(b, s.base, s.metallic, m.specular, m.specular_color, m.ior, m.transmission, s.irid, s.dt);
     return b;
 }
 
 // Does b have a part that light sampling can reach (anything but Dirac lobes)?
 bool bsdf_has_smooth(Bsdf b)
 {
-    return any(greaterThan(b.diffuse, vec3(0.0))) ||
+    return any(greaterThan(b.diffuse, vec3(0.0))) || (GN_HAS(GN_FEAT_LAYERS) && brdf_has_dt(b)) ||
            (b.lobe != BRDF_LOBE_NONE && b.lobe != BRDF_LOBE_MIRROR) ||
            (b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN) ||
            (GN_HAS(GN_FEAT_LAYERS) && (any(greaterThan(b.sheen, vec3(0.0))) ||

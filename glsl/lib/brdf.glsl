@@ -62,6 +62,15 @@ struct Bsdf {
     // KHR_materials_anisotropy (bsdf_anisotropy; GN_FEAT_ANISO): the GGX of the lobe and the
     // glass stretched to alpha aniso_at along aniso_dir (unit, local xy), shape across it.
     vec2 aniso_dir; float aniso_at;   // aniso_at 0: isotropic
+    // In the base (bsdf_gltf_film; GN_FEAT_LAYERS): KHR_materials_iridescence's thin film on
+    // the lobe's Schlick Fresnel and KHR_materials_diffuse_transmission's Lambert lobe through
+    // the surface (thin-walled).
+    float irid; float irid_ior;       // the film's weight (0: none); its index
+    float irid_d; float irid_wd;      // its thickness (nm); the dielectric lobe's weight (1-m)(1-t) specular
+    vec3 irid_f0; float irid_wm;      // the dielectric's F0 under the film; the metal's weight m
+    vec3 irid_base;                   // the metal's F0 (base colour)
+    vec3 irid_avg;                    // the cosine-weighted mean of the dielectric's F_film (brdf_irid_mean)
+    vec3 dt;                          // the transmission's Lambert weight kt (0: none)
 };
 
 struct BsdfSample {
@@ -340,6 +349,91 @@ bool brdf_refract(vec3 wo, vec3 n, float eta, out vec3 wt)
     return true;
 }
 
+// ---- KHR_materials_iridescence: a thin film over the base's Fresnel -------------------------
+// Belcour & Barla 2017 ("A Practical Extension to Microfacet Theory for the Modeling of
+// Varying Iridescence") as the extension's reference evaluates it in RGB: the Airy sum of the
+// film's multiple reflections written as a DC term plus its first two orders of interference,
+// each order's spectrum integrated against the colour-matching functions in closed form
+// through a fit of their Fourier transform by Gaussians (brdf_irid_sensitivity). The inner
+// interface's reflectance is Schlick's, as the base's is; outside index 1.
+
+// The colour-matching functions' response (XYZ, then linear sRGB) to a cosine of optical path
+// difference opd (nm) and phase shift: Belcour & Barla's Gaussian fit of their Fourier
+// transform, the extension's constants.
+vec3 brdf_irid_sensitivity(float opd, vec3 shift)
+{
+    float phase = 2.0 * BRDF_PI * opd * 1e-9;
+    vec3 val = vec3(5.4856e-13, 4.4201e-13, 5.2481e-13);
+    vec3 pos = vec3(1.6810e+06, 1.7953e+06, 2.2084e+06);
+    vec3 var = vec3(4.3278e+09, 9.3046e+09, 6.6121e+09);
+    vec3 xyz = val * sqrt(2.0 * BRDF_PI * var) * cos(pos * phase + shift) * exp(-phase * phase * var);
+    xyz.x += 9.7470e-14 * sqrt(2.0 * BRDF_PI * 4.5282e+09) * cos(2.2399e+06 * phase + shift.x) *
+             exp(-4.5282e+09 * phase * phase);
+    xyz /= 1.0685e-7;
+    return mat3(3.2404542, -0.9692660, 0.0556434, -1.5371385, 1.8760108, -0.2040259,
+                -0.4985314, 0.0415560, 1.0572252) * xyz;
+}
+
+// Reflectance at cos1 (from outside, index 1) of a film of index film_ior and thickness d (nm)
+// over a base whose normal-incidence reflectance against index 1 is f0 (its index recovered
+// from f0). Clamped to [0, 1]: the fit's colours can leave the gamut.
+vec3 brdf_iridescence(float cos1, float film_ior, float d, vec3 f0)
+{
+    // A film of thickness 0 is no film (the approximation is not continuous there by itself).
+    float n2 = mix(1.0, film_ior, smoothstep(0.0, 0.03, d));
+    float c1 = clamp(cos1, 0.0, 1.0);
+    // Snell: n2 >= 1, so no total reflection; cos^2 in the film as (n2^2 - sin^2) / n2^2, which
+    // keeps grazing cosines exact where the film's index is the outside's
+    float c2 = sqrt(max(n2 * n2 - 1.0 + c1 * c1, 0.0)) / n2;
+    // The outer interface by the exact Fresnel equations (with the cosines above), not
+    // Schlick's as the extension's reference has it: Schlick's F90 of 1 would reflect at
+    // grazing angles where no film is (index 1, or thickness 0), and the film's limits would
+    // not be the base's F.
+    float rp = (n2 * c1 - c2) / max(n2 * c1 + c2, 1e-30), rn = (c1 - n2 * c2) / max(c1 + n2 * c2, 1e-30);
+    float r12 = 0.5 * (rp * rp + rn * rn), t121 = 1.0 - r12;
+    // phase shifts at the interfaces: pi where light reflects off a denser medium
+    float phi21 = BRDF_PI; // (phi12 = 0: the film is at least as dense as the outside)
+    vec3 sf = sqrt(clamp(f0, vec3(0.0), vec3(0.9999)));
+    vec3 n3 = (1.0 + sf) / (1.0 - sf);
+    vec3 r1 = (n3 - n2) / (n3 + n2);
+    vec3 r23 = brdf_fresnel_schlick(c2, r1 * r1, 1.0);
+    vec3 phi = vec3(phi21) + mix(vec3(0.0), vec3(BRDF_PI), lessThan(n3, vec3(n2)));
+    float opd = 2.0 * n2 * d * c2;
+    vec3 r123 = clamp(r12 * r23, vec3(0.0), vec3(0.9999));
+    vec3 rr = sqrt(r123);
+    vec3 rs = t121 * t121 * r23 / (1.0 - r123);
+    vec3 cm = (rs - t121) * rr; // the orders m = 1, 2 (unrolled: a loop costs llvmpipe passes)
+    vec3 i = r12 + rs + cm * 2.0 * brdf_irid_sensitivity(opd, phi);
+    cm *= rr;
+    i += cm * 2.0 * brdf_irid_sensitivity(2.0 * opd, 2.0 * phi);
+    return clamp(i, vec3(0.0), vec3(1.0));
+}
+
+// The cosine-weighted mean 2 int F c dc of the dielectric's F under the film (specular times
+// F_film), which has no closed form: Gauss-Legendre with 6 nodes (exact for Schlick's F, a
+// polynomial of degree 6; the film's F is smooth in cos), unrolled (a loop costs llvmpipe passes).
+vec3 brdf_irid_mean(Bsdf b)
+{
+    vec3 x = vec3(0.2386191860831969, 0.6612093864662645, 0.9324695142031521) * 0.5;
+    vec3 w = vec3(0.4679139345726910, 0.3607615730481386, 0.1713244923791704);
+    vec3 c = 0.5 - x, d = 0.5 + x;
+    vec3 m = w.x * (c.x * brdf_iridescence(c.x, b.irid_ior, b.irid_d, b.irid_f0) +
+                    d.x * brdf_iridescence(d.x, b.irid_ior, b.irid_d, b.irid_f0));
+    m += w.y * (c.y * brdf_iridescence(c.y, b.irid_ior, b.irid_d, b.irid_f0) +
+                d.y * brdf_iridescence(d.y, b.irid_ior, b.irid_d, b.irid_f0));
+    m += w.z * (c.z * brdf_iridescence(c.z, b.irid_ior, b.irid_d, b.irid_f0) +
+                d.z * brdf_iridescence(d.z, b.irid_ior, b.irid_d, b.irid_f0));
+    return b.couple_f90 * m;
+}
+
+// The lobe's Fresnel under the film: the dielectric's and the metal's, each weighted as
+// bsdf_gltf weights their Schlick F0.
+vec3 brdf_irid_lobe(Bsdf b, float c)
+{
+    return b.irid_wd * brdf_iridescence(c, b.irid_ior, b.irid_d, b.irid_f0) +
+           b.irid_wm * brdf_iridescence(c, b.irid_ior, b.irid_d, b.irid_base);
+}
+
 // ---- the parts of a Bsdf -----------------------------------------------------------------
 
 // The lobe's Fresnel factor times its weight, at cos = wo.wh.
@@ -349,23 +443,39 @@ vec3 brdf_lobe_fresnel(Bsdf b, float c)
         return b.specular * brdf_fresnel_dielectric(c, b.ior);
     if (GN_HAS(GN_FEAT_FRESNEL_CONDUCTOR) && b.fresnel == BRDF_FRESNEL_CONDUCTOR)
         return b.specular * brdf_fresnel_conductor(c, b.eta, b.k);
-    if (GN_HAS(GN_FEAT_FRESNEL_SCHLICK) && b.fresnel == BRDF_FRESNEL_SCHLICK)
-        return brdf_fresnel_schlick(c, b.specular, b.f90);
+    if (GN_HAS(GN_FEAT_FRESNEL_SCHLICK) && b.fresnel == BRDF_FRESNEL_SCHLICK) {
+        vec3 f = brdf_fresnel_schlick(c, b.specular, b.f90);
+        if (GN_HAS(GN_FEAT_LAYERS) && b.irid > 0.0) // KHR_materials_iridescence: F = mix(F, F_film, factor)
+            f = mix(f, brdf_irid_lobe(b, c), b.irid);
+        return f;
+    }
     return b.specular;
 }
 
 // Lambert under a Fresnel layer: kd/pi (1 - F(wo))(1 - F(wi)) / (1 - F_avg), with
 // F_avg = F0 + (F90 - F0)/21 the cosine-weighted mean of Schlick's F. Its albedo is
 // kd (1 - F(wo)) (Shirley et al. 1997), it is reciprocal, and with couple_f0 = f90 = 0 it is
-// the plain Lambert kd/pi.
-vec3 brdf_diffuse(Bsdf b, float co, float ci)
+// the plain Lambert kd/pi. kd: the reflection's (diffuse) or the diffuse transmission's (dt)
+// weight; co, ci: the cosines' magnitudes. Under an iridescent film F is the lobe's,
+// mix(F, F_film, factor), and F_avg its mean (b.irid_avg).
+vec3 brdf_coupled(Bsdf b, vec3 kd, float co, float ci)
 {
     if (!GN_HAS(GN_FEAT_COUPLED)) // couple_f0 = couple_f90 = 0: exactly the plain Lambert
-        return b.diffuse / BRDF_PI;
+        return kd / BRDF_PI;
     vec3 fo = brdf_fresnel_schlick(co, b.couple_f0, b.couple_f90);
     vec3 fi = brdf_fresnel_schlick(ci, b.couple_f0, b.couple_f90);
     vec3 avg = b.couple_f0 + (b.couple_f90 - b.couple_f0) / 21.0;
-    return b.diffuse / BRDF_PI * (1.0 - fo) * (1.0 - fi) / max(1.0 - avg, vec3(1e-6));
+    if (GN_HAS(GN_FEAT_LAYERS) && b.irid > 0.0) {
+        fo = mix(fo, b.couple_f90 * brdf_iridescence(co, b.irid_ior, b.irid_d, b.irid_f0), b.irid);
+        fi = mix(fi, b.couple_f90 * brdf_iridescence(ci, b.irid_ior, b.irid_d, b.irid_f0), b.irid);
+        avg = mix(avg, b.irid_avg, b.irid);
+    }
+    return kd / BRDF_PI * (1.0 - fo) * (1.0 - fi) / max(1.0 - avg, vec3(1e-6));
+}
+
+vec3 brdf_diffuse(Bsdf b, float co, float ci)
+{
+    return brdf_coupled(b, b.diffuse, co, ci);
 }
 
 // f and pdf of the specular lobe for wo, wi above the surface.
@@ -483,6 +593,46 @@ void brdf_rough_dielectric(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
     }
 }
 
+// ---- KHR_materials_diffuse_transmission: a Lambert lobe through the surface -----------------
+// kt/pi on the other side, coupled to the base's Fresnel on both sides as the reflection is
+// (brdf_coupled at |cos|): the two share the diffuse albedo, kd (1 - F) + kt (1 - F). Thin-walled:
+// the path goes on beyond the surface in the medium it was in. Part of the base's diffuse part:
+// one cosine-weighted sample, on the far side with the transmission's share of the two albedos.
+
+bool brdf_has_dt(Bsdf b)
+{
+    return any(greaterThan(b.dt, vec3(0.0)));
+}
+
+// The albedo estimates at wo of the diffuse reflection (x, none from below) and transmission (y).
+vec2 brdf_dt_weights(Bsdf b, vec3 wo)
+{
+    vec3 t = 1.0 - brdf_fresnel_schlick(abs(wo.z), b.couple_f0, b.couple_f90);
+    vec3 r = wo.z > 0.0 ? b.diffuse * t : vec3(0.0);
+    t *= b.dt;
+    return vec2(r.r + r.g + r.b, t.r + t.g + t.b) / 3.0;
+}
+
+// The probability that the diffuse part samples the far side.
+float brdf_dt_prob(Bsdf b, vec3 wo)
+{
+    vec2 w = brdf_dt_weights(b, wo);
+    return w.y > 0.0 ? w.y / (w.x + w.y) : 0.0;
+}
+
+// Adds the transmission to the base's f and pdf (px: the diffuse part's probability), and
+// takes its share of the diffuse part's pdf from the reflection.
+void brdf_dt_eval_pdf(Bsdf b, vec3 wo, vec3 wi, float px, inout vec3 f, inout float pdf)
+{
+    float q = brdf_dt_prob(b, wo), pd = px * abs(wi.z) / BRDF_PI;
+    if (wo.z > 0.0 && wi.z > 0.0) {
+        pdf -= q * pd;
+    } else if (wo.z * wi.z < 0.0) {
+        f += brdf_coupled(b, b.dt, abs(wo.z), abs(wi.z));
+        pdf += q * pd;
+    }
+}
+
 // Probabilities of sampling the diffuse layer, the lobe and the dielectric from wo: their
 // albedo estimates at wo, normalised.
 vec3 brdf_part_weights(Bsdf b, vec3 wo)
@@ -496,6 +646,8 @@ vec3 brdf_part_weights(Bsdf b, vec3 wo)
             p.y = (s.r + s.g + s.b) / 3.0;
         }
     }
+    if (GN_HAS(GN_FEAT_LAYERS) && brdf_has_dt(b))
+        p.x += brdf_dt_weights(b, wo).y;
     if (GN_HAS(GN_FEAT_GLASS) && wo.z != 0.0)
         p.z = b.dielectric;
     return p;
@@ -530,6 +682,8 @@ void brdf_base_eval_pdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
         f += b.dielectric * ft;
         pdf += p.z * pt;
     }
+    if (GN_HAS(GN_FEAT_LAYERS) && brdf_has_dt(b))
+        brdf_dt_eval_pdf(b, wo, wi, p.x, f, pdf);
 }
 
 // Picks a part with u.x (then reuses u.x, rescaled, for reflect-or-refract) and a direction
@@ -544,6 +698,10 @@ BsdfSample brdf_base_sample(Bsdf b, vec3 wo, vec3 u)
                          // lands on the other side is no sample of it (pbrt-v4 does the same)
     if (u.x < p.x) {
         wi = sampling_cosine_hemisphere(u.yz);
+        if (GN_HAS(GN_FEAT_LAYERS) && brdf_has_dt(b) && u.x < p.x * brdf_dt_prob(b, wo)) {
+            wi.z = wo.z > 0.0 ? -wi.z : wi.z; // diffuse transmission: the far side
+            reflect = false;
+        }
     } else if (GN_HAS(GN_FEAT_LOBES) && u.x < p.x + p.y) {
         if (GN_HAS(GN_FEAT_MIRROR) && b.lobe == BRDF_LOBE_MIRROR) {
             s.wi = vec3(-wo.xy, wo.z);
@@ -875,6 +1033,15 @@ Bsdf brdf_empty()
     b.sheen_r = 0.0;
     b.aniso_dir = vec2(1.0, 0.0);
     b.aniso_at = 0.0;
+    b.irid = 0.0;
+    b.irid_ior = 1.0;
+    b.irid_d = 0.0;
+    b.irid_wd = 0.0;
+    b.irid_f0 = vec3(0.0);
+    b.irid_wm = 0.0;
+    b.irid_base = vec3(0.0);
+    b.irid_avg = vec3(0.0);
+    b.dt = vec3(0.0);
     return b;
 }
 
@@ -968,6 +1135,35 @@ Bsdf bsdf_anisotropy(Bsdf b, float strength, vec2 dir)
     b.shape = max(b.shape, BRDF_ALPHA_MIN);
     b.aniso_at = at;
     b.aniso_dir = dot(dir, dir) > 1e-20 ? normalize(dir) : vec2(1.0, 0.0);
+    return b;
+}
+
+// KHR_materials_iridescence and _diffuse_transmission on b = bsdf_gltf(...) of the same
+// parameters: irid = (factor, the film's ior, its thickness in nm), dt = (colour, factor).
+// - the film: the lobe's F = mix(F, F_film, factor), F_film of the dielectric's F0 and of the
+//   metal's (the base colour) weighted as bsdf_gltf weights the two (brdf_irid_lobe); the
+//   diffuse is coupled to that F (brdf_coupled), so its albedo stays kd (1 - F(wo));
+// - the diffuse transmission: the diffuse weight kd = (1-m)(1-t) base colour becomes
+//   (1 - factor) kd reflected and kt = factor (1-m)(1-t) colour transmitted (brdf_dt_eval_pdf).
+// Factors of 0 leave b exactly as it is.
+Bsdf bsdf_gltf_film(Bsdf b, vec3 base_color, float metallic, float specular, vec3 specular_color,
+                    float ior, float transmission, vec3 irid, vec4 dt)
+{
+    float m = clamp(metallic, 0.0, 1.0), t = clamp(transmission, 0.0, 1.0);
+    float wd = (1.0 - m) * (1.0 - t), k = clamp(dt.w, 0.0, 1.0);
+    b.irid = clamp(irid.x, 0.0, 1.0);
+    b.irid_ior = max(irid.y, 1.0);
+    b.irid_d = max(irid.z, 0.0);
+    b.irid_wd = wd * specular;
+    b.irid_f0 = min(vec3(brdf_schlick_f0(ior)) * specular_color, vec3(1.0));
+    b.irid_wm = m;
+    b.irid_base = base_color;
+    if (b.irid > 0.0) // (once here: it depends on the material only)
+        b.irid_avg = brdf_irid_mean(b);
+    if (k > 0.0) {
+        b.dt = k * wd * clamp(dt.rgb, vec3(0.0), vec3(1.0));
+        b.diffuse *= 1.0 - k;
+    }
     return b;
 }
 

@@ -239,7 +239,28 @@ struct Surface {
     // world space (the tangent frame's, rotated; 0 where the mesh has no tangents)
     float aniso;
     vec3 aniso_t;
+    // KHR_materials_iridescence (factor, film ior, thickness in nm) and _diffuse_transmission
+    // (colour, factor), textures applied (GN_FEAT_LAYERS; else factors 0)
+    vec3 irid;
+    vec4 dt;
 };
+
+// KHR_materials_iridescence: factor x texture R, thickness mix(min, max, texture G) (max
+// without one); KHR_materials_diffuse_transmission: factor x texture A, colour x texture RGB.
+void surface_film(inout Surface s, GnMaterial m)
+{
+    s.irid = vec3(m.iridescence, m.iridescence_ior, m.iridescence_thickness_max);
+    if (GN_HAS(GN_FEAT_TEXTURES) && s.irid.x > 0.0 && m.tex_iridescence != GN_INVALID)
+        s.irid.x *= texture_sample(m.tex_iridescence, s.uv, false).r;
+    if (GN_HAS(GN_FEAT_TEXTURES) && s.irid.x > 0.0 && m.tex_iridescence_thickness != GN_INVALID)
+        s.irid.z = mix(m.iridescence_thickness_min, m.iridescence_thickness_max,
+                       texture_sample(m.tex_iridescence_thickness, s.uv, false).g);
+    s.dt = vec4(m.diffuse_transmission_color, m.diffuse_transmission);
+    if (GN_HAS(GN_FEAT_TEXTURES) && s.dt.w > 0.0 && m.tex_diffuse_transmission != GN_INVALID)
+        s.dt.w *= texture_sample(m.tex_diffuse_transmission, s.uv, false).a;
+    if (GN_HAS(GN_FEAT_TEXTURES) && s.dt.w > 0.0 && m.tex_diffuse_transmission_color != GN_INVALID)
+        s.dt.rgb *= texture_sample(m.tex_diffuse_transmission_color, s.uv, true).rgb;
+}
 
 // tri: BVH-order triangle index; (u, v): barycentrics of v1 and v2; d: ray direction.
 Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
@@ -290,6 +311,8 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     s.coat_n = n;
     s.sheen = vec3(0.0);
     s.sheen_roughness = 0.0;
+    s.irid = vec3(0.0);
+    s.dt = vec4(0.0);
     vec4 tg = w * a.tangent + u * b.tangent + v * c.tangent;
     if (GN_HAS(GN_FEAT_LAYERS)) {
         s.coat = m.clearcoat;
@@ -317,6 +340,7 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
             }
         }
         s.coat_n = shading_normal_valid(flip ? -s.coat_n : s.coat_n, ng, -d);
+        surface_film(s, m);
     }
     s.aniso = 0.0;
     s.aniso_t = vec3(0.0);

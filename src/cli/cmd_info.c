@@ -66,6 +66,28 @@ static void print_anisotropy(const scene *sc)
     }
 }
 
+/* KHR_materials_iridescence and _diffuse_transmission: one line per material that has them. */
+static void print_films(const scene *sc)
+{
+    for (uint32_t i = 0; i < sc->num_materials; i++) {
+        const GnMaterial *m = &sc->materials[i];
+        const char *name = sc->material_names[i][0] ? sc->material_names[i] : "(unnamed)";
+        if (m->iridescence > 0 && m->tex_iridescence_thickness != GN_INVALID)
+            printf("iridescence %-3u \"%s\" factor %g%s, film ior %g, thickness %g - %g nm (texture G)\n", i, name,
+                   m->iridescence, m->tex_iridescence != GN_INVALID ? " x texture" : "", m->iridescence_ior,
+                   m->iridescence_thickness_min, m->iridescence_thickness_max);
+        else if (m->iridescence > 0)
+            printf("iridescence %-3u \"%s\" factor %g%s, film ior %g, thickness %g nm\n", i, name, m->iridescence,
+                   m->tex_iridescence != GN_INVALID ? " x texture" : "", m->iridescence_ior,
+                   m->iridescence_thickness_max);
+        if (m->diffuse_transmission > 0)
+            printf("diffuse transmission %-3u \"%s\" factor %g%s, colour (%g, %g, %g)%s\n", i, name,
+                   m->diffuse_transmission, m->tex_diffuse_transmission != GN_INVALID ? " x texture" : "",
+                   m->diffuse_transmission_color.x, m->diffuse_transmission_color.y, m->diffuse_transmission_color.z,
+                   m->tex_diffuse_transmission_color != GN_INVALID ? " x texture" : "");
+    }
+}
+
 int cmd_info(int argc, char **argv)
 {
     bool outside = false;
@@ -80,7 +102,10 @@ int cmd_info(int argc, char **argv)
                  "medium (KHR_materials_volume) or disperses (KHR_materials_dispersion): attenuation\n"
                  "colour and distance, the absorption coefficient they give, thickness (unused by the\n"
                  "path tracer), IOR and dispersion; one line per anisotropic material\n"
-                 "(KHR_materials_anisotropy): strength, rotation and whether a texture sets them.\n",
+                 "(KHR_materials_anisotropy): strength, rotation and whether a texture sets them;\n"
+                 "and one line per material with an iridescent film (KHR_materials_iridescence:\n"
+                 "factor, film IOR, thickness) or a diffuse transmission\n"
+                 "(KHR_materials_diffuse_transmission: factor, colour).\n",
         CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given"};
     cli_args args;
     scene sc = {0};
@@ -108,6 +133,7 @@ int cmd_info(int argc, char **argv)
     print_emitters(&sc);
     print_media(&sc);
     print_anisotropy(&sc);
+    print_films(&sc);
     printf("cameras        %u\n", sc.num_cameras);
     for (uint32_t i = 0; i < sc.num_cameras; i++) {
         const scene_camera *c = &sc.cameras[i];

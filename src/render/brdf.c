@@ -172,7 +172,8 @@ bool brdf_spec_check(const char *spec)
 
 bool brdf_setting_two_sided(const brdf_setting *s)
 {
-    return s->model->id == BRDF_DIELECTRIC || (s->model->id == BRDF_GLTF && s->v[BRDF_SLOT_EXTRA + 3] > 0);
+    return s->model->id == BRDF_DIELECTRIC ||
+           (s->model->id == BRDF_GLTF && (s->v[BRDF_SLOT_EXTRA + 3] > 0 || s->v[BRDF_SLOT_DT + 3] > 0));
 }
 
 void brdf_setting_to_query(const brdf_setting *s, BrdfQuery *q)

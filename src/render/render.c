@@ -225,6 +225,14 @@ static uint32_t material_features(const GnMaterial *m)
             if (t > 0 && metal_lo < 1)
                 f |= GN_FEAT_ROUGH_GLASS;
         }
+        /* bsdf_gltf_film: an iridescent film, a diffuse transmission (textures as above) */
+        if (m->iridescence > 0 || m->diffuse_transmission > 0) {
+            f |= GN_FEAT_LAYERS;
+            if ((m->iridescence > 0 && (m->tex_iridescence != GN_INVALID || m->tex_iridescence_thickness != GN_INVALID)) ||
+                (m->diffuse_transmission > 0 && (m->tex_diffuse_transmission != GN_INVALID ||
+                                                 m->tex_diffuse_transmission_color != GN_INVALID)))
+                f |= GN_FEAT_TEXTURES;
+        }
         break;
     }
     default: {
@@ -1422,6 +1430,11 @@ static void apply_setting(GnMaterial *m, const brdf_setting *st)
         memcpy(&m->sheen_color.x, st->v + BRDF_SLOT_SHEEN, 3 * sizeof(float));
         m->anisotropy_strength = st->v[BRDF_SLOT_ANISO];
         m->anisotropy_rotation = st->v[BRDF_SLOT_ANISO + 1];
+        m->iridescence = st->v[BRDF_SLOT_IRID];
+        m->iridescence_ior = st->v[BRDF_SLOT_IRID + 1];
+        m->iridescence_thickness_max = st->v[BRDF_SLOT_IRID + 2];
+        memcpy(&m->diffuse_transmission_color.x, st->v + BRDF_SLOT_DT, 3 * sizeof(float));
+        m->diffuse_transmission = st->v[BRDF_SLOT_DT + 3];
     }
 }
 
@@ -1445,6 +1458,11 @@ static void setting_from_material(brdf_setting *st, const brdf_model *model, con
         memcpy(st->v + BRDF_SLOT_SHEEN, &m->sheen_color.x, 3 * sizeof(float));
         st->v[BRDF_SLOT_ANISO] = m->anisotropy_strength;
         st->v[BRDF_SLOT_ANISO + 1] = m->anisotropy_rotation;
+        st->v[BRDF_SLOT_IRID] = m->iridescence;
+        st->v[BRDF_SLOT_IRID + 1] = m->iridescence_ior;
+        st->v[BRDF_SLOT_IRID + 2] = m->iridescence_thickness_max;
+        memcpy(st->v + BRDF_SLOT_DT, &m->diffuse_transmission_color.x, 3 * sizeof(float));
+        st->v[BRDF_SLOT_DT + 3] = m->diffuse_transmission;
     }
 }
 

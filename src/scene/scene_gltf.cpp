@@ -55,7 +55,7 @@ const char *const SUPPORTED_EXTENSIONS[] = {
     "KHR_texture_transform",      "KHR_mesh_quantization",           "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",    "KHR_materials_variants",          "KHR_materials_volume",
     "KHR_materials_dispersion",   "KHR_materials_clearcoat",         "KHR_materials_sheen",
-    "KHR_materials_anisotropy"};
+    "KHR_materials_anisotropy",   "KHR_materials_iridescence",       "KHR_materials_diffuse_transmission"};
 
 using Json = nlohmann::json;
 
@@ -2026,6 +2026,35 @@ void convert_material(Ctx &c, int mi, GnMaterial &g, scene_material_extras &x, c
         g.anisotropy_rotation = std::isfinite(rot) ? float(std::remainder(rot, 2 * M_PI)) : 0.0f;
         g.tex_anisotropy = texture_slot(c, ext_texture(e, "anisotropyTexture"), what, "anisotropyTexture");
     }
+    if (const tinygltf::Value *e = extension(mat, "KHR_materials_iridescence")) {
+        /* (thicknesses up to 1 mm and indices up to 100 keep the film's phase finite in float) */
+        g.iridescence = ranged(c, ext_number(c, *e, "iridescenceFactor", 0, what), 0, 1, what, "iridescenceFactor");
+        g.iridescence_ior = ranged(c, ext_number(c, *e, "iridescenceIor", 1.3, what), 1, 100, what, "iridescenceIor");
+        g.iridescence_thickness_min = ranged(c, ext_number(c, *e, "iridescenceThicknessMinimum", 100, what), 0,
+                                             1e6, what, "iridescenceThicknessMinimum");
+        g.iridescence_thickness_max = ranged(c, ext_number(c, *e, "iridescenceThicknessMaximum", 400, what), 0,
+                                             1e6, what, "iridescenceThicknessMaximum");
+        g.tex_iridescence = texture_slot(c, ext_texture(e, "iridescenceTexture"), what, "iridescenceTexture");
+        g.tex_iridescence_thickness =
+            texture_slot(c, ext_texture(e, "iridescenceThicknessTexture"), what, "iridescenceThicknessTexture");
+    }
+    if (const tinygltf::Value *e = extension(mat, "KHR_materials_diffuse_transmission")) {
+        float t[3];
+        g.diffuse_transmission = ranged(c, ext_number(c, *e, "diffuseTransmissionFactor", 0, what), 0, 1, what,
+                                        "diffuseTransmissionFactor");
+        if (e->IsObject() && e->Has("diffuseTransmissionColorFactor")) {
+            if (number_triple(e->Get("diffuseTransmissionColorFactor"), t))
+                g.diffuse_transmission_color = vec3{ranged(c, t[0], 0, 1, what, "diffuseTransmissionColorFactor"),
+                                                    ranged(c, t[1], 0, 1, what, "diffuseTransmissionColorFactor"),
+                                                    ranged(c, t[2], 0, 1, what, "diffuseTransmissionColorFactor")};
+            else
+                warn(c, "%s: diffuseTransmissionColorFactor must be 3 numbers (ignored)", what.c_str());
+        }
+        g.tex_diffuse_transmission =
+            texture_slot(c, ext_texture(e, "diffuseTransmissionTexture"), what, "diffuseTransmissionTexture");
+        g.tex_diffuse_transmission_color = texture_slot(c, ext_texture(e, "diffuseTransmissionColorTexture"), what,
+                                                        "diffuseTransmissionColorTexture");
+    }
     if (extension(mat, "KHR_materials_unlit"))
         g.flags |= GN_MAT_UNLIT;
     if (mat.doubleSided)
@@ -2535,6 +2564,22 @@ void Doc::check_material(const Json &m, const std::string &p)
             number(*an, "anisotropyStrength", pa);
             number(*an, "anisotropyRotation", pa);
             texture_info(*an, "anisotropyTexture", pa);
+        }
+        if (const Json *ir = object(*ex, "KHR_materials_iridescence", pe)) {
+            std::string pi = at(pe, "KHR_materials_iridescence");
+            number(*ir, "iridescenceFactor", pi);
+            number(*ir, "iridescenceIor", pi);
+            number(*ir, "iridescenceThicknessMinimum", pi);
+            number(*ir, "iridescenceThicknessMaximum", pi);
+            texture_info(*ir, "iridescenceTexture", pi);
+            texture_info(*ir, "iridescenceThicknessTexture", pi);
+        }
+        if (const Json *dt = object(*ex, "KHR_materials_diffuse_transmission", pe)) {
+            std::string pd = at(pe, "KHR_materials_diffuse_transmission");
+            number(*dt, "diffuseTransmissionFactor", pd);
+            numbers(*dt, "diffuseTransmissionColorFactor", pd, 3);
+            texture_info(*dt, "diffuseTransmissionTexture", pd);
+            texture_info(*dt, "diffuseTransmissionColorTexture", pd);
         }
     }
     texture_info(m, "emissiveTexture", p);

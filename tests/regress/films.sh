@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# films.sh: KHR_materials_iridescence and KHR_materials_diffuse_transmission in the path tracer.
+# - a thin sheet of diffuse transmission factor k and colour c (black base, no specular lobe)
+#   under a large emitter of radiance Le, seen from the other side by an orthographic camera
+#   (black environment): the far side's radiance is k c Le F, F the view factor of the emitter
+#   (a square of half-size a at distance h: the parallel-rectangle formula, computed here);
+#   it is reached only through light sampling of a light behind the surface and BSDF samples
+#   through it;
+# - factors of 0 render bit for bit as the files without the extensions;
+# - the specialised kernel gives the unspecialised one's pixels;
+# - gonio info shows both, and neither is an unsupported extension;
+# - IridescenceSuzanne (when $GONIO_ASSETS has it) renders without warnings, its metallic
+#   Suzanne coloured by the film.
+. "$(dirname "$0")/../lib.sh"
+G=$GONIO
+T=$TESTTOOL
+command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
+
+python3 - "$tmp" <<'PY' || { fail "scenes"; finish; exit; }
+import base64, json, math, struct, sys
+out = sys.argv[1]
+A, H, LE = 2.0, 1.0, 2.0  # emitter half-size, distance, radiance
+def quad(z, a, down):
+    p = [(-a, -a, z), (a, -a, z), (a, a, z), (-a, a, z)]
+    return [p[0], p[2], p[1], p[0], p[3], p[2]] if down else [p[0], p[1], p[2], p[0], p[2], p[3]]
+def scene(name, sheet_ext, irid=None):
+    pos = quad(0.0, 1.0, False) + quad(H, A, True)
+    raw = b"".join(struct.pack("<3f", *p) for p in pos)
+    sheet = {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0, "roughnessFactor": 1},
+             "extensions": dict({"KHR_materials_specular": {"specularFactor": 0}}, **sheet_ext)}
+    if irid is not None:
+        sheet = {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 1, "roughnessFactor": 0.3},
+                 "extensions": irid}
+        pos[:6] = quad(0.0, 1.0, True)  # faces the camera: the emitter's light reflected
+        raw = b"".join(struct.pack("<3f", *p) for p in pos)
+    emitter = {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [1, 1, 1],
+               "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": LE}}}
+    d = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
+         "buffers": [{"byteLength": len(raw), "uri": "data:application/octet-stream;base64," + base64.b64encode(raw).decode()}],
+         "bufferViews": [{"buffer": 0, "byteLength": 72}, {"buffer": 0, "byteOffset": 72, "byteLength": 72}],
+         "accessors": [{"bufferView": i, "componentType": 5126, "count": 6, "type": "VEC3",
+                        "min": [min(p[a] for p in pos[6 * i:6 * i + 6]) for a in range(3)],
+                        "max": [max(p[a] for p in pos[6 * i:6 * i + 6]) for a in range(3)]} for i in range(2)],
+         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]},
+                    {"primitives": [{"attributes": {"POSITION": 1}, "material": 1}]}],
+         "materials": [sheet, emitter],
+         "cameras": [{"type": "orthographic", "orthographic": {"xmag": 0.1, "ymag": 0.1, "znear": 0.01, "zfar": 100}}],
+         # below the sheet, looking up (+z), or (iridescence) above the emitter's light, looking down
+         "nodes": [{"mesh": 0}, {"mesh": 1},
+                   {"camera": 0, "translation": [0, 0, -5], "rotation": [0, 1, 0, 0]} if irid is None else
+                   {"camera": 0, "translation": [0, 0, 0.5]}]}
+    d["extensionsUsed"] = sorted({e for m in d["materials"] for e in m.get("extensions", {})})
+    json.dump(d, open("%s/%s.gltf" % (out, name), "w"))
+C = [1.0, 0.5, 0.25]
+scene("dt", {"KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 0.6, "diffuseTransmissionColorFactor": C}})
+scene("dt0", {"KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 0, "diffuseTransmissionColorFactor": C}})
+scene("nodt", {})
+scene("irid", {}, {"KHR_materials_iridescence": {"iridescenceFactor": 1, "iridescenceThicknessMaximum": 350}})
+scene("irid0", {}, {"KHR_materials_iridescence": {"iridescenceFactor": 0, "iridescenceThicknessMaximum": 350}})
+scene("noirid", {}, {})
+X = Y = A / H
+f = lambda x, y: (x / math.sqrt(1 + x * x) * math.atan(y / math.sqrt(1 + x * x)) +
+                  y / math.sqrt(1 + y * y) * math.atan(x / math.sqrt(1 + y * y))) / (2 * math.pi)
+F = 4 * f(X, Y)
+open(out + "/dt.ref", "w").write(" ".join("%.9g" % (0.6 * c * LE * F) for c in C) + "\n")
+PY
+
+near() { python3 -c "import sys; a, b, t = map(float, sys.argv[1:]); sys.exit(0 if abs(a - b) <= t * (b if b > 0 else 1) else 1)" "$@"; }
+means() { "$T" rgb "$1" | awk '{print $2, $3, $4}'; }
+
+check "info shows the diffuse transmission" sh -c "'$G' info '$tmp/dt.gltf' | grep -q 'diffuse transmission 0 .* factor 0.6, colour (1, 0.5, 0.25)'"
+check "info shows the film" sh -c "'$G' info '$tmp/irid.gltf' | grep -q 'iridescence 0 .* factor 1, film ior 1.3, thickness 350 nm'"
+for s in dt irid; do
+    check_fails "$s: no unsupported-extension warning" 0 "$G" info "$tmp/$s.gltf"
+    check "  (none printed)" sh -c "! grep -q 'unsupported extension' '$tmp/last'"
+done
+
+P="--env 0 --quiet --spp 64 --size 32x32"
+check "sheet: render" "$G" render "$tmp/dt.gltf" -o "$tmp/dt.exr" $P
+got=($(means "$tmp/dt.exr")) ref=($(cat "$tmp/dt.ref"))
+for k in 0 1 2; do
+    check "sheet: far side's radiance k c Le F, channel $k: ${got[$k]} vs ${ref[$k]}" near "${got[$k]}" "${ref[$k]}" 5e-3
+done
+# each strategy alone: light sampling of the light behind the surface, BSDF samples through it
+for st in light bsdf; do
+    check "sheet, $st sampling alone: render" "$G" render "$tmp/dt.gltf" -o "$tmp/dt-$st.exr" $P --estimator $st
+    got=($(means "$tmp/dt-$st.exr"))
+    check "  channel 0: ${got[0]} vs ${ref[0]}" near "${got[0]}" "${ref[0]}" 1e-2
+done
+for s in dt0 nodt irid0 noirid; do
+    "$G" render "$tmp/$s.gltf" -o "$tmp/$s.exr" $P || fail "render $s"
+done
+check "diffuse transmission 0 is the file without the extension" "$T" same "$tmp/nodt.exr" "$tmp/dt0.exr"
+check "iridescence 0 is the file without the extension" "$T" same "$tmp/noirid.exr" "$tmp/irid0.exr"
+check "iridescence: render" "$G" render "$tmp/irid.gltf" -o "$tmp/irid.exr" $P
+check_fails "  (the film changes the reflection)" 1 "$T" same "$tmp/noirid.exr" "$tmp/irid.exr"
+
+# The kernel specialised on the scene's features (GN_FEAT_LAYERS) gives the unspecialised pixels.
+for s in dt irid; do
+    "$G" render "$tmp/$s.gltf" -o "$tmp/$s-a.exr" --env 0.5 --quiet --spp 3 --size 24x24 &&
+        GONIO_ALL_FEATURES=1 "$G" render "$tmp/$s.gltf" -o "$tmp/$s-b.exr" --env 0.5 --quiet --spp 3 --size 24x24 ||
+        fail "$s: renders"
+    check "$s: specialised = unspecialised" "$T" same "$tmp/$s-a.exr" "$tmp/$s-b.exr"
+done
+
+S=${GONIO_ASSETS:-}/gltf/IridescenceSuzanne/glTF/IridescenceSuzanne.gltf
+if [ -f "$S" ]; then
+    check_fails "IridescenceSuzanne: renders without warnings" 0 "$G" render "$S" -o "$tmp/suzanne.exr" \
+        --look-at 0,0.3,7,0,0,0 --fov 40 --env 0.6,0.6,0.6 --spp 8 --size 96x32 --quiet
+    check "  (no warning)" sh -c "! grep -q 'warning' '$tmp/last'"
+    check "IridescenceSuzanne: info shows its thickness texture's range" sh -c \
+        "'$G' info '$S' | grep -q 'iridescence 2 .* film ior 1.8, thickness 200 - 600 nm (texture G)'"
+else
+    echo "  note: \$GONIO_ASSETS has no IridescenceSuzanne: its checks skipped"
+fi
+finish
