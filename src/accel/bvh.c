@@ -339,8 +339,22 @@ static const float *vertex(const builder *bd, uint32_t tri, int k)
     return bd->positions + (size_t)bd->indices[3 * (size_t)tri + k] * bd->stride;
 }
 
+/* Do vertices i and j sit at the same point, bit for bit? Pairs are made by positions, not
+ * vertex indices: a flat-shaded or UV-seamed mesh repeats a point once per face that meets
+ * it, and the pair test needs only the shared corners' positions to be the same floats (its
+ * shared edge function is then the exact negation of the neighbour's). */
+static bool same_point(const builder *bd, uint32_t i, uint32_t j)
+{
+    if (i == j)
+        return true;
+    uint32_t x[3], y[3];
+    memcpy(x, bd->positions + (size_t)i * bd->stride, sizeof x);
+    memcpy(y, bd->positions + (size_t)j * bd->stride, sizeof y);
+    return x[0] == y[0] && x[1] == y[1] && x[2] == y[2];
+}
+
 /* Triangles t and u make one GnTriPair when they share exactly one
- * edge (by vertex index; neither repeats an index), are wound alike (so that GnPrim can
+ * edge (by position: same_point; neither repeats a point), are wound alike (so that GnPrim can
  * list B's corners in the test's order by a rotation, keeping its winding), and the pair's
  * box is no larger (in surface area) than the two boxes together: the SAH's view, since a
  * pair costs the walk about what one triangle does (three texel fetches) and is entered
@@ -348,11 +362,13 @@ static const float *vertex(const builder *bd, uint32_t tri, int k)
 static bool pairs_with(const builder *bd, uint32_t t, uint32_t u)
 {
     const uint32_t *a = bd->indices + 3 * (size_t)t, *b = bd->indices + 3 * (size_t)u;
-    if (a[0] == a[1] || a[1] == a[2] || a[2] == a[0] || b[0] == b[1] || b[1] == b[2] || b[2] == b[0])
-        return false;
+    for (int k = 0; k < 3; k++)
+        if (same_point(bd, a[k], a[(k + 1) % 3]) || same_point(bd, b[k], b[(k + 1) % 3]))
+            return false;
     int shared = 0;
     for (int k = 0; k < 3; k++)
-        shared += (a[k] == b[0]) + (a[k] == b[1]) + (a[k] == b[2]);
+        for (int m = 0; m < 3; m++)
+            shared += same_point(bd, a[k], b[m]);
     if (shared != 2)
         return false;
     /* wound alike: B runs the shared edge the other way (then B's own corner order is a
@@ -360,7 +376,7 @@ static bool pairs_with(const builder *bd, uint32_t t, uint32_t u)
     bool alike = false;
     for (int k = 0; k < 3; k++)
         for (int m = 0; m < 3; m++)
-            alike |= a[k] == b[(m + 1) % 3] && a[(k + 1) % 3] == b[m];
+            alike |= same_point(bd, a[k], b[(m + 1) % 3]) && same_point(bd, a[(k + 1) % 3], b[m]);
     if (!alike)
         return false;
     aabb ba = empty_box, bb = empty_box, bu;
@@ -407,7 +423,8 @@ static void *pair_worker(void *arg)
     return NULL;
 }
 
-/* An edge of a single triangle: its two vertex indices, the smaller first, and the triangle. */
+/* An edge of a single triangle: its two points (as the vertex indices pair_by_edges gives
+ * them), the smaller first, and the triangle. */
 typedef struct edge_ref {
     uint64_t key;
     uint32_t tri;
@@ -417,6 +434,19 @@ static int edge_order(const void *pa, const void *pb)
 {
     const edge_ref *a = pa, *b = pb;
     return a->key != b->key ? (a->key < b->key ? -1 : 1) : (a->tri > b->tri) - (a->tri < b->tri);
+}
+
+/* A corner of a single triangle: its position's bits, its vertex and its place in the list. */
+typedef struct corner_ref {
+    uint32_t bits[3];
+    uint32_t vertex, corner;
+} corner_ref;
+
+static int corner_order(const void *pa, const void *pb)
+{
+    const corner_ref *a = pa, *b = pb;
+    int d = memcmp(a->bits, b->bits, sizeof a->bits);
+    return d ? d : (a->vertex > b->vertex) - (a->vertex < b->vertex);
 }
 
 static uint64_t edge_key(uint32_t x, uint32_t y)
@@ -446,14 +476,36 @@ static void pair_by_edges(builder *bd)
         n += bd->mate[t] == GN_INVALID;
     if (n < 2)
         return;
-    edge_ref *e = util_malloc(3 * n * sizeof *e);
+    /* each corner's point as one vertex index (the least of the corners at that point), so
+     * that an edge is keyed by its two points */
+    corner_ref *c = util_malloc(3 * n * sizeof *c);
+    uint32_t *point = util_malloc(3 * n * sizeof *point);
     size_t m = 0;
     for (uint32_t t = 0; t < bd->num_tris; t++)
         if (bd->mate[t] == GN_INVALID)
-            for (int k = 0; k < 3; k++) {
-                const uint32_t *v = bd->indices + 3 * (size_t)t;
-                e[m++] = (edge_ref){edge_key(v[k], v[(k + 1) % 3]), t};
+            for (int k = 0; k < 3; k++, m++) {
+                uint32_t v = bd->indices[3 * (size_t)t + k];
+                c[m].vertex = v;
+                c[m].corner = (uint32_t)m;
+                memcpy(c[m].bits, bd->positions + (size_t)v * bd->stride, sizeof c[m].bits);
             }
+    qsort(c, m, sizeof *c, corner_order);
+    for (size_t lo = 0, hi; lo < m; lo = hi) {
+        for (hi = lo + 1; hi < m && !memcmp(c[hi].bits, c[lo].bits, sizeof c[lo].bits); hi++)
+            ;
+        for (size_t i = lo; i < hi; i++)
+            point[c[i].corner] = c[lo].vertex;
+    }
+    free(c);
+    edge_ref *e = util_malloc(3 * n * sizeof *e);
+    m = 0;
+    for (uint32_t t = 0, i = 0; t < bd->num_tris; t++)
+        if (bd->mate[t] == GN_INVALID) {
+            for (int k = 0; k < 3; k++)
+                e[m++] = (edge_ref){edge_key(point[3 * i + k], point[3 * i + (k + 1) % 3]), t};
+            i++;
+        }
+    free(point);
     qsort(e, m, sizeof *e, edge_order);
     /* candidates: for each single triangle (in order), up to 3 others */
     uint32_t *slot = util_malloc(bd->num_tris * sizeof *slot), *cand = util_malloc(3 * n * sizeof *cand);
@@ -568,10 +620,12 @@ static void write_pair(const builder *bd, uint32_t rec, uint32_t i, GnTriPair *q
     uint32_t tb = pair ? bd->mate[ta] : GN_INVALID;
     const uint32_t *a = bd->indices + 3 * (size_t)ta, *b = pair ? bd->indices + 3 * (size_t)tb : a;
     uint32_t rot = 0, rot_b = 0, idx[4];
+    /* (corners are the same by position: pairs_with) */
+#define SAME(x, y) same_point(bd, x, y)
     if (pair) /* the edge (a[k], a[k + 1]) that B has: rotate it to (p2, p0) */
         for (uint32_t k = 0; k < 3; k++) {
             uint32_t x = a[k], y = a[(k + 1) % 3];
-            if ((x == b[0] || x == b[1] || x == b[2]) && (y == b[0] || y == b[1] || y == b[2]))
+            if ((SAME(x, b[0]) || SAME(x, b[1]) || SAME(x, b[2])) && (SAME(y, b[0]) || SAME(y, b[1]) || SAME(y, b[2])))
                 rot = (k + 1) % 3;
         }
     for (uint32_t k = 0; k < 3; k++)
@@ -579,11 +633,12 @@ static void write_pair(const builder *bd, uint32_t rec, uint32_t i, GnTriPair *q
     idx[3] = idx[2];
     if (pair)
         for (uint32_t k = 0; k < 3; k++) {
-            if (b[k] != idx[0] && b[k] != idx[2])
+            if (!SAME(b[k], idx[0]) && !SAME(b[k], idx[2]))
                 idx[3] = b[k];
-            if (b[k] == idx[0]) /* B's own corner k is the test's p0 */
+            if (SAME(b[k], idx[0])) /* B's own corner k is the test's p0 */
                 rot_b = k;
         }
+#undef SAME
     vec3 *p[4] = {&q->p0, &q->p1, &q->p2, &q->p3};
     for (int k = 0; k < 4; k++) {
         const float *x = bd->positions + (size_t)idx[k] * bd->stride;

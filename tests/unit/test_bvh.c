@@ -97,13 +97,14 @@ static void check_structure(const bvh *b, const meshgen_mesh *m)
         bool lone = b->tri_index[2 * i + 1] == GN_INVALID;
         if (lone) {
             bad_pair += memcmp(&q->p2, &q->p3, sizeof q->p2) != 0;
-        } else { /* A and B share exactly one edge (two vertex indices) */
+        } else { /* A and B share exactly one edge (two points, bit for bit) */
             const uint32_t *ia = m->indices + 3 * (size_t)b->tri_index[2 * i];
             const uint32_t *ib = m->indices + 3 * (size_t)b->tri_index[2 * i + 1];
             int shared = 0;
             for (int j = 0; j < 3; j++)
                 for (int k = 0; k < 3; k++)
-                    shared += ia[j] == ib[k];
+                    shared += memcmp(m->positions + 3 * (size_t)ia[j], m->positions + 3 * (size_t)ib[k],
+                                     3 * sizeof(float)) == 0;
             bad_pair += shared != 2;
         }
         for (int w = 0; w < (lone ? 1 : 2); w++)
@@ -698,6 +699,32 @@ TEST(bvh, pairs_any_order)
     CHECKF(2 * pa >= 0.9 * m.num_triangles, "in order: only %u pairs of %u triangles", pa, m.num_triangles);
     bvh_destroy(&a);
     bvh_destroy(&b);
+    free(s.indices);
+    meshgen_destroy(&m);
+}
+
+/* A flat-shaded mesh repeats each point once per triangle (no vertex is shared): pairs are
+ * made by position, so it pairs as the welded mesh does, and its answers stay exact. */
+TEST(bvh, pairs_by_position)
+{
+    meshgen_mesh m = meshgen_bench_mesh(20000), s = m;
+    s.num_vertices = 3 * m.num_triangles;
+    s.positions = malloc(3 * sizeof *s.positions * s.num_vertices);
+    s.normals = NULL;
+    s.indices = malloc(3 * sizeof *s.indices * m.num_triangles);
+    for (uint32_t i = 0; i < 3 * m.num_triangles; i++) {
+        memcpy(s.positions + 3 * i, m.positions + 3 * (size_t)m.indices[i], 3 * sizeof *s.positions);
+        s.indices[i] = i;
+    }
+    bvh a, b;
+    CHECK(build_mesh(&a, &m) && build_mesh(&b, &s));
+    check_structure(&b, &s);
+    check_rays(&b, &s, 2000, 11);
+    uint32_t pa = a.num_tris - a.num_pairs, pb = b.num_tris - b.num_pairs; /* pairs made */
+    CHECKF(pb >= 0.97 * pa, "flat-shaded: %u pairs, welded: %u (of %u triangles)", pb, pa, m.num_triangles);
+    bvh_destroy(&a);
+    bvh_destroy(&b);
+    free(s.positions);
     free(s.indices);
     meshgen_destroy(&m);
 }

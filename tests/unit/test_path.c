@@ -120,9 +120,15 @@ TEST(path, furnace)
         if (!render_file(&g, path, NULL, s, &img))
             continue;
         for (int c = 0; c < 3; c++) {
-            int n;
+            int n, bg = 0, bad = 0;
             double se, mean = covered_mean(&img, c, &se, &n);
             CHECKF(n > 300, "case %zu: only %d covered pixels", i, n);
+            /* a pixel no camera ray hits shows the environment, exactly: every sample is 1
+             * (a lane that misses starts its next path at once: path.comp, RETRACE) */
+            for (int p = 0, a = image_channel(&img, "A"); p < img.width * img.height; p++)
+                if (img.planes[a][p] == 0.0f)
+                    bg++, bad += img.planes[c][p] != 1.0f;
+            CHECKF(bg > 0 && bad == 0, "case %zu: %d of %d background pixels are not exactly 1", i, bad, bg);
             if (cases[i].expect > 0)
                 CHECKF(fabs(mean - cases[i].expect) <= Z_MAX * se + 1e-4,
                        "case %zu (%s): furnace gives %.5f +- %.5f, expected %.3f", i,
