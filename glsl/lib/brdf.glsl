@@ -220,22 +220,6 @@ float brdf_lambda_beckmann(vec3 w, float a)
     return max(0.0, 0.5 * (exp(-m * m) / (m * 1.7724538509) - erfc));
 }
 
-// Visible normal of GGX seen from w (w.z > 0), Heitz 2018 (JCGT 7(4)): pdf of the normal is
-// G1(w) max(0, w.h) D(h) / w.z.
-vec3 brdf_ggx_sample_vndf(vec3 w, float a, vec2 u)
-{
-    vec3 vh = normalize(vec3(a * w.x, a * w.y, w.z));
-    float len2 = dot(vh.xy, vh.xy);
-    vec3 t1 = len2 > 0.0 ? vec3(-vh.y, vh.x, 0.0) * inversesqrt(len2) : vec3(1.0, 0.0, 0.0);
-    vec3 t2 = cross(vh, t1);
-    float r = sqrt(u.x), phi = 2.0 * BRDF_PI * u.y;
-    float p1 = r * cos(phi), p2 = r * sin(phi);
-    float s = 0.5 * (1.0 + vh.z);
-    p2 = (1.0 - s) * sqrt(max(0.0, 1.0 - p1 * p1)) + s * p2;
-    vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
-    return normalize(vec3(a * nh.x, a * nh.y, max(0.0, nh.z)));
-}
-
 // ---- anisotropic GGX (KHR_materials_anisotropy) --------------------------------------------
 // Heitz 2014 (JCGT 3(2)), eqs. 85-86, and Heitz 2018's sampling with alpha = (a_t, a_b) on the
 // axes of the frame (x along the anisotropy direction): the isotropic formulas above are the
@@ -268,8 +252,8 @@ float brdf_ggx_aniso_v(vec3 wo, vec3 wi, vec2 a)
     return 0.5 / (lo + li);
 }
 
-// Visible normal seen from w (w.z > 0): brdf_ggx_sample_vndf with the view stretched by
-// (a_t, a_b) instead of a.
+// Visible normal seen from w (w.z > 0), Heitz 2018 (JCGT 7(4)), of the GGX stretched by
+// (a_t, a_b) on the frame's axes: pdf of the normal is G1(w) max(0, w.h) D(h) / w.z.
 vec3 brdf_ggx_aniso_vndf(vec3 w, vec2 a, vec2 u)
 {
     vec3 vh = normalize(vec3(a * w.xy, w.z));
@@ -283,6 +267,9 @@ vec3 brdf_ggx_aniso_vndf(vec3 w, vec2 a, vec2 u)
     vec3 nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
     return normalize(vec3(a * nh.xy, max(0.0, nh.z)));
 }
+
+// The isotropic case (the same floats: each axis is scaled by a alone).
+vec3 brdf_ggx_sample_vndf(vec3 w, float a, vec2 u) { return brdf_ggx_aniso_vndf(w, vec2(a), u); }
 
 bool brdf_is_aniso(Bsdf b)
 {
