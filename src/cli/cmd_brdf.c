@@ -240,7 +240,7 @@ static int run_plot(brdf_runner *r, const brdf_setting *s, double theta_deg, con
     const brdf_param *kd = brdf_param_find(s->model, "diffuse"), *ks = brdf_param_find(s->model, "specular");
     bool layered = kd && ks && s->model->id != BRDF_LAMBERT;
     bool full = brdf_setting_two_sided(s);
-    brdf_format_setting(title, sizeof title, s);
+    brdf_format_title(title, sizeof title, s);
     curves[n] = (plot_curve){layered ? "combined: f = diffuse + specular" : "f", 0x1f4e9affu, {0}};
     plot_eval(r, s, theta, curves[n++].f);
     if (layered) { /* Lambertian, specular, combined */
@@ -303,7 +303,7 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
     gpu_buffer sbuf, accum, sheen;
     gpu_pipeline p;
     image img;
-    char desc[512];
+    char desc[2048];
     const char *names[] = {"R", "G", "B"};
     vec4 *px = util_malloc(sizeof *px * (size_t)w * (size_t)h);
     bool ok = true;

@@ -190,17 +190,29 @@ void brdf_setting_to_query(const brdf_setting *s, BrdfQuery *q)
     q->dt = (vec4){v[BRDF_SLOT_DT], v[BRDF_SLOT_DT + 1], v[BRDF_SLOT_DT + 2], v[BRDF_SLOT_DT + 3]};
 }
 
-void brdf_format_setting(char *out, size_t cap, const brdf_setting *s)
+static void format_setting(char *out, size_t cap, const brdf_setting *s, bool changed_only)
 {
     const brdf_model *m = s->model;
     size_t len = (size_t)snprintf(out, cap, "%s", m->name);
     for (int i = 0; i < m->num_params && len < cap; i++) {
         const float *v = &s->v[m->params[i].slot];
+        if (changed_only && !memcmp(v, m->params[i].def, sizeof(float) * (size_t)m->params[i].count))
+            continue;
         if (m->params[i].count == 3 && (v[0] != v[1] || v[1] != v[2]))
             len += (size_t)snprintf(out + len, cap - len, " %s=%g,%g,%g", m->params[i].name, v[0], v[1], v[2]);
         else
             len += (size_t)snprintf(out + len, cap - len, " %s=%g", m->params[i].name, v[0]);
     }
+}
+
+void brdf_format_setting(char *out, size_t cap, const brdf_setting *s) { format_setting(out, cap, s, false); }
+
+void brdf_format_title(char *out, size_t cap, const brdf_setting *s)
+{
+    bool changed_only = s->model->num_params > BRDF_TITLE_PARAMS;
+    format_setting(out, cap, s, changed_only);
+    if (changed_only && strlen(out) + 1 < cap)
+        snprintf(out + strlen(out), cap - strlen(out), " (the rest at their defaults)");
 }
 
 void brdf_runner_create(brdf_runner *r, gpu *g, uint32_t capacity)

@@ -81,6 +81,10 @@ void brdf_setting_to_query(const brdf_setting *s, BrdfQuery *q);
 /* "name param=value ..." (colours as one value when grey, else R,G,B): the `gonio brdf
  * --list` line of a default setting. */
 void brdf_format_setting(char *out, size_t cap, const brdf_setting *s);
+/* The same for a plot's title: a model of more than BRDF_TITLE_PARAMS parameters (glTF's)
+ * lists only those that differ from their defaults, so that the title stays a few lines. */
+#define BRDF_TITLE_PARAMS 8
+void brdf_format_title(char *out, size_t cap, const brdf_setting *s);
 
 /* Batches BrdfQuery records through brdf_test.comp. */
 typedef struct brdf_runner {
