@@ -9,11 +9,11 @@
 #include "sampling.glsl"
 
 // GnFrame is read from a storage buffer, not a uniform buffer: lavapipe inlines uniform
-// values that steer loops and re-specializes the shader whenever they change, which cost
-// ~18 ms per dispatch of the path kernel (7x the whole render of a 32x32 image).
+// values that steer loops and re-specializes the shader whenever they change, a cost per
+// dispatch larger than a small render (docs/performance.md).
 layout(std430, binding = GN_BIND_FRAME) readonly buffer FrameBlock { GnFrame frame; };
 // The BVH nodes (GnBvhNode = 4 texels), triangle pairs (GnTriPair = 3), shading triangles
-// (GnPrim = 1), vertices (GnVertex = 4), materials (GnMaterial = 17), textures (GnTexture =
+// (GnPrim = 1), vertices (GnVertex = 5), materials (GnMaterial = 21), textures (GnTexture =
 // 1; their RGBA8 images: R32UI) and path.comp's lights (GnEmitter = 1) are read from texel
 // buffers, not storage buffers: llvmpipe fetches a storage buffer with per-lane offsets one
 // lane and one component at a time, branching on each lane's mask, a texel buffer with
