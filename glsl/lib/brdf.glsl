@@ -421,6 +421,26 @@ vec3 brdf_irid_lobe(Bsdf b, float c)
            b.irid_wm * brdf_iridescence(c, b.irid_ior, b.irid_d, b.irid_base);
 }
 
+// The glass's reflectance at microfacet cosine mo (either side; its transmittance is 1 - F):
+// the exact dielectric F, and under an iridescent film F + factor (F_film - F_Schlick), the
+// film's change to Schlick's F of the same index, taken at the outside's cosine, so that a
+// pair of directions through the surface has one F either way (reciprocal, R + T = 1 on both
+// sides). Total internal reflection stays 1; a film of thickness 0 or index 1 changes nothing.
+vec3 brdf_glass_fresnel(Bsdf b, float mo)
+{
+    float fr = brdf_fresnel_dielectric(mo, b.ior);
+    if (!GN_HAS(GN_FEAT_LAYERS) || !(b.irid > 0.0) || fr >= 1.0)
+        return vec3(fr);
+    float c = abs(mo);
+    if (mo < 0.0) // from inside: the cosine of the refracted direction outside
+        c = sqrt(max(1.0 - b.ior * b.ior * (1.0 - c * c), 0.0));
+    vec3 f0 = vec3(brdf_schlick_f0(b.ior));
+    vec3 film = brdf_iridescence(c, b.irid_ior, b.irid_d, f0) - brdf_fresnel_schlick(c, f0, 1.0);
+    return clamp(vec3(fr) + b.irid * film, vec3(0.0), vec3(1.0));
+}
+
+float brdf_mean(vec3 v) { return (v.r + v.g + v.b) / 3.0; }
+
 // ---- the parts of a Bsdf -----------------------------------------------------------------
 
 // The lobe's Fresnel factor times its weight, at cos = wo.wh.
@@ -565,18 +585,19 @@ void brdf_rough_dielectric(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
     float mo = dot(wm, wo), mi = dot(wm, wi);
     if (mo * co <= 0.0 || mi * ci <= 0.0)
         return; // the microfacet faces away from one of the directions
-    float fr = brdf_fresnel_dielectric(mo, b.ior);
+    vec3 fr = brdf_glass_fresnel(b, mo);
+    float pr = brdf_mean(fr); // the probability of sampling reflection
     float d = brdf_base_d(b, wm);
     float v = brdf_base_v(b, wo, wi);
     float pdf_m = brdf_base_g1(b, wo) * abs(mo) * d / abs(co);
     if (reflect) {
-        f = vec3(fr * d * v);
-        pdf = fr * pdf_m / (4.0 * abs(mo));
+        f = fr * d * v;
+        pdf = pr * pdf_m / (4.0 * abs(mo));
     } else {
         float denom = mi + mo / etap;
         denom *= denom;
         f = b.tint * ((1.0 - fr) * d * 4.0 * v * abs(mi * mo) / denom);
-        pdf = (1.0 - fr) * pdf_m * abs(mi) / denom;
+        pdf = (1.0 - pr) * pdf_m * abs(mi) / denom;
     }
 }
 
@@ -627,10 +648,10 @@ vec3 brdf_part_weights(Bsdf b, vec3 wo)
     vec3 p = vec3(0.0);
     if (wo.z > 0.0) {
         vec3 d = b.diffuse * (1.0 - brdf_fresnel_schlick(wo.z, b.couple_f0, b.couple_f90));
-        p.x = (d.r + d.g + d.b) / 3.0;
+        p.x = brdf_mean(d);
         if (GN_HAS(GN_FEAT_LOBES) && b.lobe != BRDF_LOBE_NONE) {
             vec3 s = brdf_lobe_fresnel(b, wo.z);
-            p.y = (s.r + s.g + s.b) / 3.0;
+            p.y = brdf_mean(s);
         }
     }
     if (GN_HAS(GN_FEAT_LAYERS) && brdf_has_dt(b))
@@ -701,15 +722,16 @@ BsdfSample brdf_base_sample(Bsdf b, vec3 wo, vec3 u)
     } else if (GN_HAS(GN_FEAT_GLASS) && p.z > 0.0) {
         float x = min((u.x - p.x - p.y) / p.z, 1.0);
         if (GN_HAS(GN_FEAT_SMOOTH_GLASS) && b.shape < BRDF_ALPHA_MIN) {
-            float fr = brdf_fresnel_dielectric(wo.z, b.ior);
-            if (x < fr) {
+            vec3 fr = brdf_glass_fresnel(b, wo.z);
+            float pr = brdf_mean(fr);
+            if (x < pr) {
                 s.wi = vec3(-wo.xy, wo.z);
-                s.pdf = p.z * fr;
-                s.weight = vec3(b.dielectric / p.z);
+                s.pdf = p.z * pr;
+                s.weight = b.dielectric * (fr / pr) / p.z;
                 s.flags = BRDF_FLAG_REFLECTION | BRDF_FLAG_DELTA;
             } else if (brdf_refract(wo, vec3(0.0, 0.0, 1.0), b.ior, s.wi)) {
-                s.pdf = p.z * (1.0 - fr);
-                s.weight = b.dielectric * b.tint / p.z;
+                s.pdf = p.z * (1.0 - pr);
+                s.weight = b.dielectric * b.tint * ((1.0 - fr) / (1.0 - pr)) / p.z;
                 s.flags = BRDF_FLAG_TRANSMISSION | BRDF_FLAG_DELTA;
             }
             return s;
@@ -718,7 +740,7 @@ BsdfSample brdf_base_sample(Bsdf b, vec3 wo, vec3 u)
             return s;
         vec3 wm = brdf_base_vndf(b, wo.z >= 0.0 ? wo : -wo, u.yz);
         float mo = dot(wo, wm);
-        reflect = x < brdf_fresnel_dielectric(mo, b.ior);
+        reflect = x < brdf_mean(brdf_glass_fresnel(b, mo));
         if (reflect)
             wi = 2.0 * mo * wm - wo;
         else if (!brdf_refract(wo, wm, b.ior, wi))

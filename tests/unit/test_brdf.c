@@ -72,6 +72,8 @@ static const config configs[] = {
     {"gltf", "iridescence=1 iridescence-ior=1.8 iridescence-thickness=250 metallic=1 base-color=0.9,0.6,0.2 roughness=0.5"},
     {"gltf", "iridescence=0.6 iridescence-thickness=800 roughness=0 base-color=1"},
     {"gltf", "iridescence=1 iridescence-ior=2 iridescence-thickness=150 metallic=0.5 roughness=0.25 base-color=1"},
+    {"gltf", "iridescence=1 iridescence-thickness=350 transmission=1 roughness=0.3"},
+    {"gltf", "iridescence=0.8 iridescence-ior=1.8 iridescence-thickness=500 transmission=1 roughness=0"},
     {"gltf", "diffuse-transmission=0.5 base-color=1 roughness=0.4"},
     {"gltf", "diffuse-transmission=1 diffuse-transmission-color=0.9,0.5,0.2 roughness=0"},
     {"gltf", "diffuse-transmission=0.7 diffuse-transmission-color=1 base-color=1 specular=0"},
@@ -1102,17 +1104,24 @@ TEST(brdf, anisotropy_ndf)
 
 /* ---- KHR_materials_iridescence and _diffuse_transmission -------------------------------------- */
 
-/* The lobe's Fresnel factor at cos c of a smooth glTF setting with no diffuse: the weight of
- * its one (mirror) sample, F(wo.z) itself. */
-static void mirror_weights(const brdf_setting *s, const double *cs, int n, vec3 *out)
+/* The reflectance at cos c of a smooth glTF setting with no diffuse: the weight of its one
+ * (mirror) sample, F(wo.z) itself; of smooth glass (glass), the mirror sample's weight F / P
+ * times its probability P (u.x = 0 picks the reflection). */
+static void mirror_weights(const brdf_setting *s, const double *cs, int n, vec3 *out, bool glass)
 {
     BrdfQuery *q = qbuf;
     BrdfResult *r = rbuf;
     for (int i = 0; i < n; i++)
-        q[i] = query(s, BRDF_OP_SAMPLE, polar(acos(cs[i]), 0.5), v3(0, 0, 1), v3(0.5, 0.5, 0.5));
+        q[i] = query(s, BRDF_OP_SAMPLE, polar(acos(cs[i]), 0.5), v3(0, 0, 1), v3(glass ? 0 : 0.5, 0.5, 0.5));
     brdf_runner_run(&runner, q, r, (size_t)n);
-    for (int i = 0; i < n; i++)
+    for (int i = 0; i < n; i++) {
         out[i] = r[i].s_weight;
+        if (glass) {
+            out[i].x *= r[i].s_pdf, out[i].y *= r[i].s_pdf, out[i].z *= r[i].s_pdf;
+            if (!(r[i].s_flags & BRDF_FLAG_REFLECTION))
+                out[i] = v3(-1, -1, -1); /* no reflection sampled: fails any comparison */
+        }
+    }
 }
 
 /* The CIE 1931 colour-matching functions by Wyman, Sloan and Shirley's multi-lobe Gaussian fit
@@ -1158,21 +1167,23 @@ static void airy_rgb(double n2, double d, double f0, double out[3])
 }
 
 /* The film at normal incidence against the Airy formula integrated over the spectrum, for
- * thicknesses 0-1500 nm on a dielectric (F0 0.04) and a metal-like base (F0 0.9). The
+ * thicknesses 0-1500 nm on a dielectric (F0 0.04), a metal-like base (F0 0.9) and glass
+ * (F0 0.04, the film on its reflection, which the transmission gets 1 - F of). The
  * extension's RGB evaluation is an approximation (Schlick's interfaces, two orders of
  * interference, and the interference terms' colour not white-balanced as the DC term is):
  * measured here within 0.007 (dielectric) and 0.013 (F0 0.9) of the reference; a thickness
  * 10% off is 0.04 and 0.07 away. */
 TEST(brdf, iridescence_airy)
 {
-    static const struct { const char *base; double f0, n2, tol; } airy_cases[] = {
-        {"base-color=0 ior=1.5", 0.04, 1.3, 0.01},
-        {"metallic=1 base-color=0.9", 0.9, 1.3, 0.02},
+    static const struct { const char *base; double f0, n2, tol; bool glass; } airy_cases[] = {
+        {"base-color=0 ior=1.5", 0.04, 1.3, 0.01, false},
+        {"metallic=1 base-color=0.9", 0.9, 1.3, 0.02, false},
+        {"transmission=1 ior=1.5", 0.04, 1.3, 0.01, true}, /* the film on glass (brdf_glass_fresnel) */
     };
     enum { ND = 76 };
     if (!open_runner())
         return;
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < 3; k++) {
         double worst = 0, at = 0, one = 1;
         int bad = 0;
         for (int j = 0; j < ND; j++) {
@@ -1183,7 +1194,7 @@ TEST(brdf, iridescence_airy)
             snprintf(params, sizeof params, "%s roughness=0 iridescence=1 iridescence-ior=%g iridescence-thickness=%g",
                      airy_cases[k].base, airy_cases[k].n2, d);
             make_setting(&(config){"gltf", params}, &s);
-            mirror_weights(&s, &one, 1, &w);
+            mirror_weights(&s, &one, 1, &w, airy_cases[k].glass);
             airy_rgb(airy_cases[k].n2, d, airy_cases[k].f0, ref);
             for (int c = 0; c < 3; c++) {
                 double e = fabs((&w.x)[c] - ref[c]);
@@ -1201,13 +1212,14 @@ TEST(brdf, iridescence_airy)
 
 /* The film's limits: thickness 0 and a film of the outside's index (1) are no film, and a
  * factor of 1 then gives the base's own f and pdf (the lobe's Schlick F and the diffuse
- * coupled to it; dielectric, metal, a mix with a specular factor; rough and smooth), over
- * random directions. */
+ * coupled to it; dielectric, metal, a mix with a specular factor; rough and smooth) and the
+ * glass's exact F (rough and smooth glass), over random directions on both sides. */
 TEST(brdf, iridescence_limits)
 {
     static const char *bases[] = {"base-color=0.8 ior=1.5 roughness=0.4", "metallic=1 base-color=0.9,0.6,0.2 roughness=0.3",
                                   "metallic=0.4 base-color=0.5,0.8,0.3 ior=1.7 specular=0.8 roughness=0.5",
-                                  "base-color=0.8 roughness=0"};
+                                  "base-color=0.8 roughness=0", "transmission=1 roughness=0.3 ior=1.5",
+                                  "transmission=1 roughness=0 ior=1.4 base-color=0.9,0.8,0.6"};
     static const char *films[] = {"iridescence-thickness=0 iridescence-ior=1.8", "iridescence-thickness=500 iridescence-ior=1"};
     enum { N = 4096 };
     if (!open_runner())
@@ -1215,7 +1227,7 @@ TEST(brdf, iridescence_limits)
     BrdfQuery *q = qbuf;
     BrdfResult *r = rbuf;
     rng_state = 10;
-    for (int k = 0; k < 4; k++)
+    for (int k = 0; k < 6; k++)
         for (int f = 0; f < 2; f++) {
             char params[256];
             brdf_setting plain, film;
@@ -1235,13 +1247,69 @@ TEST(brdf, iridescence_limits)
                 for (int c = 0; c < 3; c++) {
                     bad += fabs(x[c] - y[c]) > 1e-4 * fabs(x[c]) + 1e-7;
                     bad += fabs(xs[c] - ys[c]) > 1e-4 * fabs(xs[c]) + 1e-7;
-                    nonzero += x[c] > 0;
+                    nonzero += x[c] > 0 || xs[c] > 0;
                 }
                 bad += fabs(r[2 * i].pdf - r[2 * i + 1].pdf) > 1e-4 * r[2 * i].pdf + 1e-7;
             }
             CHECKF(bad == 0, "%s with %s: %d values differ from the base's", bases[k], films[f], bad);
             CHECKF(nonzero > N / 2, "%s: only %d non-zero values", bases[k], nonzero);
         }
+    close_runner();
+}
+
+/* The film on smooth glass (white, index 1.5): reflection and transmission share the light,
+ * R + T = 1 per channel, each the weight of its sample (u.x = 0 picks the reflection, u.x near
+ * 1 the transmission) times its probability, from outside and from inside below the critical
+ * angle; and the reflectance seen from inside at theta_i is the one from outside at the angle
+ * Snell's law pairs it with (both at the outside's cosine), for three films. */
+TEST(brdf, iridescence_glass)
+{
+    static const char *films[] = {"iridescence-thickness=250", "iridescence-thickness=600 iridescence-ior=1.8",
+                                  "iridescence=0.5 iridescence-thickness=400"};
+    static const double out_deg[] = {0, 30, 55, 75, 85};
+    enum { NA = 5 };
+    const double n = 1.5;
+    if (!open_runner())
+        return;
+    BrdfQuery *q = qbuf;
+    BrdfResult *r = rbuf;
+    for (int f = 0; f < 3; f++) {
+        char params[200];
+        brdf_setting s;
+        snprintf(params, sizeof params, "transmission=1 roughness=0 base-color=1 ior=%g iridescence=1 %s", n, films[f]);
+        make_setting(&(config){"gltf", params}, &s);
+        /* side 0: wo outside at theta_o; side 1: wo inside at theta_i, sin theta_o = n sin theta_i */
+        for (int side = 0; side < 2; side++)
+            for (int a = 0; a < NA; a++) {
+                double to = out_deg[a] * PI / 180, ti = asin(sin(to) / n);
+                vec3 wo = side ? polar(PI - ti, 0.3) : polar(to, 0.3);
+                for (int k = 0; k < 2; k++)
+                    q[(side * NA + a) * 2 + k] = query(&s, BRDF_OP_SAMPLE, wo, v3(0, 0, 1), v3(k ? 0.99999 : 0, 0.5, 0.5));
+            }
+        brdf_runner_run(&runner, q, r, 4 * NA);
+        double worst_sum = 0, worst_side = 0, spread = 0;
+        int wrong = 0;
+        for (int a = 0; a < NA; a++) {
+            double refl[2][3];
+            for (int side = 0; side < 2; side++) {
+                const BrdfResult *x = &r[(side * NA + a) * 2], *y = x + 1;
+                wrong += !(x->s_flags & BRDF_FLAG_REFLECTION) || !(y->s_flags & BRDF_FLAG_TRANSMISSION);
+                for (int c = 0; c < 3; c++) {
+                    refl[side][c] = (&x->s_weight.x)[c] * x->s_pdf;
+                    worst_sum = fmax(worst_sum, fabs(refl[side][c] + (&y->s_weight.x)[c] * y->s_pdf - 1));
+                }
+            }
+            for (int c = 0; c < 3; c++)
+                worst_side = fmax(worst_side, fabs(refl[0][c] - refl[1][c]));
+            spread = fmax(spread, fmax(fabs(refl[0][0] - refl[0][1]), fabs(refl[0][1] - refl[0][2])));
+        }
+        printf("    %s: worst |R + T - 1| %.2g, worst |R_out - R_in| %.2g, colour spread of R up to %.3f\n", films[f],
+               worst_sum, worst_side, spread);
+        CHECKF(wrong == 0, "%s: %d samples not of the part u.x picks", films[f], wrong);
+        CHECKF(worst_sum < 1e-5, "%s: R + T off 1 by %g", films[f], worst_sum);
+        CHECKF(worst_side < 1e-4, "%s: the reflectances from the two sides differ by %g", films[f], worst_side);
+        CHECKF(spread > 0.005, "%s: the film colours nothing (channels within %g)", films[f], spread);
+    }
     close_runner();
 }
 
