@@ -362,16 +362,17 @@ float medium_ior(GnMaterial m)
 
 float medium_ior_of(uint id) { return id == GN_INVALID ? 1.0 : medium_ior(material_at(id)); }
 
-// At a hit on material m (surface s) with a dielectric part: picks the path's channel at its
-// first dispersive interface (u: uniform; the throughput of the one channel times 3, its
-// selection's inverse probability) and sets b.ior to the interface's ratio (the back side's
-// medium over the front side's). Returns the medium on the far side of the interface.
+// At a hit on material m (surface s) with a dielectric part or a diffuse transmission: picks
+// the path's channel at its first dispersive interface (u: uniform; the throughput of the one
+// channel times 3, its selection's inverse probability) and sets b.ior to the interface's
+// ratio (the back side's medium over the front side's). Returns the medium on the far side of
+// the interface, which a shadow ray through it crosses.
 uint medium_interface(Surface s, GnMaterial m, inout Bsdf b, float u, inout vec3 throughput)
 {
     uint top = medium_top();
-    if (b.dielectric <= 0.0)
+    if (b.dielectric <= 0.0 && !(GN_HAS(GN_FEAT_LAYERS) && brdf_has_dt(b)))
         return top;
-    if (m.dispersion > 0.0 && channel > 2u && m.brdf == BRDF_GLTF) {
+    if (b.dielectric > 0.0 && m.dispersion > 0.0 && channel > 2u && m.brdf == BRDF_GLTF) {
         channel = min(uint(u * 3.0), 2u);
         throughput *= vec3(channel == 0u, channel == 1u, channel == 2u) * 3.0;
     }

@@ -205,8 +205,9 @@ static uint32_t material_features(const GnMaterial *m)
         }
         if (t > 0 && metal_lo < 1)
             f |= (smooth ? GN_FEAT_SMOOTH_GLASS : 0u) | (rough ? GN_FEAT_ROUGH_GLASS : 0u);
-        /* KHR_materials_volume and _dispersion act only where the glass can transmit */
-        if (t > 0 && metal_lo < 1 && (m->volume || m->dispersion > 0))
+        /* KHR_materials_volume acts only where the surface transmits (glass or a diffuse
+         * transmission), _dispersion only where it refracts */
+        if (metal_lo < 1 && ((t > 0 && (m->volume || m->dispersion > 0)) || (m->diffuse_transmission > 0 && m->volume)))
             f |= GN_FEAT_VOLUME;
         /* bsdf_layers: a coat or a sheen (their textures only scale the factors) */
         if (m->clearcoat > 0 || m->sheen_color.x > 0 || m->sheen_color.y > 0 || m->sheen_color.z > 0) {

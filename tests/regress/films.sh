@@ -6,6 +6,8 @@
 #   (a square of half-size a at distance h: the parallel-rectangle formula, computed here);
 #   it is reached only through light sampling of a light behind the surface and BSDF samples
 #   through it;
+# - a closed cube of diffuse transmission bounding a medium, an emitter inside: light sampling
+#   alone and BSDF sampling alone agree (light samples into the medium are attenuated by it);
 # - factors of 0 render bit for bit as the files without the extensions;
 # - the specialised kernel gives the unspecialised one's pixels;
 # - gonio info shows both, and neither is an unsupported extension;
@@ -58,6 +60,43 @@ scene("nodt", {})
 scene("irid", {}, {"KHR_materials_iridescence": {"iridescenceFactor": 1, "iridescenceThicknessMaximum": 350}})
 scene("irid0", {}, {"KHR_materials_iridescence": {"iridescenceFactor": 0, "iridescenceThicknessMaximum": 350}})
 scene("noirid", {}, {})
+# A closed cube of diffuse transmission (white, no reflection) bounding a medium, a small emitter
+# inside facing the camera: light reaches the camera only through the medium, by light samples
+# from the cube's faces into it and by paths that cross it.
+def cube_scene(name, volume):
+    pos = []
+    for ax in range(3):
+        for sg in (-1, 1):
+            u, v = (ax + 1) % 3, (ax + 2) % 3
+            def P(a, b):
+                q = [0.0] * 3; q[ax] = float(sg); q[u] = float(a); q[v] = float(b); return tuple(q)
+            c = [P(-1, -1), P(1, -1), P(1, 1), P(-1, 1)]
+            pos += [c[0], c[1], c[2], c[0], c[2], c[3]] if sg > 0 else [c[0], c[2], c[1], c[0], c[3], c[2]]
+    pos += quad(0.5, 0.4, False)  # the emitter at z = 0.5, facing +z
+    raw = b"".join(struct.pack("<3f", *p) for p in pos)
+    ext = {"KHR_materials_specular": {"specularFactor": 0},
+           "KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1}}
+    if volume:
+        ext["KHR_materials_volume"] = {"thicknessFactor": 2, "attenuationColor": [0.5, 0.7, 0.9], "attenuationDistance": 0.5}
+    shell = {"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0, "roughnessFactor": 1},
+             "extensions": ext}
+    emitter = {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [1, 1, 1],
+               "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}}
+    d = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
+         "buffers": [{"byteLength": len(raw), "uri": "data:application/octet-stream;base64," + base64.b64encode(raw).decode()}],
+         "bufferViews": [{"buffer": 0, "byteLength": 36 * 12}, {"buffer": 0, "byteOffset": 36 * 12, "byteLength": 72}],
+         "accessors": [{"bufferView": 0, "componentType": 5126, "count": 36, "type": "VEC3", "min": [-1] * 3, "max": [1] * 3},
+                       {"bufferView": 1, "componentType": 5126, "count": 6, "type": "VEC3",
+                        "min": [-0.4, -0.4, 0.5], "max": [0.4, 0.4, 0.5]}],
+         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]},
+                    {"primitives": [{"attributes": {"POSITION": 1}, "material": 1}]}],
+         "materials": [shell, emitter],
+         "cameras": [{"type": "orthographic", "orthographic": {"xmag": 0.3, "ymag": 0.3, "znear": 0.01, "zfar": 100}}],
+         "nodes": [{"mesh": 0}, {"mesh": 1}, {"camera": 0, "translation": [0, 0, 5]}]}
+    d["extensionsUsed"] = sorted({e for m in d["materials"] for e in m.get("extensions", {})})
+    json.dump(d, open("%s/%s.gltf" % (out, name), "w"))
+cube_scene("dtvol", True)
+cube_scene("dtnovol", False)
 X = Y = A / H
 f = lambda x, y: (x / math.sqrt(1 + x * x) * math.atan(y / math.sqrt(1 + x * x)) +
                   y / math.sqrt(1 + y * y) * math.atan(x / math.sqrt(1 + y * y))) / (2 * math.pi)
@@ -87,6 +126,21 @@ for st in light bsdf; do
     got=($(means "$tmp/dt-$st.exr"))
     check "  channel 0: ${got[0]} vs ${ref[0]}" near "${got[0]}" "${ref[0]}" 1e-2
 done
+# A medium behind diffuse transmission: a light sample into it is attenuated as a path through
+# it is, so light sampling alone and BSDF sampling alone agree (without the medium on the light
+# sample's side, light sampling alone is brighter), and the medium darkens the cube.
+check "info: the cube of diffuse transmission bounds a medium" sh -c "'$G' info '$tmp/dtvol.gltf' | grep -q 'medium 0'"
+for st in light bsdf; do
+    check "cube with a medium, $st sampling alone: render" "$G" render "$tmp/dtvol.gltf" -o "$tmp/dtvol-$st.exr" \
+        --env 0 --quiet --spp 512 --size 16x16 --estimator $st
+done
+check "cube without the medium: render" "$G" render "$tmp/dtnovol.gltf" -o "$tmp/dtnovol.exr" --env 0 --quiet --spp 64 --size 16x16
+gl=($(means "$tmp/dtvol-light.exr")) gb=($(means "$tmp/dtvol-bsdf.exr")) gn=($(means "$tmp/dtnovol.exr"))
+for k in 0 1 2; do
+    check "  channel $k: light sampling ${gl[$k]} = BSDF sampling ${gb[$k]}" near "${gl[$k]}" "${gb[$k]}" 0.03
+done
+check "  the medium darkens red (${gb[0]}) below half of no medium's (${gn[0]})" \
+    python3 -c "import sys; sys.exit(0 if ${gb[0]} < 0.5 * ${gn[0]} else 1)"
 for s in dt0 nodt irid0 noirid; do
     "$G" render "$tmp/$s.gltf" -o "$tmp/$s.exr" $P || fail "render $s"
 done
