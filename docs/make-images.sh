@@ -47,6 +47,8 @@ ball iridescence gltf --base-color 0.5 --metallic 1 --roughness 0.25 --iridescen
     --iridescence-ior 1.33
 ball diffuse-transmission gltf --base-color 0.3,0.6,0.2 --roughness 0.5 --diffuse-transmission 0.8 \
     --diffuse-transmission-color 0.9,0.8,0.3
+ball clearcoat gltf --base-color 0.6,0.05,0.05 --metallic 0 --roughness 0.6 --clearcoat 1 --clearcoat-roughness 0.05
+ball sheen gltf --base-color 0.1,0.1,0.35 --roughness 0.8 --sheen-color 0.9,0.7,0.9 --sheen-roughness 0.4
 
 # ---- docs/shading.md ----------------------------------------------------------------------
 # The OpenGL 1.x teapot in all four modes (path is skipped while unavailable), 320x240.
