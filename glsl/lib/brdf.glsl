@@ -618,7 +618,7 @@ vec2 brdf_dt_weights(Bsdf b, vec3 wo)
     vec3 t = 1.0 - brdf_fresnel_schlick(abs(wo.z), b.couple_f0, b.couple_f90);
     vec3 r = wo.z > 0.0 ? b.diffuse * t : vec3(0.0);
     t *= b.dt;
-    return vec2(r.r + r.g + r.b, t.r + t.g + t.b) / 3.0;
+    return vec2(brdf_mean(r), brdf_mean(t));
 }
 
 // The probability that the diffuse part samples the far side.
