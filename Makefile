@@ -194,8 +194,8 @@ fuzz-run: fuzz all test-deps
 	@GONIO=$(GONIO) FUZZ_TIME=$(FUZZ_TIME) tests/fuzz/run.sh $(FUZZ_TARGETS)
 
 # The figures of docs/ (docs/make-images.sh lists them).
-docs-images: all
-	GONIO=$(GONIO) docs/make-images.sh
+docs-images: all $(TESTTOOL)
+	GONIO=$(GONIO) TESTTOOL=$(TESTTOOL) docs/make-images.sh
 
 # The man page is help2man's reading of every command's --help (docs/make-man.sh).
 $(BUILD)/gonio.1: $(GONIO) docs/make-man.sh

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # make-images.sh: regenerates every figure in docs/img (make docs-images): the BRDF lobe
 # plots and material balls of docs/brdf.md section 6, the shading comparison and sweep of
-# docs/shading.md, and the path-traced scenes of docs/path-tracing.md (the glTF sample
+# docs/shading.md, the path-traced scenes of docs/path-tracing.md and its pictures of the glTF
+# extensions' test scenes (tests/regress writes them; the glTF sample
 # models are skipped when $GONIO_ASSETS is absent). Environment: GONIO (the program;
-# default build/gonio), GONIO_ASSETS (default ../shared/assets).
+# default build/gonio), TESTTOOL (default: testtool beside it), GONIO_ASSETS (default
+# ../shared/assets).
 set -eu
 cd "$(dirname "$0")/.."
 G=${GONIO:-build/gonio}
@@ -11,6 +13,8 @@ img=docs/img
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 mkdir -p $img
+font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf # fonts-dejavu-core; ImageMagick's default may be absent
+label_font=$( [ -f $font ] && echo "-font $font" )
 
 # ---- docs/brdf.md -------------------------------------------------------------------------
 "$G" brdf lambert --theta 30 -o $img/brdf-lambert.png
@@ -67,10 +71,10 @@ cp "$tmp/sweep/sweep.csv" $img/shading-sweep.csv
 
 # glass, metals and a textured model under a sky: a lat-long map made here (blue zenith to a
 # white horizon, a dark ground), rendered from the glTF sample models in place.
+convert -size 512x128 gradient:'#5a8ee0'-'#f0f0ff' \( -size 512x128 gradient:'#505048'-'#100c08' \) \
+    -append "$tmp/sky.exr"
 assets=${GONIO_ASSETS:-../shared/assets}/gltf
 if [ -d "$assets" ]; then
-    convert -size 512x128 gradient:'#5a8ee0'-'#f0f0ff' \( -size 512x128 gradient:'#505048'-'#100c08' \) \
-        -append "$tmp/sky.exr"
     sky() { # sky MODEL OUT.png [OPTIONS...]
         local model=$1 out=$2; shift 2
         "$G" render "$assets/$model/glTF/$model.gltf" --env "$tmp/sky.exr" -o "$tmp/sky-render.exr" \
@@ -89,8 +93,63 @@ if [ -d "$assets" ]; then
         "$G" render "$f" --png "$tmp/sample-$m.png" --size 160x160 --spp 64 --quiet
         tiles+=(-label "$m" "$tmp/sample-$m.png")
     done
-    font=/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf # fonts-dejavu-core; ImageMagick's default may be absent
-    montage "${tiles[@]}" $( [ -f $font ] && echo -font $font ) -tile 5x -geometry +2+2 -pointsize 11 \
+    montage "${tiles[@]}" $label_font -tile 5x -geometry +2+2 -pointsize 11 \
         -background white "$tmp/samples.png"
     convert "$tmp/samples.png" -quality 85 $img/samples.jpg
 fi
+
+# ---- docs/path-tracing.md: the glTF extensions' test scenes ----------------------------
+# The scenes that tests/regress/{textures,gltf_ext,volume}.sh write (the suites run here with
+# TEST_TMP, which keeps them), rendered larger: what each check looks at.
+t=$tmp/tests
+mkdir -p "$t"
+export GONIO=$(realpath "$G")
+export TESTTOOL=$(realpath "${TESTTOOL:-$(dirname "$GONIO")/testtool}")
+for s in textures gltf_ext volume; do
+    TEST_TMP=$t tests/regress/$s.sh >"$t/$s.log" 2>&1 || { cat "$t/$s.log"; exit 1; }
+done
+tile=() # tile LABEL SCENE [RENDER OPTIONS...]: one labelled picture of a test scene
+tile() {
+    local label=$1 scene=$2; shift 2
+    "$G" render "$t/$scene" -o "$tmp/tile.exr" --png "$tmp/tile-${#tiles[@]}.png" --quiet "$@"
+    tiles+=(-label "$label" "$tmp/tile-${#tiles[@]}.png")
+}
+sheet() { # sheet OUT.png COLUMNS: the tiles so far, then none
+    montage "${tiles[@]}" $label_font -tile $2x -geometry +2+2 -pointsize 10 -background white $img/$1
+    tiles=()
+}
+A="--mode albedo --spp 1 --size 120x120"
+tiles=()
+tile "no transform" textures/plain.gltf $A
+tile "offset 0.25, -0.5" textures/offset.gltf $A
+tile "scale 2, 0.5" textures/scale.gltf $A
+tile "rotation 30 deg" textures/rotation.gltf $A
+tile "all three" textures/all.gltf $A
+tile "TEXCOORD_1" textures/uv1.gltf $A
+tile "transform texCoord 1" textures/uv1tt.gltf $A
+tile "REPEAT" textures/repeat.gltf $A
+tile "MIRRORED_REPEAT" textures/mirror.gltf $A
+tile "CLAMP_TO_EDGE" textures/clamp.gltf $A
+tile "CLAMP S, MIRROR T" textures/mixed.gltf $A
+tile "magFilter LINEAR" textures/linear.gltf $A
+sheet gltf-textures.png 6
+tile "float" textures/float_q.gltf $A
+tile "quantized" textures/quant.gltf $A
+tile "float normals" textures/nfloat.gltf --mode normal --spp 1 --size 120x120
+tile "byte normals" textures/nquant.gltf --mode normal --spp 1 --size 120x120
+sheet gltf-quantization.png 4
+C="--spp 64 --size 160x120"
+tile "teapot" gltf_ext/teapot.gltf $C
+tile "Draco" gltf_ext/teapot-draco.gltf $C
+tile "meshopt" gltf_ext/teapot-meshopt.gltf $C
+tile "variants: default" gltf_ext/variants.gltf $C
+tile "--variant green_left" gltf_ext/variants.gltf $C --variant green_left
+sheet gltf-compression-variants.png 5
+V="--camera frame --env $tmp/sky.exr --spp 128 --size 144x144"
+tile "slab, index 1.5" volume/slab15.gltf $V
+tile "liquid in glass" volume/nested.gltf $V
+tile "touching media" volume/touching.gltf $V
+D="--env 0 --spp 512 --size 144x144"
+tile "glass, no dispersion" volume/nodisp.gltf $D
+tile "dispersion 1 (Abbe 20)" volume/disp1.gltf $D
+sheet gltf-volume.png 5
