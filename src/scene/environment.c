@@ -22,10 +22,13 @@ int env_parse_option(env_option *e, const char *cmd, const char *opt, const char
     if (!strcmp(opt, "--env")) {
         e->given = true;
         e->path = NULL;
+        e->studio = !strcmp(val, "studio");
+        if (e->studio)
+            return 1;
         if (util_has_suffix(val, ".exr") || util_has_suffix(val, ".hdr"))
             e->path = val;
         else if (!util_parse_rgb(val, e->color) || e->color[0] > ENV_MAX || e->color[1] > ENV_MAX || e->color[2] > ENV_MAX)
-            return cli_usage_error(cmd, "--env '%s': expected R,G,B or one value in [0, %g], FILE.exr or FILE.hdr",
+            return cli_usage_error(cmd, "--env '%s': expected R,G,B or one value in [0, %g], FILE.exr, FILE.hdr or studio",
                                    val, ENV_MAX);
         return 1;
     }
@@ -201,17 +204,17 @@ bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_se
     memset(map, 0, sizeof *map);
     s->env_map = NULL;
     s->env_rotation = e->rotation;
-    if (e->given && !e->path) {
+    if (e->given && !e->path && !e->studio) {
         for (int k = 0; k < 3; k++)
             mean[k] = s->env[k] = e->color[k] * scale;
     } else if (e->given || !env_scene_has_light(sc)) {
-        if (e->given) {
+        if (e->path) {
             bool ok = util_has_suffix(e->path, ".hdr") ? environment_read_hdr(map, e->path) : image_read_exr(map, e->path);
             if (!ok)
                 return false;
         } else {
             *studio_used = true;
-            if (!quiet)
+            if (!quiet && !e->studio)
                 util_info("%s has no lights: lit by gonio's studio environment (--env 0 for black)", sc->path);
             if (local) {
                 /* The local modes see the studio as its key light plus the mean of the rest. */

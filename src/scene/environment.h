@@ -19,6 +19,7 @@
 typedef struct env_option {
     bool given;              /* --env was on the command line */
     const char *path;        /* a map (.exr or .hdr), else NULL: the constant `color` */
+    bool studio;             /* --env studio: gonio's studio, whatever lights the scene has */
     float color[3];
     float rotation;          /* degrees about +Y, right-handed (--env-rotate) */
     float intensity;         /* scale of the radiance (--env-intensity); 0 means 1 */
@@ -33,7 +34,9 @@ typedef struct env_option {
     {NULL, NULL,                                                                               \
      "  --env FILE          a lat-long HDR environment map, OpenEXR (.exr) or Radiance (.hdr),\n" \
      "                      +Y up; importance sampled by the path tracer, its mean radiance is\n" \
-     "                      the local modes' ambient light\n",                                 \
+     "                      the local modes' ambient light\n"                                  \
+     "  --env studio        gonio's studio environment besides the scene's own lights (as model\n" \
+     "                      viewers light a scene that has only punctual lights)\n",            \
      CLI_TEXT, NULL, 0, 0, NULL, NULL},                                                        \
     {"--env-rotate", "DEG", "turn the environment about +Y (right-handed, default 0)",        \
      CLI_CALL, CLI_AS(env_option, env), 0, 0, NULL, env_take_option},                                            \

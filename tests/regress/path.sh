@@ -171,4 +171,35 @@ check_fails "merge -o x.png" 2 "$G" merge "$tmp/a.exr" "$tmp/b.exr" -o "$tmp/x.p
 check "merge --half --compression piz" "$G" merge "$tmp/a.exr" "$tmp/b.exr" -o "$tmp/mh.exr" --half --compression piz
 check "... half channels, piz" sh -c "exrheader '$tmp/mh.exr' | grep -q 'R, 16-bit floating' && exrheader '$tmp/mh.exr' | grep -q '^compression (type compression): piz'"
 check "... the same image to half precision" "$G" diff "$tmp/mh.exr" "$tmp/m.exr" --max-rel-bias 1e-3 --quiet
+# --env studio: gonio's studio besides the scene's own lights. Light adds up, so the teapot
+# with its sun and the studio has, channel by channel, the mean of the teapot with its sun
+# plus that of the teapot without it (which the studio lights by default).
+python3 - scenes/teapot.gltf "$tmp/sunless.gltf" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+for n in d["nodes"]:
+    n.pop("extensions", None)
+d.pop("extensions", None)
+d["extensionsUsed"] = [e for e in d.get("extensionsUsed", []) if e != "KHR_lights_punctual"]
+json.dump(d, open(sys.argv[2], "w"))
+PY
+S="--camera 0 --size 48x36 --spp 64 --quiet"
+check "--env studio: render" "$G" render scenes/teapot.gltf -o "$tmp/st-both.exr" $S --env studio
+check "... its own lights alone" "$G" render scenes/teapot.gltf -o "$tmp/st-sun.exr" $S
+check_fails "... the scene without its lights" 0 "$G" render "$tmp/sunless.gltf" -o "$tmp/st-studio.exr" --camera 0 --size 48x36 --spp 64
+check "... which the studio lights by default" grep -q "has no lights: lit by gonio's studio" "$tmp/last"
+check "... the studio adds to the scene's lights" python3 -c "
+import subprocess, sys
+m = lambda f: [float(x) for x in subprocess.check_output(['$TESTTOOL', 'rgb', f]).split()[1:4]]
+both, sun, studio = m('$tmp/st-both.exr'), m('$tmp/st-sun.exr'), m('$tmp/st-studio.exr')
+print('both', both, 'sun + studio', [a + b for a, b in zip(sun, studio)], 'studio', studio)
+sys.exit(0 if all(abs(b - (s + t)) <= 0.03 * (s + t) and t > 0.2 * s for b, s, t in zip(both, sun, studio)) else 1)"
+check_fails "--env studio --env-intensity 2: render" 0 "$G" render scenes/teapot.gltf -o "$tmp/st-2.exr" $S --env studio --env-intensity 2
+check "... no studio announcement when asked for" sh -c "! grep -q 'lit by gonio' '$tmp/last'"
+check "... twice the studio's share" python3 -c "
+import subprocess, sys
+m = lambda f: [float(x) for x in subprocess.check_output(['$TESTTOOL', 'rgb', f]).split()[1:4]]
+two, sun, studio = m('$tmp/st-2.exr'), m('$tmp/st-sun.exr'), m('$tmp/st-studio.exr')
+print('intensity 2', two, 'sun + 2 studio', [a + 2 * b for a, b in zip(sun, studio)])
+sys.exit(0 if all(abs(w - (s + 2 * t)) <= 0.03 * (s + 2 * t) for w, s, t in zip(two, sun, studio)) else 1)"
 finish
