@@ -108,8 +108,7 @@ export TESTTOOL=$(realpath "${TESTTOOL:-$(dirname "$GONIO")/testtool}")
 for s in textures gltf_ext volume; do
     TEST_TMP=$t tests/regress/$s.sh >"$t/$s.log" 2>&1 || { cat "$t/$s.log"; exit 1; }
 done
-tile=() # tile LABEL SCENE [RENDER OPTIONS...]: one labelled picture of a test scene
-tile() {
+tile() { # tile LABEL SCENE [RENDER OPTIONS...]: one labelled picture of a test scene
     local label=$1 scene=$2; shift 2
     "$G" render "$t/$scene" -o "$tmp/tile.exr" --png "$tmp/tile-${#tiles[@]}.png" --quiet "$@"
     tiles+=(-label "$label" "$tmp/tile-${#tiles[@]}.png")
@@ -118,7 +117,7 @@ sheet() { # sheet OUT.png COLUMNS: the tiles so far, then none
     montage "${tiles[@]}" $label_font -tile $2x -geometry +2+2 -pointsize 10 -background white $img/$1
     tiles=()
 }
-A="--mode albedo --spp 1 --size 120x120"
+A="--mode albedo --spp 1 --size 120x120" N="--mode normal --spp 1 --size 120x120"
 tiles=()
 tile "no transform" textures/plain.gltf $A
 tile "offset 0.25, -0.5" textures/offset.gltf $A
@@ -135,8 +134,8 @@ tile "magFilter LINEAR" textures/linear.gltf $A
 sheet gltf-textures.png 6
 tile "float" textures/float_q.gltf $A
 tile "quantized" textures/quant.gltf $A
-tile "float normals" textures/nfloat.gltf --mode normal --spp 1 --size 120x120
-tile "byte normals" textures/nquant.gltf --mode normal --spp 1 --size 120x120
+tile "float normals" textures/nfloat.gltf $N
+tile "byte normals" textures/nquant.gltf $N
 sheet gltf-quantization.png 4
 C="--spp 64 --size 160x120"
 tile "teapot" gltf_ext/teapot.gltf $C

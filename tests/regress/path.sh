@@ -188,18 +188,19 @@ check "--env studio: render" "$G" render scenes/teapot.gltf -o "$tmp/st-both.exr
 check "... its own lights alone" "$G" render scenes/teapot.gltf -o "$tmp/st-sun.exr" $S
 check_fails "... the scene without its lights" 0 "$G" render "$tmp/sunless.gltf" -o "$tmp/st-studio.exr" --camera 0 --size 48x36 --spp 64
 check "... which the studio lights by default" grep -q "has no lights: lit by gonio's studio" "$tmp/last"
-check "... the studio adds to the scene's lights" python3 -c "
+# adds_up K IMAGE: IMAGE's channel means are the sun's plus K times the studio's, to 3%,
+# and the studio's share is no trace (above a fifth of the sun's)
+adds_up() {
+    python3 -c "
 import subprocess, sys
 m = lambda f: [float(x) for x in subprocess.check_output(['$TESTTOOL', 'rgb', f]).split()[1:4]]
-both, sun, studio = m('$tmp/st-both.exr'), m('$tmp/st-sun.exr'), m('$tmp/st-studio.exr')
-print('both', both, 'sun + studio', [a + b for a, b in zip(sun, studio)], 'studio', studio)
-sys.exit(0 if all(abs(b - (s + t)) <= 0.03 * (s + t) and t > 0.2 * s for b, s, t in zip(both, sun, studio)) else 1)"
+k, got, sun, studio = $1, m('$2'), m('$tmp/st-sun.exr'), m('$tmp/st-studio.exr')
+want = [s + k * t for s, t in zip(sun, studio)]
+print('got', got, 'sun + %g studio' % k, want, 'studio', studio)
+sys.exit(0 if all(abs(g - w) <= 0.03 * w and t > 0.2 * s for g, w, s, t in zip(got, want, sun, studio)) else 1)"
+}
+check "... the studio adds to the scene's lights" adds_up 1 "$tmp/st-both.exr"
 check_fails "--env studio --env-intensity 2: render" 0 "$G" render scenes/teapot.gltf -o "$tmp/st-2.exr" $S --env studio --env-intensity 2
 check "... no studio announcement when asked for" sh -c "! grep -q 'lit by gonio' '$tmp/last'"
-check "... twice the studio's share" python3 -c "
-import subprocess, sys
-m = lambda f: [float(x) for x in subprocess.check_output(['$TESTTOOL', 'rgb', f]).split()[1:4]]
-two, sun, studio = m('$tmp/st-2.exr'), m('$tmp/st-sun.exr'), m('$tmp/st-studio.exr')
-print('intensity 2', two, 'sun + 2 studio', [a + 2 * b for a, b in zip(sun, studio)])
-sys.exit(0 if all(abs(w - (s + 2 * t)) <= 0.03 * (s + 2 * t) for w, s, t in zip(two, sun, studio)) else 1)"
+check "... twice the studio's share" adds_up 2 "$tmp/st-2.exr"
 finish
