@@ -1,5 +1,7 @@
 /* cli.c: option helpers shared by the subcommands. */
 #include <assert.h>
+#include <float.h>
+#include <limits.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -48,6 +50,15 @@ static int bad_value(const cli_command *c, const char *opt, const char *val, con
     return cli_usage_error(c->name, "%s '%s': expected %s", opt, val, expect);
 }
 
+/* A number outside an option's range: the message gives the range ("(0, 1e+06]": more
+ * than 0; "[0, 1e+09]": 0 to 1e9, both included). */
+static int out_of_range(const cli_command *c, const cli_option *o, const char *opt, const char *val)
+{
+    const bool open_low = o->kind == CLI_FLOAT || o->kind == CLI_DOUBLE ? o->min == FLT_MIN : false;
+    return cli_usage_error(c->name, "%s '%s': out of range: must be in %s%.10g, %.10g]", opt, val,
+                           open_low ? "(" : "[", open_low ? 0.0 : o->min, o->max);
+}
+
 /* Stores val in option o's destination; -1 ok, else 2 after a usage error. */
 static int take_value(const cli_command *c, const cli_option *o, const char *opt, const char *val)
 {
@@ -60,7 +71,8 @@ static int take_value(const cli_command *c, const cli_option *o, const char *opt
     case CLI_INT:
     case CLI_U32:
         if (!util_parse_int(val, (long)o->min, (long)o->max, &v))
-            return bad_value(c, opt, val, o->expect);
+            return util_parse_int(val, LONG_MIN, LONG_MAX, &v) ? out_of_range(c, o, opt, val)
+                                                                : bad_value(c, opt, val, o->expect);
         if (o->kind == CLI_INT)
             *(int *)o->dest = (int)v;
         else
@@ -68,8 +80,10 @@ static int take_value(const cli_command *c, const cli_option *o, const char *opt
         return -1;
     case CLI_FLOAT:
     case CLI_DOUBLE:
-        if (!util_parse_float(val, &f) || !(f >= o->min && f <= o->max))
+        if (!util_parse_float(val, &f))
             return bad_value(c, opt, val, o->expect);
+        if (!(f >= o->min && f <= o->max))
+            return out_of_range(c, o, opt, val);
         if (o->kind == CLI_FLOAT)
             *(float *)o->dest = f;
         else

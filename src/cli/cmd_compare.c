@@ -181,11 +181,12 @@ typedef struct compare_row {
 
 static bool write_metrics(const char *path, const compare_row *rows, int n, bool print)
 {
-    char tmp[4200];
+    util_out out;
     FILE *f;
-    bool ok;
-    if (!(f = util_tmp_open(tmp, sizeof tmp, path, "w")))
+    if (!util_out_open(&out, path))
         return false;
+    if (!(f = util_out_file(&out)))
+        return util_out_commit(&out, false);
     fprintf(f, "mode,reference,rmse,rel_bias,max_err\n");
     if (print)
         printf("%-8s %-9s %10s %10s %10s\n", "mode", "reference", "rmse", "rel_bias", "max_err");
@@ -196,8 +197,7 @@ static bool write_metrics(const char *path, const compare_row *rows, int n, bool
         if (print)
             printf("%-8s %-9s %10.5f %+10.4f %10.4f\n", a, b, m->rmse, m->rel_bias, m->max_err);
     }
-    ok = fclose(f) == 0;
-    return util_commit_file(tmp, path, ok);
+    return util_out_commit(&out, true);
 }
 
 static bool run_compare(renderer *r, const compare_opts *o)
@@ -368,11 +368,12 @@ static bool write_sweep_plot(const char *path, const sweep_row *rows, int n)
 
 static bool write_sweep_csv(const char *path, const sweep_row *rows, int n, bool print)
 {
-    char tmp[4200];
+    util_out out;
     FILE *f;
-    bool ok;
-    if (!(f = util_tmp_open(tmp, sizeof tmp, path, "w")))
+    if (!util_out_open(&out, path))
         return false;
+    if (!(f = util_out_file(&out)))
+        return util_out_commit(&out, false);
     fprintf(f, "level,triangles,gouraud_rmse,gouraud_rel_bias,gouraud_max_err,"
                "flat_rmse,flat_rel_bias,flat_max_err\n");
     if (print)
@@ -387,8 +388,7 @@ static bool write_sweep_csv(const char *path, const sweep_row *rows, int n, bool
             printf("%5d %9u %12.6f %12.6f %12.4f\n", s->level, s->triangles, s->gouraud.rmse,
                    s->flat.rmse, s->gouraud.max_err);
     }
-    ok = fclose(f) == 0;
-    return util_commit_file(tmp, path, ok);
+    return util_out_commit(&out, true);
 }
 
 /* The teapot at each level through `gonio teapot` (into DIR, removed once loaded). */

@@ -51,6 +51,28 @@ static bool overlap(const image *a, const image *b)
            b->y0 < a->y0 + a->height;
 }
 
+/* Every value of the channels that are merged is finite: a NaN or Inf would spread into the
+ * result unseen. False, with an error naming the file, channel, pixel and count, if not. */
+static bool finite_pixels(const char *path, const image *img)
+{
+    for (int c = 0; c < img->num_channels; c++) {
+        const size_t n = (size_t)img->width * (size_t)img->height;
+        size_t bad = 0, first = 0;
+        if (is_sum(img->names[c]))
+            continue;
+        for (size_t p = 0; p < n; p++)
+            if (!isfinite(img->planes[c][p]) && bad++ == 0)
+                first = p;
+        if (bad) {
+            util_error("%s: channel '%s' has %zu NaN or infinite value(s), the first at pixel (%d, %d); "
+                       "a render writes none", path, img->names[c], bad, img->x0 + (int)(first % (size_t)img->width),
+                       img->y0 + (int)(first / (size_t)img->width));
+            return false;
+        }
+    }
+    return true;
+}
+
 /* The file's sample count: a finite positive integer no larger than INT32_MAX. */
 static bool read_spp(const char *path, int64_t *out)
 {
@@ -209,6 +231,14 @@ int cmd_merge(int argc, char **argv)
         double s;
         if (!image_read_exr(&imgs[i], inputs[i]) || !read_spp(inputs[i], &spp[i]))
             goto done;
+        if (!image_inside_frame(&imgs[i])) {
+            util_error("%s: its data window (%d,%d)+%dx%d lies outside its %dx%d display window: not a tile "
+                       "of a render", inputs[i], imgs[i].x0, imgs[i].y0, imgs[i].width, imgs[i].height,
+                       imgs[i].full_width, imgs[i].full_height);
+            goto done;
+        }
+        if (!finite_pixels(inputs[i], &imgs[i]))
+            goto done;
         if (frame_width(&imgs[i]) != frame_width(&imgs[0]) || frame_height(&imgs[i]) != frame_height(&imgs[0]) ||
             pixel_channels(&imgs[i]) != pixel_channels(&imgs[0])) {
             util_error("%s: a %dx%d frame with %d channels, but %s is %dx%d with %d", inputs[i],
@@ -234,18 +264,29 @@ int cmd_merge(int argc, char **argv)
             goto done;
         }
     }
-    /* A seed may repeat in tiles that do not overlap; in overlapping ones its samples repeat. */
-    for (int a = 0; a < seeds.count; a++)
-        for (int b = 0; b < a; b++)
-            if (seeds.seed[a] == seeds.seed[b] && overlap(&imgs[seeds.file[a]], &imgs[seeds.file[b]])) {
-                if (!force) {
-                    util_error("%s and %s: both have seed %u: its samples repeat and add no information "
-                               "(--force merges anyway)", inputs[seeds.file[b]], inputs[seeds.file[a]], seeds.seed[a]);
-                    goto done;
+    /* A seed may repeat in tiles that do not overlap; in overlapping ones its samples repeat.
+     * With --force, one warning for all the repeats, not one per pair. */
+    {
+        long repeats = 0;
+        int fa = 0, fb = 0;
+        uint32_t first_seed = 0;
+        for (int a = 0; a < seeds.count; a++)
+            for (int b = 0; b < a; b++)
+                if (seeds.seed[a] == seeds.seed[b] && overlap(&imgs[seeds.file[a]], &imgs[seeds.file[b]]) &&
+                    repeats++ == 0) {
+                    fa = seeds.file[b];
+                    fb = seeds.file[a];
+                    first_seed = seeds.seed[a];
                 }
-                util_warn("%s and %s: both have seed %u (merged: --force)", inputs[seeds.file[b]],
-                          inputs[seeds.file[a]], seeds.seed[a]);
-            }
+        if (repeats && !force) {
+            util_error("%s and %s: both have seed %u: its samples repeat and add no information "
+                       "(--force merges anyway)", inputs[fa], inputs[fb], first_seed);
+            goto done;
+        }
+        if (repeats)
+            util_warn("%ld pair(s) of overlapping inputs share a seed, the first %s and %s (seed %u): merged "
+                      "(--force)", repeats, inputs[fa], inputs[fb], first_seed);
+    }
 
     {
         const char *names[IMAGE_MAX_CHANNELS];

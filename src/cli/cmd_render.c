@@ -37,16 +37,47 @@ static void on_signal(int sig)
         return;
 }
 
-/* A file-name pattern with exactly one %d, %Nd or %0Nd and no other '%'. */
-static bool frame_pattern(const char *p)
+/* --frames' file-name patterns: exactly one %d, %Nd or %0Nd, N at most FRAME_WIDTH_MAX, and
+ * no other '%'. */
+#define FRAME_WIDTH_MAX 16
+
+static bool frame_pattern(const char *p, const char *opt)
 {
-    const char *c = strchr(p, '%');
+    const char *c = strchr(p, '%'), *digits;
     if (!c)
-        return false;
-    c++;
-    while (*c >= '0' && *c <= '9')
+        return cli_usage_error("render", "%s '%s': with --frames, a pattern with one %%d (e.g. frame_%%04d.exr)",
+                               opt, p), false;
+    digits = ++c;
+    if (*c == '0')
         c++;
-    return *c == 'd' && !strchr(c, '%');
+    while (*c >= '0' && *c <= '9' && c - digits <= 3)
+        c++;
+    if (*c >= '0' && *c <= '9')
+        return cli_usage_error("render", "%s '%s': the width of the frame number is too large (at most %d)", opt,
+                               p, FRAME_WIDTH_MAX), false;
+    if (*c != 'd' || strchr(c, '%'))
+        return cli_usage_error("render", "%s '%s': with --frames, a pattern with one %%d, %%Nd or %%0Nd and no "
+                               "other %% (e.g. frame_%%04d.exr)", opt, p), false;
+    if (c > digits && atoi(digits) > FRAME_WIDTH_MAX)
+        return cli_usage_error("render", "%s '%s': the width of the frame number is too large (at most %d)", opt,
+                               p, FRAME_WIDTH_MAX), false;
+    return true;
+}
+
+/* The name of frame f of a checked pattern, into out (PATH_MAX bytes); false when it does
+ * not fit or no longer names the pattern's format. */
+static bool frame_name(const char *pattern, long f, const char *opt, char *out, size_t cap)
+{
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+    int n = snprintf(out, cap, pattern, (int)f); /* checked: frame_pattern */
+#pragma GCC diagnostic pop
+    if (n < 0 || (size_t)n >= cap)
+        return cli_usage_error("render", "%s '%s': frame %ld's name is too long", opt, pattern, f), false;
+    if (image_format_of(out) != image_format_of(pattern))
+        return cli_usage_error("render", "%s '%s': frame %ld's name '%s' does not end in the pattern's extension",
+                               opt, pattern, f, out), false;
+    return true;
 }
 
 /* --crop X0,Y0,X1,Y1: pixels, or fractions when any value has a '.'. */
@@ -99,6 +130,60 @@ static bool apply_crop(const crop_option *c, render_settings *s, const char *val
     return true;
 }
 
+/* The sums of a --resumable file are trusted only as far as they are what a render writes:
+ * each sum.* and sum2.* channel stored as 32-bit float, every value finite, sum.N (each
+ * pixel's sample count) the header's spp everywhere, each pixel's coverage sum.A a whole
+ * number from 0 to spp, the sums of depth, albedo and squares (and of radiance, in path
+ * mode) not negative, of normals within +-spp. False with an error naming the first
+ * problem: the channel, the pixel and the value. */
+static bool check_sums(const char *path, const image *prev, int spp, uint32_t mode)
+{
+    const size_t n = (size_t)prev->width * (size_t)prev->height;
+    const int cn = image_channel(prev, "sum.N");
+    if (cn < 0) {
+        util_error("%s: cannot resume: no sum.N channel (each pixel's sample count; written by "
+                   "--resumable since this version: render it again)", path);
+        return false;
+    }
+    for (int c = 0; c < prev->num_channels; c++) {
+        const char *name = prev->names[c];
+        const float *v = prev->planes[c];
+        const bool nonneg = !strcmp(name, "sum.A") || !strcmp(name, "sum.depth.Z") ||
+                            !strncmp(name, "sum.albedo.", 11) || !strncmp(name, "sum2.", 5) ||
+                            (mode == GN_MODE_PATH && (!strcmp(name, "sum.R") || !strcmp(name, "sum.G") ||
+                                                      !strcmp(name, "sum.B")));
+        const bool unit = !strncmp(name, "sum.normal.", 11), coverage = !strcmp(name, "sum.A");
+        if (strncmp(name, "sum.", 4) && strncmp(name, "sum2.", 5))
+            continue;
+        if (prev->stored[c] != IMAGE_STORED_FLOAT) {
+            util_error("%s: cannot resume: channel '%s' is stored as %s; the sums are 32-bit float", path, name,
+                       prev->stored[c] == IMAGE_STORED_HALF ? "16-bit half" : "unsigned int");
+            return false;
+        }
+        for (size_t p = 0; p < n; p++) {
+            const char *why = !isfinite(v[p])                ? "not finite"
+                              : c == cn && v[p] != (float)spp ? "the header's gonio:spp is %d"
+                              : nonneg && v[p] < 0            ? "negative"
+                              : coverage && (v[p] > spp || v[p] != floorf(v[p]))
+                                  ? "not a whole number of samples from 0 to gonio:spp (%d)"
+                              : unit && fabsf(v[p]) > spp ? "beyond gonio:spp (%d) samples of a unit vector"
+                                                          : NULL;
+            if (why) {
+                char text[128];
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+                snprintf(text, sizeof text, why, spp); /* one of the literals above */
+#pragma GCC diagnostic pop
+                util_error("%s: cannot resume: channel '%s' at pixel (%d, %d) is %g: %s", path, name,
+                           prev->x0 + (int)(p % (size_t)prev->width), prev->y0 + (int)(p / (size_t)prev->width),
+                           (double)v[p], text);
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
 /* --resume FILE: the file must be an earlier render of exactly this one (identity, seed,
  * region) with fewer samples and the sums; loads it into *prev and sets s->resume. */
 static bool check_resume(const char *path, const renderer *r, render_settings *s, const char *brdf, image *prev)
@@ -146,6 +231,12 @@ static bool check_resume(const char *path, const renderer *r, render_settings *s
             return false;
         }
     }
+    if (!image_inside_frame(prev)) {
+        util_error("%s: cannot resume: its data window lies outside its display window", path);
+        return false;
+    }
+    if (!check_sums(path, prev, (int)spp, s->mode))
+        return false;
     if (s->time_limit <= 0 && spp >= s->spp) {
         util_error("%s: cannot resume: it has %d spp already, and --spp %d is the total wanted", path,
                    (int)spp, s->spp);
@@ -295,24 +386,26 @@ static int render_frames(const render_job *job)
     if (!dash || !util_parse_int(range, 0, 1 << 24, &a) || !util_parse_int(dash + 1, 0, 1 << 24, &b) || b < a)
         return cli_usage_error("render", "--frames '%s': expected A-B, frames 0 <= A <= B", job->frames);
     const char *outs[2] = {job->out_path, job->png_path}, *opts[2] = {"-o", "--png"};
-    for (int k = 0; k < 2; k++)
-        if (outs[k] && !frame_pattern(outs[k]))
-            return cli_usage_error("render", "%s '%s': with --frames, a pattern with one %%d (e.g. frame_%%04d.exr)",
-                                   opts[k], outs[k]);
+    /* Every name is checked before any work: the pattern's form, and the first and last
+     * frames' names (the longest is the last's). */
+    for (int k = 0; k < 2; k++) {
+        if (!outs[k])
+            continue;
+        if (!frame_pattern(outs[k], opts[k]) || !frame_name(outs[k], a, opts[k], names[k], sizeof names[k]) ||
+            !frame_name(outs[k], b, opts[k], names[1 - k], sizeof names[k]))
+            return 2;
+        if (!util_check_output(names[k]) || !util_check_output(names[1 - k]))
+            return 1;
+    }
     if (job->frame >= 0 || job->at >= 0)
         return cli_usage_error("render", "--frames and %s exclude each other", job->frame >= 0 ? "--frame" : "--at");
     for (long f = a; f <= b && rc == 0 && !stop_requested; f++) {
         render_job one = *job;
         one.frames = NULL;
         one.frame = (int)f;
-        for (int k = 0; k < 2; k++) {
-            if (!outs[k])
-                continue;
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wformat-nonliteral"
-            snprintf(names[k], sizeof names[k], outs[k], (int)f); /* checked: frame_pattern */
-#pragma GCC diagnostic pop
-        }
+        for (int k = 0; k < 2; k++)
+            if (outs[k] && !frame_name(outs[k], f, opts[k], names[k], sizeof names[k]))
+                return 2;
         one.out_path = outs[0] ? names[0] : NULL;
         one.png_path = outs[1] ? names[1] : NULL;
         rc = render_run(&one);
@@ -529,7 +622,7 @@ static int render_run(const render_job *job)
             util_warn("interrupted: writing the %d spp rendered so far%s", st.spp,
                       stop_requested == SIGTERM && exr_path ? " (resumable: --resume)" : "");
         if (resumable || stop_requested == SIGTERM)
-            renderer_sums(&r, s.aov, &img);
+            renderer_sums(&r, st.spp, s.aov, &img);
         render_region(&s, region);
         if (s.crop_x1 > 0) { /* the region in the whole frame: OpenEXR's data window */
             img.x0 = region[0];

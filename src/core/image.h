@@ -17,7 +17,14 @@ typedef struct image {
     int num_channels;
     char names[IMAGE_MAX_CHANNELS][32]; /* EXR channel names, e.g. "R", "G", "B", "A", "normal.X" */
     float *planes[IMAGE_MAX_CHANNELS];  /* width * height floats each, rows top to bottom */
+    /* How image_read_exr found each channel stored (IMAGE_STORED_NONE for an image made in
+     * memory): data that must be exact (a --resume file's sums) must have been float. */
+    unsigned char stored[IMAGE_MAX_CHANNELS];
 } image;
+enum { IMAGE_STORED_NONE, IMAGE_STORED_UINT, IMAGE_STORED_HALF, IMAGE_STORED_FLOAT };
+/* The data window lies inside the display window (always, for an image that is the whole
+ * frame). */
+bool image_inside_frame(const image *img);
 
 typedef enum image_attr_type { IMAGE_ATTR_STRING, IMAGE_ATTR_INT, IMAGE_ATTR_DOUBLE, IMAGE_ATTR_M44F } image_attr_type;
 

@@ -1209,10 +1209,13 @@ static float *sum_buffer(const renderer *r, int buffer, int *stride)
     return buffer == 0 ? at.accum : buffer == 1 ? at.aov : at.squares;
 }
 
-void renderer_sums(const renderer *r, uint32_t aov, image *out)
+void renderer_sums(const renderer *r, int spp, uint32_t aov, image *out)
 {
     const sums_at at = sums_of(r);
     const VkDeviceSize pixels = (VkDeviceSize)at.width * at.height;
+    float *n = add_channel(out, "sum.N");
+    for (VkDeviceSize p = 0; p < pixels; p++)
+        n[p] = (float)spp; /* exact: spp <= 2^24 */
     for (size_t k = 0; k < sizeof sum_channels / sizeof *sum_channels; k++) {
         const struct sum_channel *c = &sum_channels[k];
         int stride;

@@ -152,8 +152,9 @@ uint32_t renderer_finish(renderer *r, uint32_t mode, uint32_t next); /* returns 
 void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out);
 /* Appends the exact accumulation sums to out, the state --resume goes on from: sum.R/G/B/A
  * always, sum.normal.X/Y/Z, sum.albedo.R/G/B, sum.depth.Z with the GPU AOVs of aov, and
- * sum2.R/G/B (the squares) with variance. The EXR keeps them as 32-bit floats. */
-void renderer_sums(const renderer *r, uint32_t aov, image *out);
+ * sum2.R/G/B (the squares) with variance; and sum.N, each pixel's sample count (spp), which
+ * --resume checks against the header. The EXR keeps them as 32-bit floats. */
+void renderer_sums(const renderer *r, int spp, uint32_t aov, image *out);
 
 /* Renders and fills `out` with R, G, B, A (A = coverage) and the channels of the AOVs in
  * s->aov, in the order normal.X/Y/Z, albedo.R/G/B, depth.Z, variance.R/G/B. Each is the

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "image.h"
@@ -74,6 +75,10 @@ static int camera_from_exr(camera_option *c, const char *cmd, const char *path)
 {
     char view[256];
     double fov = 0, ortho = 0;
+    int fd = util_open_read(path); /* a missing file, a FIFO: its own message, nothing more */
+    if (fd < 0)
+        return 2;
+    close(fd);
     if (!image_exr_attr_string(path, "gonio:look-at", view, sizeof view))
         return cli_usage_error(cmd, "--camera '%s': not an EXR with a gonio:look-at header (written by "
                                     "gonio render or preview)", path);

@@ -159,23 +159,47 @@ void environment_mean(const image *map, float out[3])
 
 /* ---- Radiance .hdr ---------------------------------------------------------------------- */
 
+/* The size line of a Radiance header (after the header's empty line): "-Y H +X W", the
+ * orientation stb_image reads. False when it is not there: stb_image names the problem. */
+static bool hdr_size(FILE *f, long *w, long *h)
+{
+    char line[256];
+    bool blank = false;
+    for (int n = 0; n < 4096 && fgets(line, sizeof line, f); n++) {
+        if (blank) {
+            char sy, sx;
+            return sscanf(line, "%cY %ld %cX %ld", &sy, h, &sx, w) == 4;
+        }
+        blank = line[0] == '\n';
+    }
+    return false;
+}
+
 bool environment_read_hdr(image *out, const char *path)
 {
     static const char *const names[3] = {"R", "G", "B"};
+    const long max_pixels = 1L << 28;
     int w, h, comp;
+    long fw, fh;
     memset(out, 0, sizeof *out);
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        util_error("%s: cannot open: %s", path, strerror(errno));
+    FILE *f = util_fopen_read(path);
+    if (!f)
         return false;
-    }
     /* stb_image would convert an 8-bit image to "HDR" through a guessed gamma: refuse it. */
     if (!stbi_is_hdr_from_file(f)) {
         fclose(f);
         util_error("%s: not a Radiance HDR (RGBE) file", path);
         return false;
     }
-    if (!stbi_info_from_file(f, &w, &h, &comp) || (double)w * h > (double)(1 << 28)) {
+    /* stb_image refuses a huge image as one of no format it knows ("not BMP"): say why. */
+    if (hdr_size(f, &fw, &fh) && (fw < 1 || fh < 1 || fw > max_pixels / (fh > 0 ? fh : 1))) {
+        fclose(f);
+        util_error("%s: a Radiance HDR of %ldx%ld pixels: %s", path, fw, fh,
+                   fw < 1 || fh < 1 ? "an empty image" : "too large (at most 2^28 pixels)");
+        return false;
+    }
+    rewind(f);
+    if (!stbi_info_from_file(f, &w, &h, &comp) || (double)w * h > (double)max_pixels) {
         fclose(f);
         util_error("%s: %s", path, stbi_failure_reason() ? stbi_failure_reason() : "image too large");
         return false;
