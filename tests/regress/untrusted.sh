@@ -59,7 +59,7 @@ d = {"asset": {"version": "2.0"}, "buffers": [{"uri": "buffer.bin", "byteLength"
 json.dump(d, open(sys.argv[1] + "/buffer.gltf", "w"))
 PY
 check_fails "a FIFO as a scene's buffer" 1 timeout 20 "$G" info "$F/buffer.gltf"
-check "... is not a regular file" grep -q "'buffer.bin' is not a regular file" "$tmp/last"
+check "... is not a regular file" grep -q "buffer.bin' is not a regular file" "$tmp/last"
 check "no output was written" test ! -e "$F/x.exr"
 
 # ---- --resume: only what a render writes ----------------------------------------------------
