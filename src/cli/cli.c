@@ -181,7 +181,11 @@ bool cli_take_tonemap(const char *cmd, const char *opt, const char *value, void 
 
 bool cli_take_variant(const char *cmd, const char *opt, const char *value, void *dest)
 {
-    (void)cmd, (void)opt, (void)dest;
+    (void)dest;
+    if (!*value) {
+        cli_usage_error(cmd, "%s '': a variant's name (gonio info lists them)", opt);
+        return false;
+    }
     scene_select_variant(value);
     return true;
 }

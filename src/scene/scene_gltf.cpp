@@ -319,6 +319,20 @@ size_t comp_size(int ct)
 
 size_t num_comps(const tinygltf::Accessor &a) { return size_t(tinygltf::GetNumComponentsInType(uint32_t(a.type))); }
 
+const char *type_name(int type)
+{
+    switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
+    case TINYGLTF_TYPE_VEC2: return "VEC2";
+    case TINYGLTF_TYPE_VEC3: return "VEC3";
+    case TINYGLTF_TYPE_VEC4: return "VEC4";
+    case TINYGLTF_TYPE_MAT2: return "MAT2";
+    case TINYGLTF_TYPE_MAT3: return "MAT3";
+    case TINYGLTF_TYPE_MAT4: return "MAT4";
+    default: return "?";
+    }
+}
+
 size_t elem_size(const tinygltf::Accessor &a)
 {
     size_t cs = comp_size(a.componentType);
@@ -682,9 +696,6 @@ bool sample_channel(Ctx &c, const tinygltf::Animation &a, int sm, double t, size
     if (keys == 0 || num_comps(c.m.accessors[size_t(smp.input)]) != 1 || vals.size() != keys * per * n)
         return fail(c, "animation '%s': sampler %d has %zu key times and %zu output values (%zu needed)",
                     a.name.c_str(), sm, keys, vals.size(), keys * per * n);
-    for (size_t k = 0; k < keys; k++)
-        if (!std::isfinite(times[k]) || (k && times[k] < times[k - 1]))
-            return fail(c, "animation '%s': sampler %d's key times are not finite and increasing", a.name.c_str(), sm);
     auto value = [&](size_t k, size_t part, size_t j) { return vals[(k * per + part) * n + j]; };
     size_t k = 0; /* the last key at or before t */
     while (k + 1 < keys && times[k + 1] <= t)
@@ -727,6 +738,55 @@ bool sample_channel(Ctx &c, const tinygltf::Animation &a, int sm, double t, size
             return fail(c, "animation '%s': sampler %d gives a zero rotation", a.name.c_str(), sm);
         for (size_t j = 0; j < 4; j++)
             out[j] /= len;
+    }
+    return true;
+}
+
+/* The animation samplers as the glTF spec requires them, whether or not a render samples
+ * them: key times float scalars, finite and strictly increasing; output values of the
+ * formats the channel's path allows (rotations and weights float or normalized integers;
+ * translations and scales float, or any integer type with KHR_mesh_quantization), with
+ * the number of values the keys need. Errors name the JSON path and the value. */
+bool check_animations(Ctx &c)
+{
+    const bool quant = uses_extension(c.m, "KHR_mesh_quantization");
+    for (size_t ai = 0; ai < c.m.animations.size(); ai++) {
+        const auto &a = c.m.animations[ai];
+        const std::string pa = "animations[" + std::to_string(ai) + "]";
+        for (size_t si = 0; si < a.samplers.size(); si++) {
+            const auto &s = a.samplers[si];
+            const std::string ps = pa + ".samplers[" + std::to_string(si) + "]";
+            if (!in_range(s.input, c.m.accessors.size()) || !in_range(s.output, c.m.accessors.size()))
+                return fail(c, "%s: its accessors do not exist", ps.c_str());
+            const auto &in = c.m.accessors[size_t(s.input)];
+            if (in.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT || in.type != TINYGLTF_TYPE_SCALAR)
+                return fail(c, "%s.input: accessor %d is not float scalars (key times in seconds)", ps.c_str(), s.input);
+            std::vector<double> t = read_accessor(c, s.input);
+            for (size_t k = 0; k < t.size(); k++)
+                if (!std::isfinite(t[k]) || t[k] < 0 || (k && !(t[k] > t[k - 1])))
+                    return fail(c, "%s.input: key %zu at %.9g s %s", ps.c_str(), k, t[k],
+                                !std::isfinite(t[k]) || t[k] < 0 ? "is not a time >= 0"
+                                : "is not after the key before it: key times must increase strictly");
+        }
+        for (size_t ci = 0; ci < a.channels.size(); ci++) {
+            const auto &ch = a.channels[ci];
+            const std::string pc = pa + ".channels[" + std::to_string(ci) + "]";
+            if (!in_range(ch.sampler, a.samplers.size()))
+                return fail(c, "%s.sampler: %d does not exist", pc.c_str(), ch.sampler);
+            const auto &s = a.samplers[size_t(ch.sampler)];
+            const auto &out = c.m.accessors[size_t(s.output)];
+            const bool rot = ch.target_path == "rotation", w = ch.target_path == "weights";
+            const unsigned bit = format_bit(out);
+            const unsigned normalized = F_I8N | F_U8N | F_I16N | F_U16N;
+            const unsigned allowed = rot || w ? F_F | normalized : quant ? F_QUANT_ANY : F_F;
+            const int type = rot ? TINYGLTF_TYPE_VEC4 : w ? TINYGLTF_TYPE_SCALAR : TINYGLTF_TYPE_VEC3;
+            if (!(bit & allowed) || out.type != type)
+                return fail(c, "animations[%zu].samplers[%d].output: accessor %d (component type %d%s, %s) is not "
+                            "allowed for '%s' (%s)", ai, ch.sampler, s.output, out.componentType,
+                            out.normalized ? " normalized" : "", type_name(out.type), ch.target_path.c_str(),
+                            rot || w ? "float, or normalized byte or short"
+                            : quant ? "float or integer VEC3" : "float VEC3 (integers need KHR_mesh_quantization)");
+        }
     }
     return true;
 }
@@ -2216,6 +2276,7 @@ struct Doc {
     bool glb;
     int errors = 0;
     std::vector<bool> unbounded; /* per accessor: a POSITION without min or max */
+    size_t num_variants = 0;     /* KHR_materials_variants' variants */
     size_t num_unbounded = 0, first_unbounded = 0;
 
     Doc(Ctx &ctx, const Json &r, bool is_glb) : c(ctx), root(r), glb(is_glb) {}
@@ -2481,6 +2542,31 @@ void Doc::check_primitive(const Json &pr, const std::string &p)
     index(pr, "indices", p, "accessors");
     index(pr, "material", p, "materials");
     enum_int(pr, "mode", p, {0, 1, 2, 3, 4, 5, 6});
+    /* KHR_materials_variants: each mapping names existing variants (each at most once in the
+     * primitive's mappings) and an existing material. */
+    const Json *ext = object(pr, "extensions", p);
+    const Json *kv = ext ? object(*ext, "KHR_materials_variants", at(p, "extensions")) : nullptr;
+    if (kv) {
+        const std::string pk = at(at(p, "extensions"), "KHR_materials_variants");
+        std::vector<std::string> seen(num_variants);
+        if (!array(*kv, "mappings", pk, true))
+            return;
+        each(*kv, "mappings", pk, [&](const Json &mp, const std::string &pm, size_t) {
+            index(mp, "material", pm, "materials", true);
+            const Json *vs = array(mp, "variants", pm, true);
+            if (vs && vs->empty())
+                error(at(pm, "variants"), "is empty (a mapping names at least one variant)");
+            for (size_t i = 0; vs && i < vs->size(); i++) {
+                std::string pv = item(at(pm, "variants"), i);
+                int64_t v = index((*vs)[i], pv, "KHR_materials_variants variants", num_variants);
+                if (v >= 0 && !seen[size_t(v)].empty())
+                    error(pv, "variant %lld is mapped already, at %s (a variant has one material per primitive)",
+                          (long long)v, seen[size_t(v)].c_str());
+                else if (v >= 0)
+                    seen[size_t(v)] = pv;
+            }
+        });
+    }
 }
 
 void Doc::check_node(const Json &n, const std::string &p)
@@ -2606,6 +2692,13 @@ void Doc::check()
                 error(item("extensionsRequired", i), "%s is not a string", show((*e)[i]).c_str());
     index(root, "scene", "", "scenes");
     each(root, "scenes", "", [&](const Json &s, const std::string &p, size_t) { indices(s, "nodes", p, "nodes"); });
+    if (const Json *ext = object(root, "extensions", ""))
+        if (const Json *kv = object(*ext, "KHR_materials_variants", "extensions")) {
+            const std::string pk = "extensions.KHR_materials_variants";
+            if (const Json *vs = array(*kv, "variants", pk, true))
+                num_variants = vs->size();
+            each(*kv, "variants", pk, [&](const Json &v, const std::string &p, size_t) { string(v, "name", p, true); });
+        }
     each(root, "buffers", "", [&](const Json &b, const std::string &p, size_t i) {
         string(b, "uri", p);
         /* tinygltf would read the folder as the buffer's file. */
@@ -2619,14 +2712,48 @@ void Doc::check()
             error(p, "has no uri (only the first buffer of a GLB, its BIN chunk, or a meshopt fallback buffer may omit it)");
         integer(b, "byteLength", p, 1, MAX, true);
     });
+    /* A range of a buffer: inside the buffer's declared byteLength (checked against the
+     * data later, but a meshopt fallback buffer has no data to check against). */
+    auto inside_buffer = [&](const std::string &p, int64_t buf, int64_t off, int64_t len) {
+        if (buf < 0 || len < 0)
+            return;
+        const Json &b = root.at("buffers").at(size_t(buf));
+        auto bl = b.is_object() ? b.find("byteLength") : b.end();
+        if (bl != b.end() && bl->is_number_unsigned() && uint64_t(off < 0 ? 0 : off) + uint64_t(len) > bl->get<uint64_t>())
+            error(p, "bytes %lld to %lld lie beyond buffers[%lld].byteLength %llu", (long long)(off < 0 ? 0 : off),
+                  (long long)((off < 0 ? 0 : off) + len), (long long)buf, (unsigned long long)bl->get<uint64_t>());
+    };
     each(root, "bufferViews", "", [&](const Json &v, const std::string &p, size_t) {
-        index(v, "buffer", p, "buffers", true);
-        integer(v, "byteOffset", p, 0, MAX);
-        integer(v, "byteLength", p, 1, MAX, true);
+        int64_t buf = index(v, "buffer", p, "buffers", true);
+        int64_t off = integer(v, "byteOffset", p, 0, MAX);
+        int64_t len = integer(v, "byteLength", p, 1, MAX, true);
         int64_t stride = integer(v, "byteStride", p, 4, 252);
         if (stride > 0 && stride % 4)
             error(at(p, "byteStride"), "%lld is not a multiple of 4", (long long)stride);
         enum_int(v, "target", p, {34962, 34963});
+        inside_buffer(p, buf, off, len);
+        /* EXT_meshopt_compression: the compressed range, and the layout the parent view must
+         * hold once decoded (the extension's "for the extension object to be valid" rules). */
+        const Json *ext = object(v, "extensions", p);
+        const Json *mo = ext ? object(*ext, "EXT_meshopt_compression", at(p, "extensions")) : nullptr;
+        if (!mo)
+            return;
+        const std::string pm = at(at(p, "extensions"), "EXT_meshopt_compression");
+        int64_t mbuf = index(*mo, "buffer", pm, "buffers", true);
+        int64_t moff = integer(*mo, "byteOffset", pm, 0, MAX);
+        int64_t mlen = integer(*mo, "byteLength", pm, 1, MAX, true);
+        int64_t mstride = integer(*mo, "byteStride", pm, 1, 256, true);
+        int64_t count = integer(*mo, "count", pm, 1, UINT32_MAX, true);
+        enum_str(*mo, "mode", pm, {"ATTRIBUTES", "TRIANGLES", "INDICES"}, true);
+        enum_str(*mo, "filter", pm, {"NONE", "OCTAHEDRAL", "QUATERNION", "EXPONENTIAL"});
+        inside_buffer(pm, mbuf, moff, mlen);
+        if (stride > 0 && mstride > 0 && stride != mstride)
+            error(at(pm, "byteStride"), "%lld is not the buffer view's byteStride %lld", (long long)mstride,
+                  (long long)stride);
+        if (len > 0 && mstride > 0 && count > 0 && uint64_t(mstride) * uint64_t(count) != uint64_t(len))
+            error(pm, "count %lld x byteStride %lld = %llu bytes, but the buffer view's byteLength is %lld",
+                  (long long)count, (long long)mstride, (unsigned long long)(uint64_t(mstride) * uint64_t(count)),
+                  (long long)len);
     });
     unbounded.assign(count_of("accessors"), false);
     each(root, "accessors", "", [&](const Json &a, const std::string &p, size_t) { check_accessor(a, p); });
@@ -2805,7 +2932,7 @@ bool load(scene *out, const char *path, int scene_index)
         for (size_t pi = 0; pi < c.m.meshes[mi].primitives.size(); pi++)
             check_primitive(c, int(mi), int(pi));
     }
-    if (c.failed || !check_textures_and_materials(c) || !check_nodes_and_scenes(c))
+    if (c.failed || !check_textures_and_materials(c) || !check_nodes_and_scenes(c) || !check_animations(c))
         return false;
     check_cameras(c);
     check_lights(c);
