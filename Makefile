@@ -97,7 +97,7 @@ FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
 	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
 
 .PHONY: all deps test-deps run test unit regress bench clean install shaders docs-images \
-	fuzz fuzz-deps fuzz-targets fuzz-run test-farm bench-peer
+	fuzz fuzz-deps fuzz-targets fuzz-run fuzz-partials test-farm bench-peer
 all: $(GONIO) build/gonio
 
 deps:
@@ -182,7 +182,7 @@ bench-peer: all
 
 # libFuzzer targets over scene_load and image_read_exr (tests/fuzz); fuzz-run runs each for
 # FUZZ_TIME seconds from seeds of $GONIO_ASSETS and EXRs gonio writes (tests/fuzz/run.sh).
-FUZZ_TARGETS := build/fuzz/fuzz_scene build/fuzz/fuzz_exr
+FUZZ_TARGETS := build/fuzz/fuzz_scene build/fuzz/fuzz_exr build/fuzz/fuzz_merge
 FUZZ_TIME ?= 60
 fuzz: fuzz-deps
 	@$(MAKE) --no-print-directory config=fuzz CC=clang CXX=clang++ fuzz-targets
@@ -192,6 +192,13 @@ build/fuzz/fuzz_%: $(BUILD)/tests/fuzz/fuzz_%.o $(LIB_OBJ) | deps
 	$(CXX) $(LDFLAGS) -fsanitize=fuzzer -o $@ $^ $(PKG_LIBS) $(LIBS_EXTRA) -lm
 fuzz-run: fuzz all test-deps
 	@GONIO=$(GONIO) FUZZ_TIME=$(FUZZ_TIME) tests/fuzz/run.sh $(FUZZ_TARGETS)
+
+# PARTIALS damaged resumable partials and tiles through the sanitizer build's gonio
+# (tests/fuzz/partials.sh): no crash, hang, sanitizer report, or NaN written with exit 0.
+PARTIALS ?= 2000
+fuzz-partials:
+	@$(MAKE) --no-print-directory config=sanitize all
+	@GONIO=build/sanitize/gonio tests/fuzz/partials.sh $(PARTIALS)
 
 # The figures of docs/ (docs/make-images.sh lists them).
 docs-images: all $(TESTTOOL)
