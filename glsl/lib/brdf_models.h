@@ -11,7 +11,7 @@
 #include "shared.h"
 
 /* ---- the models: one table, expanded by C (src/render/brdf.c: names, parameters, --list;
- * src/render/render.c: material_features) and GLSL (brdf.glsl: bsdf_from_model). A row is
+ * src/render/render_material.c: material_features) and GLSL (brdf.glsl: bsdf_from_model). A row is
  *   X(id, name, summary, lobe, fresnel, layout, lobe_feats, feats, params)
  * - id: GnMaterial.brdf; unique (tests/unit/test_brdf.c checks), never reused. BRDF_GLTF is
  *   built by bsdf_gltf from GnMaterial's own fields, the rest by bsdf_from_model from a
@@ -24,7 +24,7 @@
  *   BRDF_ALPHA_MIN becomes the mirror;
  * - lobe_feats: the GN_FEAT_* of the lobes the model can build (GN_FEAT_LOBES is their
  *   union); feats: its other GN_FEAT_* (Fresnel, glass). The path kernel is specialised on
- *   their union for a scene whose materials use the model (src/render/render.c: material_features;
+ *   their union for a scene whose materials use the model (src/render/render_material.c: material_features;
  *   glTF's bits depend on the material's values and are worked out there).
  * Adding a model: a row here, its lobe in brdf.glsl if it has a new one, its section in
  * docs/brdf.md (docs/architecture.md: Adding a BRDF model). */
@@ -102,7 +102,7 @@
 
 /* Below this GGX/Beckmann alpha a lobe is treated as smooth (a Dirac lobe): a narrower lobe
  * is under a tenth of a degree wide, which float directions cannot resolve (brdf.glsl's
- * constructors; src/render/render.c: material_features, which must agree). */
+ * constructors; src/render/render_material.c: material_features, which must agree). */
 #define BRDF_ALPHA_MIN 1e-3f
 
 /* The union of every model's lobe features: may a kernel meet any specular lobe at all. */

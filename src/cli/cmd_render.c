@@ -15,6 +15,7 @@
 #include "environment.h"
 #include "image.h"
 #include "render.h"
+#include "render_material.h"
 #include "render_output.h"
 #include "scene.h"
 #include "util.h"

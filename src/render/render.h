@@ -165,12 +165,6 @@ void renderer_sums(const renderer *r, int spp, uint32_t aov, image *out);
  * kept on the host), so --time, a stop and the progress act on whole rounds of bands. */
 bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats);
 
-/* Applies BRDF-model overrides to the scene's materials (GnMaterial.brdf, brdf_params and
- * the model's colour): each material's extras {"gonio": {"brdf": NAME, PARAM: VALUE...}}
- * and, when brdf is not NULL, "NAME[:PARAM=VALUE...]" for every material (winning over
- * extras). False with an error naming the scene and material on a bad name or value. */
-bool render_material_overrides(scene *sc, const char *brdf);
-
 /* The render modes (glsl/lib/shared.h: GN_MODES) as the host reads them, indexed by GN_MODE_*. */
 typedef struct render_mode_info {
     const char *name; /* --mode's */

@@ -1,0 +1,187 @@
+/* render_material.c: the renderer's view of a material: the GN_FEAT_* it can need in the path
+ * kernel, and the --brdf / extras.gonio overrides that replace its model. */
+#include "render_material.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "brdf.h"
+#include "util.h"
+
+static double luminance(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+static float clamp01(float x) { return x < 0 ? 0 : x > 1 ? 1 : x; }
+
+/* The GN_FEAT_* that material m can need in the path kernel: the parts of the Bsdf that
+ * bsdf_gltf or bsdf_from_model (glsl/lib/brdf.glsl) can build from it with a nonzero weight,
+ * its textures, emission and unlit flag. Where a texture can change a value (roughness,
+ * metalness) every value it can reach counts. */
+uint32_t material_features(const GnMaterial *m)
+{
+    uint32_t f = 0;
+    bool textured = m->tex_base != GN_INVALID || m->tex_mr != GN_INVALID ||
+                    m->tex_emissive != GN_INVALID || m->tex_occlusion != GN_INVALID;
+    if (textured)
+        f |= GN_FEAT_TEXTURES;
+    if (m->tex_normal != GN_INVALID)
+        f |= GN_FEAT_NORMAL_MAP | GN_FEAT_TEXTURES;
+    if (m->flags & GN_MAT_UNLIT)
+        f |= GN_FEAT_UNLIT;
+    if (m->flags & (GN_MAT_MASK | GN_MAT_BLEND))
+        f |= GN_FEAT_ALPHA;
+    if (luminance(&m->emissive.x) > 0)
+        f |= GN_FEAT_EMISSIVE;
+    switch (m->brdf) {
+    case BRDF_GLTF: {
+        /* bsdf_gltf: a GGX lobe (a mirror below BRDF_ALPHA_MIN) with Schlick's F of weight
+         * wd f0 + m base and F90 wd specular + m; the diffuse coupled to that layer when
+         * specular > 0; glass of weight (1 - m) t. The texture scales roughness and
+         * metalness by [0, 1]. */
+        float metal_hi = clamp01(m->metallic), metal_lo = m->tex_mr != GN_INVALID ? 0 : metal_hi;
+        float rough_hi = clamp01(m->roughness), rough_lo = m->tex_mr != GN_INVALID ? 0 : rough_hi;
+        float t = clamp01(m->transmission);
+        bool smooth = rough_lo * rough_lo < BRDF_ALPHA_MIN, rough = rough_hi * rough_hi >= BRDF_ALPHA_MIN;
+        f |= GN_FEAT_GLTF;
+        if (m->specular != 0 || metal_hi > 0) {
+            f |= GN_FEAT_FRESNEL_SCHLICK | (smooth ? GN_FEAT_MIRROR : 0u) | (rough ? GN_FEAT_GGX : 0u);
+            if (m->specular != 0)
+                f |= GN_FEAT_COUPLED;
+        }
+        if (t > 0 && metal_lo < 1)
+            f |= (smooth ? GN_FEAT_SMOOTH_GLASS : 0u) | (rough ? GN_FEAT_ROUGH_GLASS : 0u);
+        /* KHR_materials_volume acts only where the surface transmits (glass or a diffuse
+         * transmission), _dispersion only where it refracts */
+        if (metal_lo < 1 && ((t > 0 && (m->volume || m->dispersion > 0)) || (m->diffuse_transmission > 0 && m->volume)))
+            f |= GN_FEAT_VOLUME;
+        /* bsdf_layers: a coat or a sheen (their textures only scale the factors) */
+        if (m->clearcoat > 0 || m->sheen_color.x > 0 || m->sheen_color.y > 0 || m->sheen_color.z > 0) {
+            f |= GN_FEAT_LAYERS;
+            if (m->tex_clearcoat != GN_INVALID || m->tex_clearcoat_roughness != GN_INVALID ||
+                m->tex_clearcoat_normal != GN_INVALID || m->tex_sheen_color != GN_INVALID ||
+                m->tex_sheen_roughness != GN_INVALID)
+                f |= GN_FEAT_TEXTURES;
+        }
+        /* bsdf_anisotropy: the lobe and the glass stay GGX where roughness 0 would make them
+         * Dirac (the texture only scales the strength) */
+        if (m->anisotropy_strength > 0) {
+            f |= GN_FEAT_ANISO | (m->tex_anisotropy != GN_INVALID ? GN_FEAT_TEXTURES : 0u);
+            if (m->specular != 0 || metal_hi > 0)
+                f |= GN_FEAT_GGX;
+            if (t > 0 && metal_lo < 1)
+                f |= GN_FEAT_ROUGH_GLASS;
+        }
+        /* bsdf_gltf_film: an iridescent film, a diffuse transmission (textures as above) */
+        if (m->iridescence > 0 || m->diffuse_transmission > 0) {
+            f |= GN_FEAT_LAYERS;
+            if ((m->iridescence > 0 && (m->tex_iridescence != GN_INVALID || m->tex_iridescence_thickness != GN_INVALID)) ||
+                (m->diffuse_transmission > 0 && (m->tex_diffuse_transmission != GN_INVALID ||
+                                                 m->tex_diffuse_transmission_color != GN_INVALID)))
+                f |= GN_FEAT_TEXTURES;
+        }
+        break;
+    }
+    default: {
+        /* an override model: its row of the table (glsl/lib/brdf_models.h); an id unknown to it
+         * keeps every feature */
+        uint32_t mf = GN_FEAT_ALL;
+        for (int i = 0; i < brdf_num_models; i++)
+            if (brdf_models[i].id == m->brdf)
+                mf = brdf_models[i].features;
+        f |= mf | GN_FEAT_MODELS;
+    }
+    }
+    return f;
+}
+
+/* Sets m's model from a setting: the glTF model writes the material's own fields back. */
+static void apply_setting(GnMaterial *m, const brdf_setting *st)
+{
+    memcpy(&m->base_color.x, st->v, 3 * sizeof(float));
+    memcpy(&m->brdf_params.x, st->v + BRDF_SLOT_PARAMS, 4 * sizeof(float));
+    m->brdf = st->model->id;
+    if (st->model->id == BRDF_GLTF) {
+        m->metallic = st->v[BRDF_SLOT_PARAMS];
+        m->roughness = st->v[BRDF_SLOT_PARAMS + 1];
+        m->specular = st->v[BRDF_SLOT_PARAMS + 2];
+        m->ior = st->v[BRDF_SLOT_PARAMS + 3];
+        memcpy(&m->specular_color.x, st->v + BRDF_SLOT_EXTRA, 3 * sizeof(float));
+        m->transmission = st->v[BRDF_SLOT_EXTRA + 3];
+        m->clearcoat = st->v[BRDF_SLOT_LAYER];
+        m->clearcoat_roughness = st->v[BRDF_SLOT_LAYER + 1];
+        m->sheen_roughness = st->v[BRDF_SLOT_LAYER + 2];
+        memcpy(&m->sheen_color.x, st->v + BRDF_SLOT_SHEEN, 3 * sizeof(float));
+        m->anisotropy_strength = st->v[BRDF_SLOT_ANISO];
+        m->anisotropy_rotation = st->v[BRDF_SLOT_ANISO + 1];
+        m->iridescence = st->v[BRDF_SLOT_IRID];
+        m->iridescence_ior = st->v[BRDF_SLOT_IRID + 1];
+        m->iridescence_thickness_max = st->v[BRDF_SLOT_IRID + 2];
+        memcpy(&m->diffuse_transmission_color.x, st->v + BRDF_SLOT_DT, 3 * sizeof(float));
+        m->diffuse_transmission = st->v[BRDF_SLOT_DT + 3];
+    }
+}
+
+/* A setting of `model` that starts from m: its colour is the material's base colour (but a
+ * conductor's, its complex index, keeps the model's default); glTF starts from every field. */
+static void setting_from_material(brdf_setting *st, const brdf_model *model, const GnMaterial *m)
+{
+    brdf_setting_init(st, model);
+    if (model->id != BRDF_CONDUCTOR)
+        memcpy(st->v, &m->base_color.x, 3 * sizeof(float));
+    if (model->id == BRDF_GLTF) {
+        st->v[BRDF_SLOT_PARAMS] = m->metallic;
+        st->v[BRDF_SLOT_PARAMS + 1] = m->roughness;
+        st->v[BRDF_SLOT_PARAMS + 2] = m->specular;
+        st->v[BRDF_SLOT_PARAMS + 3] = m->ior;
+        memcpy(st->v + BRDF_SLOT_EXTRA, &m->specular_color.x, 3 * sizeof(float));
+        st->v[BRDF_SLOT_EXTRA + 3] = m->transmission;
+        st->v[BRDF_SLOT_LAYER] = m->clearcoat;
+        st->v[BRDF_SLOT_LAYER + 1] = m->clearcoat_roughness;
+        st->v[BRDF_SLOT_LAYER + 2] = m->sheen_roughness;
+        memcpy(st->v + BRDF_SLOT_SHEEN, &m->sheen_color.x, 3 * sizeof(float));
+        st->v[BRDF_SLOT_ANISO] = m->anisotropy_strength;
+        st->v[BRDF_SLOT_ANISO + 1] = m->anisotropy_rotation;
+        st->v[BRDF_SLOT_IRID] = m->iridescence;
+        st->v[BRDF_SLOT_IRID + 1] = m->iridescence_ior;
+        st->v[BRDF_SLOT_IRID + 2] = m->iridescence_thickness_max;
+        memcpy(st->v + BRDF_SLOT_DT, &m->diffuse_transmission_color.x, 3 * sizeof(float));
+        st->v[BRDF_SLOT_DT + 3] = m->diffuse_transmission;
+    }
+}
+
+bool render_material_overrides(scene *sc, const char *brdf)
+{
+    const brdf_model *global = NULL;
+    if (brdf && !(global = brdf_spec_model(brdf)))
+        return false;
+    for (uint32_t i = 0; i < sc->num_materials; i++) {
+        GnMaterial *m = &sc->materials[i];
+        const scene_material_extras *x = &sc->material_extras[i];
+        brdf_setting st;
+        if (global) {
+            setting_from_material(&st, global, m);
+            if (!brdf_spec_apply(&st, brdf))
+                return false;
+        } else if (x->brdf[0]) {
+            const brdf_model *model = brdf_model_find(x->brdf);
+            if (!model) {
+                util_error("%s: material '%s': extras.gonio.brdf names no BRDF model", sc->path,
+                           sc->material_names[i]);
+                return false;
+            }
+            setting_from_material(&st, model, m);
+            for (int k = 0; k < x->num_params; k++) {
+                char value[32];
+                snprintf(value, sizeof value, "%.9g", x->param_values[k]);
+                if (!brdf_setting_set(&st, x->param_names[k], value)) {
+                    util_error("%s: material '%s': bad extras.gonio parameter '%s'", sc->path,
+                               sc->material_names[i], x->param_names[k]);
+                    return false;
+                }
+            }
+        } else {
+            continue;
+        }
+        apply_setting(m, &st);
+    }
+    return true;
+}
