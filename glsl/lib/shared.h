@@ -37,7 +37,7 @@ typedef uint32_t uint;
  * prefers a leaf; GnBvhNode's count field has room for 8). */
 #define GN_BVH_MAX_LEAF 8
 /* Loop passes one node visit of a walk can cost: the visit, and the two leaves it may open,
- * each one pass plus one a pair (src/render/render.c: traversal_budget). */
+ * each one pass plus one a pair (src/render/render_limits.c: traversal_budget). */
 #define GN_WALK_VISIT_PASSES (1u + 2u * (1u + GN_BVH_MAX_LEAF))
 
 /* ---- descriptor bindings (set 0) of the render kernels -------------------------------- */
@@ -66,7 +66,7 @@ typedef uint32_t uint;
 /* Work-group size of the 2D image kernels: 8x8 matches lavapipe's 8-wide SIMD rows and is a
  * good default for GPUs (64 threads = 2 warps / 1 wavefront). */
 /* The most samples per pixel one dispatch of the path kernel takes (glsl/kernels/path.comp;
- * src/render/render.c: path_samples picks the number for a scene). */
+ * src/render/render_limits.c: path_samples picks the number for a scene). */
 #define GN_PATH_SAMPLES 32u
 /* Entries of a BVH walk's stack (glsl/lib/bvh.glsl: Walk), a sentinel and a spare included:
  * room for the 63 nodes a tree of the builder's 64 levels (src/accel/bvh.c) can put off. */
@@ -88,7 +88,7 @@ typedef uint32_t uint;
 /* ---- render modes: the one list -------------------------------------------------------
  * X(ID, value, kernel, flags, name, help): mode GN_MODE_<ID> = value (0, 1, ... in list
  * order: --mode's list, the help and the preview's number keys follow it), the kernel that
- * renders it, its GN_MODEF_* and, for the host only (src/render/render.c's registry; glslang drops
+ * renders it, its GN_MODEF_* and, for the host only (src/render/render_modes.c; glslang drops
  * the unexpanded strings), its --mode name and its line of help. A mode of the local kernel
  * is one branch of glsl/kernels/local.comp's local_color: a new mode is an entry here and that branch
  * (docs/architecture.md, "Adding a render mode"). */
@@ -121,7 +121,7 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
 #define GN_LIGHT_SPOT 1u
 #define GN_LIGHT_DIRECTIONAL 2u
 /* A small Lambertian emitter seen as a point: I(theta) = color * max(cos theta, 0) around
- * direction. Stands in for emissive geometry in the local modes (src/render/render.c). */
+ * direction. Stands in for emissive geometry in the local modes (src/render/render_lights.c). */
 #define GN_LIGHT_COSINE 3u
 
 #define GN_INVALID 0xffffffffu

@@ -16,6 +16,7 @@
 #include "draw.h"
 #include "environment.h"
 #include "image.h"
+#include "progress.h"
 #include "render.h"
 #include "scene.h"
 #include "util.h"
@@ -61,9 +62,11 @@ static bool choose_view(const scene *sc, compare_opts *o)
 static bool render_one(renderer *r, const compare_opts *o, uint32_t mode, image *out)
 {
     render_stats st;
+    cli_progress progress;
     render_settings s = {.mode = mode, .width = o->width, .height = o->height,
                          .spp = mode == GN_MODE_PATH || o->spp < COMPARE_LOCAL_SPP ? o->spp : COMPARE_LOCAL_SPP,
-                         .view = &o->view, .progress = !o->quiet};
+                         .view = &o->view, .progress = o->quiet ? NULL : cli_progress_report,
+                         .progress_user = &progress};
     return renderer_render(r, &s, out, &st);
 }
 

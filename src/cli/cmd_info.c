@@ -18,8 +18,9 @@ static const char *shown(const char *name)
     return name[0] ? util_escape(name, b, sizeof buf[0]) : "(unnamed)";
 }
 
-/* The area lights as the path tracer sees them (render.c: build_emitters): triangles of
- * non-zero area whose material emits and is not unlit; prints the materials by name. */
+/* The area lights as the path tracer sees them (src/render/render_lights.c: build_emitters):
+ * triangles of non-zero area whose material emits and is not unlit; prints the materials by
+ * name. */
 static void print_emitters(const scene *sc)
 {
     uint32_t tris = 0, mats = 0;

@@ -14,6 +14,7 @@
 #include "cli.h"
 #include "environment.h"
 #include "image.h"
+#include "progress.h"
 #include "render.h"
 #include "render_material.h"
 #include "render_output.h"
@@ -424,8 +425,7 @@ static int render_frames(const render_job *job)
 
 int cmd_render(int argc, char **argv)
 {
-    render_job j = {.s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .progress = true,
-                          .stop = &stop_requested},
+    render_job j = {.s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .stop = &stop_requested},
                     .frame = -1, .fps = 24, .at = -1, .device = -1, .scene_index = -1,
                     .tm = IMAGE_TONEMAP_CLAMP, .exr = IMAGE_EXR_DEFAULTS};
     bool no_shadows = false;
@@ -567,7 +567,9 @@ static int render_run(const render_job *job)
         png_o = out_path;
     exr.exact_prefix = "sum"; /* sum.* and sum2.*: the state --resume needs exactly */
     util_set_quiet(quiet);
-    s.progress = !quiet;
+    cli_progress progress;
+    s.progress = quiet ? NULL : cli_progress_report;
+    s.progress_user = &progress;
     scene_allow_outside_files(job->outside);
     if ((out_path && !util_check_output(out_path)) || (png_path && !util_check_output(png_path)))
         return 1;
