@@ -8,9 +8,9 @@
 
 #include "gpu.h"
 
+struct image;
+struct render_settings;
 struct scene;
-
-#define GONIO_VERSION "0.1.0"
 
 int cmd_render(int argc, char **argv);
 int cmd_info(int argc, char **argv);
@@ -119,6 +119,63 @@ bool cli_take_exr_compression(const char *cmd, const char *opt, const char *valu
     {"--compression", "C", "EXR: none, rle, zips, zip (default), piz, pxr24, b44, b44a",      \
      CLI_CALL, CLI_AS(int, dest), 0, 0, "none, rle, zips, zip, piz, pxr24, b44 or b44a",       \
      cli_take_exr_compression}
+
+/* ---- the view: camera and environment (options.c) --------------------------------------- */
+
+/* The camera options of render, preview and compare: a camera_option (camera.h). */
+#define CAMERA_OPTIONS(cam)                                                                    \
+    {"--camera", "C",                                                                          \
+     "N: the scene's N-th camera (0 = the first in the default scene's\n"                      \
+     "node order, the default); frame: frame the bounds from a raised\n"                       \
+     "three-quarter view (the default without a camera); FILE.exr: the\n"                      \
+     "view recorded by gonio render or preview",                                               \
+     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, cli_take_camera},                      \
+    {"--look-at", "E,T[,U]",                                                                   \
+     "place a camera: eye EX,EY,EZ, target TX,TY,TZ, up UX,UY,UZ\n"                            \
+     "(default 0,1,0), world coordinates",                                                     \
+     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, cli_take_camera},                       \
+    {"--fov", "DEGREES", "vertical field of view (default: the camera's own, else 45)",        \
+     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, cli_take_camera}
+/* The camera options' parser (dest: the camera_option). */
+bool cli_take_camera(const char *cmd, const char *opt, const char *val, void *dest);
+
+typedef struct env_option {
+    bool given;              /* --env was on the command line */
+    const char *path;        /* a map (.exr or .hdr), else NULL: the constant `color` */
+    bool studio;             /* --env studio: gonio's studio, whatever lights the scene has */
+    float color[3];
+    float rotation;          /* degrees about +Y, right-handed (--env-rotate) */
+    float intensity;         /* scale of the radiance (--env-intensity); 0 means 1 */
+} env_option;
+
+/* The environment options of render and preview: an env_option. */
+#define ENV_OPTIONS(env)                                                                       \
+    {"--env", "R,G,B | V",                                                                     \
+     "constant environment radiance; 0: black (default: the scene's own\n"                     \
+     "lights, or gonio's studio environment when it has none)",                                \
+     CLI_CALL, CLI_AS(env_option, env), 0, 0, NULL, cli_take_env},                            \
+    {NULL, NULL,                                                                               \
+     "  --env FILE          a lat-long HDR environment map, OpenEXR (.exr) or Radiance (.hdr),\n" \
+     "                      +Y up; importance sampled by the path tracer, its mean radiance is\n" \
+     "                      the local modes' ambient light\n"                                  \
+     "  --env studio        gonio's studio environment besides the scene's own lights (as model\n" \
+     "                      viewers light a scene that has only punctual lights)\n",            \
+     CLI_TEXT, NULL, 0, 0, NULL, NULL},                                                        \
+    {"--env-rotate", "DEG", "turn the environment about +Y (right-handed, default 0)",        \
+     CLI_CALL, CLI_AS(env_option, env), 0, 0, NULL, cli_take_env},                             \
+    {"--env-intensity", "X", "scale the environment's radiance (default 1)",                  \
+     CLI_CALL, CLI_AS(env_option, env), 0, 0, NULL, cli_take_env}
+/* The environment options' parser (dest: the env_option). */
+bool cli_take_env(const char *cmd, const char *opt, const char *val, void *dest);
+
+/* Sets s's environment (env, env_map, env_rotation) from e for scene sc, reading a map into
+ * *map (which the caller destroys), or the studio when e is not given and the scene has no
+ * light, announced on stderr unless quiet; *studio tells which. For a local mode (s->mode)
+ * the environment's mean radiance becomes the ambient light (unless s->ambient_set) and the
+ * studio's key light is added to sc's lights. False with an error naming the file on a bad
+ * map. */
+bool env_setup(const env_option *e, struct scene *sc, bool quiet, struct image *map, struct render_settings *s,
+               bool *studio);
 
 /* "gonio CMD: MESSAGE" and the hint to use --help; returns 2. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);

@@ -195,7 +195,7 @@ static bool check_resume(const char *path, const renderer *r, render_settings *s
     int region[4];
     double spp;
     uint32_t seed;
-    render_header_build(&h, r, s, &st, brdf);
+    render_header_build(&h, r, s, &st, brdf, cli_command_line());
     if (!image_read_exr(prev, path))
         return false;
     if (!image_exr_attr_double(path, "gonio:spp", &spp) || !(spp >= 1 && spp <= INT32_MAX && spp == floor(spp))) {
@@ -615,7 +615,7 @@ static int render_run(const render_job *job)
         render_header h;
         bool ok = true;
         int region[4];
-        render_header_build(&h, &r, &s, &st, brdf);
+        render_header_build(&h, &r, &s, &st, brdf, cli_command_line());
         if (at >= 0 && h.count + 2 <= RENDER_HEADER_MAX) { /* the animation's time, and frame */
             h.attrs[h.count++] = (image_attr){"gonio:time", IMAGE_ATTR_DOUBLE, NULL, 0, at, NULL};
             if (frame >= 0)

@@ -261,7 +261,7 @@ static bool save_accumulated(preview *p)
      * view, so --camera FILE.exr renders it again). */
     render_header h;
     render_stats st = {.spp = p->spp};
-    render_header_build(&h, &p->r, &p->s, &st, NULL);
+    render_header_build(&h, &p->r, &p->s, &st, NULL, cli_command_line());
     if (p->spp == 0)
         return true;
     for (int n = 1;; n++) {
