@@ -395,27 +395,25 @@ int cmd_brdf(int argc, char **argv)
     }
     cli_option options[BRDF_FIXED_OPTIONS + BRDF_MAX_PARAMS] = {
         {"--list", NULL, "the models, one a line: name, then each parameter=default", CLI_FLAG, CLI_AS(bool, &list), 0, 0,
-         NULL, NULL},
+         NULL, NULL, NULL},
         {NULL, NULL, "  --PARAM VALUE       a model parameter (see --list); colours as R,G,B or one value\n",
-         CLI_TEXT, NULL, 0, 0, NULL, NULL},
+         CLI_TEXT, NULL, 0, 0, NULL, NULL, NULL},
         {"--theta", "DEG", "lobe plot: incident (light) direction, degrees from the normal\n"
                            "(default 30); the curve is f(wi, wo) for wo in the plane of incidence",
-         CLI_FLOAT, CLI_AS(float, &theta), 0, 90, "degrees in [0, 90]", NULL},
+         CLI_FLOAT, CLI_AS(float, &theta), 0, 90, "degrees in [0, 90]", NULL, NULL},
         {"--albedo", NULL, "print 'theta_deg albedo_r albedo_g albedo_b' for theta = 0, 5, ...,\n"
                            "85, 89: the directional albedo (reflected + transmitted fraction)\n"
                            "of light from theta",
-         CLI_FLAG, CLI_AS(bool, &albedo), 0, 0, NULL, NULL},
+         CLI_FLAG, CLI_AS(bool, &albedo), 0, 0, NULL, NULL, NULL},
         {"--sphere", NULL, "render a unit sphere of the material: directional light + constant sky",
-         CLI_FLAG, CLI_AS(bool, &sphere), 0, 0, NULL, NULL},
+         CLI_FLAG, CLI_AS(bool, &sphere), 0, 0, NULL, NULL, NULL},
         {"-o, --output", "FILE", "the lobe plot: a .png; the sphere: a .exr (linear float OpenEXR)\n"
                                  "or a .png (sRGB, clamped); any other name is a usage error",
-         CLI_STRING, CLI_AS(const char *, &out), 0, 0, NULL, NULL},
-        {"--png", "FILE", "sphere: also a PNG (sRGB, clamped)", CLI_STRING, CLI_AS(const char *, &png), 0, 0, NULL, NULL},
-        {"--size", "WxH", "image size (lobe default 560x360, 560x560 with transmission;\n"
-                          "sphere 256x256)",
-         CLI_CALL, size, 0, 0, "WxH (1..16384 each)", cli_take_size},
-        {"--spp", "N", "sphere: samples per pixel (default 64)", CLI_INT, CLI_AS(int, &spp), 1, 1 << 20,
-         "a count in [1, 1048576]", NULL},
+         CLI_STRING, CLI_AS(const char *, &out), 0, 0, NULL, NULL, "*.exr *.png"},
+        CLI_OPT_PNG(&png, "sphere: also a PNG (sRGB, clamped)"),
+        CLI_OPT_SIZE(size, "image size (lobe default 560x360, 560x560 with transmission;\n"
+                           "sphere 256x256)"),
+        CLI_OPT_SPP(&spp, "sphere: samples per pixel (default 64)"),
         CLI_OPT_DEVICE(&device),
         CLI_OPT_VALIDATE(&validate),
     };
@@ -430,7 +428,7 @@ int cmd_brdf(int argc, char **argv)
         else
             snprintf(help[i], sizeof help[i], "%s: in [%g, %g] (default %g)", m->name, p->min, p->max, p->def[0]);
         options[n++] = (cli_option){names[i], p->count == 3 ? "R,G,B" : "V", help[i], CLI_CALL, &s, 0, 0, NULL,
-                                    take_param};
+                                    take_param, NULL};
     }
     const cli_command command = {
         .name = "brdf",
@@ -440,6 +438,7 @@ int cmd_brdf(int argc, char **argv)
                     "       gonio brdf MODEL [--PARAM VALUE ...] --sphere -o BALL.exr|BALL.png [--png BALL.png]\n"
                     "                  [--size WxH] [--spp N]",
         .options = options, .num_options = n, .max_args = m ? 1 : 0,
+        .complete_args = m ? NULL : cli_brdf_models(),
         .unknown_hint = " (gonio brdf --list: the models' parameters)"};
     cli_args args;
     if ((rc = cli_parse(&command, argc, argv, &args)) >= 0)

@@ -117,7 +117,8 @@ int cmd_info(int argc, char **argv)
                  "and one line per material with an iridescent film (KHR_materials_iridescence:\n"
                  "factor, film IOR, thickness) or a diffuse transmission\n"
                  "(KHR_materials_diffuse_transmission: factor, colour).\n",
-        CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given"};
+        CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given",
+        .complete_args = "*.gltf *.glb"};
     cli_args args;
     scene sc = {0};
     bvh b = {0};

@@ -250,13 +250,13 @@ static int run(int argc, char **argv, bool teapot_command)
     const cli_option options[] = {
         {NULL, NULL, "  cornell             the Cornell box (published measurements, metres, one area light)\n"
                      "  teapot              the Utah teapot as in the classic OpenGL 1.x example\n",
-         CLI_TEXT, NULL, 0, 0, NULL, NULL},
+         CLI_TEXT, NULL, 0, 0, NULL, NULL, NULL},
         {"-o, --output", "FILE", "the file to write, in the format its name says: .gltf JSON with\n"
                                  "the buffer embedded, .glb binary glTF (any other name is a usage error)",
-         CLI_STRING, CLI_AS(const char *, &out), 0, 0, NULL, NULL},
+         CLI_STRING, CLI_AS(const char *, &out), 0, 0, NULL, NULL, "*.gltf *.glb"},
         {"--level", "N", "teapot: N x N grid cells per Bezier patch, 1..256 (default 8);\n"
                          "64 N^2 - 8 N triangles",
-         CLI_INT, CLI_AS(int, &level), 1, SCENE_TEAPOT_MAX_LEVEL, "an integer 1..256", NULL},
+         CLI_INT, CLI_AS(int, &level), 1, SCENE_TEAPOT_MAX_LEVEL, "an integer 1..256", NULL, NULL},
     };
     const cli_command cmd = {
         .name = teapot_command ? "teapot" : "scene",
@@ -267,7 +267,7 @@ static int run(int argc, char **argv, bool teapot_command)
         /* gonio teapot has no scene names to list */
         .options = options + teapot_command, .num_options = (int)(sizeof options / sizeof *options) - teapot_command,
         .min_args = teapot_command ? 0 : 1, .max_args = teapot_command ? 0 : 1,
-        .missing = "which scene? (cornell or teapot)"};
+        .missing = "which scene? (cornell or teapot)", .complete_args = teapot_command ? NULL : "cornell teapot"};
     cli_args args;
     int rc = cli_parse(&cmd, argc, argv, &args);
     if (rc >= 0)

@@ -1,18 +1,73 @@
-/* options.c: the options of the view, which several commands take: the camera (--camera,
- * --look-at, --fov) and the environment (--env, --env-rotate, --env-intensity), and the
- * rule that turns the environment options into a render's light (cli.h). */
+/* options.c: the options several commands take (cli.h): the parsers of the shared values
+ * (size, mode, tonemap, variant, EXR compression), the view (the camera: --camera,
+ * --look-at, --fov; the environment: --env, --env-rotate, --env-intensity) and the rule that
+ * turns the environment options into a render's light (env_setup). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "brdf.h"
 #include "camera.h"
 #include "cli.h"
 #include "environment.h"
 #include "image.h"
 #include "render.h"
 #include "util.h"
+
+/* ---- shared values ---------------------------------------------------------------------- */
+
+bool cli_take_size(const char *cmd, const char *opt, const char *value, void *dest)
+{
+    (void)cmd, (void)opt;
+    int *wh = dest;
+    return util_parse_size(value, &wh[0], &wh[1]);
+}
+
+bool cli_take_mode(const char *cmd, const char *opt, const char *value, void *dest)
+{
+    int m = render_mode_from_name(value);
+    if (m < 0) {
+        cli_usage_error(cmd, "%s '%s': expected one of %s", opt, value, render_mode_list());
+        return false;
+    }
+    *(uint32_t *)dest = (uint32_t)m;
+    return true;
+}
+
+bool cli_take_tonemap(const char *cmd, const char *opt, const char *value, void *dest)
+{
+    (void)cmd, (void)opt;
+    return image_tonemap_from_name(value, dest);
+}
+
+bool cli_take_variant(const char *cmd, const char *opt, const char *value, void *dest)
+{
+    (void)dest;
+    if (!*value) {
+        cli_usage_error(cmd, "%s '': a variant's name (gonio info lists them)", opt);
+        return false;
+    }
+    scene_select_variant(value);
+    return true;
+}
+
+bool cli_take_exr_compression(const char *cmd, const char *opt, const char *value, void *dest)
+{
+    (void)cmd, (void)opt;
+    return image_exr_compression_from_name(value, dest);
+}
+
+const char *cli_brdf_models(void)
+{
+    static char list[512];
+    const char *names[64];
+    int n = 0;
+    for (int i = 0; i < brdf_num_models && n < 64; i++)
+        names[n++] = brdf_models[i].name;
+    return list[0] ? list : util_join(list, sizeof list, names, n);
+}
 
 /* ---- the camera ------------------------------------------------------------------------- */
 

@@ -79,6 +79,8 @@ void render_region(const render_settings *s, int region[4]);
 #define RENDER_AOV_GPU (RENDER_AOV_NORMAL | RENDER_AOV_ALBEDO | RENDER_AOV_DEPTH)
 /* "normal", "albedo", "depth", "variance" -> RENDER_AOV_*; 0 when unknown. */
 uint32_t render_aov_from_name(const char *name);
+/* Every AOV's name, ", "-separated. */
+const char *render_aov_list(void);
 
 typedef struct render_stats {
     int spp;                /* samples per pixel actually taken */

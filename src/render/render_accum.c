@@ -124,13 +124,21 @@ void free_bands(renderer *r)
     r->band_accum = r->band_aov = r->band_squares = NULL;
 }
 
+/* The AOVs' names, in the order of their RENDER_AOV_* bits. */
+static const char *const aov_names[] = {"normal", "albedo", "depth", "variance"};
+
 uint32_t render_aov_from_name(const char *name)
 {
-    static const char *const names[] = {"normal", "albedo", "depth", "variance"};
     for (uint32_t i = 0; i < 4; i++)
-        if (!strcmp(name, names[i]))
+        if (!strcmp(name, aov_names[i]))
             return 1u << i;
     return 0;
+}
+
+const char *render_aov_list(void)
+{
+    static char list[64];
+    return list[0] ? list : util_join(list, sizeof list, aov_names, 4);
 }
 
 /* Appends one zeroed channel and returns its plane. */
