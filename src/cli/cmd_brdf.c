@@ -14,6 +14,7 @@
 #include "draw.h"
 #include "image.h"
 #include "util.h"
+#include "vec.h"
 
 
 static int bad_usage(const char *fmt, const char *arg)
@@ -30,7 +31,6 @@ static bool take_param(const char *cmd, const char *opt, const char *val, void *
     return brdf_setting_set(dest, opt + 2, val);
 }
 
-static double luminance(vec3 c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 
 /* ---- lobe plot ------------------------------------------------------------------------ */
 
@@ -64,7 +64,7 @@ static void plot_eval(brdf_runner *r, const brdf_setting *s, double theta, doubl
     }
     brdf_runner_run(r, q, res, PLOT_N);
     for (int k = 0; k < PLOT_N; k++)
-        out[k] = luminance(res[k].f);
+        out[k] = vec_luminance(&res[k].f.x);
     free(q);
     free(res);
 }
@@ -92,7 +92,7 @@ static int plot_dirac_lobes(brdf_runner *r, const brdf_setting *s, double theta,
             continue;
         seen |= kind;
         out[n].psi = atan2(res[k].s_wi.x, res[k].s_wi.z) * 180 / M_PI;
-        out[n++].reflectance = luminance(res[k].s_weight) * res[k].s_pdf;
+        out[n++].reflectance = vec_luminance(&res[k].s_weight.x) * res[k].s_pdf;
     }
     return n;
 }

@@ -13,6 +13,7 @@
 #include "render_internal.h"
 #include "render_material.h"
 #include "util.h"
+#include "vec.h"
 
 bool renderer_create(renderer *r, gpu *g, const scene *sc)
 {
@@ -136,8 +137,6 @@ void renderer_destroy(renderer *r)
     memset(r, 0, sizeof *r);
 }
 
-static vec3 v3(const float *p) { return (vec3){p[0], p[1], p[2]}; }
-
 bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out)
 {
     scene_camera c;
@@ -159,10 +158,10 @@ bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out)
     } else {
         scene_default_camera(r->sc, aspect, &c);
     }
-    out->position = v3(c.position);
-    out->right = v3(c.right);
-    out->up = v3(c.up);
-    out->forward = v3(c.forward);
+    out->position = vec3_of(c.position);
+    out->right = vec3_of(c.right);
+    out->up = vec3_of(c.up);
+    out->forward = vec3_of(c.forward);
     out->tan_half_fovy = tanf(0.5f * c.yfov);
     out->ortho_half_height = c.ortho_half_height;
     out->aspect = aspect; /* the image's: a camera's own aspect only suggests the size */
@@ -258,7 +257,7 @@ bool frame_setup(renderer *r, const render_settings *s, const int region[4], GnF
     frame->env_color = (vec3){s->env[0], s->env[1], s->env[2]};
     frame->env_cos = (float)cos(s->env_rotation * M_PI / 180);
     frame->env_sin = (float)-sin(s->env_rotation * M_PI / 180);
-    frame->ambient = v3(s->ambient_set ? s->ambient : r->sc->ambient);
+    frame->ambient = vec3_of(s->ambient_set ? s->ambient : r->sc->ambient);
     frame->traversal_budget = traversal_budget(r->g, 1 + (!s->no_shadows ? r->num_lights : 0));
     r->state_stride = 0; /* path_begin sets it, and the loop cap, for the path kernel */
     return s->mode != GN_MODE_PATH || path_begin(r, s, frame);

@@ -7,6 +7,7 @@
 
 #include "render_internal.h"
 #include "util.h"
+#include "vec.h"
 
 
 /* Emissive geometry as lights for the local modes when a scene has no punctual light (the
@@ -29,7 +30,7 @@ uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap)
             for (int k = 0; k < 3; k++)
                 p[k] = &sc->vertices[sc->indices[3 * t + k]].position.x;
             scene_triangle_cross(sc, t, cr);
-            a = 0.5 * sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+            a = 0.5 * vec_length_d(cr);
             area += a;
             for (int k = 0; k < 3; k++) {
                 c[k] += a * (p[0][k] + p[1][k] + p[2][k]) / 3.0;
@@ -39,7 +40,7 @@ uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap)
         if (area <= 0)
             continue;
         GnLight *l = &out[n++];
-        double len = sqrt(an[0] * an[0] + an[1] * an[1] + an[2] * an[2]);
+        double len = vec_length_d(an);
         memset(l, 0, sizeof *l);
         l->position = (vec3){(float)(c[0] / area), (float)(c[1] / area), (float)(c[2] / area)};
         if (len > 0.9 * area) {
@@ -59,8 +60,6 @@ uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap)
     }
     return n;
 }
-
-static double luminance(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
 
 /* Squared radius of the scene's bounding sphere (1 when empty): the area through which
@@ -94,10 +93,10 @@ void build_emitters(renderer *r, const GnPrim *prims)
                    *p2 = &sc->vertices[prims[i].i2].position;
         double e1[3] = {p1->x - p0->x, p1->y - p0->y, p1->z - p0->z};
         double e2[3] = {p2->x - p0->x, p2->y - p0->y, p2->z - p0->z};
-        double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                       e1[0] * e2[1] - e1[1] * e2[0]};
-        double area = 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-        double lum = luminance(&m->emissive.x);
+        double c[3];
+        vec_cross_d(e1, e2, c);
+        double area = 0.5 * vec_length_d(c);
+        double lum = vec_luminance(&m->emissive.x);
         if (lum <= 0 || !(area > 0) || (m->flags & GN_MAT_UNLIT))
             continue;
         r->emitter_table[n] = (GnEmitter){i, (float)area, 0, 0};
@@ -106,7 +105,7 @@ void build_emitters(renderer *r, const GnPrim *prims)
     r->num_area_emitters = n;
     for (uint32_t i = 0; i < sc->num_lights; i++) {
         const GnLight *l = &sc->lights[i];
-        double w = luminance(&l->color.x);
+        double w = vec_luminance(&l->color.x);
         w *= l->type == GN_LIGHT_POINT ? 4 : l->type == GN_LIGHT_SPOT ? 2 * (1 - l->outer_cos)
                                                                          : scene_radius2(sc);
         if (w <= 0)
@@ -173,7 +172,7 @@ static bool upload_env_map(renderer *r, const image *map)
             }
             data[2 * i] = hc[0] | (uint32_t)hc[1] << 16;
             data[2 * i + 1] = hc[2];
-            sum += luminance(c) * st;
+            sum += vec_luminance(c) * st;
             cond[i] = (float)sum;
         }
         for (int x = 0; x < w; x++) /* an unlit row is never picked; keep its CDF valid */
@@ -215,7 +214,7 @@ bool path_lights(renderer *r, const render_settings *s, GnFrame *frame, double *
         frame->env_height = (uint32_t)s->env_map->height;
         env = r->env_weight;
     } else {
-        env = 4 * M_PI * scene_radius2(r->sc) * luminance(s->env);
+        env = 4 * M_PI * scene_radius2(r->sc) * vec_luminance(s->env);
     }
     if (env > 0) {
         r->emitter_table[n] = (GnEmitter){GN_INVALID, 0, 0, 0};

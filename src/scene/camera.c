@@ -10,37 +10,19 @@
 
 #include "image.h"
 #include "util.h"
-
-static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-static void cross3(const float a[3], const float b[3], float out[3])
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static bool normalize3(float v[3])
-{
-    float l = sqrtf(dot3(v, v));
-    if (!(l > 0) || !isfinite(l))
-        return false;
-    for (int k = 0; k < 3; k++)
-        v[k] /= l;
-    return true;
-}
+#include "vec.h"
 
 /* The orthonormal frame of eye, target and up; false when the view is degenerate (target
  * at the eye, or up along the view). */
 bool camera_look_at_frame(const float eye[3], const float target[3], const float up[3], scene_camera *out)
 {
     float f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]}, r[3], u[3];
-    if (!normalize3(f))
+    if (!vec_normalize(f))
         return false;
-    cross3(f, up, r);
-    if (!normalize3(r) || fabsf(dot3(f, up)) > 0.9999f * sqrtf(dot3(up, up)))
+    vec_cross(f, up, r);
+    if (!vec_normalize(r) || fabsf(vec_dot(f, up)) > 0.9999f * sqrtf(vec_dot(up, up)))
         return false;
-    cross3(r, f, u);
+    vec_cross(r, f, u);
     memcpy(out->position, eye, sizeof out->position);
     memcpy(out->forward, f, sizeof out->forward);
     memcpy(out->right, r, sizeof out->right);
@@ -141,7 +123,7 @@ void camera_world_to_camera(const scene_camera *c, float m[16])
     for (int j = 0; j < 3; j++) {
         for (int i = 0; i < 3; i++)
             m[4 * i + j] = axes[j][i];
-        m[12 + j] = -dot3(c->position, axes[j]);
+        m[12 + j] = -vec_dot(c->position, axes[j]);
         m[4 * j + 3] = 0;
     }
     m[15] = 1;

@@ -11,6 +11,7 @@
 #include <stb_image.h>
 
 #include "util.h"
+#include "vec.h"
 
 
 bool env_scene_has_light(const scene *sc)
@@ -51,11 +52,11 @@ static float smoothstepf(float a, float b, float x)
     return t * t * (3 - 2 * t);
 }
 
+/* The unit vector along v (the studio's directions). */
 static void unit(const float v[3], float out[3])
 {
-    float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    for (int k = 0; k < 3; k++)
-        out[k] = v[k] / l;
+    memcpy(out, v, 3 * sizeof *out);
+    vec_normalize(out);
 }
 
 /* A soft disc of angular radius r degrees about unit direction c: 1 inside 70 % of r, 0 outside. */
