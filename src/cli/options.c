@@ -138,7 +138,8 @@ static int camera_parse_option(camera_option *c, const char *cmd, const char *op
             c->kind = CAMERA_INDEX;
             c->index = (int)v;
         } else {
-            return cli_usage_error(cmd, "--camera '%s': expected an index >= 0, 'frame' or FILE.exr", val);
+            return cli_usage_error(cmd, "--camera '%s': expected an index in [0, %d], 'frame' or FILE.exr", val,
+                                   1 << 20);
         }
         return 1;
     }

@@ -30,6 +30,17 @@ for c in "render $C -o $tmp/x.exr --spp" "preview $C --frames" "bench --seconds"
     check "${c%% *} ${c##* }=bogus: the option's own message" \
         sh -c "grep -q bogus '$tmp/last' && ! grep -q 'unknown option' '$tmp/last'"
 done
+# Options several commands take are defined once: the same range and message everywhere.
+for c in "render $C -o $tmp/x.exr" "preview $C"; do
+    check_fails "${c%% *} --max-depth 65537" 2 "$G" $c --max-depth 65537
+    check "... names the range" grep -q "out of range: must be in \[0, 65536\]" "$tmp/last"
+done
+for c in "render $C -o $tmp/x.exr" "preview $C" "compare $C -o $tmp/cmp" "brdf lambert --sphere -o $tmp/b.exr"; do
+    check_fails "${c%% *} --spp 0" 2 "$G" $c --spp 0
+    check "... names the range" grep -q "out of range: must be in \[1, 16777216\]" "$tmp/last"
+    check_fails "${c%% *} --size 0x8" 2 "$G" $c --size 0x8
+    check "... names the range" grep -q "expected WxH, e.g. 640x480 (each 1..16384)" "$tmp/last"
+done
 check_fails "a flag given a value" 2 "$G" render $C -o "$tmp/x.exr" --quiet=yes
 check "... says it takes none" grep -q -- "--quiet takes no value" "$tmp/last"
 check "--name=value splits at the first =" "$G" brdf torrance-sparrow --exponent=64 --albedo
