@@ -140,6 +140,8 @@ static bool check_sums(const char *path, const image *prev, int spp, uint32_t mo
 {
     const size_t n = (size_t)prev->width * (size_t)prev->height;
     const int cn = image_channel(prev, "sum.N");
+    if (image_channel(prev, "sum.R") < 0)
+        return true; /* not a --resumable file: the render names the first channel it lacks */
     if (cn < 0) {
         util_error("%s: cannot resume: no sum.N channel (each pixel's sample count; written by "
                    "--resumable since this version: render it again)", path);
