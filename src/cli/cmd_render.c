@@ -605,6 +605,8 @@ static int render_run(const render_job *job)
     image_destroy(&img);
     image_destroy(&prev);
     image_destroy(&env_map);
+    if (job->denoise)
+        denoise_shutdown();
     renderer_destroy(&r);
     if (!cli_gpu_finish(&g))
         rc = 1;

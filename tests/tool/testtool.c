@@ -296,6 +296,54 @@ static int pick_channel(const char *in, const char *from, const char *out)
     return ok ? 0 : 1;
 }
 
+/* IN.exr -> OUT.exr with channels renamed or dropped: SPEC is "OLD=NEW,OLD2=,..." (an
+ * empty NEW drops the channel): other renderers' layer names, files without a beauty. */
+static int rename_channels(const char *in, const char *out, const char *spec)
+{
+    image a;
+    char buf[1024], *tok, *save;
+    bool ok;
+    if (!image_read_exr(&a, in))
+        return 1;
+    snprintf(buf, sizeof buf, "%s", spec);
+    for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        char *eq = strchr(tok, '=');
+        int c;
+        if (!eq || (*eq = 0, (c = image_channel(&a, tok)) < 0) || strlen(eq + 1) >= sizeof a.names[0]) {
+            fprintf(stderr, "%s: bad rename '%s' (no such channel, or no '=')\n", in, tok);
+            image_destroy(&a);
+            return 1;
+        }
+        if (eq[1])
+            strcpy(a.names[c], eq + 1);
+        else
+            image_remove_channel(&a, c);
+    }
+    ok = image_write_exr(&a, out, NULL, 0);
+    image_destroy(&a);
+    return ok ? 0 : 1;
+}
+
+/* IN.exr -> OUT.exr with channel `name` of pixel (x, y) set to value ("nan", "inf" too). */
+static int poke_value(const char *in, const char *name, int x, int y, const char *value, const char *out)
+{
+    image a;
+    int c;
+    bool ok;
+    if (!image_read_exr(&a, in))
+        return 1;
+    c = image_channel(&a, name);
+    if (c < 0 || x < 0 || y < 0 || x >= a.width || y >= a.height) {
+        fprintf(stderr, "%s: no channel %s or pixel (%d, %d)\n", in, name, x, y);
+        image_destroy(&a);
+        return 1;
+    }
+    a.planes[c][(size_t)y * a.width + x] = strtof(value, NULL);
+    ok = image_write_exr(&a, out, NULL, 0);
+    image_destroy(&a);
+    return ok ? 0 : 1;
+}
+
 /* Prints channel `name` of pixel (x, y) with %.9g. */
 static int print_value(const char *in, const char *name, int x, int y)
 {
@@ -451,6 +499,10 @@ int main(int argc, char **argv)
         return print_value(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]));
     if (argc == 5 && !strcmp(argv[1], "png") && (!strcmp(argv[2], "depth") || !strcmp(argv[2], "normal")))
         return check_png(argv[2], argv[3], argv[4]);
+    if (argc == 5 && !strcmp(argv[1], "rename"))
+        return rename_channels(argv[2], argv[3], argv[4]);
+    if (argc == 8 && !strcmp(argv[1], "poke"))
+        return poke_value(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]), argv[6], argv[7]);
     if (argc == 5 && !strcmp(argv[1], "pick"))
         return pick_channel(argv[2], argv[3], argv[4]);
     if (argc == 5 && !strcmp(argv[1], "compress") && (!strcmp(argv[2], "draco") || !strcmp(argv[2], "meshopt")))
@@ -463,7 +515,8 @@ int main(int argc, char **argv)
     fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool compress draco|meshopt IN.gltf OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n"
                     "       testtool png depth|normal PNG REF.exr | testtool pick IN.exr CHANNEL OUT.exr\n"
                     "       testtool at IN.exr CHANNEL X Y | testtool same WHOLE.exr PART.exr | testtool rgb IN.exr\n"
-                    "       testtool moments IN.exr\n"
+                    "       testtool moments IN.exr | testtool rename IN.exr OUT.exr OLD=NEW,OLD2=,...\n"
+                    "       testtool poke IN.exr CHANNEL X Y VALUE OUT.exr\n"
                     "       testtool sheen-table\n");
     return 2;
 }
