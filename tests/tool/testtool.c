@@ -344,6 +344,55 @@ static int poke_value(const char *in, const char *name, int x, int y, const char
     return ok ? 0 : 1;
 }
 
+/* The denoiser's figures (tests/denoise/quality.sh) of TEST.exr's R, G, B against REF.exr:
+ * "rmse X corrected X display X mean X ref-noise X": the RMSE in linear RGB; the same less
+ * the reference's own noise (the mean of its variance.R/G/B channels, when it has them:
+ * sqrt(max(0, rmse^2 - noise^2))); the RMSE of both clamped to [0, 1] (what the default PNG
+ * shows before its sRGB curve); mean(TEST) / mean(REF) - 1; and that noise. */
+static int denoise_errors(const char *test, const char *refp)
+{
+    static const char *const rgb[3] = {"R", "G", "B"}, *const var[3] = {"variance.R", "variance.G", "variance.B"};
+    image a, b;
+    double se = 0, sd = 0, ma = 0, mb = 0, noise = 0;
+    int rc = 1;
+    if (!image_read_exr(&a, test))
+        return 1;
+    if (!image_read_exr(&b, refp)) {
+        image_destroy(&a);
+        return 1;
+    }
+    size_t n = (size_t)a.width * (size_t)a.height;
+    if (a.width != b.width || a.height != b.height) {
+        fprintf(stderr, "%s and %s differ in size\n", test, refp);
+        goto done;
+    }
+    for (int c = 0; c < 3; c++) {
+        int ca = image_channel(&a, rgb[c]), cb = image_channel(&b, rgb[c]), cv = image_channel(&b, var[c]);
+        if (ca < 0 || cb < 0) {
+            fprintf(stderr, "no channel %s in %s or %s\n", rgb[c], test, refp);
+            goto done;
+        }
+        for (size_t p = 0; p < n; p++) {
+            double x = a.planes[ca][p], y = b.planes[cb][p];
+            double xd = fmin(fmax(x, 0.0), 1.0), yd = fmin(fmax(y, 0.0), 1.0);
+            se += (x - y) * (x - y);
+            sd += (xd - yd) * (xd - yd);
+            ma += x;
+            mb += y;
+            noise += cv >= 0 ? b.planes[cv][p] : 0.0;
+        }
+    }
+    se /= 3.0 * (double)n;
+    noise /= 3.0 * (double)n;
+    printf("rmse %.6f corrected %.6f display %.6f mean %+.6f ref-noise %.6f\n", sqrt(se), sqrt(fmax(0.0, se - noise)),
+           sqrt(sd / (3.0 * (double)n)), ma / mb - 1, sqrt(noise));
+    rc = 0;
+done:
+    image_destroy(&a);
+    image_destroy(&b);
+    return rc;
+}
+
 /* Prints channel `name` of pixel (x, y) with %.9g. */
 static int print_value(const char *in, const char *name, int x, int y)
 {
@@ -499,6 +548,8 @@ int main(int argc, char **argv)
         return print_value(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]));
     if (argc == 5 && !strcmp(argv[1], "png") && (!strcmp(argv[2], "depth") || !strcmp(argv[2], "normal")))
         return check_png(argv[2], argv[3], argv[4]);
+    if (argc == 4 && !strcmp(argv[1], "errors"))
+        return denoise_errors(argv[2], argv[3]);
     if (argc == 5 && !strcmp(argv[1], "rename"))
         return rename_channels(argv[2], argv[3], argv[4]);
     if (argc == 8 && !strcmp(argv[1], "poke"))
@@ -516,7 +567,7 @@ int main(int argc, char **argv)
                     "       testtool png depth|normal PNG REF.exr | testtool pick IN.exr CHANNEL OUT.exr\n"
                     "       testtool at IN.exr CHANNEL X Y | testtool same WHOLE.exr PART.exr | testtool rgb IN.exr\n"
                     "       testtool moments IN.exr | testtool rename IN.exr OUT.exr OLD=NEW,OLD2=,...\n"
-                    "       testtool poke IN.exr CHANNEL X Y VALUE OUT.exr\n"
+                    "       testtool poke IN.exr CHANNEL X Y VALUE OUT.exr | testtool errors TEST.exr REF.exr\n"
                     "       testtool sheen-table\n");
     return 2;
 }
