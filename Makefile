@@ -1,6 +1,7 @@
 # gonio: build, run, test, bench.
 #   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
-#   make run | test | test-farm | bench | bench-peer | denoiser | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
+#   make run | test | test-farm | bench | bench-peer | bench-denoise | denoiser | docs-images | clean
+#   make install [PREFIX=/usr/local] [DESTDIR=]
 #   make fuzz (libFuzzer targets, clang, in build/fuzz) | fuzz-run [FUZZ_TIME=60]
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
 # is printed and make stops.
@@ -97,7 +98,7 @@ FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
 	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
 
 .PHONY: all deps test-deps run test unit regress bench clean install shaders docs-images \
-	fuzz fuzz-deps fuzz-targets fuzz-run test-farm bench-peer denoiser denoiser-if-possible
+	fuzz fuzz-deps fuzz-targets fuzz-run test-farm bench-peer denoiser denoiser-if-possible bench-denoise
 all: $(GONIO) build/gonio
 
 deps:
@@ -175,7 +176,7 @@ $(OIDN_LIB):
 	@if ! python3 -m pip --version >/dev/null 2>&1; then $(call apt_install,$(DEB_OIDN)); fi
 	@rm -rf build/oidn/wheel build/oidn/lib && mkdir -p build/oidn/wheel build/oidn/lib
 	@echo "gonio: fetching Open Image Denoise $(OIDN_VERSION) (pip: pyoidn==$(OIDN_VERSION).0) into build/oidn"
-	@python3 -m pip download -q --no-deps --only-binary=:all: --platform manylinux2014_x86_64 \
+	@python3 -m pip download -q --retries 1 --timeout 30 --no-deps --only-binary=:all: --platform manylinux2014_x86_64 \
 		-d build/oidn/wheel pyoidn==$(OIDN_VERSION).0 \
 		|| { rm -rf build/oidn; echo "gonio: pip could not fetch pyoidn==$(OIDN_VERSION).0"; exit 1; }
 	@python3 -c 'import sys, zipfile, glob, os; \
@@ -184,6 +185,10 @@ $(OIDN_LIB):
 		$(OIDN_FILES) || { rm -rf build/oidn; echo "gonio: the pyoidn wheel lacks the expected libraries"; exit 1; }
 	@rm -rf build/oidn/wheel
 	@echo "gonio: $(OIDN_LIB) and its CPU device are in place"
+# The denoiser's figures of docs/performance.md: quality against high-spp references and
+# the time to an RMSE with and without it (tests/denoise/quality.sh; about half an hour).
+bench-denoise: all $(TESTTOOL) denoiser
+	@tests/denoise/quality.sh $(GONIO) $(TESTTOOL) build/denoise
 denoiser-if-possible:
 	@[ -e $(OIDN_LIB) ] || $(MAKE) --no-print-directory denoiser || \
 		echo "gonio: note: no Open Image Denoise; the denoise tests will skip (make denoiser says why)"

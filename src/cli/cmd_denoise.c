@@ -94,19 +94,21 @@ static bool guide_from_file(image *img, const char *in_path, const char *path, c
     } else if (img->num_channels + 3 > IMAGE_MAX_CHANNELS) {
         util_error("%s: too many channels to add the %s of %s", in_path, role, path);
     } else {
+        /* As ROLE.R/G/B (or .X/Y/Z); the file's guide replaces the input's own of that name. */
         ok = true;
-        for (int k = 0; k < 3 && ok; k++) {
+        for (int k = 0; k < 3; k++) {
             char name[32];
+            int c;
             snprintf(name, sizeof name, "%s.%s", role, s[k]);
-            if (image_channel(img, name) >= 0) {
-                util_error("%s: has a channel '%s' already; the %s of %s cannot be added", in_path, name, role, path);
-                ok = false;
-                break;
+            if ((c = image_channel(img, name)) >= 0) {
+                free(img->planes[c]);
+            } else {
+                c = img->num_channels++;
+                snprintf(img->names[c], sizeof img->names[0], "%s", name);
             }
-            snprintf(img->names[img->num_channels], sizeof img->names[0], "%s", name);
-            img->planes[img->num_channels] = g.planes[gc[k]];
+            img->planes[c] = g.planes[gc[k]];
             g.planes[gc[k]] = NULL;
-            ch[k] = img->num_channels++;
+            ch[k] = c;
         }
     }
     image_destroy(&g);

@@ -358,7 +358,9 @@ static bool save_accumulated(preview *p)
     }
     if (!util_check_output(exr) || !util_check_output(png))
         return false;
-    renderer_resolve(&p->r, p->spp, false, &img);
+    /* With the guides when the render has them (the denoised view; not while a restart
+     * that adds them is pending): gonio denoise reads them. */
+    renderer_resolve(&p->r, p->spp, p->restart ? 0u : p->s.aov & (RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL), &img);
     ok = image_write_exr(&img, exr, h.attrs, h.count) &&
          render_write_png(&img, p->s.mode, png, p->exposure, p->tonemap); /* as gonio render's */
     if (ok) {

@@ -7,7 +7,10 @@
 # noisy and the denoised image against the reference (linear RGB; the same less the
 # reference's own noise; clamped to [0, 1] as the default PNG shows it), their ratio and the
 # denoised mean's relative difference from the reference's (testtool errors). Leaves in OUT
-# (default build/denoise) the EXRs, the PNGs and NAME-SPP.png: noisy | denoised | reference.
+# (default build/denoise) the EXRs, the PNGs, NAME-SPP.png: noisy | denoised | reference, and
+# denoise.jpg, their 16 spp rows (docs/img/denoise.jpg).
+# Then `gonio bench --paths --denoise` on each: the time to an RMSE of 0.05 and 0.02 with
+# and without the denoiser (the equal-quality speed-up).
 # References are kept and reused while OUT holds them (delete them after changing gonio).
 set -eu
 G=${1:?usage: quality.sh GONIO TESTTOOL [OUT]}
@@ -18,31 +21,34 @@ REF_SPP=${REF_SPP:-1024}
 ASSETS=${GONIO_ASSETS:-$(dirname "$0")/../../../shared/assets}
 mkdir -p "$OUT"
 
-scenes=("cornell|scenes/cornell.gltf|")
+# name|file|render options|bench options (bench takes the file's camera or frames the scene)
+scenes=("cornell|scenes/cornell.gltf||")
 if [ -f "$ASSETS/mesh/stanford-bunny.obj" ]; then
     python3 "$(dirname "$0")/bunny.py" "$ASSETS/mesh/stanford-bunny.obj" "$OUT/bunny.gltf"
-    scenes+=("bunny|$OUT/bunny.gltf|")
+    scenes+=("bunny|$OUT/bunny.gltf||")
 else
     echo "quality: the bunny skipped: $ASSETS/mesh/stanford-bunny.obj is absent"
 fi
 helmet=$ASSETS/gltf/DamagedHelmet/glTF/DamagedHelmet.gltf
 if [ -f "$helmet" ]; then
-    scenes+=("helmet|$helmet|--env 1 --look-at 1.2,0.6,2.6,0,0,0 --fov 40")
+    scenes+=("helmet|$helmet|--env 1 --look-at 1.2,0.6,2.6,0,0,0 --fov 40|--env 1")
 else
     echo "quality: DamagedHelmet skipped: $helmet is absent"
 fi
 
 echo "denoise quality: $SIZE, reference $REF_SPP spp; $("$G" --version); $(uptime | sed 's/.*load/load/')"
-printf "%-8s %4s  %-9s %-9s %-9s %-9s %-7s %-9s %-9s %-7s %-8s %-6s\n" scene spp noisy denoised \
-    noisy-c denoised-c ratio-c noisy-d denoised-d ratio-d mean "time"
+row() { printf "%-7s %4s | %-8s %-8s %-5s | %-8s %-8s %-5s | %-9s %-9s | %s\n" "$@"; }
+row scene spp noisy denoised ratio noisy-d denois-d ratio mean-noisy mean-dn "denoise s"
 for s in "${scenes[@]}"; do
-    IFS='|' read -r name file opts <<<"$s"
+    IFS='|' read -r name file opts _ <<<"$s"
     ref=$OUT/$name-ref.exr
     if [ ! -f "$ref" ]; then
         # shellcheck disable=SC2086 # opts holds several options
         "$G" render "$file" $opts --size "$SIZE" --spp "$REF_SPP" --seed 1 --aov variance -o "$ref" \
-            --png "$OUT/$name-ref.png" --quiet
+            --quiet
     fi
+    [ -f "$OUT/$name-ref.png" ] || "$T" png "$ref" "$OUT/$name-ref.png"
+
     for spp in 16 64; do
         # shellcheck disable=SC2086
         "$G" render "$file" $opts --size "$SIZE" --spp "$spp" -o "$OUT/$name-$spp-noisy.exr" \
@@ -50,16 +56,27 @@ for s in "${scenes[@]}"; do
         # shellcheck disable=SC2086
         "$G" render "$file" $opts --size "$SIZE" --spp "$spp" --denoise -o "$OUT/$name-$spp.exr" \
             --png "$OUT/$name-$spp-denoised.png" 2>"$OUT/$name-$spp.log"
-        read -r _ n _ nc _ nd _ _ _ _ < <("$T" errors "$OUT/$name-$spp-noisy.exr" "$ref")
-        read -r _ d _ dc _ dd _ mean _ _ < <("$T" errors "$OUT/$name-$spp.exr" "$ref")
+        read -r _ _ _ n _ _ _ nd _ nm _ _ < <("$T" errors "$OUT/$name-$spp-noisy.exr" "$ref")
+        read -r _ _ _ d _ _ _ dd _ dm _ _ < <("$T" errors "$OUT/$name-$spp.exr" "$ref")
         secs=$(sed -n 's/.*denoised in \([0-9.]*\) s.*/\1/p' "$OUT/$name-$spp.log")
-        printf "%-8s %4s  %-9s %-9s %-9s %-9s %-7s %-9s %-9s %-7s %-8s %-6s\n" "$name" "$spp" "$n" "$d" "$nc" "$dc" \
-            "$(awk -v a="$nc" -v b="$dc" 'BEGIN { printf "%.2f", b / a }')" "$nd" "$dd" \
-            "$(awk -v a="$nd" -v b="$dd" 'BEGIN { printf "%.2f", b / a }')" "$mean" "$secs"
+        row "$name" "$spp" "$n" "$d" "$(awk -v a="$n" -v b="$d" 'BEGIN { printf "%.2f", b / a }')" "$nd" "$dd" \
+            "$(awk -v a="$nd" -v b="$dd" 'BEGIN { printf "%.2f", b / a }')" "$nm" "$dm" "$secs"
         convert "$OUT/$name-$spp-noisy.png" "$OUT/$name-$spp-denoised.png" "$OUT/$name-ref.png" +append \
             "$OUT/$name-$spp.png"
     done
 done
-echo "columns: RMSE of the noisy and denoised images against the reference (linear RGB); -c: the"
-echo "same less the reference's own noise; -d: both clamped to [0, 1]; ratio: denoised / noisy;"
-echo "mean: the denoised image's mean / the reference's - 1; time: the denoise's seconds"
+# docs/img/denoise.jpg: the 16 spp rows, one a scene.
+rows=()
+for s in "${scenes[@]}"; do rows+=("$OUT/${s%%|*}-16.png"); done
+convert "${rows[@]}" -append -quality 85 "$OUT/denoise.jpg"
+echo "noisy, denoised: the RMSE against the reference in linear RGB less the reference's own"
+echo "noise; -d: of both clamped to [0, 1] (the default PNG before its sRGB curve), less the"
+echo "noise of the reference's values below 1; ratio: denoised / noisy; mean: the image's mean"
+echo "over the reference's - 1; denoise s: the denoise's time (render --denoise's summary)"
+
+for s in "${scenes[@]}"; do
+    IFS='|' read -r name file _ bopts <<<"$s"
+    echo "== gonio bench $name --paths --denoise --size 256x256 $bopts"
+    # shellcheck disable=SC2086
+    "$G" bench "$file" --paths --denoise --size 256x256 $bopts | grep -E "^(paths|reference|rmse|denoised|denoise speed)"
+done

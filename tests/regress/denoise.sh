@@ -127,20 +127,21 @@ check_fails "gonio denoise -o a name it cannot write is bad usage" 2 "$G" denois
 # ---- quality: nearer the reference, its mean kept ----------------------------------------------
 # The Cornell box's lower half (the boxes, walls and floor: no light in view, whose
 # antialiased edge the denoiser leaves as noisy as it is, docs/denoise.md) at 64x64:
-# 16 spp, denoised, against 512 spp of another seed. Measured here: the noisy RMSE
-# 0.0245, the denoised 0.0067 (3.7x lower; the reference's own noise, about 0.004, is in
-# both); the means within 0.3% of the reference's. Required: at least 2.5x lower, and
-# the mean within 1%.
+# 16 spp, denoised, against 512 spp of another seed. Measured with seeds 0, 2, 3, 4, 5:
+# the noisy RMSE 0.0145-0.0156, the denoised 0.0053-0.0055, 2.7 to 2.9 times lower (the
+# reference's own noise, 0.0026, is in both); the denoised mean within 0.11% of the noisy
+# image's own (whose mean is within 0.7% of the reference's: the noise of a 64x64 mean).
+# Required: at least 2.2 times lower, and the mean within 0.5% of the noisy one's.
 V="--look-at 0,0.15,0.8,0,0.12,0 --fov 30 --size 64x64 --quiet"
 check "reference: 512 spp" "$G" render $C -o "$tmp/q-ref.exr" --spp 512 --seed 1 $V
 check "16 spp, --denoise" "$G" render $C -o "$tmp/q.exr" --spp 16 --denoise $V
 check "... its noisy layer" "$T" rename "$tmp/q.exr" "$tmp/q-noisy.exr" R=,G=,B=,noisy.R=R,noisy.G=G,noisy.B=B
 rmse() { "$G" diff "$1" "$tmp/q-ref.exr" | sed -n 's/^rmse //p'; }
-bias() { "$G" diff "$1" "$tmp/q-ref.exr" | sed -n 's/^rel_bias //p'; }
 noisy=$(rmse "$tmp/q-noisy.exr")
 denoised=$(rmse "$tmp/q.exr")
-echo "  quality: rmse noisy $noisy, denoised $denoised; relative bias noisy $(bias "$tmp/q-noisy.exr"), denoised $(bias "$tmp/q.exr")"
-check "the denoised RMSE is at most 1/2.5 of the noisy one" awk -v n="$noisy" -v d="$denoised" 'BEGIN { exit !(d > 0 && d * 2.5 <= n) }'
-check "the denoised mean is within 1% of the reference's" awk -v b="$(bias "$tmp/q.exr")" 'BEGIN { exit !(b < 0.01 && b > -0.01) }'
+bias=$("$G" diff "$tmp/q.exr" "$tmp/q-noisy.exr" | sed -n 's/^rel_bias //p')
+echo "  quality: rmse noisy $noisy, denoised $denoised; the denoised mean over the noisy one's - 1: $bias"
+check "the denoised RMSE is at most 1/2.2 of the noisy one" awk -v n="$noisy" -v d="$denoised" 'BEGIN { exit !(d > 0 && d * 2.2 <= n) }'
+check "the denoised mean is within 0.5% of the noisy one's" awk -v b="$bias" 'BEGIN { exit !(b != "" && b < 0.005 && b > -0.005) }'
 
 finish

@@ -345,15 +345,17 @@ static int poke_value(const char *in, const char *name, int x, int y, const char
 }
 
 /* The denoiser's figures (tests/denoise/quality.sh) of TEST.exr's R, G, B against REF.exr:
- * "rmse X corrected X display X mean X ref-noise X": the RMSE in linear RGB; the same less
- * the reference's own noise (the mean of its variance.R/G/B channels, when it has them:
- * sqrt(max(0, rmse^2 - noise^2))); the RMSE of both clamped to [0, 1] (what the default PNG
- * shows before its sRGB curve); mean(TEST) / mean(REF) - 1; and that noise. */
+ * "rmse X corrected X display X display-corrected X mean X ref-noise X": the RMSE in linear
+ * RGB; the same less the reference's own noise (the mean of its variance.R/G/B channels,
+ * when it has them: sqrt(max(0, rmse^2 - noise^2))); the RMSE of both clamped to [0, 1]
+ * (what the default PNG shows before its sRGB curve), and the same less the noise of the
+ * reference's values below 1 (clamping leaves those as they are and flattens the rest);
+ * mean(TEST) / mean(REF) - 1; and the reference's noise. */
 static int denoise_errors(const char *test, const char *refp)
 {
     static const char *const rgb[3] = {"R", "G", "B"}, *const var[3] = {"variance.R", "variance.G", "variance.B"};
     image a, b;
-    double se = 0, sd = 0, ma = 0, mb = 0, noise = 0;
+    double se = 0, sd = 0, ma = 0, mb = 0, noise = 0, noise_d = 0;
     int rc = 1;
     if (!image_read_exr(&a, test))
         return 1;
@@ -380,12 +382,16 @@ static int denoise_errors(const char *test, const char *refp)
             ma += x;
             mb += y;
             noise += cv >= 0 ? b.planes[cv][p] : 0.0;
+            /* Clamped, a value well below 1 keeps its noise, one above loses it (nearly all). */
+            noise_d += cv >= 0 && y < 1.0 ? b.planes[cv][p] : 0.0;
         }
     }
     se /= 3.0 * (double)n;
+    sd /= 3.0 * (double)n;
     noise /= 3.0 * (double)n;
-    printf("rmse %.6f corrected %.6f display %.6f mean %+.6f ref-noise %.6f\n", sqrt(se), sqrt(fmax(0.0, se - noise)),
-           sqrt(sd / (3.0 * (double)n)), ma / mb - 1, sqrt(noise));
+    noise_d /= 3.0 * (double)n;
+    printf("rmse %.6f corrected %.6f display %.6f display-corrected %.6f mean %+.6f ref-noise %.6f\n", sqrt(se),
+           sqrt(fmax(0.0, se - noise)), sqrt(sd), sqrt(fmax(0.0, sd - noise_d)), ma / mb - 1, sqrt(noise));
     rc = 0;
 done:
     image_destroy(&a);
@@ -548,6 +554,12 @@ int main(int argc, char **argv)
         return print_value(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]));
     if (argc == 5 && !strcmp(argv[1], "png") && (!strcmp(argv[2], "depth") || !strcmp(argv[2], "normal")))
         return check_png(argv[2], argv[3], argv[4]);
+    if (argc == 4 && !strcmp(argv[1], "png")) { /* IN.exr -> OUT.png as render --png writes it */
+        image a;
+        bool ok = image_read_exr(&a, argv[2]) && image_write_png_from(&a, argv[3], 0.0f, IMAGE_TONEMAP_CLAMP);
+        image_destroy(&a);
+        return ok ? 0 : 1;
+    }
     if (argc == 4 && !strcmp(argv[1], "errors"))
         return denoise_errors(argv[2], argv[3]);
     if (argc == 5 && !strcmp(argv[1], "rename"))
@@ -568,6 +580,7 @@ int main(int argc, char **argv)
                     "       testtool at IN.exr CHANNEL X Y | testtool same WHOLE.exr PART.exr | testtool rgb IN.exr\n"
                     "       testtool moments IN.exr | testtool rename IN.exr OUT.exr OLD=NEW,OLD2=,...\n"
                     "       testtool poke IN.exr CHANNEL X Y VALUE OUT.exr | testtool errors TEST.exr REF.exr\n"
+                    "       testtool png IN.exr OUT.png\n"
                     "       testtool sheen-table\n");
     return 2;
 }
