@@ -208,8 +208,8 @@ static bool bench_paths(renderer *r, render_settings *s, double t_start, float s
         }
         for (int k = 0; k < 2; k++) {
             if (!spps[d][k])
-                printf("%s < %.2f%s not reached in %d spp (%.2f s)\n", d ? "denoised rmse" : "rmse",
-                       bench_thresholds[k], d ? "" : "         ", ref_spp, times[d][k]);
+                printf("%s < %.2f%snot reached in %d spp (%.2f s)\n", d ? "denoised rmse" : "rmse",
+                       bench_thresholds[k], d ? " " : "        ", ref_spp, times[d][k]);
             else if (!d)
                 printf("rmse < %.2f        %.2f s (%d spp, rmse %.4f, %dx%d)\n", bench_thresholds[k], times[d][k],
                        spps[d][k], rmses[d][k], ref_w, ref_h);

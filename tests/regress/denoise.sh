@@ -64,6 +64,15 @@ check "... is denoised" sh -c "exrheader '$tmp/dt.exr' | grep -q 'gonio:denoiser
 check "the summary line reports the denoise time apart" \
     sh -c "'$G' render $C -o '$tmp/ds.exr' --spp 4 --size 32x32 --denoise 2>&1 | grep -q 'denoised in [0-9.]* s'"
 
+# ---- bench --paths --denoise: the equal-quality speed-up (docs/performance.md) ----------------
+check "bench --paths --denoise" "$G" bench $C --paths --denoise --size 16x16 --seconds 0.2 --reference 16x16:32
+cp "$tmp/out" "$tmp/bench.txt"
+for line in "rmse < 0.05 " "rmse < 0.02 " "denoised rmse < 0.05 " "denoised rmse < 0.02 " \
+    "denoise speed-up .* at rmse 0.05" "denoise speed-up .* at rmse 0.02"; do
+    check "... prints '$line'" grep -Eq "^$line" "$tmp/bench.txt"
+done
+check_fails "bench --denoise without --paths is bad usage" 2 "$G" bench $C --denoise
+
 # ---- merge and resume -------------------------------------------------------------------------
 check_fails "gonio merge refuses a denoised file" 1 "$G" merge "$tmp/d.exr" "$tmp/n.exr" -o "$tmp/m.exr"
 check "... saying why and what to do instead" sh -c "grep -q 'is denoised' '$tmp/last' && grep -q 'gonio denoise' '$tmp/last'"
