@@ -12,6 +12,7 @@
 # Then `gonio bench --paths --denoise` on each (its camera, or the framing one): the time to
 # an RMSE of 0.05 and 0.02 with and without the denoiser (the equal-quality speed-up).
 # References are kept and reused while OUT holds them (delete them after changing gonio).
+# BENCH=0 leaves the benches out.
 set -eu
 G=${1:?usage: quality.sh GONIO TESTTOOL [OUT]}
 T=${2:?usage: quality.sh GONIO TESTTOOL [OUT]}
@@ -74,6 +75,7 @@ echo "noise; -d: of both clamped to [0, 1] (the default PNG before its sRGB curv
 echo "noise of the reference's values below 1; ratio: denoised / noisy; mean: the image's mean"
 echo "over the reference's - 1; denoise s: the denoise's time (render --denoise's summary)"
 
+[ "${BENCH:-1}" = 0 ] && exit 0 # BENCH=0: the table and pictures only
 for s in "${scenes[@]}"; do
     IFS='|' read -r name file _ bopts <<<"$s"
     # A 2048 spp reference: the default 512's own noise (0.011-0.013 in the Cornell box and

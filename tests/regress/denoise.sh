@@ -14,6 +14,7 @@ C=scenes/cornell.gltf
 R="--size 64x64 --quiet"
 
 # ---- without the library: clear errors, no output ------------------------------------------
+rm -f "$tmp/x.exr"
 check_fails "GONIO_OIDN_LIB naming no file: render --denoise exits 1" 1 \
     env GONIO_OIDN_LIB="$tmp/none.so" "$G" render $C -o "$tmp/x.exr" --denoise $R
 check "... naming the file, the variable and make denoiser" \
