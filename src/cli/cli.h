@@ -23,6 +23,7 @@ int cmd_teapot(int argc, char **argv);
 int cmd_merge(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_preview(int argc, char **argv);
+int cmd_denoise(int argc, char **argv);
 
 /* One of `gonio scene`'s scenes ("cornell", "teapot") loaded as from its glTF (written to a
  * temporary directory and removed), so a default scene needs no file in the working
