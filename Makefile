@@ -1,6 +1,7 @@
 # gonio: build, run, test, bench.
 #   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
-#   make run | test | check-layers | test-farm | bench | bench-peer | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
+#   make run | test | check-layers | test-farm | bench | bench-peer | bench-denoise | denoiser | docs-images
+#   make clean | install [PREFIX=/usr/local] [DESTDIR=]
 #   make fuzz (libFuzzer targets, clang, in build/fuzz) | fuzz-run [FUZZ_TIME=60]
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
 # is printed and make stops.
@@ -110,7 +111,8 @@ FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
 	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
 
 .PHONY: all deps test-deps run test check-layers unit regress bench clean install shaders docs-images \
-	fuzz fuzz-deps fuzz-targets fuzz-run fuzz-partials test-farm bench-peer
+	fuzz fuzz-deps fuzz-targets fuzz-run fuzz-partials test-farm bench-peer denoiser denoiser-if-possible \
+	bench-denoise
 all: $(GONIO) build/gonio
 
 deps:
@@ -167,8 +169,43 @@ run: all
 	@mkdir -p out
 	$(GONIO) render scenes/cornell.gltf -o out/cornell.exr --png out/cornell.png
 
-test: check-layers all $(UNIT) $(TESTTOOL) test-deps
+test: check-layers all $(UNIT) $(TESTTOOL) test-deps denoiser-if-possible
 	@GONIO=$(GONIO) UNIT=$(UNIT) TESTTOOL=$(TESTTOOL) CONFIG=$(config) tests/run.sh
+
+# Intel Open Image Denoise 2 for `render --denoise` and `gonio denoise` (src/core/denoise.h,
+# docs/denoise.md). Debian 12 packages no OIDN 2: its CPU libraries (the RT filter's
+# weights in _core, the CPU device, TBB) come from PyPI's pyoidn wheel, fetched with pip
+# into build/oidn and unpacked there without the GPU devices' libraries (CUDA, HIP, SYCL),
+# which the CPU device does not load. gonio loads it at run time; a plain `make` fetches
+# nothing. `make test` fetches it where it can (its denoise tests skip, saying so, where
+# not); `make denoiser` fails where it cannot. Version pinned: the one measured in
+# docs/performance.md.
+OIDN_VERSION := 2.5.1
+OIDN_LIB := build/oidn/lib/libOpenImageDenoise.so.2
+OIDN_FILES := libOpenImageDenoise.so.2 libOpenImageDenoise_core.so.$(OIDN_VERSION) \
+	libOpenImageDenoise_device_cpu.so.$(OIDN_VERSION) libtbb.so.12
+DEB_OIDN := python3-pip
+denoiser: $(OIDN_LIB)
+$(OIDN_LIB):
+	@if ! python3 -m pip --version >/dev/null 2>&1; then $(call apt_install,$(DEB_OIDN)); fi
+	@rm -rf build/oidn/wheel build/oidn/lib && mkdir -p build/oidn/wheel build/oidn/lib
+	@echo "gonio: fetching Open Image Denoise $(OIDN_VERSION) (pip: pyoidn==$(OIDN_VERSION).0) into build/oidn"
+	@python3 -m pip download -q --retries 1 --timeout 30 --no-deps --only-binary=:all: --platform manylinux2014_x86_64 \
+		-d build/oidn/wheel pyoidn==$(OIDN_VERSION).0 \
+		|| { rm -rf build/oidn; echo "gonio: pip could not fetch pyoidn==$(OIDN_VERSION).0"; exit 1; }
+	@python3 -c 'import sys, zipfile, glob, os; \
+		z = zipfile.ZipFile(glob.glob("build/oidn/wheel/*.whl")[0]); \
+		[open(os.path.join("build/oidn/lib", f), "wb").write(z.read("pyoidn/oidn/lib/" + f)) for f in sys.argv[1:]]' \
+		$(OIDN_FILES) || { rm -rf build/oidn; echo "gonio: the pyoidn wheel lacks the expected libraries"; exit 1; }
+	@rm -rf build/oidn/wheel
+	@echo "gonio: $(OIDN_LIB) and its CPU device are in place"
+# The denoiser's figures of docs/performance.md: quality against high-spp references and
+# the time to an RMSE with and without it (tests/denoise/quality.sh; about half an hour).
+bench-denoise: all $(TESTTOOL) denoiser
+	@tests/denoise/quality.sh $(GONIO) $(TESTTOOL) build/denoise
+denoiser-if-possible:
+	@[ -e $(OIDN_LIB) ] || $(MAKE) --no-print-directory denoiser || \
+		echo "gonio: note: no Open Image Denoise; the denoise tests will skip (make denoiser says why)"
 
 # A one-node Slurm cluster on localhost runs farm/slurm-tiles.sh (tests/farm/slurm.sh);
 # it skips, saying why, where slurm-wlm and munge cannot be installed or started.

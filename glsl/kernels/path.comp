@@ -27,7 +27,7 @@ layout(std430, binding = GN_BIND_ACCUM) buffer AccumBlock { vec4 accum[]; };
 layout(std430, binding = GN_BIND_AOV) buffer AovBlock { vec4 aov[]; };
 // GnEmitter[] as one RGBA32UI texel each (a storage buffer read with per-lane indices costs
 // llvmpipe a scalar load per lane and component: scene.glsl).
-layout(binding = GN_BIND_EMITTERS) uniform usamplerBuffer emitter_texels;
+layout(binding = GN_BIND_EMITTERS) uniform utextureBuffer emitter_texels;
 GnEmitter emitter_at(uint i)
 {
     uvec4 t = texelFetch(emitter_texels, int(i));
@@ -38,7 +38,7 @@ layout(std430, binding = GN_BIND_SQUARES) buffer SquaresBlock { vec4 squares[]; 
 // Lat-long map: 2 words (RGB as half floats) per texel, rows top (+Y) to bottom, then the
 // marginal CDF of the rows (env_height floats), then each row's conditional CDF.
 // (An R32UI texel buffer: a storage buffer's per-lane reads cost llvmpipe a branch per lane.)
-layout(binding = GN_BIND_ENV) uniform usamplerBuffer env_texels;
+layout(binding = GN_BIND_ENV) uniform utextureBuffer env_texels;
 uint envdata(uint i) { return texelFetch(env_texels, int(i)).x; }
 layout(push_constant) uniform PushBlock { GnPush push; };
 

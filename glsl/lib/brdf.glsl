@@ -23,7 +23,8 @@
 // brdf_sheen_table): as a constant array llvmpipe took minutes to compile the kernel. A kernel
 // that has the table elsewhere defines BRDF_SHEEN_FETCH before including this file.
 #ifndef BRDF_SHEEN_FETCH
-layout(binding = BRDF_BIND_SHEEN) uniform usamplerBuffer sheen_table;
+#extension GL_EXT_samplerless_texture_functions : require // a buffer image, no sampler (scene.glsl)
+layout(binding = BRDF_BIND_SHEEN) uniform utextureBuffer sheen_table;
 #define BRDF_SHEEN_FETCH(i) uintBitsToFloat(texelFetch(sheen_table, (i)).x)
 #endif
 

@@ -19,20 +19,23 @@ layout(std430, binding = GN_BIND_FRAME) readonly buffer FrameBlock { GnFrame fra
 // lane and one component at a time, branching on each lane's mask, a texel buffer with
 // one load per lane and no branches, which makes the walk several times faster there;
 // GPUs read both at full speed.
+// They are textureBuffers, images without a sampler (texelFetch needs none): SPIR-V deprecates
+// a sampler combined with a buffer image, and Mesa 25 warns at every such binding.
+#extension GL_EXT_samplerless_texture_functions : require
 // An integer format passes every bit through (a float format may flush the denormals that
 // small integers stored as floats are); floats come back with uintBitsToFloat.
-layout(binding = GN_BIND_NODES) uniform usamplerBuffer node_texels;
-layout(binding = GN_BIND_TRIS) uniform usamplerBuffer tri_texels;
-layout(binding = GN_BIND_PRIMS) uniform usamplerBuffer prim_texels;
-layout(binding = GN_BIND_VERTICES) uniform usamplerBuffer vertex_texels;
-layout(binding = GN_BIND_MATERIALS) uniform usamplerBuffer material_texels;
+layout(binding = GN_BIND_NODES) uniform utextureBuffer node_texels;
+layout(binding = GN_BIND_TRIS) uniform utextureBuffer tri_texels;
+layout(binding = GN_BIND_PRIMS) uniform utextureBuffer prim_texels;
+layout(binding = GN_BIND_VERTICES) uniform utextureBuffer vertex_texels;
+layout(binding = GN_BIND_MATERIALS) uniform utextureBuffer material_texels;
 layout(std430, binding = GN_BIND_LIGHTS) readonly buffer LightBlock { GnLight lights[]; };
-layout(binding = GN_BIND_TEXELS) uniform usamplerBuffer texels; // R32UI: one RGBA8 texel each
-layout(binding = GN_BIND_TEXTURES) uniform usamplerBuffer texture_texels; // GnTexture[]
+layout(binding = GN_BIND_TEXELS) uniform utextureBuffer texels; // R32UI: one RGBA8 texel each
+layout(binding = GN_BIND_TEXTURES) uniform utextureBuffer texture_texels; // GnTexture[]
 
 #define PI GN_PI // (the name path.comp and bench.comp use)
 
-vec4 texel_f(usamplerBuffer b, uint i) { return uintBitsToFloat(texelFetch(b, int(i))); }
+vec4 texel_f(utextureBuffer b, uint i) { return uintBitsToFloat(texelFetch(b, int(i))); }
 
 GnPrim prim_at(uint i)
 {

@@ -23,6 +23,7 @@ int cmd_teapot(int argc, char **argv);
 int cmd_merge(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_preview(int argc, char **argv);
+int cmd_denoise(int argc, char **argv);
 
 /* One of `gonio scene`'s scenes ("cornell", "teapot") loaded as from its glTF (written to a
  * temporary directory and removed), so a default scene needs no file in the working
@@ -143,6 +144,9 @@ void cli_complete_print(const char *list);
 #define CLI_OPT_TONEMAP(dest, help)                                                               \
     {"--tonemap", "T", help, CLI_CALL, CLI_AS(image_tonemap, dest), 0, 0, NULL, cli_take_tonemap, \
      image_tonemap_list()}
+/* Intel Open Image Denoise on the result (src/core/denoise.h). */
+#define CLI_OPT_DENOISE(dest, help)                                                       \
+    {"--denoise", NULL, help, CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL, NULL}
 #define CLI_OPT_PNG(dest, help)                                                                   \
     {"--png", "FILE", help, CLI_STRING, CLI_AS(const char *, dest), 0, 0, NULL, NULL, "*.png"}
 #define CLI_OPT_DEVICE(dest)                                                                      \

@@ -1,4 +1,5 @@
 /* cmd_render.c: `gonio render`. */
+#include <assert.h>
 #include <errno.h>
 #include <float.h>
 #include <math.h>
@@ -12,6 +13,7 @@
 #include "brdf.h"
 #include "camera.h"
 #include "cli.h"
+#include "denoise.h"
 #include "environment.h"
 #include "image.h"
 #include "progress.h"
@@ -142,6 +144,8 @@ static bool check_sums(const char *path, const image *prev, int spp, uint32_t mo
 {
     const size_t n = (size_t)prev->width * (size_t)prev->height;
     const int cn = image_channel(prev, "sum.N");
+    if (image_channel(prev, "sum.R") < 0)
+        return true; /* not a --resumable file: the render names the first channel it lacks */
     if (cn < 0) {
         util_error("%s: cannot resume: no sum.N channel (each pixel's sample count; written by "
                    "--resumable since this version: render it again)", path);
@@ -303,7 +307,7 @@ typedef struct render_job {
     env_option env;
     crop_option crop;
     int size[2];  /* --size */
-    bool size_given, quiet, validate, resumable, outside;
+    bool size_given, quiet, validate, resumable, outside, denoise;
     int frame;   /* --frame, -1 none */
     float fps;
     float at;    /* --at, -1 none */
@@ -475,6 +479,10 @@ int cmd_render(int argc, char **argv)
                                  "seed and options (checked): --spp is the total; the result is the\n"
                                  "render of --spp in one run, bit for bit",
          CLI_STRING, CLI_AS(const char *, &j.resume_path), 0, 0, NULL, NULL, "*.exr"},
+        CLI_OPT_DENOISE(&j.denoise, "path: denoise with Intel Open Image Denoise (RT filter), guided by\n"
+                                    "the albedo and normal (rendered for it, written only as --aov\n"
+                                    "says): the PNG and the EXR's R,G,B denoised, its noisy.R/G/B the\n"
+                                    "render itself (make denoiser fetches the library; docs/denoise.md)"),
         {"--aov", "LIST", "extra EXR channels, exactly those listed: any of normal (normal.XYZ),\n"
                           "albedo (albedo.RGB), depth (depth.Z, 0 on a miss), variance\n"
                           "(variance.RGB: of each pixel's mean), comma-separated",
@@ -532,7 +540,32 @@ int cmd_render(int argc, char **argv)
         return cli_usage_error("render", "--resume '%s': expected a .exr render", j.resume_path);
     if (j.frame >= 0 && j.at >= 0 && !j.frames)
         return cli_usage_error("render", "--frame and --at exclude each other");
+    if (j.denoise && j.s.mode != GN_MODE_PATH)
+        return cli_usage_error("render", "--denoise is for --mode path (the other modes have no noise to remove)");
     return j.frames ? render_frames(&j) : render_run(&j);
+}
+
+/* ---- --denoise ---------------------------------------------------------------------------
+ * The render's albedo and normal guide OIDN (src/core/denoise.h); they stay in the EXR only
+ * when --aov asked for them. The header says what the denoiser did and how long it took. */
+static bool denoise_render(image *img, uint32_t user_aov, const char *name, denoise_info *info)
+{
+    denoise_channels ch;
+    static const char *const names[9] = {"R", "G", "B", "albedo.R", "albedo.G", "albedo.B",
+                                         "normal.X", "normal.Y", "normal.Z"};
+    for (int k = 0; k < 3; k++) {
+        ch.beauty[k] = image_channel(img, names[k]);
+        ch.albedo[k] = image_channel(img, names[3 + k]);
+        ch.normal[k] = image_channel(img, names[6 + k]);
+    }
+    if (!denoise_image(img, &ch, true, info, name))
+        return false;
+    for (int k = 0; k < 6; k++) {
+        int c = image_channel(img, names[3 + k]);
+        if (!(user_aov & (k < 3 ? RENDER_AOV_ALBEDO : RENDER_AOV_NORMAL)) && c >= 0)
+            image_remove_channel(img, c);
+    }
+    return true;
 }
 
 /* One render of the job: load, render, write. */
@@ -573,6 +606,11 @@ static int render_run(const render_job *job)
     scene_allow_outside_files(job->outside);
     if ((out_path && !util_check_output(out_path)) || (png_path && !util_check_output(png_path)))
         return 1;
+    if (job->denoise) { /* the library is there, before any work; the guides are rendered */
+        if (!denoise_load())
+            return 1;
+        s.aov |= RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL;
+    }
 
     if (frame >= 0)
         at = frame / (double)job->fps;
@@ -615,6 +653,7 @@ static int render_run(const render_job *job)
         render_header h;
         bool ok = true;
         int region[4];
+        denoise_info dn = {0};
         render_header_build(&h, &r, &s, &st, brdf, cli_command_line());
         if (at >= 0 && h.count + 2 <= RENDER_HEADER_MAX) { /* the animation's time, and frame */
             h.attrs[h.count++] = (image_attr){"gonio:time", IMAGE_ATTR_DOUBLE, NULL, 0, at, NULL};
@@ -624,7 +663,16 @@ static int render_run(const render_job *job)
         if (stop_requested && !quiet)
             util_warn("interrupted: writing the %d spp rendered so far%s", st.spp,
                       stop_requested == SIGTERM && exr_path ? " (resumable: --resume)" : "");
-        if (resumable || stop_requested == SIGTERM)
+        if (job->denoise) {
+            ok = denoise_render(&img, job->s.aov, out_path ? out_path : png_path, &dn);
+            if (ok) {
+                assert(h.count + 2 <= RENDER_HEADER_MAX); /* a path render's header has 22 at most */
+                h.attrs[h.count++] = (image_attr){"gonio:denoiser", IMAGE_ATTR_STRING, dn.description, 0, 0, NULL};
+                h.attrs[h.count++] = (image_attr){"gonio:denoise-seconds", IMAGE_ATTR_DOUBLE, NULL, 0, dn.seconds, NULL};
+            }
+        }
+        /* With --denoise the sums include the guides', so that --resume --denoise goes on. */
+        if (ok && (resumable || stop_requested == SIGTERM))
             renderer_sums(&r, st.spp, s.aov, &img);
         render_region(&s, region);
         if (s.crop_x1 > 0) { /* the region in the whole frame: OpenEXR's data window */
@@ -633,7 +681,7 @@ static int render_run(const render_job *job)
             img.full_width = s.width;
             img.full_height = s.height;
         }
-        if (exr_path)
+        if (ok && exr_path)
             ok = image_write_exr_with(&img, exr_path, h.attrs, h.count, &exr);
         if (ok && png_o)
             ok = render_write_png(&img, s.mode, png_o, job->exposure, job->tm);
@@ -646,11 +694,16 @@ static int render_run(const render_job *job)
                     out_path ? out_path : png_path, s.width, s.height, camera_text, render_mode_name(s.mode),
                     st.spp, seconds, st.seconds > 0 ? (double)st.rays / st.seconds * 1e-6 : 0.0,
                     s.mode == GN_MODE_PATH ? "M paths/s" : "Mrays/s primary", st.setup_seconds);
+        if (ok && !quiet && job->denoise)
+            fprintf(stderr, "gonio: denoised in %.2f s (%s; library and device setup %.2f s)\n", dn.seconds,
+                    dn.description, dn.setup_seconds);
         rc = !ok ? 1 : stop_requested ? 128 + stop_requested : 0;
     }
     image_destroy(&img);
     image_destroy(&prev);
     image_destroy(&env_map);
+    if (job->denoise)
+        denoise_shutdown();
     renderer_destroy(&r);
     if (!cli_gpu_finish(&g))
         rc = 1;

@@ -17,6 +17,7 @@ static const struct {
     {"devices", cmd_devices, "list the Vulkan devices"},
     {"compare", cmd_compare, "flat vs Gouraud vs per-pixel Phong vs path traced, side by side"},
     {"merge", cmd_merge, "combine renders of one scene with different seeds, exactly"},
+    {"denoise", cmd_denoise, "denoise an EXR render (Intel Open Image Denoise)"},
     {"diff", cmd_diff, "compare two EXR images (RMSE, PSNR, bias); exit 1 above thresholds"},
     {"bench", cmd_bench, "measure BVH build, ray throughput and path tracing (--paths)"},
     {"brdf", cmd_brdf, "virtual goniophotometer: BRDF lobe plots, albedo, material balls"},

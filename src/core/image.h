@@ -42,6 +42,8 @@ void image_create(image *img, int width, int height, int num_channels, const cha
 void image_destroy(image *img); /* accepts a zeroed struct */
 /* Index of a channel by name, or -1. */
 int image_channel(const image *img, const char *name);
+/* Removes channel c (its plane freed); the later channels move up one. */
+void image_remove_channel(image *img, int c);
 
 /* The file formats an output name can ask for, by its extension (case-insensitive). */
 typedef enum image_format { IMAGE_FORMAT_UNKNOWN, IMAGE_FORMAT_EXR, IMAGE_FORMAT_PNG } image_format;
@@ -83,6 +85,16 @@ bool image_exr_attr_double(const char *path, const char *name, double *out);
 bool image_exr_attr_string(const char *path, const char *name, char *out, int cap);
 /* The size of an EXR's data window; false if path is not a readable EXR. */
 bool image_exr_size(const char *path, int *width, int *height);
+/* The header attributes of an EXR that image_write_exr_with can write again: string, int,
+ * double, m44f, and float (as double); OpenEXR's required attributes (channels, windows,
+ * compression...) and other types left out. False (with an error) if path is not a readable
+ * EXR. The list owns its names and values: image_attr_list_destroy frees them. */
+typedef struct image_attr_list {
+    int count;
+    image_attr *attrs;
+} image_attr_list;
+bool image_exr_attrs(const char *path, image_attr_list *out);
+void image_attr_list_destroy(image_attr_list *l); /* accepts a zeroed struct */
 
 typedef enum image_tonemap { IMAGE_TONEMAP_CLAMP, IMAGE_TONEMAP_ACES, IMAGE_TONEMAP_REINHARD } image_tonemap;
 

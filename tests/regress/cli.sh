@@ -158,7 +158,7 @@ if command -v help2man >/dev/null && command -v man >/dev/null; then
     # --help lists (so any option added to a table) is offered, nothing else is, and the
     # script itself names none of them.
     all_opts=
-    for c in render preview info devices compare merge diff bench brdf "brdf phong" scene teapot; do
+    for c in render preview info devices compare merge diff bench brdf "brdf phong" scene teapot denoise; do
         want=$({ "$G" $c --help | sed -n 's/^ \{1,4\}\(-[-a-zA-Z]*\)\(, \(--[-a-z]*\)\)\{0,1\}.*/\1 \3/p'
             echo --help; } | tr ' ' '\n' | grep -- '^--' | grep -v -- '--PARAM' | sort -u | tr '\n' ' ')
         check "completion: gonio $c -- offers the options of its --help" \

@@ -965,7 +965,8 @@ TEST(scene, bad_geometry)
     } bad[] = {
         {"{\"bufferView\":0,\"componentType\":5126,\"count\":5,\"type\":\"VEC3\"}", "\"POSITION\":6", "does not fit in buffer view 0"},
         {"{\"bufferView\":0,\"byteOffset\":2,\"componentType\":5126,\"count\":1,\"type\":\"VEC3\"}", "\"POSITION\":6", "not a multiple"},
-        {"{\"bufferView\":6,\"componentType\":5126,\"count\":1,\"type\":\"VEC3\"}", "\"POSITION\":6", "does not fit in buffer 0"},
+        {"{\"bufferView\":6,\"componentType\":5126,\"count\":1,\"type\":\"VEC3\"}", "\"POSITION\":6",
+         "bufferViews[6]: bytes 160 to 260 lie beyond buffers[0].byteLength 168"},
         {"{\"bufferView\":6,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"}", "\"POSITION\":6", "smaller than the element size"},
         {"{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"}", "\"POSITION\":6", "not allowed for attribute POSITION"},
         {"{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"}", "\"POSITION\":0,\"NORMAL\":6", "same count"},
