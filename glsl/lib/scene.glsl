@@ -13,7 +13,7 @@
 // dispatch larger than a small render (docs/performance.md).
 layout(std430, binding = GN_BIND_FRAME) readonly buffer FrameBlock { GnFrame frame; };
 // The BVH nodes (GnBvhNode = 4 texels), triangle pairs (GnTriPair = 3), shading triangles
-// (GnPrim = 1), vertices (GnVertex = 5), materials (GnMaterial = 21), textures (GnTexture =
+// (GnPrim = 1), vertices (GnVertex = 5), materials (GnMaterial = GN_MATERIAL_TEXELS), textures (GnTexture =
 // 1; their RGBA8 images: R32UI) and path.comp's lights (GnEmitter = 1) are read from texel
 // buffers, not storage buffers: llvmpipe fetches a storage buffer with per-lane offsets one
 // lane and one component at a time, branching on each lane's mask, a texel buffer with
@@ -61,34 +61,14 @@ void tri_corners(uint i, out vec3 a, out vec3 b, out vec3 c)
 // Does the scene have vertex colours (glTF COLOR_0)? Without, GnVertex.color is not read.
 bool vertex_colors() { return GN_HAS(GN_FEAT_VERTEX_COLOR) && (frame.flags & GN_FRAME_VERTEX_COLOR) != 0u; }
 
-// Fields a kernel does not read are never fetched: the compiler drops unused texel loads.
+// Material i, each field from its word (glsl/lib/material.h); fields a kernel does not read are
+// never fetched: the compiler drops unused texel loads.
 GnMaterial material_at(uint i)
 {
-    uint k = 21u * i;
-    vec4 t0 = texel_f(material_texels, k), t1 = texel_f(material_texels, k + 1u);
-    vec4 t2 = texel_f(material_texels, k + 2u), t3 = texel_f(material_texels, k + 3u);
-    uvec4 t4 = texelFetch(material_texels, int(k + 4u)), t5 = texelFetch(material_texels, int(k + 5u));
-    uvec4 t6 = texelFetch(material_texels, int(k + 6u));
-    vec4 t7 = texel_f(material_texels, k + 7u), t8 = texel_f(material_texels, k + 8u);
-    vec4 t9 = texel_f(material_texels, k + 9u), t10 = texel_f(material_texels, k + 10u);
-    vec4 t11 = texel_f(material_texels, k + 11u), t12 = texel_f(material_texels, k + 12u);
-    uvec4 t13 = texelFetch(material_texels, int(k + 13u));
-    uvec4 t14 = texelFetch(material_texels, int(k + 14u)), t15 = texelFetch(material_texels, int(k + 15u));
-    vec4 t16 = texel_f(material_texels, k + 16u);
-    uvec4 t17 = texelFetch(material_texels, int(k + 17u)), t18 = texelFetch(material_texels, int(k + 18u));
-    uvec4 t19 = texelFetch(material_texels, int(k + 19u)), t20 = texelFetch(material_texels, int(k + 20u));
-    return GnMaterial(t0, t1.xyz, t1.w, t2.xyz, t2.w, t3.x, t3.y, t3.z, t3.w,
-                      uintBitsToFloat(t4.x), uintBitsToFloat(t4.y), t4.z, t4.w,
-                      t5.x, t5.y, t5.z, t5.w, t6.x, t6.y, t6.z, t6.w,
-                      t7, t8.xyz, t8.w, t9.xyz, t9.w, t10.xyz, t10.w, t11.xyz, t11.w,
-                      t12.xyz, t12.w, uintBitsToFloat(t13.x), uintBitsToFloat(t13.y), t13.z,
-                      uintBitsToFloat(t13.w),
-                      uintBitsToFloat(t14.x), uintBitsToFloat(t14.y), t14.z, t14.w,
-                      t15.x, uintBitsToFloat(t15.y), t15.z, t15.w, t16.xyz, t16.w,
-                      uintBitsToFloat(t17.x), uintBitsToFloat(t17.y), t17.z, uintBitsToFloat(t17.w),
-                      uintBitsToFloat(t18.x), uintBitsToFloat(t18.y), uintBitsToFloat(t18.z),
-                      uintBitsToFloat(t18.w), t19.x, t19.y, uintBitsToFloat(t19.z), t19.w,
-                      uintBitsToFloat(t20.xyz), t20.w);
+    uint k = GN_MATERIAL_TEXELS * i;
+    GnMaterial m;
+    GN_MATERIAL(GN_MAT_READ_PARAM, GN_MAT_READ_TEX, GN_MAT_READ_FIELD)
+    return m;
 }
 
 // ---- random numbers that depend only on (pixel, sample, dimension, seed) ---------------

@@ -253,43 +253,13 @@ GN_STRUCT(GnVertex) {
                      kernels with GN_FEAT_UV1 */
 } GN_END(GnVertex); /* 80 bytes */
 
-/* glTF metallic-roughness material plus the classic (OpenGL 1.x) Phong parameters used by
- * the local shading modes, and an optional BRDF-model override for the path tracer.
- * Texture fields index GnTexture[], GN_INVALID when absent. */
+/* A material: glTF metallic-roughness with its extensions, the classic (OpenGL 1.x) Phong
+ * parameters of the local shading modes, and an optional BRDF-model override for the path
+ * tracer. Declared field by field in glsl/lib/material.h (GN_MATERIAL), which everything that
+ * reads or writes one expands. Texture fields index GnTexture[], GN_INVALID when absent. */
+#include "material.h"
 GN_STRUCT(GnMaterial) {
-    vec4 base_color;                       /* linear RGBA factor */
-    vec3 emissive; float metallic;         /* emissive factor * KHR_materials_emissive_strength */
-    vec3 specular_color; float roughness;  /* KHR_materials_specular colour factor */
-    float specular; float ior; float transmission; float normal_scale;
-    float occlusion_strength; float alpha_cutoff; uint flags; uint brdf; /* brdf: 0 = glTF model */
-    uint tex_base; uint tex_mr; uint tex_normal; uint tex_emissive;
-    uint tex_occlusion; uint pad0; uint pad1; uint pad2;
-    vec4 brdf_params;                      /* parameters of the override model */
-    vec3 phong_ambient; float phong_shininess;
-    vec3 phong_diffuse; float phong_pad0;
-    vec3 phong_specular; float phong_pad1;
-    vec3 phong_emission; float phong_pad2;
-    /* KHR_materials_volume (read by kernels with GN_FEAT_VOLUME; docs/path-tracing.md):
-     * volume 1 when the material bounds a medium (the extension with thicknessFactor > 0),
-     * whose absorption is sigma_a = -ln(attenuation_color) / attenuation_distance (+inf: no
-     * absorption). thickness is the rasterizers' stand-in for the real geometry: kept for
-     * `gonio info`, unused in shading. dispersion: KHR_materials_dispersion, 20 / Abbe number. */
-    vec3 attenuation_color; float attenuation_distance;
-    float thickness; float dispersion; uint volume; float volume_pad0;
-    /* KHR_materials_clearcoat: factor, roughness factor and their textures (R, G); the coat's
-     * normal map and its scale (GN_INVALID: the mesh's normal, not normalTexture's) */
-    float clearcoat; float clearcoat_roughness; uint tex_clearcoat; uint tex_clearcoat_roughness;
-    uint tex_clearcoat_normal; float clearcoat_normal_scale; uint tex_sheen_color; uint tex_sheen_roughness;
-    vec3 sheen_color; float sheen_roughness; /* KHR_materials_sheen factors (textures: RGB, A) */
-    /* KHR_materials_anisotropy: strength, rotation (radians, from the tangent toward the
-     * bitangent) and the direction/strength texture (RG: direction, B: strength) */
-    float anisotropy_strength; float anisotropy_rotation; uint tex_anisotropy; float anisotropy_pad0;
-    /* KHR_materials_iridescence: factor, the film's ior, its thickness range in nm and the
-     * factor (R) and thickness (G) textures */
-    float iridescence; float iridescence_ior; float iridescence_thickness_min; float iridescence_thickness_max;
-    uint tex_iridescence; uint tex_iridescence_thickness; float diffuse_transmission; uint tex_diffuse_transmission;
-    /* KHR_materials_diffuse_transmission: factor (above, texture A) and colour (texture RGB) */
-    vec3 diffuse_transmission_color; uint tex_diffuse_transmission_color;
+    GN_MATERIAL(GN_MAT_DECL_PARAM, GN_MAT_DECL_TEX, GN_MAT_DECL_FIELD)
 } GN_END(GnMaterial); /* 336 bytes */
 
 /* glTF KHR_lights_punctual light in world space. color = colour * intensity (W/sr for point
@@ -402,12 +372,19 @@ GN_STATIC_ASSERT(sizeof(GnTriPair) == 48, "GnTriPair layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");
 GN_STATIC_ASSERT(sizeof(GnVertex) == 80, "GnVertex layout");
 GN_STATIC_ASSERT(offsetof(GnVertex, u1) == 64, "GnVertex layout");
-GN_STATIC_ASSERT(sizeof(GnMaterial) == 336, "GnMaterial layout");
-GN_STATIC_ASSERT(offsetof(GnMaterial, attenuation_color) == 192, "GnMaterial layout");
-GN_STATIC_ASSERT(offsetof(GnMaterial, clearcoat) == 224, "GnMaterial layout");
-GN_STATIC_ASSERT(offsetof(GnMaterial, sheen_color) == 256, "GnMaterial layout");
-GN_STATIC_ASSERT(offsetof(GnMaterial, brdf_params) == 112, "GnMaterial layout");
-GN_STATIC_ASSERT(offsetof(GnMaterial, phong_ambient) == 128, "GnMaterial layout");
+GN_STATIC_ASSERT(sizeof(GnMaterial) == 4 * GN_MATERIAL_WORDS && GN_MATERIAL_WORDS == 4 * GN_MATERIAL_TEXELS,
+                 "GnMaterial layout");
+/* every row of GN_MATERIAL at its word, a vec3 or vec4 at the start of a texel */
+#define GN_MAT_ALIGNED_float(word) 1
+#define GN_MAT_ALIGNED_uint(word) 1
+#define GN_MAT_ALIGNED_vec3(word) ((word) % 4 == 0)
+#define GN_MAT_ALIGNED_vec4(word) ((word) % 4 == 0)
+#define GN_MAT_ASSERT_FIELD(name, type, word) \
+    GN_STATIC_ASSERT(offsetof(GnMaterial, name) == 4 * (word) && GN_MAT_ALIGNED_##type(word), \
+                     "GnMaterial." #name " is not at word " #word " (glsl/lib/material.h)");
+#define GN_MAT_ASSERT_PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf) GN_MAT_ASSERT_FIELD(name, type, word)
+#define GN_MAT_ASSERT_TEX(name, word, ext, json, space, gate, uses) GN_MAT_ASSERT_FIELD(name, uint, word)
+GN_MATERIAL(GN_MAT_ASSERT_PARAM, GN_MAT_ASSERT_TEX, GN_MAT_ASSERT_FIELD)
 GN_STATIC_ASSERT(sizeof(GnLight) == 64, "GnLight layout");
 GN_STATIC_ASSERT(sizeof(GnEmitter) == 16, "GnEmitter layout");
 GN_STATIC_ASSERT(sizeof(GnTexture) == 48, "GnTexture layout");
