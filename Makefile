@@ -148,6 +148,8 @@ $(BUILD)/spv/%.h: %.comp | deps
 	spirv-val --target-env vulkan1.1 $(BUILD)/spv/$*.spv
 	glslangValidator -V --target-env vulkan1.1 -Iglsl/lib --vn spv_$(subst -,_,$*) -o $@ $< >/dev/null
 	@sed -i 's|\.spv:|.h:|' $(BUILD)/spv/$*.d
+	@# (and, as -MP does for C, an empty rule per included file: a file renamed or removed is no error)
+	@sed -n 's|^[^:]*: [^ ]*||p' $(BUILD)/spv/$*.d | tr ' ' '\n' | sed -n 's|^\(..*\)$$|\1:|p' >>$(BUILD)/spv/$*.d
 shaders: $(SPV_HDR)
 
 run: all

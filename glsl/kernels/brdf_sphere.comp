@@ -2,10 +2,10 @@
 // brdf_sphere.comp: the material ball of `gonio brdf --sphere`: a unit sphere lit by a
 // directional light (evaluated directly: Lo += f E cos, the point-light integral)
 // and a constant environment (reached by BSDF sampling, bounces through glass included),
-// one path per pixel per dispatch, accumulated. Uses the renderer's brdf.glsl.
+// one path per pixel per dispatch, accumulated. Uses the renderer's brdf_material.glsl.
 #extension GL_GOOGLE_include_directive : require
 
-#include "brdf.glsl"
+#include "brdf_material.glsl"
 
 layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
 

@@ -1,11 +1,11 @@
 #version 450
-// brdf_test.comp: runs brdf.glsl, the same file the renderer includes, on a buffer of
+// brdf_test.comp: runs brdf_material.glsl, the same files the renderer includes, on a buffer of
 // queries (one per invocation) so the unit tests and `gonio brdf` measure the shader code
 // itself: eval and pdf at given directions, sample with given random numbers, and the
 // Fresnel functions (BrdfQuery/BrdfResult in brdf_models.h).
 #extension GL_GOOGLE_include_directive : require
 
-#include "brdf.glsl"
+#include "brdf_material.glsl"
 
 layout(local_size_x = 64) in;
 

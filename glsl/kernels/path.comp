@@ -3,7 +3,7 @@
 // L_o = L_e + integral f L_i cos, several path samples a pixel per dispatch. At every vertex:
 // next-event estimation (one light from the power-proportional table, area sampling on
 // triangles, the lat-long environment map by its luminance) and a BSDF sample from
-// brdf.glsl, combined by multiple importance sampling with the power heuristic (Veach &
+// brdf_bsdf.glsl, combined by multiple importance sampling with the power heuristic (Veach &
 // Guibas 1995, "Optimally combining sampling techniques"); Dirac lobes and punctual lights
 // take their one strategy exactly; Russian roulette after ROULETTE_DEPTH bounces.
 // docs/path-tracing.md derives the estimator and names the tests that check it.
@@ -19,7 +19,7 @@ layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
 #include "bvh.glsl"
 // The sheen's albedo table heads the texel buffer in scenes with layers (src/render/render.c).
 #define BRDF_SHEEN_FETCH(i) uintBitsToFloat(texelFetch(texels, (i)).x)
-#include "brdf.glsl"
+#include "brdf_material.glsl"
 
 layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
 
@@ -708,7 +708,7 @@ void main()
                 break;
 
             Bsdf b = material_bsdf(s, m);
-            // A transmitting surface needs the side: brdf.glsl's normal points outside.
+            // A transmitting surface needs the side: a Bsdf's normal points outside.
             bool flip = b.dielectric > 0.0 && !s.front;
             vec3 n = flip ? -s.n : s.n, ng = flip ? -s.ng : s.ng, tx, ty;
             sampling_basis(n, tx, ty);

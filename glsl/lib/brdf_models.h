@@ -1,9 +1,9 @@
 /* brdf_models.h: the table of BRDF models, their parameter slots and the records of the BRDF
- * test kernel, shared by C (src/render/brdf.c, src/render/render.c, the tests) and GLSL (brdf.glsl,
+ * test kernel, shared by C (src/render/brdf.c, src/render/render.c, the tests) and GLSL (brdf_material.glsl,
  * brdf_test.comp). docs/brdf.md has the models' equations.
  *
  * A model is a colour plus four scalars: GnMaterial.brdf (the id) with base_color.rgb as the
- * colour and brdf_params as the scalars; bsdf_from_model() in brdf.glsl reads them. The
+ * colour and brdf_params as the scalars; bsdf_from_model() in brdf_material.glsl reads them. The
  * glTF model (id 0) has more parameters and is built by bsdf_gltf() from GnMaterial. */
 #ifndef GONIO_BRDF_MODELS_H
 #define GONIO_BRDF_MODELS_H
@@ -11,7 +11,7 @@
 #include "shared.h"
 
 /* ---- the models: one table, expanded by C (src/render/brdf.c: names, parameters, --list;
- * src/render/render_material.c: material_features) and GLSL (brdf.glsl: bsdf_from_model). A row is
+ * src/render/render_material.c: material_features) and GLSL (brdf_material.glsl: bsdf_from_model). A row is
  *   X(id, name, summary, lobe, fresnel, layout, lobe_feats, feats, params)
  * - id: GnMaterial.brdf; unique (tests/unit/test_brdf.c checks), never reused. BRDF_GLTF is
  *   built by bsdf_gltf from GnMaterial's own fields, the rest by bsdf_from_model from a
@@ -20,13 +20,13 @@
  *   the `gonio brdf` / `--brdf` name, its --list line, and its parameters as
  *   COLOR/SCALAR(name, slot, default(s), min, max) of src/render/brdf.c, slots of src/render/brdf.h;
  * - lobe, fresnel: the Bsdf's specular lobe and its Fresnel factor (BRDF_LOBE_*,
- *   BRDF_FRESNEL_* of brdf.glsl); a microfacet lobe (Beckmann, GGX) whose alpha is below
+ *   BRDF_FRESNEL_* of brdf_bsdf.glsl); a microfacet lobe (Beckmann, GGX) whose alpha is below
  *   BRDF_ALPHA_MIN becomes the mirror;
  * - lobe_feats: the GN_FEAT_* of the lobes the model can build (GN_FEAT_LOBES is their
  *   union); feats: its other GN_FEAT_* (Fresnel, glass). The path kernel is specialised on
  *   their union for a scene whose materials use the model (src/render/render_material.c: material_features;
  *   glTF's bits depend on the material's values and are worked out there).
- * Adding a model: a row here, its lobe in brdf.glsl if it has a new one, its section in
+ * Adding a model: a row here, its lobe in brdf_bsdf.glsl if it has a new one, its section in
  * docs/brdf.md (docs/architecture.md: Adding a BRDF model). */
 #define BRDF_GLTF 0u /* the ids that code names; a new model needs none */
 #define BRDF_LAMBERT 1u
@@ -101,7 +101,7 @@
        COLOR("diffuse-transmission-color", BRDF_SLOT_DT, 1, 1, 1, 0, 1)))
 
 /* Below this GGX/Beckmann alpha a lobe is treated as smooth (a Dirac lobe): a narrower lobe
- * is under a tenth of a degree wide, which float directions cannot resolve (brdf.glsl's
+ * is under a tenth of a degree wide, which float directions cannot resolve (brdf_material.glsl's
  * constructors; src/render/render_material.c: material_features, which must agree). */
 #define BRDF_ALPHA_MIN 1e-3f
 
@@ -122,7 +122,7 @@
 #define BRDF_P_DIELECTRIC_IOR 0
 #define BRDF_P_DIELECTRIC_ALPHA 1 /* GGX alpha; 0 = smooth glass (delta) */
 
-/* The sheen's albedo table (brdf.glsl) in the BRDF kernels (brdf_test.comp, brdf_sphere.comp):
+/* The sheen's albedo table (brdf_scatter.glsl) in the BRDF kernels (brdf_test.comp, brdf_sphere.comp):
  * an R32UI texel buffer of SHEEN_N x SHEEN_N float bits. */
 #define BRDF_BIND_SHEEN 2
 

@@ -181,7 +181,7 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
 #define GN_FEAT_VARIANCE (1u << 26)     /* sums of squares (--aov variance) */
 #define GN_FEAT_TEX_TRANSFORM (1u << 27) /* KHR_texture_transform (GnTexture.transform) */
 #define GN_FEAT_UV1 (1u << 28)          /* textures reading TEXCOORD_1 (GN_TEX_UV1) */
-#define GN_FEAT_LAYERS (1u << 29)       /* KHR_materials_clearcoat, _sheen, _iridescence, _diffuse_transmission (brdf.glsl: bsdf_layers) */
+#define GN_FEAT_LAYERS (1u << 29)       /* KHR_materials_clearcoat, _sheen, _iridescence, _diffuse_transmission (brdf_material.glsl: bsdf_layers) */
 #define GN_FEAT_VOLUME (1u << 30)       /* KHR_materials_volume media, _dispersion */
 #define GN_FEAT_ANISO (1u << 31)        /* KHR_materials_anisotropy */
 /* (GN_FEAT_LOBES, every lobe a BRDF model can build: brdf_models.h, from its table) */

@@ -2,7 +2,7 @@
  * model list, polar plots of a lobe in the plane of incidence (Lambertian, specular,
  * combined), the directional albedo against incident angle (the energy-conservation
  * integral), and a material ball under a directional light
- * and a constant environment. Every number comes from glsl/lib/brdf.glsl run on the GPU. */
+ * and a constant environment. Every number comes from glsl/lib/brdf_*.glsl run on the GPU. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,4 +1,4 @@
-/* brdf.c: the table of BRDF models (docs/brdf.md, glsl/lib/brdf.glsl) with their parameters,
+/* brdf.c: the table of BRDF models (docs/brdf.md, glsl/lib/brdf_*.glsl) with their parameters,
  * strict `--PARAM VALUE` parsing, and the runner of the BRDF test kernel. */
 #include "brdf.h"
 

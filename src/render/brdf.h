@@ -1,6 +1,6 @@
 /* brdf.h: the BRDF model table (names, parameters, defaults and ranges of the models in
  * glsl/lib/brdf_models.h) with strict parsing of `--PARAM VALUE` settings, and a runner that
- * batches queries through glsl/kernels/brdf_test.comp, i.e. through the renderer's own brdf.glsl. */
+ * batches queries through glsl/kernels/brdf_test.comp, i.e. through the renderer's own brdf_*.glsl. */
 #ifndef GONIO_BRDF_H
 #define GONIO_BRDF_H
 
@@ -51,7 +51,7 @@ typedef struct brdf_setting {
 } brdf_setting;
 
 /* The sheen's directional albedo (glsl/lib/sheen_albedo.h), SHEEN_N x SHEEN_N floats, which every
- * kernel that builds a sheen reads from a texel buffer (brdf.glsl: brdf_sheen_table). */
+ * kernel that builds a sheen reads from a texel buffer (brdf_scatter.glsl: brdf_sheen_table). */
 extern const float brdf_sheen_table[];
 #define BRDF_SHEEN_TABLE_SIZE (SHEEN_N * SHEEN_N)
 

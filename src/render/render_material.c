@@ -13,7 +13,7 @@ static double luminance(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] +
 static float clamp01(float x) { return x < 0 ? 0 : x > 1 ? 1 : x; }
 
 /* The GN_FEAT_* that material m can need in the path kernel: the parts of the Bsdf that
- * bsdf_gltf or bsdf_from_model (glsl/lib/brdf.glsl) can build from it with a nonzero weight,
+ * bsdf_gltf or bsdf_from_model (glsl/lib/brdf_material.glsl) can build from it with a nonzero weight,
  * its textures, emission and unlit flag. Where a texture can change a value (roughness,
  * metalness) every value it can reach counts. */
 uint32_t material_features(const GnMaterial *m)

@@ -1,4 +1,4 @@
-/* test_brdf.c: the BRDF library (glsl/lib/brdf.glsl) proven physical on the GPU through
+/* test_brdf.c: the BRDF library (glsl/lib/brdf_*.glsl) proven physical on the GPU through
  * glsl/kernels/brdf_test.comp: finiteness and positivity everywhere, Helmholtz reciprocity, energy
  * conservation (white-furnace albedo <= 1, = albedo for Lambert), sampling against the pdf
  * by a chi-square test (as pbrt-v4 and Mitsuba 3 do), pdf normalisation, weight = f cos/pdf,
