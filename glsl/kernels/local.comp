@@ -71,13 +71,13 @@ void main()
     float depth = 0.0;
     if (h.tri != GN_INVALID) {
         Surface s = surface_at(h.tri, h.t, h.u, h.v, o, d);
-        normal = s.n;
-        albedo = s.base;
+        normal = s.sh.n;
+        albedo = s.sh.m.base_color.rgb;
         depth = h.t * dot(d, frame.camera.forward);
         if (MODE == GN_MODE_NORMAL) color = normal;
         else if (MODE == GN_MODE_ALBEDO) color = albedo;
         else if (MODE == GN_MODE_DEPTH) color = vec3(depth);
-        else if (MODE == GN_MODE_PHONG) color = phong_shade(s.p, s.n, s.ng, s.uv, s.vcolor, s.material, -d);
+        else if (MODE == GN_MODE_PHONG) color = phong_shade(s.p, s.sh.n, s.ng, s.uv, s.vcolor, s.material, -d);
         else if (MODE == GN_MODE_GOURAUD) color = gouraud_color(h, d);
         else if (MODE == GN_MODE_FLAT) color = flat_color(h, d);
     } else {

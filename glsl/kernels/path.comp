@@ -289,18 +289,6 @@ LightSample light_sample(vec3 p, vec3 u)
 }
 
 // ---- materials ------------------------------------------------------------------------------
-Bsdf material_bsdf(Surface s, GnMaterial m)
-{
-    if (GN_HAS(GN_FEAT_MODELS) && (!GN_HAS(GN_FEAT_GLTF) || m.brdf != BRDF_GLTF)) // the colour of a conductor is its index, never a texture's
-        return bsdf_from_model(m.brdf, m.brdf == BRDF_CONDUCTOR ? m.base_color.rgb : s.base, m.brdf_params);
-    Bsdf b = bsdf_gltf(s.base, s.metallic, s.roughness, m.specular, m.specular_color, m.ior, m.transmission);
-    if (GN_HAS(GN_FEAT_LAYERS)) // the coat's normal in the local frame: main() sets it
-        b = bsdf_layers(b, s.coat, s.coat_roughness, vec3(0.0, 0.0, 1.0), s.sheen, s.sheen_roughness);
-    if (GN_HAS(GN_FEAT_LAYERS)) // iridescence, diffuse transmission
-        b = bsdf_gltf_film(b, s.base, s.metallic, m.specular, m.specular_color, m.ior, m.transmission, s.irid, s.dt);
-    return b;
-}
-
 // Does b have a part that light sampling can reach (anything but Dirac lobes)?
 bool bsdf_has_smooth(Bsdf b)
 {
@@ -686,12 +674,12 @@ void main()
             GnMaterial m = material_at(s.material);
             covered = covered || depth == 0u;
             if (GN_HAS(GN_FEAT_AOV) && depth == 0u) {
-                normal = s.n;
-                albedo = s.base;
+                normal = s.sh.n;
+                albedo = s.sh.m.base_color.rgb;
                 depth_aov = h.t * dot(d, frame.camera.forward);
             }
             if (GN_HAS(GN_FEAT_UNLIT) && (m.flags & GN_MAT_UNLIT) != 0u) { // KHR_materials_unlit: the colour is the radiance
-                radiance += beta * s.base;
+                radiance += beta * s.sh.m.base_color.rgb;
                 break;
             }
             if (GN_HAS(GN_FEAT_EMISSIVE) && (s.front || (m.flags & GN_MAT_DOUBLE_SIDED) != 0u) &&
@@ -702,23 +690,20 @@ void main()
                                abs(dot(s.ng, d));
                     w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, pl);
                 }
-                radiance += beta * s.emission * w;
+                radiance += beta * s.sh.m.emissive * w;
             }
             if (frame.max_depth != 0u && depth >= frame.max_depth)
                 break;
 
-            Bsdf b = material_bsdf(s, m);
+            Bsdf b = bsdf_material(s.sh);
             // A transmitting surface needs the side: a Bsdf's normal points outside.
             bool flip = b.dielectric > 0.0 && !s.front;
-            vec3 n = flip ? -s.n : s.n, ng = flip ? -s.ng : s.ng, tx, ty;
+            vec3 n = flip ? -s.sh.n : s.sh.n, ng = flip ? -s.ng : s.ng, tx, ty;
             sampling_basis(n, tx, ty);
             vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
-            if (GN_HAS(GN_FEAT_LAYERS)) {
-                vec3 cn = flip ? -s.coat_n : s.coat_n;
-                b.coat_n = normalize(vec3(dot(cn, tx), dot(cn, ty), dot(cn, n)));
-            }
-            if (GN_HAS(GN_FEAT_ANISO) && s.aniso > 0.0 && m.brdf == BRDF_GLTF) // the direction on the shading plane
-                b = bsdf_anisotropy(b, s.aniso, vec2(dot(s.aniso_t, tx), dot(s.aniso_t, ty)));
+            vec3 cn = flip ? -s.sh.coat_n : s.sh.coat_n; // (the anisotropy's direction on the shading plane)
+            b = bsdf_orient(b, s.sh, normalize(vec3(dot(cn, tx), dot(cn, ty), dot(cn, n))),
+                            vec2(dot(s.sh.aniso_t, tx), dot(s.sh.aniso_t, ty)));
             vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
             uint far = GN_INVALID; // the medium beyond a transmitting surface
             if (GN_HAS(GN_FEAT_VOLUME))

@@ -1,10 +1,15 @@
-// brdf_material.glsl: a Bsdf (brdf_bsdf.glsl) built from a material: the models of
-// brdf_models.h's table from a colour and four scalars, and glTF metallic-roughness with its
-// extensions' layers, film, transmission and anisotropy.
+// brdf_material.glsl: a Bsdf (brdf_bsdf.glsl) built from a material at a point (a Shading of
+// material.glsl): the models of brdf_models.h's table from a colour and four scalars, and glTF
+// metallic-roughness with its extensions' layers, film, transmission and anisotropy. The path
+// kernel and the BRDF kernels build every Bsdf with the same two calls:
+//   Bsdf b = bsdf_material(material_eval(m, hit));   // in the shading frame, coat normal +z
+//   b = bsdf_orient(b, s, coat_n, aniso_dir);        // the directions, once the frame is known
+// (the frame can depend on b: a transmitting surface is shaded from the side it faces).
 #ifndef BRDF_MATERIAL_GLSL
 #define BRDF_MATERIAL_GLSL
 
 #include "brdf_bsdf.glsl"
+#include "material.glsl"
 
 // ---- construction ---------------------------------------------------------------------------
 
@@ -179,5 +184,35 @@ Bsdf bsdf_layers(Bsdf b, float c, float cr, vec3 cn, vec3 sc, float sr)
     return b;
 }
 
+// The Bsdf of the material at a point: its BRDF-model override (bsdf_from_model; the model's
+// colour is the textured base colour, but a conductor's, its index, never a texture's), or
+// glTF's (bsdf_gltf) with the layers (bsdf_layers, the coat's normal +z until bsdf_orient) and
+// the film and diffuse transmission (bsdf_gltf_film) of a kernel with GN_FEAT_LAYERS.
+Bsdf bsdf_material(Shading s)
+{
+    GnMaterial m = s.m;
+    if (GN_HAS(GN_FEAT_MODELS) && (!GN_HAS(GN_FEAT_GLTF) || m.brdf != BRDF_GLTF))
+        return bsdf_from_model(m.brdf, s.model_color, m.brdf_params);
+    vec3 base = m.base_color.rgb;
+    Bsdf b = bsdf_gltf(base, m.metallic, m.roughness, m.specular, m.specular_color, m.ior, m.transmission);
+    if (GN_HAS(GN_FEAT_LAYERS))
+        b = bsdf_layers(b, m.clearcoat, m.clearcoat_roughness, vec3(0.0, 0.0, 1.0), m.sheen_color, m.sheen_roughness);
+    if (GN_HAS(GN_FEAT_LAYERS)) // iridescence, diffuse transmission
+        b = bsdf_gltf_film(b, base, m.metallic, m.specular, m.specular_color, m.ior, m.transmission,
+                           vec3(m.iridescence, m.iridescence_ior, s.film_thickness),
+                           vec4(m.diffuse_transmission_color, m.diffuse_transmission));
+    return b;
+}
+
+// b = bsdf_material(s) on its shading frame: the coat's normal coat_n and the anisotropy's
+// direction aniso_dir (any length), both in that frame.
+Bsdf bsdf_orient(Bsdf b, Shading s, vec3 coat_n, vec2 aniso_dir)
+{
+    if (GN_HAS(GN_FEAT_LAYERS))
+        b.coat_n = coat_n;
+    if (GN_HAS(GN_FEAT_ANISO) && s.m.anisotropy_strength > 0.0 && s.m.brdf == BRDF_GLTF)
+        b = bsdf_anisotropy(b, s.m.anisotropy_strength, aniso_dir);
+    return b;
+}
 
 #endif

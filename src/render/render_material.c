@@ -93,31 +93,24 @@ uint32_t material_features(const GnMaterial *m)
     return f;
 }
 
-/* Sets m's model from a setting: the glTF model writes the material's own fields back. */
+/* A setting's values and a material are both a GnMaterial's words (brdf_setting.v); a
+ * parameter is its words there (src/render/brdf.c: the glTF model's are the material table's
+ * BRDF columns, glsl/lib/material.h). */
+static void copy_params(float *dst, const float *src, const brdf_model *model)
+{
+    for (int i = 0; i < model->num_params; i++)
+        memcpy(dst + model->params[i].slot, src + model->params[i].slot,
+               sizeof(float) * (size_t)model->params[i].count);
+}
+
+/* Sets m's model from a setting: its colour and four scalars, and every parameter (the glTF
+ * model's are the material's own fields). */
 static void apply_setting(GnMaterial *m, const brdf_setting *st)
 {
-    memcpy(&m->base_color.x, st->v, 3 * sizeof(float));
-    memcpy(&m->brdf_params.x, st->v + BRDF_SLOT_PARAMS, 4 * sizeof(float));
+    memcpy(&m->base_color.x, &st->m.base_color.x, 3 * sizeof(float));
+    m->brdf_params = st->m.brdf_params;
     m->brdf = st->model->id;
-    if (st->model->id == BRDF_GLTF) {
-        m->metallic = st->v[BRDF_SLOT_PARAMS];
-        m->roughness = st->v[BRDF_SLOT_PARAMS + 1];
-        m->specular = st->v[BRDF_SLOT_PARAMS + 2];
-        m->ior = st->v[BRDF_SLOT_PARAMS + 3];
-        memcpy(&m->specular_color.x, st->v + BRDF_SLOT_EXTRA, 3 * sizeof(float));
-        m->transmission = st->v[BRDF_SLOT_EXTRA + 3];
-        m->clearcoat = st->v[BRDF_SLOT_LAYER];
-        m->clearcoat_roughness = st->v[BRDF_SLOT_LAYER + 1];
-        m->sheen_roughness = st->v[BRDF_SLOT_LAYER + 2];
-        memcpy(&m->sheen_color.x, st->v + BRDF_SLOT_SHEEN, 3 * sizeof(float));
-        m->anisotropy_strength = st->v[BRDF_SLOT_ANISO];
-        m->anisotropy_rotation = st->v[BRDF_SLOT_ANISO + 1];
-        m->iridescence = st->v[BRDF_SLOT_IRID];
-        m->iridescence_ior = st->v[BRDF_SLOT_IRID + 1];
-        m->iridescence_thickness_max = st->v[BRDF_SLOT_IRID + 2];
-        memcpy(&m->diffuse_transmission_color.x, st->v + BRDF_SLOT_DT, 3 * sizeof(float));
-        m->diffuse_transmission = st->v[BRDF_SLOT_DT + 3];
-    }
+    copy_params((float *)m, st->v, st->model);
 }
 
 /* A setting of `model` that starts from m: its colour is the material's base colour (but a
@@ -126,26 +119,9 @@ static void setting_from_material(brdf_setting *st, const brdf_model *model, con
 {
     brdf_setting_init(st, model);
     if (model->id != BRDF_CONDUCTOR)
-        memcpy(st->v, &m->base_color.x, 3 * sizeof(float));
-    if (model->id == BRDF_GLTF) {
-        st->v[BRDF_SLOT_PARAMS] = m->metallic;
-        st->v[BRDF_SLOT_PARAMS + 1] = m->roughness;
-        st->v[BRDF_SLOT_PARAMS + 2] = m->specular;
-        st->v[BRDF_SLOT_PARAMS + 3] = m->ior;
-        memcpy(st->v + BRDF_SLOT_EXTRA, &m->specular_color.x, 3 * sizeof(float));
-        st->v[BRDF_SLOT_EXTRA + 3] = m->transmission;
-        st->v[BRDF_SLOT_LAYER] = m->clearcoat;
-        st->v[BRDF_SLOT_LAYER + 1] = m->clearcoat_roughness;
-        st->v[BRDF_SLOT_LAYER + 2] = m->sheen_roughness;
-        memcpy(st->v + BRDF_SLOT_SHEEN, &m->sheen_color.x, 3 * sizeof(float));
-        st->v[BRDF_SLOT_ANISO] = m->anisotropy_strength;
-        st->v[BRDF_SLOT_ANISO + 1] = m->anisotropy_rotation;
-        st->v[BRDF_SLOT_IRID] = m->iridescence;
-        st->v[BRDF_SLOT_IRID + 1] = m->iridescence_ior;
-        st->v[BRDF_SLOT_IRID + 2] = m->iridescence_thickness_max;
-        memcpy(st->v + BRDF_SLOT_DT, &m->diffuse_transmission_color.x, 3 * sizeof(float));
-        st->v[BRDF_SLOT_DT + 3] = m->diffuse_transmission;
-    }
+        memcpy(&st->m.base_color.x, &m->base_color.x, 3 * sizeof(float));
+    if (model->id == BRDF_GLTF)
+        copy_params(st->v, (const float *)m, model);
 }
 
 bool render_material_overrides(scene *sc, const char *brdf)
