@@ -73,7 +73,7 @@ UNIT := $(BUILD)/unit_tests
 TESTTOOL := $(BUILD)/testtool
 
 # ---- Debian packages -------------------------------------------------------------------
-# nlohmann-json3-dev: the JSON library tinygltf parses with, which scene_gltf.cpp uses to check
+# nlohmann-json3-dev: the JSON library tinygltf parses with, which gltf_json.cpp uses to check
 # the document itself (tinygltf's package does not depend on it).
 DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
 	libopenexr-dev libtinygltf-dev nlohmann-json3-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers help2man \

@@ -201,7 +201,7 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
  *                                     box is inverted (min FLT_MAX, max -FLT_MAX), so the
  *                                     walk's slab test never enters it and needs no check
  * Leaves hold at most GN_BVH_MAX_LEAF pairs and scenes at most 2^26 triangles
- * (src/scene/scene_gltf.cpp), so first fits in 27 bits. */
+ * (src/scene/scene.h: SCENE_MAX_TRIANGLES), so first fits in 27 bits. */
 #define GN_BVH_LEAF 0x80000000u
 #define GN_BVH_COUNT_SHIFT 27
 #define GN_BVH_FIRST 0x07ffffffu
