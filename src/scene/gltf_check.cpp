@@ -363,21 +363,6 @@ bool check_asset(Ctx &c)
         warn(c, "glTF version %s is newer than 2.0; read as 2.0", v.c_str());
     if (!m.asset.minVersion.empty() && m.asset.minVersion != "2.0")
         return fail(c, "requires glTF %s (gonio reads 2.0)", m.asset.minVersion.c_str());
-    auto supported = [](const std::string &e) {
-        for (size_t i = 0; i < NUM_SUPPORTED_EXTENSIONS; i++)
-            if (e == SUPPORTED_EXTENSIONS[i])
-                return true;
-        return false;
-    };
-    for (const auto &e : m.extensionsRequired)
-        if (!supported(e))
-            fail(c, "requires unsupported extension %s", e.c_str());
-    std::vector<std::string> warned; /* one warning each, however often the file lists it */
-    for (const auto &e : m.extensionsUsed)
-        if (!supported(e) && std::find(warned.begin(), warned.end(), e) == warned.end()) {
-            warn(c, "uses unsupported extension %s (ignored)", e.c_str());
-            warned.push_back(e);
-        }
     return !c.failed;
 }
 

@@ -464,38 +464,11 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
         read_colors(c, what, col, out);
     if (out.nrm.empty())
         make_flat(out);
-    const tinygltf::Material *mat = p.material >= 0 && size_t(p.material) < c.m.materials.size()
-                                        ? &c.m.materials[size_t(p.material)] : nullptr;
-    /* the tangents follow the set the normal texture reads (KHR_texture_transform's texCoord
-     * overrides the reference's) */
-    int nset = mat ? mat->normalTexture.texCoord : 0;
-    if (mat) {
-        auto xf = mat->normalTexture.extensions.find("KHR_texture_transform");
-        if (xf != mat->normalTexture.extensions.end() && xf->second.IsObject() && xf->second.Has("texCoord") &&
-            xf->second.Get("texCoord").IsInt())
-            nset = xf->second.Get("texCoord").GetNumberAsInt();
-    }
-    /* a clearcoat normal map needs them too (the set of the base's normal map, if any) */
-    bool coat_normal = false;
-    if (mat && mat->normalTexture.index < 0) {
-        tinygltf::TextureInfo ct = ext_texture(extension(*mat, "KHR_materials_clearcoat"), "clearcoatNormalTexture");
-        coat_normal = ct.index >= 0;
-        nset = ct.texCoord;
-    }
-    /* so does anisotropy: its direction is in the tangent frame (the set of its texture when
-     * no normal map chose one) */
-    bool aniso = false;
-    if (mat) {
-        const tinygltf::Value *ae = extension(*mat, "KHR_materials_anisotropy");
-        aniso = ae && ae->IsObject() && ae->Has("anisotropyStrength") && ae->Get("anisotropyStrength").IsNumber() &&
-                ae->Get("anisotropyStrength").GetNumberAsDouble() > 0;
-        if (aniso && mat->normalTexture.index < 0 && !coat_normal) {
-            tinygltf::TextureInfo at = ext_texture(ae, "anisotropyTexture");
-            nset = at.index >= 0 ? at.texCoord : 0;
-        }
-    }
-    const std::vector<float> &tuv = nset == 1 ? out.uv1 : out.uv;
-    if (out.tan.empty() && !tuv.empty() && mat && (mat->normalTexture.index >= 0 || coat_normal || aniso))
+    /* a normal map, a clearcoat normal map or anisotropy needs tangents (the mesh's, else
+     * MikkTSpace's) on the set its texture reads */
+    int set = p.material >= 0 ? material_tangent_set(c, uint32_t(p.material)) : -1;
+    const std::vector<float> &tuv = set == 1 ? out.uv1 : out.uv;
+    if (out.tan.empty() && !tuv.empty() && set >= 0)
         generate_tangents(out, tuv);
     return true;
 }

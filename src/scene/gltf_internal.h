@@ -66,6 +66,23 @@ struct Pose {
     double v[3][4] = {{0, 0, 0, 0}, {0, 0, 0, 1}, {1, 1, 1, 0}}; /* translation, rotation, scale */
 };
 
+/* A material's textureInfo, as the file has it (gltf_material.cpp: read_texture). */
+struct TextureRef {
+    int index = -1;    /* the glTF texture; -1: none */
+    int tex_coord = 0; /* the set it reads: texCoord, or KHR_texture_transform's */
+    float transform[6] = {1, 0, 0, 0, 1, 0}; /* KHR_texture_transform's T R S, as GnTexture's rows */
+    bool transformed = false;                /* ... other than the identity */
+};
+
+/* A material as read from the document (gltf_material.cpp), before its textures are known. */
+struct MaterialDraft {
+    std::string name;                  /* "" when unnamed */
+    std::string what;                  /* "material 3 'Body'": how messages name it */
+    GnMaterial g;                      /* every factor, at glTF's defaults where absent */
+    TextureRef tex[GN_MATERIAL_WORDS]; /* each texture slot, by its word in GnMaterial */
+    nlohmann::json extras;             /* its extras (extras.gonio: read once its factors are) */
+};
+
 /* One load. */
 struct Ctx {
     const char *path;
@@ -87,6 +104,7 @@ struct Ctx {
     std::string folder;                      /* realpath of the scene's folder */
     std::string base_dir;                    /* the folder as tinygltf joins URIs to it */
     std::vector<std::string> access_errors;  /* files the confined loader refused */
+    std::vector<MaterialDraft> materials;    /* per glTF material, read with the document */
 };
 
 /* ---- scene_gltf.cpp: the load, its settings and its messages ------------------------------- */
@@ -146,16 +164,21 @@ bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out);
 void bake_cameras(Ctx &c, const std::vector<Instance> &cams, scene *out);
 void bake_lights(Ctx &c, const std::vector<Instance> &lights, scene *out);
 
-/* ---- gltf_material.cpp: images, textures, materials, the extensions ------------------------ */
-extern const char *const SUPPORTED_EXTENSIONS[];
-extern const size_t NUM_SUPPORTED_EXTENSIONS;
+/* ---- gltf_material.cpp: the extensions, images, textures, materials ------------------------- */
+/* The file's extensionsRequired and extensionsUsed against the table of extensions: an
+ * unsupported required one is an error, an unsupported used one a warning (once each). */
+bool check_extensions(Ctx &c);
+/* The same list into out->extensions, with how gonio handles each. */
+void list_extensions(Ctx &c, scene *out);
 bool image_callback(tinygltf::Image *img, const int idx, std::string *, std::string *, int, int,
                     const unsigned char *bytes, int size, void *user);
-bool check_textures_and_materials(Ctx &c);
+bool check_textures(Ctx &c);
 std::vector<std::string> variant_names(const tinygltf::Model &m);
 bool select_variant(Ctx &c);
-const tinygltf::Value *extension(const tinygltf::Material &mat, const char *name);
-tinygltf::TextureInfo ext_texture(const tinygltf::Value *e, const char *key, double *scale = nullptr);
+/* The texture coordinate set glTF material `material` wants tangents for: its normal map's,
+ * else its clearcoat normal map's, else (anisotropy, whose direction is in the tangent frame)
+ * its anisotropy texture's or 0; -1 when it needs none. */
+int material_tangent_set(const Ctx &c, uint32_t material);
 void load_images_and_textures(Ctx &c, scene *out);
 void load_materials(Ctx &c, scene *out);
 

@@ -1,25 +1,139 @@
-/* gltf_material.cpp: what a glTF file's materials read: images (PNG and JPEG, each distinct
- * one decoded once), samplers, textures with their texCoord and KHR_texture_transform, the
- * materials and their extensions, and KHR_materials_variants. */
-#include "gltf_internal.h"
+/* gltf_material.cpp: what a glTF file's materials read: the table of extensions gonio knows
+ * (each one's support, and a material extension's own rules), images (PNG and JPEG, each
+ * distinct one decoded once), samplers, textures with their texCoord and
+ * KHR_texture_transform, KHR_materials_variants, and the materials, read and checked from the
+ * JSON document row by row of the material table (glsl/lib/material.h), as cgltf reads each
+ * extension into its struct: the types are checked while reading, so the check and the read
+ * cannot drift, and a wrong type is the same error everywhere. */
+#include "gltf_json.h"
 
 #include <stb_image.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 
 namespace gltf {
 
-const char *const SUPPORTED_EXTENSIONS[] = {
-    "KHR_lights_punctual",        "KHR_materials_emissive_strength", "KHR_materials_specular",
-    "KHR_materials_transmission", "KHR_materials_ior",               "KHR_materials_unlit",
-    "KHR_texture_transform",      "KHR_mesh_quantization",           "KHR_draco_mesh_compression",
-    "EXT_meshopt_compression",    "KHR_materials_variants",          "KHR_materials_volume",
-    "KHR_materials_dispersion",   "KHR_materials_clearcoat",         "KHR_materials_sheen",
-    "KHR_materials_anisotropy",   "KHR_materials_iridescence",       "KHR_materials_diffuse_transmission"};
-const size_t NUM_SUPPORTED_EXTENSIONS = sizeof SUPPORTED_EXTENSIONS / sizeof *SUPPORTED_EXTENSIONS;
+/* ---- the extensions gonio knows: one table ---------------------------------------------------
+ * A material extension's factors and textures are its rows of the material table
+ * (glsl/lib/material.h), read by material_read; `read` is what the table cannot say (a
+ * factor that scales another, a flag). Adding one: docs/architecture.md, "Adding a glTF
+ * material extension". */
+struct Extension {
+    const char *name;
+    scene_support support;
+    const char *how;  /* what gonio does with it (partly: what is left out; unsupported: why) */
+    bool material;    /* an extension of materials: its object is read by material_read */
+    void (*read)(Doc &d, const Json &e, const std::string &p, MaterialDraft &m); /* after its rows */
+};
+
+/* A factor of an extension object that is no row of the table (it scales one): the row
+ * reader's checks and messages. */
+bool read_number(Doc &d, const Json &o, const char *key, const std::string &p, const std::string &what, double lo,
+                 double hi, float *out);
+
+void read_emissive_strength(Doc &d, const Json &e, const std::string &p, MaterialDraft &m)
+{
+    float s = 1;
+    if (read_number(d, e, "emissiveStrength", p, m.what, 0, MAX_RADIANCE, &s)) {
+        m.g.emissive.x *= s;
+        m.g.emissive.y *= s;
+        m.g.emissive.z *= s;
+    }
+}
+
+/* thicknessFactor 0 (its default) means thin-walled: no medium. Any other thickness only
+ * says there is one: the path tracer follows the real geometry (docs/path-tracing.md). */
+void read_volume(Doc &, const Json &, const std::string &, MaterialDraft &m) { m.g.volume = m.g.thickness > 0; }
+
+void read_unlit(Doc &, const Json &, const std::string &, MaterialDraft &m) { m.g.flags |= GN_MAT_UNLIT; }
+
+const Extension EXTENSIONS[] = {
+    {"KHR_materials_emissive_strength", SCENE_SUPPORTED, "emissiveStrength scales emissiveFactor", true,
+     read_emissive_strength},
+    {"KHR_materials_specular", SCENE_SUPPORTED, "specularFactor, specularColorFactor and their textures", true, nullptr},
+    {"KHR_materials_transmission", SCENE_SUPPORTED,
+     "transmissionFactor and transmissionTexture: refraction through rough or smooth glass", true, nullptr},
+    {"KHR_materials_ior", SCENE_SUPPORTED, "the index of the Fresnel factor and of refraction", true, nullptr},
+    {"KHR_materials_volume", SCENE_PARTLY,
+     "absorption in the medium a closed mesh bounds; thicknessFactor and thicknessTexture only say there is one "
+     "(the path tracer follows the real geometry)",
+     true, read_volume},
+    {"KHR_materials_dispersion", SCENE_SUPPORTED, "an index per colour channel from the Abbe number", true, nullptr},
+    {"KHR_materials_clearcoat", SCENE_SUPPORTED, "a GGX coat with its own roughness and normal map", true, nullptr},
+    {"KHR_materials_sheen", SCENE_SUPPORTED, "a Charlie sheen over the base", true, nullptr},
+    {"KHR_materials_anisotropy", SCENE_SUPPORTED, "anisotropic GGX along the tangent frame's direction", true, nullptr},
+    {"KHR_materials_iridescence", SCENE_SUPPORTED, "a thin film over the base's Fresnel factor", true, nullptr},
+    {"KHR_materials_diffuse_transmission", SCENE_SUPPORTED, "a Lambert lobe through the surface", true, nullptr},
+    {"KHR_materials_unlit", SCENE_SUPPORTED, "the base colour is the radiance", true, read_unlit},
+    {"KHR_texture_transform", SCENE_SUPPORTED, "offset, rotation, scale and texCoord of every texture slot", false,
+     nullptr},
+    {"KHR_materials_variants", SCENE_SUPPORTED, "the variant that --variant names", false, nullptr},
+    {"KHR_lights_punctual", SCENE_SUPPORTED,
+     "point, spot and directional lights (intensities read as radiometric: W/sr, W/m^2)", false, nullptr},
+    {"KHR_mesh_quantization", SCENE_SUPPORTED, "integer vertex attributes", false, nullptr},
+    {"KHR_draco_mesh_compression", SCENE_SUPPORTED, "decoded by Draco", false, nullptr},
+    {"EXT_meshopt_compression", SCENE_SUPPORTED, "decoded by meshoptimizer", false, nullptr},
+    {"KHR_materials_pbrSpecularGlossiness", SCENE_UNSUPPORTED,
+     "the specular-glossiness workflow is not read: the materials' metallic-roughness values are", false, nullptr},
+    {"KHR_texture_basisu", SCENE_UNSUPPORTED, "KTX2 images are not decoded: a texture's PNG or JPEG source is", false,
+     nullptr},
+    {"EXT_texture_webp", SCENE_UNSUPPORTED, "WebP images are not decoded: a texture's PNG or JPEG source is", false,
+     nullptr},
+    {"EXT_mesh_gpu_instancing", SCENE_UNSUPPORTED, "the instances are not drawn, only the node's own mesh", false,
+     nullptr},
+    {"KHR_xmp_json_ld", SCENE_UNSUPPORTED, "metadata: nothing in it is rendered", false, nullptr},
+    {"KHR_xmp", SCENE_UNSUPPORTED, "metadata (KHR_xmp_json_ld's draft): nothing in it is rendered", false, nullptr},
+};
+
+const Extension *find_extension(const std::string &name)
+{
+    for (const Extension &e : EXTENSIONS)
+        if (name == e.name)
+            return &e;
+    return nullptr;
+}
+
+bool supported(const Extension *e) { return e && e->support != SCENE_UNSUPPORTED; }
+
+std::string why_not(const Extension *e) { return e ? std::string(" (") + e->how + ")" : std::string(); }
+
+bool check_extensions(Ctx &c)
+{
+    for (const auto &e : c.m.extensionsRequired)
+        if (!supported(find_extension(e)))
+            fail(c, "requires unsupported extension %s%s", e.c_str(), why_not(find_extension(e)).c_str());
+    std::vector<std::string> warned; /* one warning each, however often the file lists it */
+    for (const auto &e : c.m.extensionsUsed)
+        if (!supported(find_extension(e)) && std::find(warned.begin(), warned.end(), e) == warned.end()) {
+            const Extension *x = find_extension(e);
+            warn(c, "uses unsupported extension %s (ignored%s%s)", e.c_str(), x ? ": " : "", x ? x->how : "");
+            warned.push_back(e);
+        }
+    return !c.failed;
+}
+
+void list_extensions(Ctx &c, scene *out)
+{
+    std::vector<std::string> names;
+    for (const auto &e : c.m.extensionsUsed)
+        if (std::find(names.begin(), names.end(), e) == names.end())
+            names.push_back(e);
+    for (const auto &e : c.m.extensionsRequired)
+        if (std::find(names.begin(), names.end(), e) == names.end())
+            names.push_back(e);
+    out->extensions = static_cast<scene_extension *>(util_calloc(names.size() + 1, sizeof(scene_extension)));
+    for (const auto &name : names) {
+        scene_extension &x = out->extensions[out->num_extensions++];
+        snprintf(x.name, sizeof x.name, "%s", name.c_str());
+        x.required = std::find(c.m.extensionsRequired.begin(), c.m.extensionsRequired.end(), name) !=
+                     c.m.extensionsRequired.end();
+        x.support = scene_extension_support(x.name, &x.how);
+    }
+}
 
 /* Decodes PNG or JPEG, the formats glTF 2.0 allows. Anything else is refused before stb_image
  * sees it: its other decoders are not needed, and the 16-bit PNM path of the stb bundled with
@@ -75,14 +189,7 @@ bool image_callback(tinygltf::Image *img, const int idx, std::string *, std::str
     return true;
 }
 
-bool check_texture_ref(Ctx &c, const tinygltf::Material &mat, int mi, int index, const char *slot)
-{
-    if (index == -1 || in_range(index, c.m.textures.size()))
-        return true;
-    return fail(c, "%s: %s refers to texture %d, which does not exist", label("material", mi, mat.name).c_str(), slot, index);
-}
-
-bool check_textures_and_materials(Ctx &c)
+bool check_textures(Ctx &c)
 {
     const auto &m = c.m;
     for (size_t i = 0; i < m.textures.size(); i++) {
@@ -91,15 +198,6 @@ bool check_textures_and_materials(Ctx &c)
             fail(c, "texture %zu refers to image %d, which does not exist", i, t.source);
         if (t.sampler != -1 && !in_range(t.sampler, m.samplers.size()))
             fail(c, "texture %zu refers to sampler %d, which does not exist", i, t.sampler);
-    }
-    for (size_t i = 0; i < m.materials.size(); i++) {
-        const auto &mat = m.materials[i];
-        const auto &pbr = mat.pbrMetallicRoughness;
-        check_texture_ref(c, mat, int(i), pbr.baseColorTexture.index, "baseColorTexture");
-        check_texture_ref(c, mat, int(i), pbr.metallicRoughnessTexture.index, "metallicRoughnessTexture");
-        check_texture_ref(c, mat, int(i), mat.normalTexture.index, "normalTexture");
-        check_texture_ref(c, mat, int(i), mat.occlusionTexture.index, "occlusionTexture");
-        check_texture_ref(c, mat, int(i), mat.emissiveTexture.index, "emissiveTexture");
     }
     return !c.failed;
 }
@@ -156,32 +254,10 @@ bool select_variant(Ctx &c)
     return true;
 }
 
-const tinygltf::Value *extension(const tinygltf::Material &mat, const char *name)
-{
-    auto it = mat.extensions.find(name);
-    return it == mat.extensions.end() ? nullptr : &it->second;
-}
-
-/* A textureInfo of a material extension (e may be null) as tinygltf's own TextureInfo, so
- * texture_slot reads both alike; index -1 when absent. Doc::check_material has checked its
- * form (an index of an existing texture, texCoord an integer). */
-tinygltf::TextureInfo ext_texture(const tinygltf::Value *e, const char *key, double *scale)
-{
-    tinygltf::TextureInfo t;
-    if (!e || !e->IsObject() || !e->Has(key) || !e->Get(key).IsObject())
-        return t;
-    const tinygltf::Value &v = e->Get(key);
-    if (v.Has("index") && v.Get("index").IsInt())
-        t.index = v.Get("index").GetNumberAsInt();
-    if (v.Has("texCoord") && v.Get("texCoord").IsInt())
-        t.texCoord = v.Get("texCoord").GetNumberAsInt();
-    if (scale && v.Has("scale") && v.Get("scale").IsNumber())
-        *scale = v.Get("scale").GetNumberAsDouble();
-    if (v.Has("extensions") && v.Get("extensions").IsObject())
-        for (const std::string &k : v.Get("extensions").Keys())
-            t.extensions[k] = v.Get("extensions").Get(k);
-    return t;
-}
+/* The texture slots of a material (the table's TEX rows). */
+#define COUNT_TEX(name, word, ext, json, space, gate, uses) +1
+const size_t NUM_TEXTURE_SLOTS = 0 GN_MATERIAL(GN_MAT_NO_PARAM, COUNT_TEX, GN_MAT_NO_FIELD);
+#undef COUNT_TEX
 
 void decode_view_images(Ctx &c)
 {
@@ -289,7 +365,7 @@ void load_images_and_textures(Ctx &c, scene *out)
     for (const auto &alias : c.image_alias)
         c.image_map[size_t(alias.first)] = c.image_map[size_t(alias.second)];
     /* room for texture_slot's variants too: one per texture slot of a material at most */
-    c.textures_room = m.textures.size() + 10 * m.materials.size();
+    c.textures_room = m.textures.size() + NUM_TEXTURE_SLOTS * m.materials.size();
     out->textures = static_cast<scene_texture *>(util_calloc(c.textures_room, sizeof(scene_texture)));
     c.textures_out = out;
     c.texture_map.assign(m.textures.size(), GN_INVALID);
@@ -312,6 +388,16 @@ void load_images_and_textures(Ctx &c, scene *out)
     }
 }
 
+/* ---- materials: the table's rows read from the JSON document -------------------------------- */
+
+/* How messages name a row: its JSON path, less the pbrMetallicRoughness object the core's
+ * factors sit in ("baseColorFactor", "occlusionTexture.strength"). */
+const char *shown(const char *json)
+{
+    static const char pbr[] = "pbrMetallicRoughness.";
+    return strncmp(json, pbr, sizeof pbr - 1) == 0 ? json + sizeof pbr - 1 : json;
+}
+
 /* A number in [lo, hi]; outside -> warning and clamped. */
 float ranged(Ctx &c, double v, double lo, double hi, const std::string &what, const char *name)
 {
@@ -321,79 +407,230 @@ float ranged(Ctx &c, double v, double lo, double hi, const std::string &what, co
     return float(v < lo ? lo : hi);
 }
 
-/* Member `key` of an extension object, `def` when absent. */
-double ext_number(Ctx &c, const tinygltf::Value &ext, const char *key, double def, const std::string &what)
+/* The object a row's path leads to from o (its last part the value's key), and that path;
+ * nullptr when an object on the way is absent or not an object (the latter is the error of
+ * the row that reads that object, reported once). */
+const Json *row_object(const Json &o, const char *json, std::string &path, std::string &key)
 {
-    if (!ext.IsObject() || !ext.Has(key))
-        return def;
-    const tinygltf::Value &v = ext.Get(key);
-    if (v.IsNumber())
-        return v.GetNumberAsDouble();
-    warn(c, "%s: %s is not a number (ignored)", what.c_str(), key);
-    return def;
+    const Json *at = &o;
+    std::string rest = json;
+    for (size_t dot; (dot = rest.find('.')) != std::string::npos; rest = rest.substr(dot + 1)) {
+        std::string part = rest.substr(0, dot);
+        auto it = at->find(part);
+        if (it == at->end() || !it->is_object())
+            return nullptr;
+        at = &*it;
+        path = Doc::at(path, part.c_str());
+    }
+    key = rest;
+    return at;
 }
 
-/* A number pair of an extension object (KHR_texture_transform's offset and scale); false
- * (with a warning) when it is there but not two finite numbers. */
-bool ext_pair(Ctx &c, const tinygltf::Value &ext, const char *key, double out[2], const std::string &what)
+/* Row (json, n numbers, [lo, hi], rule) of object o at JSON path p into out[n]: a wrong type
+ * is an error (Doc), a value out of range gets the rule (GN_MAT_RULE_*). True when the file
+ * has a value there of the right type. */
+bool read_param(Doc &d, const Json &o, std::string p, const std::string &what, const char *json, int n, float *out,
+                double lo, double hi, int rule)
 {
-    if (!ext.Has(key))
-        return true;
-    const tinygltf::Value &v = ext.Get(key);
-    if (v.IsArray() && v.ArrayLen() == 2 && v.Get(0).IsNumber() && v.Get(1).IsNumber() &&
-        std::isfinite(v.Get(0).GetNumberAsDouble()) && std::isfinite(v.Get(1).GetNumberAsDouble())) {
-        out[0] = v.Get(0).GetNumberAsDouble();
-        out[1] = v.Get(1).GetNumberAsDouble();
-        return true;
+    std::string key;
+    const Json *obj = row_object(o, json, p, key);
+    double v[4];
+    if (!obj)
+        return false;
+    if (n == 1) {
+        const Json *x = d.member(*obj, key.c_str(), p);
+        if (!x || !d.is_number(*x, Doc::at(p, key.c_str())))
+            return false;
+        v[0] = x->get<double>();
+    } else {
+        if (!d.numbers(*obj, key.c_str(), p, size_t(n)))
+            return false;
+        for (int k = 0; k < n; k++)
+            v[k] = (*obj)[key][size_t(k)].get<double>();
     }
-    warn(c, "%s: KHR_texture_transform %s is not two finite numbers (ignored)", what.c_str(), key);
-    return false;
+    bool in = true;
+    for (int k = 0; k < n; k++)
+        in = in && v[k] >= lo && v[k] <= hi;
+    switch (rule) {
+    case GN_MAT_RULE_CLAMP:
+        for (int k = 0; k < n; k++)
+            out[k] = ranged(d.c, v[k], lo, hi, what, shown(json));
+        break;
+    case GN_MAT_RULE_CHECK:
+        if (in)
+            for (int k = 0; k < n; k++)
+                out[k] = float(v[k]);
+        else if (n == 1)
+            warn(d.c, "%s: %s %g must be in [%g, %g] (ignored)", what.c_str(), shown(json), v[0], lo, hi);
+        else
+            warn(d.c, "%s: %s must be %d numbers in [%g, %g] (ignored)", what.c_str(), shown(json), n, lo, hi);
+        break;
+    case GN_MAT_RULE_POSITIVE:
+        if (v[0] > 0)
+            out[0] = float(v[0]); /* beyond float's range: +inf */
+        else
+            warn(d.c, "%s: %s %g must be positive (ignored)", what.c_str(), shown(json), v[0]);
+        break;
+    case GN_MAT_RULE_IOR: /* KHR_materials_ior allows 0 besides [1, inf): F0 = ((ior-1)/(ior+1))^2 = 1, a mirror */
+        out[0] = v[0] == 0 ? 0.0f : ranged(d.c, v[0], lo, hi, what, shown(json));
+        break;
+    case GN_MAT_RULE_ANGLE: /* reduced to [-pi, pi], so that float keeps its precision */
+        if (std::isfinite(v[0]))
+            out[0] = float(std::remainder(v[0], 2 * M_PI));
+        break;
+    }
+    return true;
+}
+
+bool read_number(Doc &d, const Json &o, const char *key, const std::string &p, const std::string &what, double lo,
+                 double hi, float *out)
+{
+    return read_param(d, o, p, what, key, 1, out, lo, hi, GN_MAT_RULE_CLAMP);
+}
+
+/* A textureInfo of object o at JSON path p (json: its key there, or a path to it): the
+ * texture, its set and its KHR_texture_transform. */
+void read_texture(Doc &d, const Json &o, std::string p, const std::string &what, const char *json, TextureRef &t)
+{
+    std::string key;
+    const Json *obj = row_object(o, json, p, key);
+    const Json *ti = obj ? d.object(*obj, key.c_str(), p) : nullptr;
+    if (!ti)
+        return;
+    p = Doc::at(p, key.c_str());
+    t.index = int(d.index(*ti, "index", p, "textures", true));
+    int64_t set = d.integer(*ti, "texCoord", p, 0, INT32_MAX);
+    t.tex_coord = set < 0 ? 0 : int(set);
+    const Json *ex = d.object(*ti, "extensions", p);
+    const std::string pe = Doc::at(p, "extensions"), pt = Doc::at(pe, "KHR_texture_transform");
+    const Json *tt = ex ? d.object(*ex, "KHR_texture_transform", pe) : nullptr;
+    if (!tt)
+        return;
+    double offset[2] = {0, 0}, scale[2] = {1, 1}, rotation = 0;
+    const char *pairs[2] = {"offset", "scale"};
+    double *vals[2] = {offset, scale};
+    for (int k = 0; k < 2; k++)
+        if (d.numbers(*tt, pairs[k], pt, 2)) {
+            const Json &v = (*tt)[pairs[k]];
+            if (std::isfinite(v[0].get<double>()) && std::isfinite(v[1].get<double>())) {
+                vals[k][0] = v[0].get<double>();
+                vals[k][1] = v[1].get<double>();
+            } else {
+                warn(d.c, "%s: %s: KHR_texture_transform %s is not two finite numbers (ignored)", what.c_str(),
+                     shown(json), pairs[k]);
+            }
+        }
+    if (const Json *r = d.member(*tt, "rotation", pt)) {
+        if (d.is_number(*r, Doc::at(pt, "rotation")) && std::isfinite(r->get<double>()))
+            rotation = r->get<double>();
+        else if (r->is_number())
+            warn(d.c, "%s: %s: KHR_texture_transform rotation is not finite (ignored)", what.c_str(), shown(json));
+    }
+    set = d.integer(*tt, "texCoord", pt, 0, INT32_MAX);
+    if (set >= 0)
+        t.tex_coord = int(set);
+    /* KHR_texture_transform: uv' = T R S uv, R = [cos sin; -sin cos] */
+    double cr = std::cos(rotation), sr = std::sin(rotation);
+    double r[6] = {cr * scale[0], sr * scale[1], offset[0], -sr * scale[0], cr * scale[1], offset[1]};
+    for (int k = 0; k < 6; k++) {
+        t.transform[k] = float(r[k]);
+        t.transformed |= t.transform[k] != (k == 0 || k == 4 ? 1.0f : 0.0f);
+    }
+}
+
+void materials_read(Ctx &c, const Json &root)
+{
+    auto it = root.find("materials");
+    c.materials.assign(it != root.end() && it->is_array() ? it->size() : 0, MaterialDraft());
+}
+
+/* The object a row reads from: the material itself (ext "") or its extension object. */
+const Json *row_base(const Json &m, const Json *ex, const char *ext, const std::string &p, std::string &base_path)
+{
+    if (!*ext) {
+        base_path = p;
+        return &m;
+    }
+    auto it = ex ? ex->find(ext) : Json::const_iterator();
+    if (!ex || it == ex->end() || !it->is_object())
+        return nullptr;
+    base_path = Doc::at(Doc::at(p, "extensions"), ext);
+    return &*it;
+}
+
+void material_read(Doc &d, const Json &m, const std::string &p, size_t i)
+{
+    MaterialDraft &out = d.c.materials[i];
+    auto name = m.find("name");
+    out.name = name != m.end() && name->is_string() ? name->get<std::string>() : "";
+    out.what = label("material", int(i), out.name);
+    scene_material_default(&out.g);
+    /* the objects the rows read from, each checked once */
+    d.object(m, "pbrMetallicRoughness", p);
+    const Json *ex = d.object(m, "extensions", p);
+    for (const Extension &e : EXTENSIONS)
+        if (ex && e.material)
+            d.object(*ex, e.name, Doc::at(p, "extensions"));
+    std::string bp;
+#define READ_PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf)                                              \
+    if (const Json *base = row_base(m, ex, ext, p, bp))                                                               \
+        read_param(d, *base, bp, out.what, json, GN_MAT_COUNT_##type, (float *)&out.g.name, lo, hi, GN_MAT_RULE_##rule);
+#define READ_TEX(name, word, ext, json, space, gate, uses)                                                            \
+    if (const Json *base = row_base(m, ex, ext, p, bp))                                                               \
+        read_texture(d, *base, bp, out.what, json, out.tex[word]);
+    GN_MATERIAL(READ_PARAM, READ_TEX, GN_MAT_NO_FIELD)
+#undef READ_PARAM
+#undef READ_TEX
+    for (const Extension &e : EXTENSIONS)
+        if (e.read)
+            if (const Json *base = row_base(m, ex, e.name, p, bp))
+                e.read(d, *base, bp, out);
+    /* the core's own flags */
+    d.boolean(m, "doubleSided", p);
+    d.enum_str(m, "alphaMode", p, {"OPAQUE", "MASK", "BLEND"});
+    auto ds = m.find("doubleSided");
+    if (ds != m.end() && ds->is_boolean() && ds->get<bool>())
+        out.g.flags |= GN_MAT_DOUBLE_SIDED;
+    auto am = m.find("alphaMode");
+    if (am != m.end() && *am == "MASK")
+        out.g.flags |= GN_MAT_MASK;
+    else if (am != m.end() && *am == "BLEND")
+        out.g.flags |= GN_MAT_BLEND;
+    auto extras = m.find("extras");
+    if (extras != m.end())
+        out.extras = *extras;
+}
+
+int material_tangent_set(const Ctx &c, uint32_t material)
+{
+    if (material >= c.materials.size())
+        return -1;
+    const MaterialDraft &d = c.materials[material];
+    const TextureRef &normal = d.tex[GN_MAT_WORD(tex_normal)], &coat = d.tex[GN_MAT_WORD(tex_clearcoat_normal)];
+    const TextureRef &aniso = d.tex[GN_MAT_WORD(tex_anisotropy)];
+    if (normal.index >= 0)
+        return normal.tex_coord;
+    if (coat.index >= 0)
+        return coat.tex_coord;
+    if (d.g.anisotropy_strength > 0)
+        return aniso.index >= 0 ? aniso.tex_coord : 0;
+    return -1;
 }
 
 /* The scene texture a material slot uses: the glTF texture's own one, or, when the
  * reference reads TEXCOORD_1 or has a KHR_texture_transform, a copy with its set and
  * transform (GnTexture), so each slot stays one index. */
-template <typename Info> uint32_t texture_slot(Ctx &c, const Info &info, const std::string &what, const char *slot)
+uint32_t texture_slot(Ctx &c, const TextureRef &ref, const std::string &what, const char *slot)
 {
-    if (info.index < 0 || c.texture_map[size_t(info.index)] == GN_INVALID)
+    if (ref.index < 0 || c.texture_map[size_t(ref.index)] == GN_INVALID)
         return GN_INVALID;
-    int tex_coord = info.texCoord;
-    float xf[6] = {1, 0, 0, 0, 1, 0};
-    bool transformed = false;
-    auto it = info.extensions.find("KHR_texture_transform");
-    if (it != info.extensions.end() && it->second.IsObject()) {
-        const tinygltf::Value &e = it->second;
-        std::string where = what + " " + slot;
-        double offset[2] = {0, 0}, scale[2] = {1, 1};
-        double rotation = ext_number(c, e, "rotation", 0, where);
-        if (!std::isfinite(rotation)) {
-            warn(c, "%s: KHR_texture_transform rotation is not finite (ignored)", where.c_str());
-            rotation = 0;
-        }
-        ext_pair(c, e, "offset", offset, where);
-        ext_pair(c, e, "scale", scale, where);
-        if (e.Has("texCoord")) {
-            const tinygltf::Value &t = e.Get("texCoord");
-            if (t.IsInt() && t.GetNumberAsInt() >= 0)
-                tex_coord = t.GetNumberAsInt();
-            else
-                warn(c, "%s: KHR_texture_transform texCoord is not a non-negative integer (ignored)", where.c_str());
-        }
-        /* KHR_texture_transform: uv' = T R S uv, R = [cos sin; -sin cos] */
-        double cr = std::cos(rotation), sr = std::sin(rotation);
-        double r[6] = {cr * scale[0], sr * scale[1], offset[0], -sr * scale[0], cr * scale[1], offset[1]};
-        for (int k = 0; k < 6; k++) {
-            xf[k] = float(r[k]);
-            transformed |= xf[k] != (k == 0 || k == 4 ? 1.0f : 0.0f);
-        }
-    }
-    if (tex_coord > 1) {
+    if (ref.tex_coord > 1) {
         warn(c, "%s: %s uses TEXCOORD_%d, only TEXCOORD_0 and TEXCOORD_1 are supported (texture ignored)", what.c_str(),
-             slot, tex_coord);
+             slot, ref.tex_coord);
         return GN_INVALID;
     }
-    uint32_t base = c.texture_map[size_t(info.index)];
-    if (tex_coord == 0 && !transformed)
+    uint32_t base = c.texture_map[size_t(ref.index)];
+    if (ref.tex_coord == 0 && !ref.transformed)
         return base;
     scene *out = c.textures_out;
     if (out->num_textures == c.textures_room) { /* a caller beyond one call per slot */
@@ -401,43 +638,44 @@ template <typename Info> uint32_t texture_slot(Ctx &c, const Info &info, const s
         out->textures = static_cast<scene_texture *>(util_realloc(out->textures, c.textures_room * sizeof(scene_texture)));
     }
     scene_texture t = out->textures[base];
-    t.flags |= tex_coord == 1 ? GN_TEX_UV1 : 0u;
-    memcpy(t.transform, xf, sizeof xf);
+    t.flags |= ref.tex_coord == 1 ? GN_TEX_UV1 : 0u;
+    memcpy(t.transform, ref.transform, sizeof t.transform);
     out->textures[out->num_textures] = t;
     return out->num_textures++;
 }
 
-bool number_triple(const tinygltf::Value &v, float out[3])
+bool number_triple(const Json &v, float out[3])
 {
-    if (!v.IsArray() || v.ArrayLen() != 3)
+    if (!v.is_array() || v.size() != 3)
         return false;
-    for (int k = 0; k < 3; k++) {
-        if (!v.Get(k).IsNumber())
+    for (size_t k = 0; k < 3; k++) {
+        if (!v[k].is_number())
             return false;
-        out[k] = float(v.Get(k).GetNumberAsDouble());
+        out[k] = float(v[k].get<double>());
     }
     return true;
 }
 
 /* extras: {"gonio": {"brdf": NAME, PARAM: number, ..., "phong": {...}}} */
-void read_gonio_extras(Ctx &c, const tinygltf::Value &extras, const std::string &what, GnMaterial &g, scene_material_extras &x)
+void read_gonio_extras(Ctx &c, const Json &extras, const std::string &what, GnMaterial &g, scene_material_extras &x)
 {
-    if (!extras.IsObject() || !extras.Has("gonio"))
+    if (!extras.is_object() || !extras.count("gonio"))
         return;
-    const tinygltf::Value &go = extras.Get("gonio");
-    if (!go.IsObject()) {
+    const Json &go = extras["gonio"];
+    if (!go.is_object()) {
         warn(c, "%s: extras.gonio is not an object (ignored)", what.c_str());
         return;
     }
-    for (const std::string &key : go.Keys()) {
-        const tinygltf::Value &v = go.Get(key);
+    for (auto it = go.begin(); it != go.end(); ++it) {
+        const std::string &key = it.key();
+        const Json &v = it.value();
         if (key == "brdf") {
-            if (!v.IsString() || v.Get<std::string>().size() >= sizeof x.brdf)
+            if (!v.is_string() || v.get_ref<const std::string &>().size() >= sizeof x.brdf)
                 warn(c, "%s: extras.gonio.brdf must be a name of at most %zu characters (ignored)", what.c_str(), sizeof x.brdf - 1);
             else
-                snprintf(x.brdf, sizeof x.brdf, "%s", v.Get<std::string>().c_str());
+                snprintf(x.brdf, sizeof x.brdf, "%s", v.get_ref<const std::string &>().c_str());
         } else if (key == "phong") {
-            if (!v.IsObject()) {
+            if (!v.is_object()) {
                 warn(c, "%s: extras.gonio.phong is not an object (ignored)", what.c_str());
                 continue;
             }
@@ -446,185 +684,33 @@ void read_gonio_extras(Ctx &c, const tinygltf::Value &extras, const std::string 
                                                               {"specular", &g.phong_specular}, {"emission", &g.phong_emission}};
             for (auto &col : cols) {
                 float t[3];
-                if (!v.Has(col.name))
+                if (!v.count(col.name))
                     continue;
-                if (number_triple(v.Get(col.name), t) && t[0] >= 0 && t[1] >= 0 && t[2] >= 0)
+                if (number_triple(v[col.name], t) && t[0] >= 0 && t[1] >= 0 && t[2] >= 0)
                     *col.dst = vec3{t[0], t[1], t[2]};
                 else
                     warn(c, "%s: extras.gonio.phong.%s must be 3 non-negative numbers (ignored)", what.c_str(), col.name);
             }
-            if (v.Has("shininess")) {
-                const tinygltf::Value &s = v.Get("shininess");
-                if (s.IsNumber() && s.GetNumberAsDouble() >= 0)
-                    g.phong_shininess = float(s.GetNumberAsDouble());
+            if (v.count("shininess")) {
+                const Json &s = v["shininess"];
+                if (s.is_number() && s.get<double>() >= 0)
+                    g.phong_shininess = float(s.get<double>());
                 else
                     warn(c, "%s: extras.gonio.phong.shininess must be a non-negative number (ignored)", what.c_str());
             }
-        } else if (!v.IsNumber() || x.num_params == 8 || key.size() >= sizeof x.param_names[0]) {
+        } else if (!v.is_number() || x.num_params == 8 || key.size() >= sizeof x.param_names[0]) {
             warn(c, "%s: extras.gonio.%s ignored (parameters are up to 8 numbers with names of at most %zu characters)",
                  what.c_str(), key.substr(0, 64).c_str(), sizeof x.param_names[0] - 1);
         } else {
             snprintf(x.param_names[x.num_params], sizeof x.param_names[0], "%s", key.c_str());
-            x.param_values[x.num_params++] = float(v.GetNumberAsDouble());
+            x.param_values[x.num_params++] = float(v.get<double>());
         }
     }
-}
-
-void convert_material(Ctx &c, int mi, GnMaterial &g, scene_material_extras &x, char name[64])
-{
-    const auto &mat = c.m.materials[size_t(mi)];
-    const auto &pbr = mat.pbrMetallicRoughness;
-    std::string what = label("material", mi, mat.name);
-    snprintf(name, 64, "%s", mat.name.empty() ? ("material " + std::to_string(mi)).c_str() : mat.name.c_str());
-    scene_material_default(&g);
-    if (pbr.baseColorFactor.size() == 4)
-        g.base_color = vec4{ranged(c, pbr.baseColorFactor[0], 0, 1, what, "baseColorFactor"),
-                            ranged(c, pbr.baseColorFactor[1], 0, 1, what, "baseColorFactor"),
-                            ranged(c, pbr.baseColorFactor[2], 0, 1, what, "baseColorFactor"),
-                            ranged(c, pbr.baseColorFactor[3], 0, 1, what, "baseColorFactor")};
-    g.metallic = ranged(c, pbr.metallicFactor, 0, 1, what, "metallicFactor");
-    g.roughness = ranged(c, pbr.roughnessFactor, 0, 1, what, "roughnessFactor");
-    float strength = 1;
-    if (const tinygltf::Value *e = extension(mat, "KHR_materials_emissive_strength"))
-        strength = ranged(c, ext_number(c, *e, "emissiveStrength", 1, what), 0, MAX_RADIANCE, what, "emissiveStrength");
-    if (mat.emissiveFactor.size() == 3)
-        g.emissive = vec3{ranged(c, mat.emissiveFactor[0], 0, 1, what, "emissiveFactor") * strength,
-                          ranged(c, mat.emissiveFactor[1], 0, 1, what, "emissiveFactor") * strength,
-                          ranged(c, mat.emissiveFactor[2], 0, 1, what, "emissiveFactor") * strength};
-    if (const tinygltf::Value *e = extension(mat, "KHR_materials_specular")) {
-        g.specular = ranged(c, ext_number(c, *e, "specularFactor", 1, what), 0, 1, what, "specularFactor");
-        float t[3];
-        if (e->IsObject() && e->Has("specularColorFactor")) {
-            if (number_triple(e->Get("specularColorFactor"), t) && t[0] >= 0 && t[1] >= 0 && t[2] >= 0)
-                g.specular_color = vec3{t[0], t[1], t[2]};
-            else
-                warn(c, "%s: specularColorFactor must be 3 non-negative numbers (ignored)", what.c_str());
-        }
-    }
-    if (const tinygltf::Value *e = extension(mat, "KHR_materials_transmission"))
-        g.transmission = ranged(c, ext_number(c, *e, "transmissionFactor", 0, what), 0, 1, what, "transmissionFactor");
-    if (const tinygltf::Value *e = extension(mat, "KHR_materials_ior")) {
-        /* KHR_materials_ior allows 0 besides [1, inf): F0 = ((ior-1)/(ior+1))^2 = 1, a mirror. */
-        double ior = ext_number(c, *e, "ior", 1.5, what);
-        g.ior = ior == 0 ? 0.0f : ranged(c, ior, 1, INFINITY, what, "ior");
-    }
-    if (const tinygltf::Value *e = extension(mat, "KHR_materials_volume")) {
-        /* The spec's thicknessFactor 0 (its default) means thin-walled: no medium. Any other
-         * thickness only says there is one: the path tracer follows the real geometry
-         * (docs/path-tracing.md), so the value and thicknessTexture are not used in shading. */
-        g.thickness = ranged(c, ext_number(c, *e, "thicknessFactor", 0, what), 0, INFINITY, what, "thicknessFactor");
-        g.volume = g.thickness > 0;
-        double dist = ext_number(c, *e, "attenuationDistance", INFINITY, what);
-        if (dist > 0)
-            g.attenuation_distance = float(dist); /* beyond float's range: +inf, no absorption */
-        else
-            warn(c, "%s: attenuationDistance %g must be positive (ignored)", what.c_str(), dist);
-        float t[3];
-        if (e->IsObject() && e->Has("attenuationColor")) {
-            if (number_triple(e->Get("attenuationColor"), t) && t[0] >= 0 && t[0] <= 1 && t[1] >= 0 &&
-                t[1] <= 1 && t[2] >= 0 && t[2] <= 1)
-                g.attenuation_color = vec3{t[0], t[1], t[2]};
-            else
-                warn(c, "%s: attenuationColor must be 3 numbers in [0, 1] (ignored)", what.c_str());
-        }
-        if (e->IsObject() && e->Has("thicknessTexture")) {
-            const tinygltf::Value &tt = e->Get("thicknessTexture");
-            const tinygltf::Value *ix = tt.IsObject() && tt.Has("index") ? &tt.Get("index") : nullptr;
-            if (!ix || !ix->IsInt() || ix->GetNumberAsInt() < 0 || size_t(ix->GetNumberAsInt()) >= c.m.textures.size())
-                warn(c, "%s: thicknessTexture does not name a texture (ignored)", what.c_str());
-        }
-    }
-    if (const tinygltf::Value *e = extension(mat, "KHR_materials_dispersion"))
-        g.dispersion = ranged(c, ext_number(c, *e, "dispersion", 0, what), 0, INFINITY, what, "dispersion");
-    if (const tinygltf::Value *e = extension(mat, "KHR_materials_clearcoat")) {
-        double scale = 1;
-        g.clearcoat = ranged(c, ext_number(c, *e, "clearcoatFactor", 0, what), 0, 1, what, "clearcoatFactor");
-        g.clearcoat_roughness = ranged(c, ext_number(c, *e, "clearcoatRoughnessFactor", 0, what), 0, 1, what,
-                                       "clearcoatRoughnessFactor");
-        g.tex_clearcoat = texture_slot(c, ext_texture(e, "clearcoatTexture"), what, "clearcoatTexture");
-        g.tex_clearcoat_roughness =
-            texture_slot(c, ext_texture(e, "clearcoatRoughnessTexture"), what, "clearcoatRoughnessTexture");
-        g.tex_clearcoat_normal =
-            texture_slot(c, ext_texture(e, "clearcoatNormalTexture", &scale), what, "clearcoatNormalTexture");
-        g.clearcoat_normal_scale = float(scale);
-    }
-    if (const tinygltf::Value *e = extension(mat, "KHR_materials_sheen")) {
-        float t[3];
-        if (e->IsObject() && e->Has("sheenColorFactor")) {
-            if (number_triple(e->Get("sheenColorFactor"), t))
-                g.sheen_color = vec3{ranged(c, t[0], 0, 1, what, "sheenColorFactor"),
-                                     ranged(c, t[1], 0, 1, what, "sheenColorFactor"),
-                                     ranged(c, t[2], 0, 1, what, "sheenColorFactor")};
-            else
-                warn(c, "%s: sheenColorFactor must be 3 numbers (ignored)", what.c_str());
-        }
-        g.sheen_roughness = ranged(c, ext_number(c, *e, "sheenRoughnessFactor", 0, what), 0, 1, what,
-                                   "sheenRoughnessFactor");
-        g.tex_sheen_color = texture_slot(c, ext_texture(e, "sheenColorTexture"), what, "sheenColorTexture");
-        g.tex_sheen_roughness = texture_slot(c, ext_texture(e, "sheenRoughnessTexture"), what, "sheenRoughnessTexture");
-    }
-    if (const tinygltf::Value *e = extension(mat, "KHR_materials_anisotropy")) {
-        double rot = ext_number(c, *e, "anisotropyRotation", 0, what);
-        g.anisotropy_strength = ranged(c, ext_number(c, *e, "anisotropyStrength", 0, what), 0, 1, what,
-                                       "anisotropyStrength");
-        /* any angle: reduced to [-pi, pi] so that float keeps its precision */
-        g.anisotropy_rotation = std::isfinite(rot) ? float(std::remainder(rot, 2 * M_PI)) : 0.0f;
-        g.tex_anisotropy = texture_slot(c, ext_texture(e, "anisotropyTexture"), what, "anisotropyTexture");
-    }
-    if (const tinygltf::Value *e = extension(mat, "KHR_materials_iridescence")) {
-        /* (thicknesses up to 1 mm and indices up to 100 keep the film's phase finite in float) */
-        g.iridescence = ranged(c, ext_number(c, *e, "iridescenceFactor", 0, what), 0, 1, what, "iridescenceFactor");
-        g.iridescence_ior = ranged(c, ext_number(c, *e, "iridescenceIor", 1.3, what), 1, 100, what, "iridescenceIor");
-        g.iridescence_thickness_min = ranged(c, ext_number(c, *e, "iridescenceThicknessMinimum", 100, what), 0,
-                                             1e6, what, "iridescenceThicknessMinimum");
-        g.iridescence_thickness_max = ranged(c, ext_number(c, *e, "iridescenceThicknessMaximum", 400, what), 0,
-                                             1e6, what, "iridescenceThicknessMaximum");
-        g.tex_iridescence = texture_slot(c, ext_texture(e, "iridescenceTexture"), what, "iridescenceTexture");
-        g.tex_iridescence_thickness =
-            texture_slot(c, ext_texture(e, "iridescenceThicknessTexture"), what, "iridescenceThicknessTexture");
-    }
-    if (const tinygltf::Value *e = extension(mat, "KHR_materials_diffuse_transmission")) {
-        float t[3];
-        g.diffuse_transmission = ranged(c, ext_number(c, *e, "diffuseTransmissionFactor", 0, what), 0, 1, what,
-                                        "diffuseTransmissionFactor");
-        if (e->IsObject() && e->Has("diffuseTransmissionColorFactor")) {
-            if (number_triple(e->Get("diffuseTransmissionColorFactor"), t))
-                g.diffuse_transmission_color = vec3{ranged(c, t[0], 0, 1, what, "diffuseTransmissionColorFactor"),
-                                                    ranged(c, t[1], 0, 1, what, "diffuseTransmissionColorFactor"),
-                                                    ranged(c, t[2], 0, 1, what, "diffuseTransmissionColorFactor")};
-            else
-                warn(c, "%s: diffuseTransmissionColorFactor must be 3 numbers (ignored)", what.c_str());
-        }
-        g.tex_diffuse_transmission =
-            texture_slot(c, ext_texture(e, "diffuseTransmissionTexture"), what, "diffuseTransmissionTexture");
-        g.tex_diffuse_transmission_color = texture_slot(c, ext_texture(e, "diffuseTransmissionColorTexture"), what,
-                                                        "diffuseTransmissionColorTexture");
-    }
-    if (extension(mat, "KHR_materials_unlit"))
-        g.flags |= GN_MAT_UNLIT;
-    if (mat.doubleSided)
-        g.flags |= GN_MAT_DOUBLE_SIDED;
-    g.normal_scale = float(mat.normalTexture.scale);
-    g.occlusion_strength = ranged(c, mat.occlusionTexture.strength, 0, 1, what, "occlusionTexture.strength");
-    g.alpha_cutoff = ranged(c, mat.alphaCutoff, 0, INFINITY, what, "alphaCutoff");
-    if (mat.alphaMode == "MASK")
-        g.flags |= GN_MAT_MASK;
-    else if (mat.alphaMode == "BLEND")
-        g.flags |= GN_MAT_BLEND;
-    else if (mat.alphaMode != "OPAQUE")
-        warn(c, "%s: unknown alphaMode '%s' (rendered opaque)", what.c_str(), mat.alphaMode.substr(0, 64).c_str());
-    g.tex_base = texture_slot(c, pbr.baseColorTexture, what, "baseColorTexture");
-    g.tex_mr = texture_slot(c, pbr.metallicRoughnessTexture, what, "metallicRoughnessTexture");
-    g.tex_normal = texture_slot(c, mat.normalTexture, what, "normalTexture");
-    g.tex_emissive = texture_slot(c, mat.emissiveTexture, what, "emissiveTexture");
-    g.tex_occlusion = texture_slot(c, mat.occlusionTexture, what, "occlusionTexture");
-    scene_phong_from_pbr(&g);
-    read_gonio_extras(c, mat.extras, what, g, x);
 }
 
 void load_materials(Ctx &c, scene *out)
 {
-    size_t n = c.m.materials.size();
+    size_t n = c.materials.size();
     bool need_default = false;
     for (uint32_t t = 0; t < out->num_triangles; t++)
         need_default |= out->tri_material[t] == n;
@@ -632,8 +718,17 @@ void load_materials(Ctx &c, scene *out)
     out->materials = static_cast<GnMaterial *>(util_calloc(out->num_materials, sizeof(GnMaterial)));
     out->material_extras = static_cast<scene_material_extras *>(util_calloc(out->num_materials, sizeof(scene_material_extras)));
     out->material_names = static_cast<char(*)[64]>(util_calloc(out->num_materials, 64));
-    for (size_t i = 0; i < n; i++)
-        convert_material(c, int(i), out->materials[i], out->material_extras[i], out->material_names[i]);
+    for (size_t i = 0; i < n; i++) {
+        const MaterialDraft &d = c.materials[i];
+        GnMaterial &g = out->materials[i];
+        g = d.g;
+#define RESOLVE_TEX(name, word, ext, json, space, gate, uses) g.name = texture_slot(c, d.tex[word], d.what, shown(json));
+        GN_MATERIAL(GN_MAT_NO_PARAM, RESOLVE_TEX, GN_MAT_NO_FIELD)
+#undef RESOLVE_TEX
+        scene_phong_from_pbr(&g);
+        read_gonio_extras(c, d.extras, d.what, g, out->material_extras[i]);
+        snprintf(out->material_names[i], 64, "%s", d.name.empty() ? ("material " + std::to_string(i)).c_str() : d.name.c_str());
+    }
     if (need_default) {
         scene_material_default(&out->materials[n]);
         snprintf(out->material_names[n], 64, "default");
@@ -641,3 +736,10 @@ void load_materials(Ctx &c, scene *out)
 }
 
 } // namespace gltf
+
+scene_support scene_extension_support(const char *name, const char **how)
+{
+    const gltf::Extension *e = gltf::find_extension(name);
+    *how = e ? e->how : "unknown to gonio";
+    return e ? e->support : SCENE_UNSUPPORTED;
+}

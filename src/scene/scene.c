@@ -22,6 +22,7 @@ void scene_destroy(scene *s)
     free(s->material_extras);
     free(s->material_names);
     free(s->variant_names);
+    free(s->extensions);
     free(s->lights);
     free(s->images);
     free(s->textures);

@@ -44,6 +44,21 @@ typedef struct scene_material_extras {
     bool has_phong;             /* "phong": {...} was present; fields already in GnMaterial */
 } scene_material_extras;
 
+/* How gonio handles a glTF extension (the loader's table of extensions, gltf_material.cpp). */
+typedef enum scene_support {
+    SCENE_UNSUPPORTED, /* not read (how: why, and what the file gets instead) */
+    SCENE_PARTLY,      /* read, with something left out (how: what) */
+    SCENE_SUPPORTED,   /* read as its specification says (how: by what) */
+} scene_support;
+
+/* An extension a file lists (extensionsUsed, extensionsRequired). */
+typedef struct scene_extension {
+    char name[64];         /* as the file spells it, cut to 63 bytes */
+    bool required;         /* in extensionsRequired (the file is refused if unsupported) */
+    scene_support support;
+    const char *how;       /* a static sentence: what gonio does with it */
+} scene_extension;
+
 typedef struct scene {
     char path[1024];
 
@@ -65,6 +80,9 @@ typedef struct scene {
     char (*material_names)[64];
     uint32_t num_variants;      /* KHR_materials_variants of the file (any one selected or not) */
     char (*variant_names)[64];
+
+    uint32_t num_extensions;    /* the extensions the file lists, once each, in its order */
+    scene_extension *extensions;
 
     uint32_t num_lights;
     GnLight *lights;
@@ -98,6 +116,10 @@ typedef struct scene {
  * normals (de-indexed). Triangles with non-finite or absurdly large (|x| > 1e15) vertices
  * are dropped with one warning. A scene without any triangle is an error ("no triangles"). */
 bool scene_load(scene *out, const char *path);
+
+/* How gonio handles the glTF extension `name`: its support and a static sentence saying how
+ * (also for a name it does not know: SCENE_UNSUPPORTED, "unknown to gonio"). */
+scene_support scene_extension_support(const char *name, const char **how);
 
 /* Limits of a decoded scene, checked before anything is allocated, with the numbers in the
  * error: triangles and vertices after instancing (about 300 bytes each through loading and

@@ -252,7 +252,7 @@ bool load(scene *out, const char *path, int scene_index)
     data.reset();
     if (!c.limit_error.empty())
         return fail(c, "%s", c.limit_error.c_str());
-    if (!check_asset(c) || !decompress(c) || !select_variant(c) || !check_buffers_and_views(c))
+    if (!check_asset(c) || !check_extensions(c) || !decompress(c) || !select_variant(c) || !check_buffers_and_views(c))
         return false;
     for (size_t i = 0; i < c.m.accessors.size(); i++)
         check_accessor(c, int(i));
@@ -264,7 +264,7 @@ bool load(scene *out, const char *path, int scene_index)
         for (size_t pi = 0; pi < c.m.meshes[mi].primitives.size(); pi++)
             check_primitive(c, int(mi), int(pi));
     }
-    if (c.failed || !check_textures_and_materials(c) || !check_nodes_and_scenes(c) || !check_animations(c))
+    if (c.failed || !check_textures(c) || !check_nodes_and_scenes(c) || !check_animations(c))
         return false;
     check_cameras(c);
     check_lights(c);
@@ -280,6 +280,7 @@ bool load(scene *out, const char *path, int scene_index)
         return fail(c, "%s", c.limit_error.c_str());
     load_materials(c, out);
     bake_cameras(c, cams, out);
+    list_extensions(c, out);
     bake_lights(c, lights, out);
     out->num_gltf_meshes = uint32_t(c.m.meshes.size());
     out->num_nodes = uint32_t(c.m.nodes.size());
