@@ -7,9 +7,10 @@
 #extension GL_GOOGLE_include_directive : require
 
 // Specialised on GN_FEAT_ALPHA only (src/render/render.c: kernel_features): the rest is always on.
-#define GN_HAS(f) ((FEATURES & (f)) != 0u)
+#define GN_HAS(f) (((FEATURES & (f).x) | (FEATURES_HI & (f).y)) != 0u)
 #include "shared.h"
-layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
+layout(constant_id = GN_SPEC_FEATURES) const uint FEATURES = 0xffffffffu;    // GN_FEAT_* bits 0-31
+layout(constant_id = GN_SPEC_FEATURES_HI) const uint FEATURES_HI = 0xffffffffu; // ... 32-63
 
 #include "phong.glsl"
 

@@ -12,9 +12,10 @@
 
 // Specialised on the scene's features (GN_FEAT_* in shared.h): code no lane can need is
 // compiled away, which llvmpipe (running both sides of every branch) needs most.
-#define GN_HAS(f) ((FEATURES & (f)) != 0u)
+#define GN_HAS(f) (((FEATURES & (f).x) | (FEATURES_HI & (f).y)) != 0u)
 #include "shared.h"
-layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
+layout(constant_id = GN_SPEC_FEATURES) const uint FEATURES = 0xffffffffu;    // GN_FEAT_* bits 0-31
+layout(constant_id = GN_SPEC_FEATURES_HI) const uint FEATURES_HI = 0xffffffffu; // ... 32-63
 
 #include "bvh.glsl"
 // The sheen's albedo table heads the texel buffer in scenes with layers (src/render/render.c).
@@ -294,9 +295,9 @@ bool bsdf_has_smooth(Bsdf b)
 {
     return any(greaterThan(b.diffuse, vec3(0.0))) || (GN_HAS(GN_FEAT_LAYERS) && brdf_has_dt(b)) ||
            (b.lobe != BRDF_LOBE_NONE && b.lobe != BRDF_LOBE_MIRROR) ||
-           (b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN) ||
+           (b.dielectric > 0.0 && !lobes_smooth(b.shape)) ||
            (GN_HAS(GN_FEAT_LAYERS) && (any(greaterThan(b.sheen, vec3(0.0))) ||
-                                       (b.coat > 0.0 && b.coat_alpha >= BRDF_ALPHA_MIN)));
+                                       (b.coat > 0.0 && !lobes_smooth(b.coat_alpha))));
 }
 
 // ---- media: KHR_materials_volume and _dispersion (GN_FEAT_VOLUME) --------------------------
@@ -391,7 +392,7 @@ uint medium_interface(Surface s, GnMaterial m, inout Bsdf b, float u, inout vec3
     }
     float eta = inner / outer;
     // The rough BTDF collapses to a Dirac at 1 (bsdf_gltf): kept as far off it as there.
-    if (b.shape >= BRDF_ALPHA_MIN)
+    if (!lobes_smooth(b.shape))
         eta = eta >= 1.0 ? max(eta, 1.01) : min(eta, 1.0 / 1.01);
     b.ior = eta;
     return far;

@@ -17,6 +17,7 @@
 #define BRDF_BSDF_GLSL
 
 #include "brdf_scatter.glsl"
+#include "lobes.h"
 
 // Bsdf.lobe: the one specular lobe
 #define BRDF_LOBE_NONE 0u
@@ -427,7 +428,7 @@ void brdf_base_eval_pdf(Bsdf b, vec3 wo, vec3 wi, out vec3 f, out float pdf)
         f = brdf_diffuse(b, wo.z, wi.z) + fl;
         pdf = p.x * wi.z / BRDF_PI + p.y * pl;
     }
-    if (GN_HAS(GN_FEAT_ROUGH_GLASS) && b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN) {
+    if (GN_HAS(GN_FEAT_ROUGH_GLASS) && b.dielectric > 0.0 && !lobes_smooth(b.shape)) {
         vec3 ft;
         float pt;
         brdf_rough_dielectric(b, wo, wi, ft, pt);
@@ -465,7 +466,7 @@ BsdfSample brdf_base_sample(Bsdf b, vec3 wo, vec3 u)
         wi = brdf_lobe_sample(b, wo, u.yz);
     } else if (GN_HAS(GN_FEAT_GLASS) && p.z > 0.0) {
         float x = min((u.x - p.x - p.y) / p.z, 1.0);
-        if (GN_HAS(GN_FEAT_SMOOTH_GLASS) && b.shape < BRDF_ALPHA_MIN) {
+        if (GN_HAS(GN_FEAT_SMOOTH_GLASS) && lobes_smooth(b.shape)) {
             vec3 fr = brdf_glass_fresnel(b, wo.z);
             float pr = brdf_mean(fr);
             if (x < pr) {
@@ -516,7 +517,7 @@ BsdfSample brdf_base_sample(Bsdf b, vec3 wo, vec3 u)
 
 bool brdf_has_layers(Bsdf b)
 {
-    return b.coat > 0.0 || any(greaterThan(b.sheen, vec3(0.0)));
+    return lobes_layers(b.coat, b.sheen.r, b.sheen.g, b.sheen.b);
 }
 
 // w in the coat's frame (normal b.coat_n).
@@ -593,7 +594,7 @@ void brdf_layer_lobes(Bsdf b, vec3 wo, vec3 wi, out vec3 fc, out float pc, out v
     ps = 0.0;
     if (wo.z <= 0.0 || wi.z <= 0.0)
         return;
-    if (b.coat > 0.0 && b.coat_alpha >= BRDF_ALPHA_MIN) {
+    if (b.coat > 0.0 && !lobes_smooth(b.coat_alpha)) {
         vec3 o = brdf_to_coat(b, wo), i = brdf_to_coat(b, wi);
         if (o.z > 0.0 && i.z > 0.0) {
             float a = b.coat_alpha;
@@ -639,7 +640,7 @@ BsdfSample bsdf_sample(Bsdf b, vec3 wo, vec3 u)
     uint flags = BRDF_FLAG_REFLECTION;
     if (u.x < p.x) {
         vec3 o = brdf_to_coat(b, wo);
-        if (b.coat_alpha < BRDF_ALPHA_MIN) {
+        if (lobes_smooth(b.coat_alpha)) {
             s.wi = brdf_from_coat(b, vec3(-o.xy, o.z));
             if (s.wi.z <= 0.0)
                 return s;

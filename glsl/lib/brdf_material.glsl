@@ -87,7 +87,7 @@ Bsdf bsdf_from_model(uint model, vec3 color, vec4 params)
         b.lobe = BRDF_LOBE_NONE; // glTF has its own constructor; an unknown id is black
         b.fresnel = BRDF_FRESNEL_NONE;
     }
-    if ((b.lobe == BRDF_LOBE_BECKMANN || b.lobe == BRDF_LOBE_GGX) && b.shape < BRDF_ALPHA_MIN)
+    if ((b.lobe == BRDF_LOBE_BECKMANN || b.lobe == BRDF_LOBE_GGX) && lobes_smooth(b.shape))
         b.lobe = BRDF_LOBE_MIRROR;
     return b;
 }
@@ -106,19 +106,18 @@ Bsdf bsdf_gltf(vec3 base_color, float metallic, float roughness, float specular,
 {
     Bsdf b = brdf_empty();
     float m = clamp(metallic, 0.0, 1.0), t = clamp(transmission, 0.0, 1.0);
-    float alpha = clamp(roughness, 0.0, 1.0);
-    alpha *= alpha;
+    float alpha = lobes_gltf_alpha(roughness);
     vec3 f0 = min(vec3(brdf_schlick_f0(ior)) * specular_color, vec3(1.0)) * specular;
     float wd = (1.0 - m) * (1.0 - t);
     b.diffuse = wd * base_color;
     b.couple_f0 = f0;
     b.couple_f90 = specular;
-    b.lobe = alpha < BRDF_ALPHA_MIN ? BRDF_LOBE_MIRROR : BRDF_LOBE_GGX;
+    b.lobe = lobes_smooth(alpha) ? BRDF_LOBE_MIRROR : BRDF_LOBE_GGX;
     b.shape = alpha;
     b.fresnel = BRDF_FRESNEL_SCHLICK;
     b.specular = wd * f0 + m * base_color;
     b.f90 = wd * specular + m;
-    b.dielectric = (1.0 - m) * t;
+    b.dielectric = lobes_gltf_glass(metallic, transmission);
     b.tint = base_color;
     b.ior = max(ior, 1.01); // at 1 the rough BTDF collapses to a Dirac along -wo
     return b;
@@ -132,7 +131,7 @@ Bsdf bsdf_gltf(vec3 base_color, float metallic, float roughness, float specular,
 Bsdf bsdf_anisotropy(Bsdf b, float strength, vec2 dir)
 {
     float s = clamp(strength, 0.0, 1.0), at = mix(b.shape, 1.0, s * s);
-    if (!GN_HAS(GN_FEAT_ANISO) || !(s > 0.0) || at < BRDF_ALPHA_MIN)
+    if (!GN_HAS(GN_FEAT_ANISO) || !lobes_anisotropic(s) || lobes_smooth(at))
         return b;
     if (b.lobe == BRDF_LOBE_MIRROR)
         b.lobe = BRDF_LOBE_GGX;
@@ -210,7 +209,7 @@ Bsdf bsdf_orient(Bsdf b, Shading s, vec3 coat_n, vec2 aniso_dir)
 {
     if (GN_HAS(GN_FEAT_LAYERS))
         b.coat_n = coat_n;
-    if (GN_HAS(GN_FEAT_ANISO) && s.m.anisotropy_strength > 0.0 && s.m.brdf == BRDF_GLTF)
+    if (GN_HAS(GN_FEAT_ANISO) && lobes_anisotropic(s.m.anisotropy_strength) && s.m.brdf == BRDF_GLTF)
         b = bsdf_anisotropy(b, s.m.anisotropy_strength, aniso_dir);
     return b;
 }

@@ -117,7 +117,7 @@
 
 /* The union of every model's lobe features: may a kernel meet any specular lobe at all. */
 #define BRDF_X_LOBE_FEATS(id, name, summary, lobe, fresnel, layout, lobe_feats, feats, params) | (lobe_feats)
-#define GN_FEAT_LOBES (0u BRDF_MODELS(BRDF_X_LOBE_FEATS))
+#define GN_FEAT_LOBES (GN_FEAT_NONE BRDF_MODELS(BRDF_X_LOBE_FEATS))
 
 /* ---- slots of the four scalars (indices into brdf_params) ------------------------------ */
 /* BRDF_LAYOUT_LAYERED: a Lambert layer (the colour) plus one specular lobe;

@@ -80,7 +80,8 @@
     PARAM(thickness, float, 52, "KHR_materials_volume", "thicknessFactor", 0, 0, GN_INF, CLAMP, NO_BRDF) \
     PARAM(dispersion, float, 53, "KHR_materials_dispersion", "dispersion", 0, 0, GN_INF, CLAMP, NO_BRDF) /* 20 / Abbe */ \
     FIELD(volume, uint, 54) \
-    TEX(tex_thickness, 55, "KHR_materials_volume", "thicknessTexture", LINEAR, GN_FEAT_TEXTURES, USES1(thickness, g)) \
+    TEX(tex_thickness, 55, "KHR_materials_volume", "thicknessTexture", LINEAR, GN_FEAT_NONE, \
+        USES1(thickness, g)) /* (gate none: the path kernel never reads the thickness) */ \
     PARAM(clearcoat, float, 56, "KHR_materials_clearcoat", "clearcoatFactor", 0, 0, 1, CLAMP, BRDF("clearcoat", 0, 0, 1)) \
     PARAM(clearcoat_roughness, float, 57, "KHR_materials_clearcoat", "clearcoatRoughnessFactor", 0, 0, 1, CLAMP, \
           BRDF("clearcoat-roughness", 0, 0, 1)) \

@@ -33,7 +33,7 @@ typedef struct brdf_model {
     const char *summary;
     int num_params;
     brdf_param params[BRDF_MAX_PARAMS];
-    uint32_t features; /* GN_FEAT_* its Bsdf can need (the table's lobe_feats | feats) */
+    GnFeatures features; /* GN_FEAT_* its Bsdf can need (the table's lobe_feats | feats) */
 } brdf_model;
 
 /* A model and its parameters' values: a material (glTF's every field, a model's colour and

@@ -6,90 +6,81 @@
 #include <string.h>
 
 #include "brdf.h"
+#include "lobes.h"
 #include "util.h"
 
 static double luminance(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
-static float clamp01(float x) { return x < 0 ? 0 : x > 1 ? 1 : x; }
-
 /* The GN_FEAT_* that material m can need in the path kernel: the parts of the Bsdf that
- * bsdf_gltf or bsdf_from_model (glsl/lib/brdf_material.glsl) can build from it with a nonzero weight,
- * its textures, emission and unlit flag. Where a texture can change a value (roughness,
- * metalness) every value it can reach counts. */
-uint32_t material_features(const GnMaterial *m)
+ * bsdf_gltf or bsdf_from_model (glsl/lib/brdf_material.glsl) can build from it with a nonzero
+ * weight, decided by the construction's own predicates (glsl/lib/lobes.h) over every value
+ * its textures can reach (a texture scales its factor by [0, 1]); its textures, emission and
+ * unlit flag. */
+GnFeatures material_features(const GnMaterial *m)
 {
-    uint32_t f = 0;
-    bool textured = m->tex_base != GN_INVALID || m->tex_mr != GN_INVALID ||
-                    m->tex_emissive != GN_INVALID || m->tex_occlusion != GN_INVALID;
-    if (textured)
-        f |= GN_FEAT_TEXTURES;
-    if (m->tex_normal != GN_INVALID)
-        f |= GN_FEAT_NORMAL_MAP | GN_FEAT_TEXTURES;
+    GnFeatures f = GN_FEAT_NONE, gates = GN_FEAT_NONE;
+    /* each texture slot's gate (glsl/lib/material.h): the feature it is read under */
+#define TEX_GATE(name, word, ext, json, space, gate, uses) \
+    if (m->name != GN_INVALID)                              \
+        gates |= (gate);
+    GN_MATERIAL(GN_MAT_NO_PARAM, TEX_GATE, GN_MAT_NO_FIELD)
+#undef TEX_GATE
     if (m->flags & GN_MAT_UNLIT)
         f |= GN_FEAT_UNLIT;
     if (m->flags & (GN_MAT_MASK | GN_MAT_BLEND))
         f |= GN_FEAT_ALPHA;
     if (luminance(&m->emissive.x) > 0)
         f |= GN_FEAT_EMISSIVE;
-    switch (m->brdf) {
-    case BRDF_GLTF: {
-        /* bsdf_gltf: a GGX lobe (a mirror below BRDF_ALPHA_MIN) with Schlick's F of weight
+    if (m->brdf == BRDF_GLTF) {
+        /* bsdf_gltf: a GGX lobe (the mirror where lobes_smooth) with Schlick's F of weight
          * wd f0 + m base and F90 wd specular + m; the diffuse coupled to that layer when
-         * specular > 0; glass of weight (1 - m) t. The texture scales roughness and
-         * metalness by [0, 1]. */
-        float metal_hi = clamp01(m->metallic), metal_lo = m->tex_mr != GN_INVALID ? 0 : metal_hi;
-        float rough_hi = clamp01(m->roughness), rough_lo = m->tex_mr != GN_INVALID ? 0 : rough_hi;
-        float t = clamp01(m->transmission);
-        bool smooth = rough_lo * rough_lo < BRDF_ALPHA_MIN, rough = rough_hi * rough_hi >= BRDF_ALPHA_MIN;
+         * specular > 0; glass of weight lobes_gltf_glass. */
+        bool mr = m->tex_mr != GN_INVALID;
+        float metal_hi = lobes_clamp01(m->metallic), metal_lo = mr ? 0 : metal_hi;
+        float rough_hi = lobes_clamp01(m->roughness), rough_lo = mr ? 0 : rough_hi;
+        float t = lobes_clamp01(m->transmission); /* (its texture: down to 0, where the glass is none) */
+        bool smooth = lobes_smooth(lobes_gltf_alpha(rough_lo)), rough = !lobes_smooth(lobes_gltf_alpha(rough_hi));
+        bool glass = lobes_gltf_glass(metal_lo, t) > 0;
         f |= GN_FEAT_GLTF;
-        if (m->specular != 0 || metal_hi > 0) {
+        if (lobes_gltf_lobe(m->specular, metal_hi)) {
             f |= GN_FEAT_FRESNEL_SCHLICK | (smooth ? GN_FEAT_MIRROR : 0u) | (rough ? GN_FEAT_GGX : 0u);
             if (m->specular != 0)
                 f |= GN_FEAT_COUPLED;
         }
-        if (t > 0 && metal_lo < 1)
+        if (glass)
             f |= (smooth ? GN_FEAT_SMOOTH_GLASS : 0u) | (rough ? GN_FEAT_ROUGH_GLASS : 0u);
         /* KHR_materials_volume acts only where the surface transmits (glass or a diffuse
          * transmission), _dispersion only where it refracts */
         if (metal_lo < 1 && ((t > 0 && (m->volume || m->dispersion > 0)) || (m->diffuse_transmission > 0 && m->volume)))
             f |= GN_FEAT_VOLUME;
-        /* bsdf_layers: a coat or a sheen (their textures only scale the factors) */
-        if (m->clearcoat > 0 || m->sheen_color.x > 0 || m->sheen_color.y > 0 || m->sheen_color.z > 0) {
+        /* bsdf_layers (a coat, a sheen) and bsdf_gltf_film (an iridescent film, a diffuse
+         * transmission): their textures only scale their factors */
+        if (lobes_layers(m->clearcoat, m->sheen_color.x, m->sheen_color.y, m->sheen_color.z) ||
+            lobes_film(m->iridescence, m->diffuse_transmission))
             f |= GN_FEAT_LAYERS;
-            if (m->tex_clearcoat != GN_INVALID || m->tex_clearcoat_roughness != GN_INVALID ||
-                m->tex_clearcoat_normal != GN_INVALID || m->tex_sheen_color != GN_INVALID ||
-                m->tex_sheen_roughness != GN_INVALID)
-                f |= GN_FEAT_TEXTURES;
-        }
         /* bsdf_anisotropy: the lobe and the glass stay GGX where roughness 0 would make them
          * Dirac (the texture only scales the strength) */
-        if (m->anisotropy_strength > 0) {
-            f |= GN_FEAT_ANISO | (m->tex_anisotropy != GN_INVALID ? GN_FEAT_TEXTURES : 0u);
-            if (m->specular != 0 || metal_hi > 0)
+        if (lobes_anisotropic(m->anisotropy_strength)) {
+            f |= GN_FEAT_ANISO;
+            if (lobes_gltf_lobe(m->specular, metal_hi))
                 f |= GN_FEAT_GGX;
-            if (t > 0 && metal_lo < 1)
+            if (glass)
                 f |= GN_FEAT_ROUGH_GLASS;
         }
-        /* bsdf_gltf_film: an iridescent film, a diffuse transmission (textures as above) */
-        if (m->iridescence > 0 || m->diffuse_transmission > 0) {
-            f |= GN_FEAT_LAYERS;
-            if ((m->iridescence > 0 && (m->tex_iridescence != GN_INVALID || m->tex_iridescence_thickness != GN_INVALID)) ||
-                (m->diffuse_transmission > 0 && (m->tex_diffuse_transmission != GN_INVALID ||
-                                                 m->tex_diffuse_transmission_color != GN_INVALID)))
-                f |= GN_FEAT_TEXTURES;
-        }
-        break;
-    }
-    default: {
+    } else {
         /* an override model: its row of the table (glsl/lib/brdf_models.h); an id unknown to it
          * keeps every feature */
-        uint32_t mf = GN_FEAT_ALL;
+        GnFeatures mf = GN_FEAT_ALL;
         for (int i = 0; i < brdf_num_models; i++)
             if (brdf_models[i].id == m->brdf)
                 mf = brdf_models[i].features;
         f |= mf | GN_FEAT_MODELS;
     }
-    }
+    /* the textures, where the kernel reads them: under their gate's code (always for the maps
+     * of the core and of KHR_materials_specular and _transmission; the layers' and the
+     * anisotropy's where the material has them) */
+    if (gates & (GN_FEAT_TEXTURES | GN_FEAT_NORMAL_MAP | (f & (GN_FEAT_LAYERS | GN_FEAT_ANISO))))
+        f |= GN_FEAT_TEXTURES | (gates & GN_FEAT_NORMAL_MAP);
     return f;
 }
 
