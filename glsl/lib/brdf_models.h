@@ -95,7 +95,7 @@
 #define BRDF_GLTF_PARAMS
 #else
 #define BRDF_GLTF_PARAMS GN_MATERIAL(BRDF_GLTF_PARAM, GN_MAT_NO_TEX, GN_MAT_NO_FIELD)
-#define BRDF_GLTF_PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf) \
+#define BRDF_GLTF_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) \
     BRDF_GLTF_PARAM_##type(GN_MAT_WORD(name), brdf)
 /* (the BRDF(...) column arrives expanded, as its arguments: has, name, default, lo, hi) */
 #define BRDF_GLTF_PARAM_float(slot, has, name, def, lo, hi) BRDF_GLTF_SCALAR_##has(slot, name, def, lo, hi)

@@ -35,24 +35,20 @@ LOBES_FN float lobes_gltf_glass(float metallic, float transmission)
     return (1.0f - lobes_clamp01(metallic)) * lobes_clamp01(transmission);
 }
 
-/* Can bsdf_gltf's specular lobe weigh anything: a dielectric's F0 (specular > 0) or a metal? */
+/* Can bsdf_gltf's specular lobe weigh anything: a dielectric's F0 (specular > 0) or a metal?
+ * (Where not, bsdf_gltf builds it with weight 0, and the host leaves its code out.) */
 LOBES_FN bool lobes_gltf_lobe(float specular, float metallic) { return specular != 0.0f || metallic > 0.0f; }
 
 /* bsdf_layers' coat (KHR_materials_clearcoat) or sheen (KHR_materials_sheen), of these
- * weights (clamped or not: the same answer). */
+ * weights (clamped or not: the same answer). The host turns GN_FEAT_LAYERS on by the same rule,
+ * a factor above 0, from the material table's feat column. */
 LOBES_FN bool lobes_layers(float coat, float sheen_r, float sheen_g, float sheen_b)
 {
     return coat > 0.0f || sheen_r > 0.0f || sheen_g > 0.0f || sheen_b > 0.0f;
 }
 
-/* bsdf_gltf_film's iridescent film (KHR_materials_iridescence) or diffuse transmission
- * (KHR_materials_diffuse_transmission), of these factors. */
-LOBES_FN bool lobes_film(float iridescence, float diffuse_transmission)
-{
-    return iridescence > 0.0f || diffuse_transmission > 0.0f;
-}
-
-/* bsdf_anisotropy's stretch (KHR_materials_anisotropy) of this strength. */
+/* bsdf_anisotropy's stretch (KHR_materials_anisotropy) of this strength (the host: the table's
+ * feat column, GN_FEAT_ANISO). */
 LOBES_FN bool lobes_anisotropic(float strength) { return strength > 0.0f; }
 
 #endif /* GONIO_LOBES_H */

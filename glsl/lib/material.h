@@ -14,11 +14,14 @@
  *
  * The rows, in GPU order (word = the field's offset in 4-byte words; a vec3 or vec4 starts a
  * 16-byte texel, a vec3 is followed by a scalar, as everywhere in shared.h):
- *   PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf)
+ *   PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf)
  *     a factor of the file: `ext` the extension's name ("" for glTF 2.0 itself), `json` the
  *     property's path in the material (core) or the extension object, `def` its default,
  *     [lo, hi] its range and `rule` what a value outside it gets (GN_MAT_RULE_*: clamped
- *     with a warning, or ignored with one); `brdf`: BRDF(name, default, lo, hi), its
+ *     with a warning, or ignored with one); `feat`: the path kernel's feature that the glTF
+ *     model's construction needs where the factor is above 0 (its textures only scale it
+ *     down; src/render/render_material.c: material_features), GN_FEAT_NONE for none;
+ *     `brdf`: BRDF(name, default, lo, hi), its
  *     parameter of the glTF BRDF model (the default that of the material ball of `gonio
  *     brdf`, the range the one the command line accepts), or NO_BRDF. A wrong JSON type is
  *     an error naming the JSON path, for every row alike.
@@ -37,95 +40,116 @@
 #define GONIO_MATERIAL_H
 
 #define GN_MATERIAL(PARAM, TEX, FIELD) \
-    PARAM(base_color, vec4, 0, "", "pbrMetallicRoughness.baseColorFactor", 1, 0, 1, CLAMP, \
-          BRDF("base-color", 0.8f, 0, 1)) /* linear RGBA */ \
-    PARAM(emissive, vec3, 4, "", "emissiveFactor", 0, 0, 1, CLAMP, NO_BRDF) /* x KHR_materials_emissive_strength */ \
-    PARAM(metallic, float, 7, "", "pbrMetallicRoughness.metallicFactor", 1, 0, 1, CLAMP, BRDF("metallic", 0, 0, 1)) \
-    PARAM(specular_color, vec3, 8, "KHR_materials_specular", "specularColorFactor", 1, 0, GN_INF, CHECK, \
-          BRDF("specular-color", 1, 0, 100)) \
-    PARAM(roughness, float, 11, "", "pbrMetallicRoughness.roughnessFactor", 1, 0, 1, CLAMP, BRDF("roughness", 0.5f, 0, 1)) \
-    PARAM(specular, float, 12, "KHR_materials_specular", "specularFactor", 1, 0, 1, CLAMP, BRDF("specular", 1, 0, 1)) \
-    PARAM(ior, float, 13, "KHR_materials_ior", "ior", 1.5f, 1, GN_INF, IOR, BRDF("ior", 1.5f, 1, 4)) \
-    PARAM(transmission, float, 14, "KHR_materials_transmission", "transmissionFactor", 0, 0, 1, CLAMP, \
-          BRDF("transmission", 0, 0, 1)) \
-    PARAM(normal_scale, float, 15, "", "normalTexture.scale", 1, -GN_INF, GN_INF, CLAMP, NO_BRDF) \
-    PARAM(occlusion_strength, float, 16, "", "occlusionTexture.strength", 1, 0, 1, CLAMP, NO_BRDF) \
-    PARAM(alpha_cutoff, float, 17, "", "alphaCutoff", 0.5f, 0, GN_INF, CLAMP, NO_BRDF) \
-    FIELD(flags, uint, 18) /* GN_MAT_*: doubleSided, alphaMode, KHR_materials_unlit */ \
-    FIELD(brdf, uint, 19)  /* the BRDF model (brdf_models.h): 0 = glTF */ \
+    /* linear RGBA */ \
+    PARAM(base_color, vec4, 0, "", "pbrMetallicRoughness.baseColorFactor", \
+        1, 0, 1, CLAMP, GN_FEAT_NONE, BRDF("base-color", 0.8f, 0, 1)) \
+    /* x KHR_materials_emissive_strength */ \
+    PARAM(emissive, vec3, 4, "", "emissiveFactor", 0, 0, 1, CLAMP, GN_FEAT_NONE, NO_BRDF) \
+    PARAM(metallic, float, 7, "", "pbrMetallicRoughness.metallicFactor", \
+        1, 0, 1, CLAMP, GN_FEAT_NONE, BRDF("metallic", 0, 0, 1)) \
+    PARAM(specular_color, vec3, 8, "KHR_materials_specular", "specularColorFactor", \
+        1, 0, GN_INF, CHECK, GN_FEAT_NONE, BRDF("specular-color", 1, 0, 100)) \
+    PARAM(roughness, float, 11, "", "pbrMetallicRoughness.roughnessFactor", \
+        1, 0, 1, CLAMP, GN_FEAT_NONE, BRDF("roughness", 0.5f, 0, 1)) \
+    PARAM(specular, float, 12, "KHR_materials_specular", "specularFactor", \
+        1, 0, 1, CLAMP, GN_FEAT_NONE, BRDF("specular", 1, 0, 1)) \
+    PARAM(ior, float, 13, "KHR_materials_ior", "ior", 1.5f, 1, GN_INF, IOR, GN_FEAT_NONE, BRDF("ior", 1.5f, 1, 4)) \
+    PARAM(transmission, float, 14, "KHR_materials_transmission", "transmissionFactor", \
+        0, 0, 1, CLAMP, GN_FEAT_NONE, BRDF("transmission", 0, 0, 1)) \
+    PARAM(normal_scale, float, 15, "", "normalTexture.scale", 1, -GN_INF, GN_INF, CLAMP, GN_FEAT_NONE, NO_BRDF) \
+    PARAM(occlusion_strength, float, 16, "", "occlusionTexture.strength", 1, 0, 1, CLAMP, GN_FEAT_NONE, NO_BRDF) \
+    PARAM(alpha_cutoff, float, 17, "", "alphaCutoff", 0.5f, 0, GN_INF, CLAMP, GN_FEAT_NONE, NO_BRDF) \
+    /* GN_MAT_*: doubleSided, alphaMode, KHR_materials_unlit */ \
+    FIELD(flags, uint, 18) \
+    /* the BRDF model (brdf_models.h): 0 = glTF */ \
+    FIELD(brdf, uint, 19) \
     TEX(tex_base, 20, "", "pbrMetallicRoughness.baseColorTexture", SRGB, GN_FEAT_TEXTURES, USES1(base_color, rgba)) \
-    TEX(tex_mr, 21, "", "pbrMetallicRoughness.metallicRoughnessTexture", LINEAR, GN_FEAT_TEXTURES, \
-        USES2(roughness, g, metallic, b)) \
+    TEX(tex_mr, 21, "", "pbrMetallicRoughness.metallicRoughnessTexture", \
+        LINEAR, GN_FEAT_TEXTURES, USES2(roughness, g, metallic, b)) \
     TEX(tex_normal, 22, "", "normalTexture", LINEAR, GN_FEAT_NORMAL_MAP, SPECIAL) \
     TEX(tex_emissive, 23, "", "emissiveTexture", SRGB, GN_FEAT_TEXTURES, USES1(emissive, rgb)) \
-    TEX(tex_occlusion, 24, "", "occlusionTexture", LINEAR, GN_FEAT_TEXTURES, SPECIAL) /* R: phong.glsl */ \
+    /* R: phong.glsl */ \
+    TEX(tex_occlusion, 24, "", "occlusionTexture", LINEAR, GN_FEAT_TEXTURES, SPECIAL) \
     TEX(tex_specular, 25, "KHR_materials_specular", "specularTexture", LINEAR, GN_FEAT_TEXTURES, USES1(specular, a)) \
-    TEX(tex_specular_color, 26, "KHR_materials_specular", "specularColorTexture", SRGB, GN_FEAT_TEXTURES, \
-        USES1(specular_color, rgb)) \
-    TEX(tex_transmission, 27, "KHR_materials_transmission", "transmissionTexture", LINEAR, GN_FEAT_TEXTURES, \
-        USES1(transmission, r)) \
-    FIELD(brdf_params, vec4, 28) /* the override model's four scalars */ \
-    /* the classic (OpenGL 1.x) Phong parameters of the local modes (scene_phong_from_pbr, \
-     * extras.gonio.phong) */ \
-    FIELD(phong_ambient, vec3, 32) FIELD(phong_shininess, float, 35) \
-    FIELD(phong_diffuse, vec3, 36) FIELD(phong_pad0, float, 39) \
-    FIELD(phong_specular, vec3, 40) FIELD(phong_pad1, float, 43) \
-    FIELD(phong_emission, vec3, 44) FIELD(phong_pad2, float, 47) \
-    /* KHR_materials_volume: sigma_a = -ln(attenuation_color) / attenuation_distance (+inf: \
-     * none); the medium's flag (volume) is thicknessFactor > 0; the thickness itself is the \
-     * rasterizers' stand-in for the geometry the path tracer follows (docs/path-tracing.md) */ \
-    PARAM(attenuation_color, vec3, 48, "KHR_materials_volume", "attenuationColor", 1, 0, 1, CHECK, NO_BRDF) \
-    PARAM(attenuation_distance, float, 51, "KHR_materials_volume", "attenuationDistance", GN_INF, 0, GN_INF, \
-          POSITIVE, NO_BRDF) \
-    PARAM(thickness, float, 52, "KHR_materials_volume", "thicknessFactor", 0, 0, GN_INF, CLAMP, NO_BRDF) \
-    PARAM(dispersion, float, 53, "KHR_materials_dispersion", "dispersion", 0, 0, GN_INF, CLAMP, NO_BRDF) /* 20 / Abbe */ \
+    TEX(tex_specular_color, 26, "KHR_materials_specular", "specularColorTexture", \
+        SRGB, GN_FEAT_TEXTURES, USES1(specular_color, rgb)) \
+    TEX(tex_transmission, 27, "KHR_materials_transmission", "transmissionTexture", \
+        LINEAR, GN_FEAT_TEXTURES, USES1(transmission, r)) \
+    /* the override model's four scalars */ \
+    FIELD(brdf_params, vec4, 28) \
+    /* the classic (OpenGL 1.x) Phong parameters of the local modes (scene_phong_from_pbr, extras.gonio.phong) */ \
+    FIELD(phong_ambient, vec3, 32) \
+    FIELD(phong_shininess, float, 35) \
+    FIELD(phong_diffuse, vec3, 36) \
+    FIELD(phong_pad0, float, 39) \
+    FIELD(phong_specular, vec3, 40) \
+    FIELD(phong_pad1, float, 43) \
+    FIELD(phong_emission, vec3, 44) \
+    FIELD(phong_pad2, float, 47) \
+    /* KHR_materials_volume: sigma_a = -ln(attenuation_color) / attenuation_distance (+inf: none); the medium's \
+     * flag (volume) is thicknessFactor > 0; the thickness itself is the rasterizers' stand-in for the geometry the \
+     * path tracer follows (docs/path-tracing.md) */ \
+    PARAM(attenuation_color, vec3, 48, "KHR_materials_volume", "attenuationColor", \
+        1, 0, 1, CHECK, GN_FEAT_NONE, NO_BRDF) \
+    PARAM(attenuation_distance, float, 51, "KHR_materials_volume", "attenuationDistance", \
+        GN_INF, 0, GN_INF, POSITIVE, GN_FEAT_NONE, NO_BRDF) \
+    PARAM(thickness, float, 52, "KHR_materials_volume", "thicknessFactor", \
+        0, 0, GN_INF, CLAMP, GN_FEAT_NONE, NO_BRDF) \
+    /* 20 / Abbe */ \
+    PARAM(dispersion, float, 53, "KHR_materials_dispersion", "dispersion", \
+        0, 0, GN_INF, CLAMP, GN_FEAT_NONE, NO_BRDF) \
     FIELD(volume, uint, 54) \
-    TEX(tex_thickness, 55, "KHR_materials_volume", "thicknessTexture", LINEAR, GN_FEAT_NONE, \
-        USES1(thickness, g)) /* (gate none: the path kernel never reads the thickness) */ \
-    PARAM(clearcoat, float, 56, "KHR_materials_clearcoat", "clearcoatFactor", 0, 0, 1, CLAMP, BRDF("clearcoat", 0, 0, 1)) \
-    PARAM(clearcoat_roughness, float, 57, "KHR_materials_clearcoat", "clearcoatRoughnessFactor", 0, 0, 1, CLAMP, \
-          BRDF("clearcoat-roughness", 0, 0, 1)) \
-    TEX(tex_clearcoat, 58, "KHR_materials_clearcoat", "clearcoatTexture", LINEAR, GN_FEAT_LAYERS, USES1(clearcoat, r)) \
-    TEX(tex_clearcoat_roughness, 59, "KHR_materials_clearcoat", "clearcoatRoughnessTexture", LINEAR, GN_FEAT_LAYERS, \
-        USES1(clearcoat_roughness, g)) \
+    /* (gate none: the path kernel never reads the thickness) */ \
+    TEX(tex_thickness, 55, "KHR_materials_volume", "thicknessTexture", LINEAR, GN_FEAT_NONE, USES1(thickness, g)) \
+    PARAM(clearcoat, float, 56, "KHR_materials_clearcoat", "clearcoatFactor", \
+        0, 0, 1, CLAMP, GN_FEAT_LAYERS, BRDF("clearcoat", 0, 0, 1)) \
+    PARAM(clearcoat_roughness, float, 57, "KHR_materials_clearcoat", "clearcoatRoughnessFactor", \
+        0, 0, 1, CLAMP, GN_FEAT_NONE, BRDF("clearcoat-roughness", 0, 0, 1)) \
+    TEX(tex_clearcoat, 58, "KHR_materials_clearcoat", "clearcoatTexture", \
+        LINEAR, GN_FEAT_LAYERS, USES1(clearcoat, r)) \
+    TEX(tex_clearcoat_roughness, 59, "KHR_materials_clearcoat", "clearcoatRoughnessTexture", \
+        LINEAR, GN_FEAT_LAYERS, USES1(clearcoat_roughness, g)) \
     /* the coat's own normal map (GN_INVALID: the mesh's normal, never normalTexture's) */ \
-    TEX(tex_clearcoat_normal, 60, "KHR_materials_clearcoat", "clearcoatNormalTexture", LINEAR, GN_FEAT_LAYERS, SPECIAL) \
-    PARAM(clearcoat_normal_scale, float, 61, "KHR_materials_clearcoat", "clearcoatNormalTexture.scale", 1, -GN_INF, \
-          GN_INF, CLAMP, NO_BRDF) \
-    TEX(tex_sheen_color, 62, "KHR_materials_sheen", "sheenColorTexture", SRGB, GN_FEAT_LAYERS, USES1(sheen_color, rgb)) \
-    TEX(tex_sheen_roughness, 63, "KHR_materials_sheen", "sheenRoughnessTexture", LINEAR, GN_FEAT_LAYERS, \
-        USES1(sheen_roughness, a)) \
-    PARAM(sheen_color, vec3, 64, "KHR_materials_sheen", "sheenColorFactor", 0, 0, 1, CLAMP, BRDF("sheen-color", 0, 0, 1)) \
-    PARAM(sheen_roughness, float, 67, "KHR_materials_sheen", "sheenRoughnessFactor", 0, 0, 1, CLAMP, \
-          BRDF("sheen-roughness", 0, 0, 1)) \
-    /* KHR_materials_anisotropy: the rotation in radians from the tangent toward the \
-     * bitangent, any angle reduced to [-pi, pi]; the texture's RG the direction, B the strength */ \
-    PARAM(anisotropy_strength, float, 68, "KHR_materials_anisotropy", "anisotropyStrength", 0, 0, 1, CLAMP, \
-          BRDF("anisotropy", 0, 0, 1)) \
-    PARAM(anisotropy_rotation, float, 69, "KHR_materials_anisotropy", "anisotropyRotation", 0, -GN_INF, GN_INF, ANGLE, \
-          BRDF("anisotropy-rotation", 0, -6.2832f, 6.2832f)) \
+    TEX(tex_clearcoat_normal, 60, "KHR_materials_clearcoat", "clearcoatNormalTexture", \
+        LINEAR, GN_FEAT_LAYERS, SPECIAL) \
+    PARAM(clearcoat_normal_scale, float, 61, "KHR_materials_clearcoat", "clearcoatNormalTexture.scale", \
+        1, -GN_INF, GN_INF, CLAMP, GN_FEAT_NONE, NO_BRDF) \
+    TEX(tex_sheen_color, 62, "KHR_materials_sheen", "sheenColorTexture", \
+        SRGB, GN_FEAT_LAYERS, USES1(sheen_color, rgb)) \
+    TEX(tex_sheen_roughness, 63, "KHR_materials_sheen", "sheenRoughnessTexture", \
+        LINEAR, GN_FEAT_LAYERS, USES1(sheen_roughness, a)) \
+    PARAM(sheen_color, vec3, 64, "KHR_materials_sheen", "sheenColorFactor", \
+        0, 0, 1, CLAMP, GN_FEAT_LAYERS, BRDF("sheen-color", 0, 0, 1)) \
+    PARAM(sheen_roughness, float, 67, "KHR_materials_sheen", "sheenRoughnessFactor", \
+        0, 0, 1, CLAMP, GN_FEAT_NONE, BRDF("sheen-roughness", 0, 0, 1)) \
+    /* KHR_materials_anisotropy: the rotation in radians from the tangent toward the bitangent, any angle reduced \
+     * to [-pi, pi]; the texture's RG the direction, B the strength */ \
+    PARAM(anisotropy_strength, float, 68, "KHR_materials_anisotropy", "anisotropyStrength", \
+        0, 0, 1, CLAMP, GN_FEAT_ANISO, BRDF("anisotropy", 0, 0, 1)) \
+    PARAM(anisotropy_rotation, float, 69, "KHR_materials_anisotropy", "anisotropyRotation", \
+        0, -GN_INF, GN_INF, ANGLE, GN_FEAT_NONE, BRDF("anisotropy-rotation", 0, -6.2832f, 6.2832f)) \
     TEX(tex_anisotropy, 70, "KHR_materials_anisotropy", "anisotropyTexture", LINEAR, GN_FEAT_ANISO, SPECIAL) \
     FIELD(anisotropy_pad0, float, 71) \
-    /* KHR_materials_iridescence: the film's thickness is mix(min, max, texture G), max \
-     * without one (thicknesses up to 1 mm and indices up to 100 keep its phase finite) */ \
-    PARAM(iridescence, float, 72, "KHR_materials_iridescence", "iridescenceFactor", 0, 0, 1, CLAMP, \
-          BRDF("iridescence", 0, 0, 1)) \
-    PARAM(iridescence_ior, float, 73, "KHR_materials_iridescence", "iridescenceIor", 1.3f, 1, 100, CLAMP, \
-          BRDF("iridescence-ior", 1.3f, 1, 4)) \
-    PARAM(iridescence_thickness_min, float, 74, "KHR_materials_iridescence", "iridescenceThicknessMinimum", 100, 0, \
-          1e6f, CLAMP, NO_BRDF) \
-    PARAM(iridescence_thickness_max, float, 75, "KHR_materials_iridescence", "iridescenceThicknessMaximum", 400, 0, \
-          1e6f, CLAMP, BRDF("iridescence-thickness", 400, 0, 2000)) \
-    TEX(tex_iridescence, 76, "KHR_materials_iridescence", "iridescenceTexture", LINEAR, GN_FEAT_LAYERS, \
-        USES1(iridescence, r)) \
-    TEX(tex_iridescence_thickness, 77, "KHR_materials_iridescence", "iridescenceThicknessTexture", LINEAR, \
-        GN_FEAT_LAYERS, SPECIAL) \
-    PARAM(diffuse_transmission, float, 78, "KHR_materials_diffuse_transmission", "diffuseTransmissionFactor", 0, 0, 1, \
-          CLAMP, BRDF("diffuse-transmission", 0, 0, 1)) \
-    TEX(tex_diffuse_transmission, 79, "KHR_materials_diffuse_transmission", "diffuseTransmissionTexture", LINEAR, \
-        GN_FEAT_LAYERS, USES1(diffuse_transmission, a)) \
+    /* KHR_materials_iridescence: the film's thickness is mix(min, max, texture G), max without one (thicknesses up \
+     * to 1 mm and indices up to 100 keep its phase finite) */ \
+    PARAM(iridescence, float, 72, "KHR_materials_iridescence", "iridescenceFactor", \
+        0, 0, 1, CLAMP, GN_FEAT_LAYERS, BRDF("iridescence", 0, 0, 1)) \
+    PARAM(iridescence_ior, float, 73, "KHR_materials_iridescence", "iridescenceIor", \
+        1.3f, 1, 100, CLAMP, GN_FEAT_NONE, BRDF("iridescence-ior", 1.3f, 1, 4)) \
+    PARAM(iridescence_thickness_min, float, 74, "KHR_materials_iridescence", "iridescenceThicknessMinimum", \
+        100, 0, 1e6f, CLAMP, GN_FEAT_NONE, NO_BRDF) \
+    PARAM(iridescence_thickness_max, float, 75, "KHR_materials_iridescence", "iridescenceThicknessMaximum", \
+        400, 0, 1e6f, CLAMP, GN_FEAT_NONE, BRDF("iridescence-thickness", 400, 0, 2000)) \
+    TEX(tex_iridescence, 76, "KHR_materials_iridescence", "iridescenceTexture", \
+        LINEAR, GN_FEAT_LAYERS, USES1(iridescence, r)) \
+    TEX(tex_iridescence_thickness, 77, "KHR_materials_iridescence", "iridescenceThicknessTexture", \
+        LINEAR, GN_FEAT_LAYERS, SPECIAL) \
+    PARAM(diffuse_transmission, float, 78, "KHR_materials_diffuse_transmission", "diffuseTransmissionFactor", \
+        0, 0, 1, CLAMP, GN_FEAT_LAYERS, BRDF("diffuse-transmission", 0, 0, 1)) \
+    TEX(tex_diffuse_transmission, 79, "KHR_materials_diffuse_transmission", "diffuseTransmissionTexture", \
+        LINEAR, GN_FEAT_LAYERS, USES1(diffuse_transmission, a)) \
     PARAM(diffuse_transmission_color, vec3, 80, "KHR_materials_diffuse_transmission", "diffuseTransmissionColorFactor", \
-          1, 0, 1, CLAMP, BRDF("diffuse-transmission-color", 1, 0, 1)) \
+        1, 0, 1, CLAMP, GN_FEAT_NONE, BRDF("diffuse-transmission-color", 1, 0, 1)) \
     TEX(tex_diffuse_transmission_color, 83, "KHR_materials_diffuse_transmission", "diffuseTransmissionColorTexture", \
         SRGB, GN_FEAT_LAYERS, USES1(diffuse_transmission_color, rgb))
 
@@ -146,11 +170,11 @@
 #define GN_MAT_COUNT_vec4 4
 
 /* The table's expansions that make the struct (shared.h) */
-#define GN_MAT_DECL_PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf) type name;
+#define GN_MAT_DECL_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) type name;
 #define GN_MAT_DECL_TEX(name, word, ext, json, space, gate, uses) uint name;
 #define GN_MAT_DECL_FIELD(name, type, word) type name;
 /* ... and nothing (for a kind a consumer does not expand) */
-#define GN_MAT_NO_PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf)
+#define GN_MAT_NO_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf)
 #define GN_MAT_NO_TEX(name, word, ext, json, space, gate, uses)
 #define GN_MAT_NO_FIELD(name, type, word)
 
@@ -163,7 +187,7 @@
 /* m.name = its word of the material whose first texel is k in material_texels: every field
  * assigned, those a kernel never reads compiled away with their fetches (glsl/lib/scene.glsl:
  * material_at). */
-#define GN_MAT_READ_PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf) \
+#define GN_MAT_READ_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) \
     m.name = GN_MAT_LOAD_##type(material_texels, k, word);
 #define GN_MAT_READ_TEX(name, word, ext, json, space, gate, uses) m.name = GN_MAT_LOAD_uint(material_texels, k, word);
 #define GN_MAT_READ_FIELD(name, type, word) m.name = GN_MAT_LOAD_##type(material_texels, k, word);

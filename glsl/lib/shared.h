@@ -396,7 +396,7 @@ GN_STATIC_ASSERT(sizeof(GnMaterial) == 4 * GN_MATERIAL_WORDS && GN_MATERIAL_WORD
 #define GN_MAT_ASSERT_FIELD(name, type, word) \
     GN_STATIC_ASSERT(offsetof(GnMaterial, name) == 4 * (word) && GN_MAT_ALIGNED_##type(word), \
                      "GnMaterial." #name " is not at word " #word " (glsl/lib/material.h)");
-#define GN_MAT_ASSERT_PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf) GN_MAT_ASSERT_FIELD(name, type, word)
+#define GN_MAT_ASSERT_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) GN_MAT_ASSERT_FIELD(name, type, word)
 #define GN_MAT_ASSERT_TEX(name, word, ext, json, space, gate, uses) GN_MAT_ASSERT_FIELD(name, uint, word)
 GN_MATERIAL(GN_MAT_ASSERT_PARAM, GN_MAT_ASSERT_TEX, GN_MAT_ASSERT_FIELD)
 GN_STATIC_ASSERT(sizeof(GnLight) == 64, "GnLight layout");

@@ -11,6 +11,14 @@
 
 static double luminance(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
+static bool any_positive(const float *v, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (v[k] > 0)
+            return true;
+    return false;
+}
+
 /* The GN_FEAT_* that material m can need in the path kernel: the parts of the Bsdf that
  * bsdf_gltf or bsdf_from_model (glsl/lib/brdf_material.glsl) can build from it with a nonzero
  * weight, decided by the construction's own predicates (glsl/lib/lobes.h) over every value
@@ -53,15 +61,17 @@ GnFeatures material_features(const GnMaterial *m)
          * transmission), _dispersion only where it refracts */
         if (metal_lo < 1 && ((t > 0 && (m->volume || m->dispersion > 0)) || (m->diffuse_transmission > 0 && m->volume)))
             f |= GN_FEAT_VOLUME;
-        /* bsdf_layers (a coat, a sheen) and bsdf_gltf_film (an iridescent film, a diffuse
-         * transmission): their textures only scale their factors */
-        if (lobes_layers(m->clearcoat, m->sheen_color.x, m->sheen_color.y, m->sheen_color.z) ||
-            lobes_film(m->iridescence, m->diffuse_transmission))
-            f |= GN_FEAT_LAYERS;
+        /* the parts a factor above 0 switches on (the table's feat column: bsdf_layers' coat
+         * and sheen, bsdf_gltf_film's film and diffuse transmission, bsdf_anisotropy); their
+         * textures only scale the factors down */
+#define PARAM_FEAT(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) \
+    if (any_positive((const float *)&m->name, GN_MAT_COUNT_##type))            \
+        f |= (feat);
+        GN_MATERIAL(PARAM_FEAT, GN_MAT_NO_TEX, GN_MAT_NO_FIELD)
+#undef PARAM_FEAT
         /* bsdf_anisotropy: the lobe and the glass stay GGX where roughness 0 would make them
-         * Dirac (the texture only scales the strength) */
-        if (lobes_anisotropic(m->anisotropy_strength)) {
-            f |= GN_FEAT_ANISO;
+         * Dirac */
+        if (f & GN_FEAT_ANISO) {
             if (lobes_gltf_lobe(m->specular, metal_hi))
                 f |= GN_FEAT_GGX;
             if (glass)

@@ -572,7 +572,7 @@ void material_read(Doc &d, const Json &m, const std::string &p, size_t i)
         if (ex && e.material)
             d.object(*ex, e.name, Doc::at(p, "extensions"));
     std::string bp;
-#define READ_PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf)                                              \
+#define READ_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf)                                              \
     if (const Json *base = row_base(m, ex, ext, p, bp))                                                               \
         read_param(d, *base, bp, out.what, json, GN_MAT_COUNT_##type, (float *)&out.g.name, lo, hi, GN_MAT_RULE_##rule);
 #define READ_TEX(name, word, ext, json, space, gate, uses)                                                            \

@@ -141,7 +141,7 @@ static void set_default(float *v, int n, float def)
     for (int k = 0; k < n; k++)
         v[k] = def;
 }
-#define DEFAULT_PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf) \
+#define DEFAULT_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) \
     set_default((float *)&m->name, GN_MAT_COUNT_##type, (float)(def));
 #define DEFAULT_TEX(name, word, ext, json, space, gate, uses) m->name = GN_INVALID;
 

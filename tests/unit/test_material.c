@@ -34,7 +34,7 @@ static const char *word_names[GN_MATERIAL_WORDS];
 #define NAME_FIELD(name, type, word)                       \
     for (int k = 0; k < GN_MAT_COUNT_##type; k++)          \
         word_names[(word) + k] = #name;
-#define NAME_PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf) NAME_FIELD(name, type, word)
+#define NAME_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) NAME_FIELD(name, type, word)
 #define NAME_TEX(name, word, ext, json, space, gate, uses) NAME_FIELD(name, uint, word)
 
 /* Runs material_test.comp over n queries: pass 0 reads materials[i] back, MATERIAL_TEST_EVAL

@@ -1316,7 +1316,7 @@ static const struct material_row {
     int n;
     int word;
 } material_rows[] = {
-#define ROW_PARAM(name, type, word, ext, json, def, lo, hi, rule, brdf) {ext, json, GN_MAT_COUNT_##type, word},
+#define ROW_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) {ext, json, GN_MAT_COUNT_##type, word},
 #define ROW_TEX(name, word, ext, json, space, gate, uses) {ext, json, 0, word},
     GN_MATERIAL(ROW_PARAM, ROW_TEX, GN_MAT_NO_FIELD)
 #undef ROW_PARAM
