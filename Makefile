@@ -1,6 +1,6 @@
 # gonio: build, run, test, bench.
 #   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
-#   make run | test | test-farm | bench | bench-peer | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
+#   make run | test | check-layers | test-farm | bench | bench-peer | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
 #   make fuzz (libFuzzer targets, clang, in build/fuzz) | fuzz-run [FUZZ_TIME=60]
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
 # is printed and make stops.
@@ -22,12 +22,25 @@ PKGS := vulkan glfw3 OpenEXR tinygltf nlohmann_json libpng zlib stb draco
 # meshoptimizer ships no pkg-config file (Debian 12): linked by name.
 LIBS_EXTRA := -lmeshoptimizer
 WARN := -Wall -Wextra -Wshadow -Werror
-# The folders of the architecture (docs/architecture.md): core (errors, images, Vulkan, plots),
-# scene (glTF, meshes, camera, environment), accel (the BVH), render (the renderer, BRDFs,
-# outputs), cli (the commands); glsl/lib holds what kernels include, glsl/kernels the
-# program's kernels, tests/kernels the unit tests' own.
-SRC_DIRS := src/core src/scene src/accel src/render src/cli
-CPPFLAGS += $(SRC_DIRS:%=-I%) -Iglsl/lib -I$(BUILD)/spv -MMD -MP
+# The folders of the architecture (docs/architecture.md) are layers, lowest first: core
+# (errors, images, Vulkan, plots), scene (glTF, meshes, camera, environment) and accel (the
+# BVH) on it, render (the renderer, BRDFs, outputs), cli (the commands); glsl/lib (what the
+# host and the kernels share) is below them all, glsl/kernels the program's kernels (their
+# SPIR-V headers are the render and cli layers'), tests/kernels the unit tests' own.
+# LAYER_x: the folders x may include from besides its own. Each source is compiled with the
+# include paths of its layer only, so an upward #include does not compile, and make test
+# checks the include graph (tests/tool/layers.sh: also includes that name a path).
+LAYERS := core scene accel render cli
+LAYER_core :=
+LAYER_scene := core
+LAYER_accel := core
+LAYER_render := core scene accel
+LAYER_cli := core scene accel render
+SRC_DIRS := $(LAYERS:%=src/%)
+layer_includes = $(patsubst %,-Isrc/%,$(1) $(LAYER_$(1))) -Iglsl/lib $(if $(filter render cli,$(1)),-I$(BUILD)/spv)
+$(foreach l,$(LAYERS),$(eval $(BUILD)/src/$(l)/%.o: INCLUDES = $(call layer_includes,$(l))))
+INCLUDES = $(SRC_DIRS:%=-I%) -Iglsl/lib -I$(BUILD)/spv # tests, tools and fuzz targets: every layer
+CPPFLAGS += -MMD -MP
 CFLAGS += -std=c11 -D_DEFAULT_SOURCE -pthread $(WARN)
 CXXFLAGS += -std=c++14 -pthread -Wall -Wextra -Werror
 LDFLAGS += -pthread
@@ -96,7 +109,7 @@ FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
 	echo 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n) { return 0; }' | \
 	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
 
-.PHONY: all deps test-deps run test unit regress bench clean install shaders docs-images \
+.PHONY: all deps test-deps run test check-layers unit regress bench clean install shaders docs-images \
 	fuzz fuzz-deps fuzz-targets fuzz-run fuzz-partials test-farm bench-peer
 all: $(GONIO) build/gonio
 
@@ -135,11 +148,11 @@ $(TESTTOOL): $(TOOL_OBJ) $(LIB_OBJ) | deps
 
 $(BUILD)/%.o: %.c | deps $(SPV_HDR)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
+	$(CC) $(INCLUDES) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
 
 $(BUILD)/%.o: %.cpp | deps
 	@mkdir -p $(dir $@)
-	$(CXX) $(CPPFLAGS) $(PKG_CFLAGS) $(CXXFLAGS) -c -o $@ $<
+	$(CXX) $(INCLUDES) $(CPPFLAGS) $(PKG_CFLAGS) $(CXXFLAGS) -c -o $@ $<
 
 # Shaders: GLSL -> SPIR-V (checked by spirv-val) -> C array in a generated header.
 $(BUILD)/spv/%.h: %.comp | deps
@@ -156,7 +169,7 @@ run: all
 	@mkdir -p out
 	$(GONIO) render scenes/cornell.gltf -o out/cornell.exr --png out/cornell.png
 
-test: all $(UNIT) $(TESTTOOL) test-deps
+test: check-layers all $(UNIT) $(TESTTOOL) test-deps
 	@GONIO=$(GONIO) UNIT=$(UNIT) TESTTOOL=$(TESTTOOL) CONFIG=$(config) tests/run.sh
 
 # A one-node Slurm cluster on localhost runs farm/slurm-tiles.sh (tests/farm/slurm.sh);
@@ -166,6 +179,10 @@ FARM_DEPS_CHECK = { command -v slurmctld && command -v slurmd && command -v mung
 test-farm: all $(TESTTOOL)
 	@if ! $(FARM_DEPS_CHECK); then ( $(call apt_install,$(DEB_FARM)) ) || true; fi
 	@GONIO=$(GONIO) TESTTOOL=$(TESTTOOL) tests/farm/slurm.sh; rc=$$?; [ $$rc = 0 ] || [ $$rc = 77 ]
+
+# The include graph against LAYERS (also run by make test).
+check-layers:
+	@tests/tool/layers.sh $(foreach l,$(LAYERS),"$(l):$(LAYER_$(l))")
 
 unit: $(UNIT)
 	$(UNIT) $(T)

@@ -306,7 +306,7 @@ bool bsdf_has_smooth(Bsdf b)
 // back face, so nested and touching media (a glass of water: water inside glass) have the
 // right one on top, and the index at an interface is the ratio of the two sides' media.
 // Paths start in vacuum (index 1, no absorption); a fifth nested medium is not entered.
-#define MEDIA_MAX 4u
+#define MEDIA_MAX GN_MEDIA_MAX
 uint media[MEDIA_MAX];
 uint media_n;
 vec3 seg_from; // where the path's current segment starts: the vertex, not the offset origin
@@ -520,37 +520,31 @@ void path_miss(Hit h, bool light_only, bool bsdf_only)
 
 // ---- a path's saved state (GN_BIND_PSTATE: frame.state_stride words a pixel) -----------------
 // Word 0: the pixel's samples still to take, the saved one included (0: none pending); then
-// the path and its walk. Read and written only by LOOP_CAP kernels.
-uint ps_base;
-void ps_f(uint k, float x) { pstate[ps_base + k] = floatBitsToUint(x); }
-void ps_v(uint k, vec3 x) { ps_f(k, x.x); ps_f(k + 1u, x.y); ps_f(k + 2u, x.z); }
-float pl_f(uint k) { return uintBitsToFloat(pstate[ps_base + k]); }
-vec3 pl_v(uint k) { return vec3(pl_f(k), pl_f(k + 1u), pl_f(k + 2u)); }
+// the fields of GN_PATH_STATE (glsl/lib/shared.h), each saved and loaded by the expansions
+// below at word ps_k, and the walk's stack. Read and written only by LOOP_CAP kernels.
+uint ps_base, ps_k;
+#define PS_AT(i) pstate[ps_base + ps_k + (i)]
+#define PS_SAVE_U(v) PS_AT(0u) = v;
+#define PS_SAVE_I(v) PS_AT(0u) = uint(v);
+#define PS_SAVE_F(v) PS_AT(0u) = floatBitsToUint(v);
+#define PS_SAVE_B(v) PS_AT(0u) = v ? 1u : 0u;
+#define PS_SAVE_V(v) PS_AT(0u) = floatBitsToUint(v.x); PS_AT(1u) = floatBitsToUint(v.y); \
+                     PS_AT(2u) = floatBitsToUint(v.z);
+#define PS_SAVE_M(v) for (uint m = 0u; m < GN_MEDIA_MAX; m++) PS_AT(m) = v[m];
+#define PS_LOAD_U(v) v = PS_AT(0u);
+#define PS_LOAD_I(v) v = int(PS_AT(0u));
+#define PS_LOAD_F(v) v = uintBitsToFloat(PS_AT(0u));
+#define PS_LOAD_B(v) v = PS_AT(0u) != 0u;
+#define PS_LOAD_V(v) v = vec3(uintBitsToFloat(PS_AT(0u)), uintBitsToFloat(PS_AT(1u)), uintBitsToFloat(PS_AT(2u)));
+#define PS_LOAD_M(v) for (uint m = 0u; m < GN_MEDIA_MAX; m++) v[m] = PS_AT(m);
+#define PS_SAVE(kind, var, when) if (when) { PS_SAVE_##kind(var) } ps_k += GN_PS_WORDS_##kind;
+#define PS_LOAD(kind, var, when) if (when) { PS_LOAD_##kind(var) } ps_k += GN_PS_WORDS_##kind;
 
 void path_save(uint behind)
 {
     pstate[ps_base] = behind;
-    pstate[ps_base + 1u] = phase | (prev_delta ? 2u : 0u) | (covered ? 4u : 0u) | (alive ? 8u : 0u);
-    pstate[ps_base + 2u] = depth;
-    pstate[ps_base + 3u] = GN_HAS(GN_FEAT_ALPHA) ? tr_k : 0u;
-    ps_v(4u, o); ps_v(7u, d); ps_f(10u, tmin); ps_v(11u, radiance); ps_v(14u, beta);
-    ps_f(17u, prev_pdf); ps_v(18u, normal); ps_v(21u, albedo); ps_f(24u, depth_aov);
-    ps_v(25u, so); ps_v(28u, sd); ps_f(31u, smax); ps_v(32u, c);
-    if (GN_HAS(GN_FEAT_ALPHA)) {
-        ps_f(35u, tr_lo);
-        ps_f(36u, tr_max);
-    }
-    if (GN_HAS(GN_FEAT_VOLUME)) { // the media the path is in (path.comp: media)
-        for (uint k = 0u; k < MEDIA_MAX; k++)
-            pstate[ps_base + 44u + k] = media[k];
-        pstate[ps_base + 48u] = media_n | channel << 8u;
-        ps_v(49u, seg_from);
-    }
-    ps_f(37u, walk.hit.t); ps_f(38u, walk.hit.u); ps_f(39u, walk.hit.v);
-    pstate[ps_base + 40u] = walk.hit.tri;
-    pstate[ps_base + 41u] = walk.hit.steps;
-    pstate[ps_base + 42u] = walk.node;
-    pstate[ps_base + 43u] = uint(walk.sp);
+    ps_k = 1u;
+    GN_PATH_STATE(PS_SAVE)
     if (WALK_REGS > 0u) {
         for (uint k = 0u; k < WALK_REGS; k++)
             pstate[ps_base + GN_PATH_STATE_WORDS + k] = walk.regs[k];
@@ -562,26 +556,9 @@ void path_save(uint behind)
 
 void path_load()
 {
-    uint f = pstate[ps_base + 1u];
-    phase = f & 1u; prev_delta = (f & 2u) != 0u; covered = (f & 4u) != 0u; alive = (f & 8u) != 0u;
-    depth = pstate[ps_base + 2u];
-    tr_k = pstate[ps_base + 3u];
-    o = pl_v(4u); d = pl_v(7u); tmin = pl_f(10u); radiance = pl_v(11u); beta = pl_v(14u);
-    prev_pdf = pl_f(17u); normal = pl_v(18u); albedo = pl_v(21u); depth_aov = pl_f(24u);
-    so = pl_v(25u); sd = pl_v(28u); smax = pl_f(31u); c = pl_v(32u); tr_lo = pl_f(35u); tr_max = pl_f(36u);
-    if (GN_HAS(GN_FEAT_VOLUME)) {
-        for (uint k = 0u; k < MEDIA_MAX; k++)
-            media[k] = pstate[ps_base + 44u + k];
-        media_n = pstate[ps_base + 48u] & 0xffu;
-        channel = pstate[ps_base + 48u] >> 8u;
-        seg_from = pl_v(49u);
-    }
-    walk.hit.t = pl_f(37u); walk.hit.u = pl_f(38u); walk.hit.v = pl_f(39u);
-    walk.hit.tri = pstate[ps_base + 40u];
-    walk.hit.steps = pstate[ps_base + 41u];
+    ps_k = 1u;
+    GN_PATH_STATE(PS_LOAD)
     walk.hit.truncated = false;
-    walk.node = pstate[ps_base + 42u];
-    walk.sp = int(pstate[ps_base + 43u]);
     if (WALK_REGS > 0u) {
         for (uint k = 0u; k < WALK_REGS; k++)
             walk.regs[k] = pstate[ps_base + GN_PATH_STATE_WORDS + k];

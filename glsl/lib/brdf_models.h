@@ -1,6 +1,6 @@
 /* brdf_models.h: the table of BRDF models, their parameter slots and the records of the BRDF
- * test kernel, shared by C (src/render/brdf.c, src/render/render.c, the tests) and GLSL (brdf_material.glsl,
- * brdf_test.comp). docs/brdf.md has the models' equations.
+ * test kernel, shared by C (src/render/brdf.c, src/render/render_material.c, the tests) and
+ * GLSL (brdf_material.glsl, brdf_test.comp). docs/brdf.md has the models' equations.
  *
  * A model is a colour plus four scalars: GnMaterial.brdf (the id) with base_color.rgb as the
  * colour and brdf_params as the scalars; bsdf_from_model() in brdf_material.glsl reads them. The

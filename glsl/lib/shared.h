@@ -37,7 +37,7 @@ typedef uint32_t uint;
  * prefers a leaf; GnBvhNode's count field has room for 8). */
 #define GN_BVH_MAX_LEAF 8
 /* Loop passes one node visit of a walk can cost: the visit, and the two leaves it may open,
- * each one pass plus one a pair (src/render/render.c: traversal_budget). */
+ * each one pass plus one a pair (src/render/render_limits.c: traversal_budget). */
 #define GN_WALK_VISIT_PASSES (1u + 2u * (1u + GN_BVH_MAX_LEAF))
 
 /* ---- descriptor bindings (set 0) of the render kernels -------------------------------- */
@@ -66,7 +66,7 @@ typedef uint32_t uint;
 /* Work-group size of the 2D image kernels: 8x8 matches lavapipe's 8-wide SIMD rows and is a
  * good default for GPUs (64 threads = 2 warps / 1 wavefront). */
 /* The most samples per pixel one dispatch of the path kernel takes (glsl/kernels/path.comp;
- * src/render/render.c: path_samples picks the number for a scene). */
+ * src/render/render_limits.c: path_samples picks the number for a scene). */
 #define GN_PATH_SAMPLES 32u
 /* Entries of a BVH walk's stack (glsl/lib/bvh.glsl: Walk), a sentinel and a spare included:
  * room for the 63 nodes a tree of the builder's 64 levels (src/accel/bvh.c) can put off. */
@@ -79,16 +79,41 @@ typedef uint32_t uint;
 /* The path kernel's loop passes per SIMD group before its walks stop (specialization constant
  * 3; 0: none; glsl/lib/bvh.glsl: LOOP_CAP), set below llvmpipe's loop cap. */
 #define GN_SPEC_LOOP_CAP 3u
-/* Words of a path's saved state (glsl/kernels/path.comp: path_save) before its walk's stack: 44 of the
- * path and its walk, 8 of its media (GN_FEAT_VOLUME). */
-#define GN_PATH_STATE_WORDS 52u
+/* A path's saved state (glsl/kernels/path.comp: path_save, path_load; GN_BIND_PSTATE,
+ * GnFrame.state_stride words a pixel): word 0, the pixel's samples still to take, then the
+ * fields of GN_PATH_STATE in order, then the walk's stack. A row X(kind, variable, when) is a
+ * variable of the kernel, saved and loaded where the kernel's condition `when` holds (the
+ * host only counts the words). Kinds: U a uint, I an int, F a float, B a bool (a word each),
+ * V a vec3 (three), M the media stack (GN_MEDIA_MAX). A field of the path is one row here. */
+#define GN_MEDIA_MAX 4u /* media a path can be inside at once (path.comp: media) */
+#define GN_PATH_STATE(X)                                                                     \
+    X(U, phase, true) X(B, prev_delta, true) X(B, covered, true) X(B, alive, true)           \
+    X(U, depth, true) X(V, o, true) X(V, d, true) X(F, tmin, true) X(V, radiance, true)      \
+    X(V, beta, true) X(F, prev_pdf, true) X(V, normal, true) X(V, albedo, true)              \
+    X(F, depth_aov, true) X(V, so, true) X(V, sd, true) X(F, smax, true) X(V, c, true)       \
+    X(F, walk.hit.t, true) X(F, walk.hit.u, true) X(F, walk.hit.v, true)                     \
+    X(U, walk.hit.tri, true) X(U, walk.hit.steps, true) X(U, walk.node, true)                \
+    X(I, walk.sp, true)                                                                      \
+    X(U, tr_k, GN_HAS(GN_FEAT_ALPHA)) X(F, tr_lo, GN_HAS(GN_FEAT_ALPHA))                     \
+    X(F, tr_max, GN_HAS(GN_FEAT_ALPHA))                                                      \
+    X(M, media, GN_HAS(GN_FEAT_VOLUME)) X(U, media_n, GN_HAS(GN_FEAT_VOLUME))                \
+    X(U, channel, GN_HAS(GN_FEAT_VOLUME)) X(V, seg_from, GN_HAS(GN_FEAT_VOLUME))
+#define GN_PS_WORDS_U 1u
+#define GN_PS_WORDS_I 1u
+#define GN_PS_WORDS_F 1u
+#define GN_PS_WORDS_B 1u
+#define GN_PS_WORDS_V 3u
+#define GN_PS_WORDS_M GN_MEDIA_MAX
+#define GN_PS_COUNT(kind, var, when) + GN_PS_WORDS_##kind
+/* Words of a path's saved state before its walk's stack. */
+#define GN_PATH_STATE_WORDS (1u GN_PATH_STATE(GN_PS_COUNT))
 #define GN_TILE_X 8u
 #define GN_TILE_Y 8u
 
 /* ---- render modes: the one list -------------------------------------------------------
  * X(ID, value, kernel, flags, name, help): mode GN_MODE_<ID> = value (0, 1, ... in list
  * order: --mode's list, the help and the preview's number keys follow it), the kernel that
- * renders it, its GN_MODEF_* and, for the host only (src/render/render.c's registry; glslang drops
+ * renders it, its GN_MODEF_* and, for the host only (src/render/render_modes.c; glslang drops
  * the unexpanded strings), its --mode name and its line of help. A mode of the local kernel
  * is one branch of glsl/kernels/local.comp's local_color: a new mode is an entry here and that branch
  * (docs/architecture.md, "Adding a render mode"). */
@@ -121,7 +146,7 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
 #define GN_LIGHT_SPOT 1u
 #define GN_LIGHT_DIRECTIONAL 2u
 /* A small Lambertian emitter seen as a point: I(theta) = color * max(cos theta, 0) around
- * direction. Stands in for emissive geometry in the local modes (src/render/render.c). */
+ * direction. Stands in for emissive geometry in the local modes (src/render/render_lights.c). */
 #define GN_LIGHT_COSINE 3u
 
 #define GN_INVALID 0xffffffffu

@@ -18,8 +18,9 @@ static const char *shown(const char *name)
     return name[0] ? util_escape(name, b, sizeof buf[0]) : "(unnamed)";
 }
 
-/* The area lights as the path tracer sees them (render.c: build_emitters): triangles of
- * non-zero area whose material emits and is not unlit; prints the materials by name. */
+/* The area lights as the path tracer sees them (src/render/render_lights.c: build_emitters):
+ * triangles of non-zero area whose material emits and is not unlit; prints the materials by
+ * name. */
 static void print_emitters(const scene *sc)
 {
     uint32_t tris = 0, mats = 0;
@@ -130,7 +131,8 @@ int cmd_info(int argc, char **argv)
                  "factor, film IOR, thickness) or a diffuse transmission\n"
                  "(KHR_materials_diffuse_transmission: factor, colour); and one line per extension the\n"
                  "file lists: whether gonio supports it, partly (and what it leaves out) or not (and why).\n",
-        CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given"};
+        CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given",
+        .complete_args = "*.gltf *.glb"};
     cli_args args;
     scene sc = {0};
     bvh b = {0};

@@ -16,6 +16,20 @@
 #include "image.h"
 #include "scene.h"
 
+/* Progress reports of renderer_render, for a display (the command line's: src/cli/progress.c):
+ * RENDER_PROGRESS_START before the first pass, RENDER_PROGRESS_BATCH after each batch of
+ * passes, RENDER_PROGRESS_END once after the last (s->stop tells whether a stop ended it).
+ * done: the samples per pixel taken so far; elapsed: seconds since the passes began (with a
+ * time limit, the work done is the time, not the spp). */
+typedef enum render_progress_event {
+    RENDER_PROGRESS_START,
+    RENDER_PROGRESS_BATCH,
+    RENDER_PROGRESS_END,
+} render_progress_event;
+struct render_settings;
+typedef void render_progress_fn(void *user, const struct render_settings *s,
+                                render_progress_event event, int done, double elapsed);
+
 /* What to render. A zero field is the default where one exists (mode path, seed 0, no AOVs,
  * shadows on, unbounded depth, a black environment, MIS, the whole image, no resume, no
  * progress); width, height and spp must be given, and camera (-1: frame the scene). */
@@ -32,7 +46,8 @@ typedef struct render_settings {
     float env[3];           /* constant environment radiance */
     bool ambient_set;       /* local modes: ambient replaces the scene's global ambient light */
     float ambient[3];
-    bool progress;          /* progress bar on stderr */
+    render_progress_fn *progress; /* NULL: no progress reports */
+    void *progress_user;          /* progress's first argument */
     volatile sig_atomic_t *stop; /* set asynchronously to end after the current pass */
     const GnCamera *camera_override; /* non-NULL: this camera (aspect from the image), not `camera` */
     const scene_camera *view; /* non-NULL: this camera (aspect from the image), not `camera`
@@ -64,6 +79,8 @@ void render_region(const render_settings *s, int region[4]);
 #define RENDER_AOV_GPU (RENDER_AOV_NORMAL | RENDER_AOV_ALBEDO | RENDER_AOV_DEPTH)
 /* "normal", "albedo", "depth", "variance" -> RENDER_AOV_*; 0 when unknown. */
 uint32_t render_aov_from_name(const char *name);
+/* Every AOV's name, ", "-separated. */
+const char *render_aov_list(void);
 
 typedef struct render_stats {
     int spp;                /* samples per pixel actually taken */

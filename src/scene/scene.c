@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "util.h"
+#include "vec.h"
 
 void scene_destroy(scene *s)
 {
@@ -56,9 +57,7 @@ void scene_triangle_cross(const scene *s, uint32_t t, double out[3])
         e1[k] = p[1][k] - p[0][k];
         e2[k] = p[2][k] - p[0][k];
     }
-    out[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    out[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    out[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    vec_cross_d(e1, e2, out);
 }
 
 static bool position_ok(const vec3 *p)

@@ -140,6 +140,22 @@ if command -v help2man >/dev/null && command -v man >/dev/null; then
     check "completion: diff offers EXRs" test "$(cd "$tmp/files" && complete_words gonio diff '')" = "a.exr "
     check "completion: render offers glTF files" test "$(cd "$tmp/files" && complete_words gonio render '')" = "c.gltf d.glb "
     check "completion: --png offers PNGs" test "$(cd "$tmp/files" && complete_words gonio render c.gltf --png '')" = "b.png "
+    check "completion: --env offers maps and studio" \
+        test "$(cd "$tmp/files" && complete_words gonio render c.gltf --env '')" = "a.exr studio "
+    check "completion: scene offers its scenes" test "$(complete_words gonio scene '')" = "cornell teapot "
+    # The program's option tables are the one source: every long option each command's
+    # --help lists (so any option added to a table) is offered, nothing else is, and the
+    # script itself names none of them.
+    all_opts=
+    for c in render preview info devices compare merge diff bench brdf "brdf phong" scene teapot; do
+        want=$({ "$G" $c --help | sed -n 's/^ \{1,4\}\(-[-a-zA-Z]*\)\(, \(--[-a-z]*\)\)\{0,1\}.*/\1 \3/p'
+            echo --help; } | tr ' ' '\n' | grep -- '^--' | grep -v -- '--PARAM' | sort -u | tr '\n' ' ')
+        check "completion: gonio $c -- offers the options of its --help" \
+            test "$(complete_words gonio $c --)" = "$want"
+        all_opts="$all_opts $want"
+    done
+    named=$(for o in $all_opts; do grep -qF -- "$o" "$comp" && echo "$o"; done | sort -u | tr '\n' ' ')
+    check "completion: the script names no option ($named)" test -z "$named"
 else
     echo "  note: help2man or man is missing (make test-deps installs them): make install not checked"
 fi
