@@ -87,7 +87,7 @@ UNIT := $(BUILD)/unit_tests
 TESTTOOL := $(BUILD)/testtool
 
 # ---- Debian packages -------------------------------------------------------------------
-# nlohmann-json3-dev: the JSON library tinygltf parses with, which scene_gltf.cpp uses to check
+# nlohmann-json3-dev: the JSON library tinygltf parses with, which gltf_json.cpp uses to check
 # the document itself (tinygltf's package does not depend on it).
 DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
 	libopenexr-dev libtinygltf-dev nlohmann-json3-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers help2man \
@@ -163,6 +163,8 @@ $(BUILD)/spv/%.h: %.comp | deps
 	spirv-val --target-env vulkan1.1 $(BUILD)/spv/$*.spv
 	glslangValidator -V --target-env vulkan1.1 -Iglsl/lib --vn spv_$(subst -,_,$*) -o $@ $< >/dev/null
 	@sed -i 's|\.spv:|.h:|' $(BUILD)/spv/$*.d
+	@# (and, as -MP does for C, an empty rule per included file: a file renamed or removed is no error)
+	@sed -n 's|^[^:]*: [^ ]*||p' $(BUILD)/spv/$*.d | tr ' ' '\n' | sed -n 's|^\(..*\)$$|\1:|p' >>$(BUILD)/spv/$*.d
 shaders: $(SPV_HDR)
 
 run: all

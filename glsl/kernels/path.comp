@@ -3,7 +3,7 @@
 // L_o = L_e + integral f L_i cos, several path samples a pixel per dispatch. At every vertex:
 // next-event estimation (one light from the power-proportional table, area sampling on
 // triangles, the lat-long environment map by its luminance) and a BSDF sample from
-// brdf.glsl, combined by multiple importance sampling with the power heuristic (Veach &
+// brdf_bsdf.glsl, combined by multiple importance sampling with the power heuristic (Veach &
 // Guibas 1995, "Optimally combining sampling techniques"); Dirac lobes and punctual lights
 // take their one strategy exactly; Russian roulette after ROULETTE_DEPTH bounces.
 // docs/path-tracing.md derives the estimator and names the tests that check it.
@@ -12,14 +12,15 @@
 
 // Specialised on the scene's features (GN_FEAT_* in shared.h): code no lane can need is
 // compiled away, which llvmpipe (running both sides of every branch) needs most.
-#define GN_HAS(f) ((FEATURES & (f)) != 0u)
+#define GN_HAS(f) (((FEATURES & (f).x) | (FEATURES_HI & (f).y)) != 0u)
 #include "shared.h"
-layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
+layout(constant_id = GN_SPEC_FEATURES) const uint FEATURES = 0xffffffffu;    // GN_FEAT_* bits 0-31
+layout(constant_id = GN_SPEC_FEATURES_HI) const uint FEATURES_HI = 0xffffffffu; // ... 32-63
 
 #include "bvh.glsl"
 // The sheen's albedo table heads the texel buffer in scenes with layers (src/render/render.c).
 #define BRDF_SHEEN_FETCH(i) uintBitsToFloat(texelFetch(texels, (i)).x)
-#include "brdf.glsl"
+#include "brdf_material.glsl"
 
 layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
 
@@ -289,26 +290,14 @@ LightSample light_sample(vec3 p, vec3 u)
 }
 
 // ---- materials ------------------------------------------------------------------------------
-Bsdf material_bsdf(Surface s, GnMaterial m)
-{
-    if (GN_HAS(GN_FEAT_MODELS) && (!GN_HAS(GN_FEAT_GLTF) || m.brdf != BRDF_GLTF)) // the colour of a conductor is its index, never a texture's
-        return bsdf_from_model(m.brdf, m.brdf == BRDF_CONDUCTOR ? m.base_color.rgb : s.base, m.brdf_params);
-    Bsdf b = bsdf_gltf(s.base, s.metallic, s.roughness, m.specular, m.specular_color, m.ior, m.transmission);
-    if (GN_HAS(GN_FEAT_LAYERS)) // the coat's normal in the local frame: main() sets it
-        b = bsdf_layers(b, s.coat, s.coat_roughness, vec3(0.0, 0.0, 1.0), s.sheen, s.sheen_roughness);
-    if (GN_HAS(GN_FEAT_LAYERS)) // iridescence, diffuse transmission
-        b = bsdf_gltf_film(b, s.base, s.metallic, m.specular, m.specular_color, m.ior, m.transmission, s.irid, s.dt);
-    return b;
-}
-
 // Does b have a part that light sampling can reach (anything but Dirac lobes)?
 bool bsdf_has_smooth(Bsdf b)
 {
     return any(greaterThan(b.diffuse, vec3(0.0))) || (GN_HAS(GN_FEAT_LAYERS) && brdf_has_dt(b)) ||
            (b.lobe != BRDF_LOBE_NONE && b.lobe != BRDF_LOBE_MIRROR) ||
-           (b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN) ||
+           (b.dielectric > 0.0 && !lobes_smooth(b.shape)) ||
            (GN_HAS(GN_FEAT_LAYERS) && (any(greaterThan(b.sheen, vec3(0.0))) ||
-                                       (b.coat > 0.0 && b.coat_alpha >= BRDF_ALPHA_MIN)));
+                                       (b.coat > 0.0 && !lobes_smooth(b.coat_alpha))));
 }
 
 // ---- media: KHR_materials_volume and _dispersion (GN_FEAT_VOLUME) --------------------------
@@ -403,7 +392,7 @@ uint medium_interface(Surface s, GnMaterial m, inout Bsdf b, float u, inout vec3
     }
     float eta = inner / outer;
     // The rough BTDF collapses to a Dirac at 1 (bsdf_gltf): kept as far off it as there.
-    if (b.shape >= BRDF_ALPHA_MIN)
+    if (!lobes_smooth(b.shape))
         eta = eta >= 1.0 ? max(eta, 1.01) : min(eta, 1.0 / 1.01);
     b.ior = eta;
     return far;
@@ -663,12 +652,12 @@ void main()
             GnMaterial m = material_at(s.material);
             covered = covered || depth == 0u;
             if (GN_HAS(GN_FEAT_AOV) && depth == 0u) {
-                normal = s.n;
-                albedo = s.base;
+                normal = s.sh.n;
+                albedo = s.sh.m.base_color.rgb;
                 depth_aov = h.t * dot(d, frame.camera.forward);
             }
             if (GN_HAS(GN_FEAT_UNLIT) && (m.flags & GN_MAT_UNLIT) != 0u) { // KHR_materials_unlit: the colour is the radiance
-                radiance += beta * s.base;
+                radiance += beta * s.sh.m.base_color.rgb;
                 break;
             }
             if (GN_HAS(GN_FEAT_EMISSIVE) && (s.front || (m.flags & GN_MAT_DOUBLE_SIDED) != 0u) &&
@@ -679,23 +668,20 @@ void main()
                                abs(dot(s.ng, d));
                     w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, pl);
                 }
-                radiance += beta * s.emission * w;
+                radiance += beta * s.sh.m.emissive * w;
             }
             if (frame.max_depth != 0u && depth >= frame.max_depth)
                 break;
 
-            Bsdf b = material_bsdf(s, m);
-            // A transmitting surface needs the side: brdf.glsl's normal points outside.
+            Bsdf b = bsdf_material(s.sh);
+            // A transmitting surface needs the side: a Bsdf's normal points outside.
             bool flip = b.dielectric > 0.0 && !s.front;
-            vec3 n = flip ? -s.n : s.n, ng = flip ? -s.ng : s.ng, tx, ty;
+            vec3 n = flip ? -s.sh.n : s.sh.n, ng = flip ? -s.ng : s.ng, tx, ty;
             sampling_basis(n, tx, ty);
             vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
-            if (GN_HAS(GN_FEAT_LAYERS)) {
-                vec3 cn = flip ? -s.coat_n : s.coat_n;
-                b.coat_n = normalize(vec3(dot(cn, tx), dot(cn, ty), dot(cn, n)));
-            }
-            if (GN_HAS(GN_FEAT_ANISO) && s.aniso > 0.0 && m.brdf == BRDF_GLTF) // the direction on the shading plane
-                b = bsdf_anisotropy(b, s.aniso, vec2(dot(s.aniso_t, tx), dot(s.aniso_t, ty)));
+            vec3 cn = flip ? -s.sh.coat_n : s.sh.coat_n; // (the anisotropy's direction on the shading plane)
+            b = bsdf_orient(b, s.sh, normalize(vec3(dot(cn, tx), dot(cn, ty), dot(cn, n))),
+                            vec2(dot(s.sh.aniso_t, tx), dot(s.sh.aniso_t, ty)));
             vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
             uint far = GN_INVALID; // the medium beyond a transmitting surface
             if (GN_HAS(GN_FEAT_VOLUME))

@@ -2,7 +2,7 @@
  * model list, polar plots of a lobe in the plane of incidence (Lambertian, specular,
  * combined), the directional albedo against incident angle (the energy-conservation
  * integral), and a material ball under a directional light
- * and a constant environment. Every number comes from glsl/lib/brdf.glsl run on the GPU. */
+ * and a constant environment. Every number comes from glsl/lib/brdf_*.glsl run on the GPU. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -310,15 +310,7 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
     memset(&q, 0, sizeof q);
     memset(&scene, 0, sizeof scene);
     brdf_setting_to_query(s, &q);
-    scene.color = q.color;
-    scene.model = q.model;
-    scene.params = q.params;
-    scene.extra = q.extra;
-    scene.layer = q.layer;
-    scene.sheen = q.sheen;
-    scene.aniso = q.aniso;
-    scene.irid = q.irid;
-    scene.dt = q.dt;
+    scene.material = q.material;
     scene.light_dir = (vec3){-0.5f / 0.9718f, 0.6f / 0.9718f, 0.55f / 0.9718f}; /* upper left, front */
     scene.light_irradiance = (vec3){2.5f, 2.5f, 2.5f};
     scene.env = (vec3){0.3f, 0.3f, 0.3f};

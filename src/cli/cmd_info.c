@@ -99,6 +99,19 @@ static void print_films(const scene *sc)
     }
 }
 
+/* The extensions the file lists, one line each: how gonio handles it (scene.h: scene_extension). */
+static void print_extensions(const scene *sc)
+{
+    static const char *const support[] = {[SCENE_UNSUPPORTED] = "unsupported (ignored)", [SCENE_PARTLY] = "partly",
+                                          [SCENE_SUPPORTED] = "supported"};
+    printf("extensions     %u\n", sc->num_extensions);
+    for (uint32_t i = 0; i < sc->num_extensions; i++) {
+        const scene_extension *e = &sc->extensions[i];
+        printf("extension      %s%s: %s: %s\n", shown(e->name), e->required ? " (required)" : "", support[e->support],
+               e->how);
+    }
+}
+
 int cmd_info(int argc, char **argv)
 {
     bool outside = false;
@@ -116,7 +129,8 @@ int cmd_info(int argc, char **argv)
                  "(KHR_materials_anisotropy): strength, rotation and whether a texture sets them;\n"
                  "and one line per material with an iridescent film (KHR_materials_iridescence:\n"
                  "factor, film IOR, thickness) or a diffuse transmission\n"
-                 "(KHR_materials_diffuse_transmission: factor, colour).\n",
+                 "(KHR_materials_diffuse_transmission: factor, colour); and one line per extension the\n"
+                 "file lists: whether gonio supports it, partly (and what it leaves out) or not (and why).\n",
         CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given",
         .complete_args = "*.gltf *.glb"};
     cli_args args;
@@ -140,6 +154,7 @@ int cmd_info(int argc, char **argv)
     printf("variants       %u\n", sc.num_variants);
     for (uint32_t i = 0; i < sc.num_variants; i++)
         printf("variant %-6u \"%s\"\n", i, shown(sc.variant_names[i]));
+    print_extensions(&sc);
     printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
     printf("lights         %u\n", sc.num_lights);
     print_emitters(&sc);

@@ -297,29 +297,32 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
 
 /* The GN_FEAT_* a mode's kernel is built for: those it is specialised on as the scene and
  * settings need them, every other one compiled in. */
-static uint32_t kernel_features(const renderer *r, uint32_t mode)
+static GnFeatures kernel_features(const renderer *r, uint32_t mode)
 {
-    const uint32_t spec = mode_kernel(mode)->specialised;
+    const GnFeatures spec = mode_kernel(mode)->specialised;
     return (GN_FEAT_ALL & ~spec) | (r->path_features & spec);
 }
 
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec)
 {
     spec->values[0] = mode;
-    spec->values[1] = kernel_features(r, mode);
+    spec->values[1] = (uint32_t)kernel_features(r, mode);
     spec->values[2] = walk_regs(r);
     spec->values[3] = 0; /* the loop cap: only the path kernel's (renderer_pipeline) */
-    for (uint32_t i = 0; i < 4; i++)
+    spec->values[4] = (uint32_t)(kernel_features(r, mode) >> 32);
+    for (uint32_t i = 0; i < 5; i++)
         spec->entries[i] = (VkSpecializationMapEntry){i, i * (uint32_t)sizeof(uint32_t), sizeof(uint32_t)};
-    assert(spec->entries[2].constantID == GN_SPEC_WALK_REGS && spec->entries[3].constantID == GN_SPEC_LOOP_CAP);
-    spec->info = (VkSpecializationInfo){4, spec->entries, sizeof spec->values, spec->values};
+    assert(spec->entries[GN_SPEC_FEATURES].constantID == GN_SPEC_FEATURES &&
+           spec->entries[GN_SPEC_FEATURES_HI].constantID == GN_SPEC_FEATURES_HI &&
+           spec->entries[2].constantID == GN_SPEC_WALK_REGS && spec->entries[3].constantID == GN_SPEC_LOOP_CAP);
+    spec->info = (VkSpecializationInfo){5, spec->entries, sizeof spec->values, spec->values};
     return &spec->info;
 }
 
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
 {
     gpu_pipeline *p = &r->pipelines[mode];
-    uint32_t features = kernel_features(r, mode);
+    GnFeatures features = kernel_features(r, mode);
     if (p->pipeline && r->pipeline_features[mode] != features)
         gpu_pipeline_destroy(r->g, p); /* built for other features: a new kernel */
     if (!p->pipeline) {

@@ -114,9 +114,9 @@ typedef struct renderer {
     double env_weight;        /* its selection weight */
     int width, height;
     double setup_seconds;
-    uint32_t material_features; /* GN_FEAT_* the materials need (renderer_create) */
-    uint32_t path_features;     /* ... and the current path render (renderer_begin) */
-    uint32_t pipeline_features[GN_MODE_COUNT]; /* what each cached kernel was built for */
+    GnFeatures material_features; /* GN_FEAT_* the materials need (renderer_create) */
+    GnFeatures path_features;     /* ... and the current path render (renderer_begin) */
+    GnFeatures pipeline_features[GN_MODE_COUNT]; /* what each cached kernel was built for */
     uint32_t path_samples;      /* samples per path dispatch (1..GN_PATH_SAMPLES) */
     bool failed;                /* renderer_create refused the scene: nothing renders */
     VkDeviceSize vcolor_bytes;  /* Gouraud's colours: more than a storage buffer holds when
@@ -146,10 +146,11 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame);
 uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
 
 /* Specialization constants of the render kernels: constant 0 = mode (or a kernel's own
- * variant); constant 1 = the GN_FEAT_* set (the path kernel reads it; others ignore it). */
+ * variant); constants GN_SPEC_FEATURES and GN_SPEC_FEATURES_HI = the GN_FEAT_* set's two words (the
+ * path kernel reads them; others ignore them). */
 typedef struct renderer_spec {
-    uint32_t values[4];
-    VkSpecializationMapEntry entries[4];
+    uint32_t values[5];
+    VkSpecializationMapEntry entries[5];
     VkSpecializationInfo info;
 } renderer_spec;
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec);

@@ -26,7 +26,7 @@ typedef struct render_kernel {
     const char *name;
     const uint32_t *code;
     size_t code_size;
-    uint32_t specialised;
+    GnFeatures specialised;
     bool batched;
 } render_kernel;
 const render_kernel *mode_kernel(uint32_t mode);

@@ -6,118 +6,112 @@
 #include <string.h>
 
 #include "brdf.h"
+#include "lobes.h"
 #include "util.h"
 
 static double luminance(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
-static float clamp01(float x) { return x < 0 ? 0 : x > 1 ? 1 : x; }
+static bool any_positive(const float *v, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (v[k] > 0)
+            return true;
+    return false;
+}
 
 /* The GN_FEAT_* that material m can need in the path kernel: the parts of the Bsdf that
- * bsdf_gltf or bsdf_from_model (glsl/lib/brdf.glsl) can build from it with a nonzero weight,
- * its textures, emission and unlit flag. Where a texture can change a value (roughness,
- * metalness) every value it can reach counts. */
-uint32_t material_features(const GnMaterial *m)
+ * bsdf_gltf or bsdf_from_model (glsl/lib/brdf_material.glsl) can build from it with a nonzero
+ * weight, decided by the construction's own predicates (glsl/lib/lobes.h) over every value
+ * its textures can reach (a texture scales its factor by [0, 1]); its textures, emission and
+ * unlit flag. */
+GnFeatures material_features(const GnMaterial *m)
 {
-    uint32_t f = 0;
-    bool textured = m->tex_base != GN_INVALID || m->tex_mr != GN_INVALID ||
-                    m->tex_emissive != GN_INVALID || m->tex_occlusion != GN_INVALID;
-    if (textured)
-        f |= GN_FEAT_TEXTURES;
-    if (m->tex_normal != GN_INVALID)
-        f |= GN_FEAT_NORMAL_MAP | GN_FEAT_TEXTURES;
+    GnFeatures f = GN_FEAT_NONE, gates = GN_FEAT_NONE;
+    /* each texture slot's gate (glsl/lib/material.h): the feature it is read under */
+#define TEX_GATE(name, word, ext, json, space, gate, uses) \
+    if (m->name != GN_INVALID)                              \
+        gates |= (gate);
+    GN_MATERIAL(GN_MAT_NO_PARAM, TEX_GATE, GN_MAT_NO_FIELD)
+#undef TEX_GATE
     if (m->flags & GN_MAT_UNLIT)
         f |= GN_FEAT_UNLIT;
     if (m->flags & (GN_MAT_MASK | GN_MAT_BLEND))
         f |= GN_FEAT_ALPHA;
     if (luminance(&m->emissive.x) > 0)
         f |= GN_FEAT_EMISSIVE;
-    switch (m->brdf) {
-    case BRDF_GLTF: {
-        /* bsdf_gltf: a GGX lobe (a mirror below BRDF_ALPHA_MIN) with Schlick's F of weight
+    if (m->brdf == BRDF_GLTF) {
+        /* bsdf_gltf: a GGX lobe (the mirror where lobes_smooth) with Schlick's F of weight
          * wd f0 + m base and F90 wd specular + m; the diffuse coupled to that layer when
-         * specular > 0; glass of weight (1 - m) t. The texture scales roughness and
-         * metalness by [0, 1]. */
-        float metal_hi = clamp01(m->metallic), metal_lo = m->tex_mr != GN_INVALID ? 0 : metal_hi;
-        float rough_hi = clamp01(m->roughness), rough_lo = m->tex_mr != GN_INVALID ? 0 : rough_hi;
-        float t = clamp01(m->transmission);
-        bool smooth = rough_lo * rough_lo < BRDF_ALPHA_MIN, rough = rough_hi * rough_hi >= BRDF_ALPHA_MIN;
+         * specular > 0; glass of weight lobes_gltf_glass. */
+        bool mr = m->tex_mr != GN_INVALID;
+        float metal_hi = lobes_clamp01(m->metallic), metal_lo = mr ? 0 : metal_hi;
+        float rough_hi = lobes_clamp01(m->roughness), rough_lo = mr ? 0 : rough_hi;
+        float t = lobes_clamp01(m->transmission); /* (its texture: down to 0, where the glass is none) */
+        bool smooth = lobes_smooth(lobes_gltf_alpha(rough_lo)), rough = !lobes_smooth(lobes_gltf_alpha(rough_hi));
+        bool glass = lobes_gltf_glass(metal_lo, t) > 0;
         f |= GN_FEAT_GLTF;
-        if (m->specular != 0 || metal_hi > 0) {
+        if (lobes_gltf_lobe(m->specular, metal_hi)) {
             f |= GN_FEAT_FRESNEL_SCHLICK | (smooth ? GN_FEAT_MIRROR : 0u) | (rough ? GN_FEAT_GGX : 0u);
             if (m->specular != 0)
                 f |= GN_FEAT_COUPLED;
         }
-        if (t > 0 && metal_lo < 1)
+        if (glass)
             f |= (smooth ? GN_FEAT_SMOOTH_GLASS : 0u) | (rough ? GN_FEAT_ROUGH_GLASS : 0u);
         /* KHR_materials_volume acts only where the surface transmits (glass or a diffuse
          * transmission), _dispersion only where it refracts */
         if (metal_lo < 1 && ((t > 0 && (m->volume || m->dispersion > 0)) || (m->diffuse_transmission > 0 && m->volume)))
             f |= GN_FEAT_VOLUME;
-        /* bsdf_layers: a coat or a sheen (their textures only scale the factors) */
-        if (m->clearcoat > 0 || m->sheen_color.x > 0 || m->sheen_color.y > 0 || m->sheen_color.z > 0) {
-            f |= GN_FEAT_LAYERS;
-            if (m->tex_clearcoat != GN_INVALID || m->tex_clearcoat_roughness != GN_INVALID ||
-                m->tex_clearcoat_normal != GN_INVALID || m->tex_sheen_color != GN_INVALID ||
-                m->tex_sheen_roughness != GN_INVALID)
-                f |= GN_FEAT_TEXTURES;
-        }
+        /* the parts a factor above 0 switches on (the table's feat column: bsdf_layers' coat
+         * and sheen, bsdf_gltf_film's film and diffuse transmission, bsdf_anisotropy); their
+         * textures only scale the factors down */
+#define PARAM_FEAT(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) \
+    if (any_positive((const float *)&m->name, GN_MAT_COUNT_##type))            \
+        f |= (feat);
+        GN_MATERIAL(PARAM_FEAT, GN_MAT_NO_TEX, GN_MAT_NO_FIELD)
+#undef PARAM_FEAT
         /* bsdf_anisotropy: the lobe and the glass stay GGX where roughness 0 would make them
-         * Dirac (the texture only scales the strength) */
-        if (m->anisotropy_strength > 0) {
-            f |= GN_FEAT_ANISO | (m->tex_anisotropy != GN_INVALID ? GN_FEAT_TEXTURES : 0u);
-            if (m->specular != 0 || metal_hi > 0)
+         * Dirac */
+        if (f & GN_FEAT_ANISO) {
+            if (lobes_gltf_lobe(m->specular, metal_hi))
                 f |= GN_FEAT_GGX;
-            if (t > 0 && metal_lo < 1)
+            if (glass)
                 f |= GN_FEAT_ROUGH_GLASS;
         }
-        /* bsdf_gltf_film: an iridescent film, a diffuse transmission (textures as above) */
-        if (m->iridescence > 0 || m->diffuse_transmission > 0) {
-            f |= GN_FEAT_LAYERS;
-            if ((m->iridescence > 0 && (m->tex_iridescence != GN_INVALID || m->tex_iridescence_thickness != GN_INVALID)) ||
-                (m->diffuse_transmission > 0 && (m->tex_diffuse_transmission != GN_INVALID ||
-                                                 m->tex_diffuse_transmission_color != GN_INVALID)))
-                f |= GN_FEAT_TEXTURES;
-        }
-        break;
-    }
-    default: {
+    } else {
         /* an override model: its row of the table (glsl/lib/brdf_models.h); an id unknown to it
          * keeps every feature */
-        uint32_t mf = GN_FEAT_ALL;
+        GnFeatures mf = GN_FEAT_ALL;
         for (int i = 0; i < brdf_num_models; i++)
             if (brdf_models[i].id == m->brdf)
                 mf = brdf_models[i].features;
         f |= mf | GN_FEAT_MODELS;
     }
-    }
+    /* the textures, where the kernel reads them: under their gate's code (always for the maps
+     * of the core and of KHR_materials_specular and _transmission; the layers' and the
+     * anisotropy's where the material has them) */
+    if (gates & (GN_FEAT_TEXTURES | GN_FEAT_NORMAL_MAP | (f & (GN_FEAT_LAYERS | GN_FEAT_ANISO))))
+        f |= GN_FEAT_TEXTURES | (gates & GN_FEAT_NORMAL_MAP);
     return f;
 }
 
-/* Sets m's model from a setting: the glTF model writes the material's own fields back. */
+/* A setting's values and a material are both a GnMaterial's words (brdf_setting.v); a
+ * parameter is its words there (src/render/brdf.c: the glTF model's are the material table's
+ * BRDF columns, glsl/lib/material.h). */
+static void copy_params(float *dst, const float *src, const brdf_model *model)
+{
+    for (int i = 0; i < model->num_params; i++)
+        memcpy(dst + model->params[i].slot, src + model->params[i].slot,
+               sizeof(float) * (size_t)model->params[i].count);
+}
+
+/* Sets m's model from a setting: its colour and four scalars, and every parameter (the glTF
+ * model's are the material's own fields). */
 static void apply_setting(GnMaterial *m, const brdf_setting *st)
 {
-    memcpy(&m->base_color.x, st->v, 3 * sizeof(float));
-    memcpy(&m->brdf_params.x, st->v + BRDF_SLOT_PARAMS, 4 * sizeof(float));
+    memcpy(&m->base_color.x, &st->m.base_color.x, 3 * sizeof(float));
+    m->brdf_params = st->m.brdf_params;
     m->brdf = st->model->id;
-    if (st->model->id == BRDF_GLTF) {
-        m->metallic = st->v[BRDF_SLOT_PARAMS];
-        m->roughness = st->v[BRDF_SLOT_PARAMS + 1];
-        m->specular = st->v[BRDF_SLOT_PARAMS + 2];
-        m->ior = st->v[BRDF_SLOT_PARAMS + 3];
-        memcpy(&m->specular_color.x, st->v + BRDF_SLOT_EXTRA, 3 * sizeof(float));
-        m->transmission = st->v[BRDF_SLOT_EXTRA + 3];
-        m->clearcoat = st->v[BRDF_SLOT_LAYER];
-        m->clearcoat_roughness = st->v[BRDF_SLOT_LAYER + 1];
-        m->sheen_roughness = st->v[BRDF_SLOT_LAYER + 2];
-        memcpy(&m->sheen_color.x, st->v + BRDF_SLOT_SHEEN, 3 * sizeof(float));
-        m->anisotropy_strength = st->v[BRDF_SLOT_ANISO];
-        m->anisotropy_rotation = st->v[BRDF_SLOT_ANISO + 1];
-        m->iridescence = st->v[BRDF_SLOT_IRID];
-        m->iridescence_ior = st->v[BRDF_SLOT_IRID + 1];
-        m->iridescence_thickness_max = st->v[BRDF_SLOT_IRID + 2];
-        memcpy(&m->diffuse_transmission_color.x, st->v + BRDF_SLOT_DT, 3 * sizeof(float));
-        m->diffuse_transmission = st->v[BRDF_SLOT_DT + 3];
-    }
+    copy_params((float *)m, st->v, st->model);
 }
 
 /* A setting of `model` that starts from m: its colour is the material's base colour (but a
@@ -126,26 +120,9 @@ static void setting_from_material(brdf_setting *st, const brdf_model *model, con
 {
     brdf_setting_init(st, model);
     if (model->id != BRDF_CONDUCTOR)
-        memcpy(st->v, &m->base_color.x, 3 * sizeof(float));
-    if (model->id == BRDF_GLTF) {
-        st->v[BRDF_SLOT_PARAMS] = m->metallic;
-        st->v[BRDF_SLOT_PARAMS + 1] = m->roughness;
-        st->v[BRDF_SLOT_PARAMS + 2] = m->specular;
-        st->v[BRDF_SLOT_PARAMS + 3] = m->ior;
-        memcpy(st->v + BRDF_SLOT_EXTRA, &m->specular_color.x, 3 * sizeof(float));
-        st->v[BRDF_SLOT_EXTRA + 3] = m->transmission;
-        st->v[BRDF_SLOT_LAYER] = m->clearcoat;
-        st->v[BRDF_SLOT_LAYER + 1] = m->clearcoat_roughness;
-        st->v[BRDF_SLOT_LAYER + 2] = m->sheen_roughness;
-        memcpy(st->v + BRDF_SLOT_SHEEN, &m->sheen_color.x, 3 * sizeof(float));
-        st->v[BRDF_SLOT_ANISO] = m->anisotropy_strength;
-        st->v[BRDF_SLOT_ANISO + 1] = m->anisotropy_rotation;
-        st->v[BRDF_SLOT_IRID] = m->iridescence;
-        st->v[BRDF_SLOT_IRID + 1] = m->iridescence_ior;
-        st->v[BRDF_SLOT_IRID + 2] = m->iridescence_thickness_max;
-        memcpy(st->v + BRDF_SLOT_DT, &m->diffuse_transmission_color.x, 3 * sizeof(float));
-        st->v[BRDF_SLOT_DT + 3] = m->diffuse_transmission;
-    }
+        memcpy(&st->m.base_color.x, &m->base_color.x, 3 * sizeof(float));
+    if (model->id == BRDF_GLTF)
+        copy_params(st->v, (const float *)m, model);
 }
 
 bool render_material_overrides(scene *sc, const char *brdf)

@@ -10,7 +10,7 @@
 
 /* The GN_FEAT_* that material m can need in the path kernel (renderer_create ORs them over
  * the scene's materials to specialise the kernel). */
-uint32_t material_features(const GnMaterial *m);
+GnFeatures material_features(const GnMaterial *m);
 
 /* Applies BRDF-model overrides to the scene's materials (GnMaterial.brdf, brdf_params and
  * the model's colour): each material's extras {"gonio": {"brdf": NAME, PARAM: VALUE...}}
