@@ -157,6 +157,9 @@ int cmd_info(int argc, char **argv)
     print_extensions(&sc);
     printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
     printf("lights         %u\n", sc.num_lights);
+    if (sc.environment.num_channels)
+        printf("environment    %s (a %dx%d lat-long map)\n", shown(sc.environment_what), sc.environment.width,
+               sc.environment.height);
     print_emitters(&sc);
     print_media(&sc);
     print_anisotropy(&sc);

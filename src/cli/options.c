@@ -224,6 +224,21 @@ bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_se
     if (e->given && !e->path && !e->studio) {
         for (int k = 0; k < 3; k++)
             mean[k] = s->env[k] = e->color[k] * scale;
+    } else if (!e->given && sc->environment.num_channels) {
+        /* The file's own image-based light (EXT_lights_image_based): its environment. */
+        const image *src = &sc->environment;
+        static const char *const rgb[3] = {"R", "G", "B"};
+        image_create(map, src->width, src->height, 3, rgb);
+        for (int c = 0; c < 3; c++)
+            memcpy(map->planes[c], src->planes[c], sizeof(float) * (size_t)src->width * src->height);
+        if (!quiet)
+            util_info("%s: lit by its image-based light (%s; --env replaces it)", sc->path, sc->environment_what);
+        if (scale != 1)
+            for (int c = 0; c < 3; c++)
+                for (size_t i = 0; i < (size_t)map->width * map->height; i++)
+                    map->planes[c][i] *= scale;
+        environment_mean(map, mean);
+        s->env_map = map;
     } else if (e->given || !env_scene_has_light(sc)) {
         if (e->path) {
             bool ok = util_has_suffix(e->path, ".hdr") ? environment_read_hdr(map, e->path) : image_read_exr(map, e->path);

@@ -16,7 +16,7 @@
 
 bool env_scene_has_light(const scene *sc)
 {
-    if (sc->num_lights > 0)
+    if (sc->num_lights > 0 || sc->environment.num_channels > 0)
         return true;
     /* Core glTF's emissive factor stops at 1: emission within that range is a glow texture
      * (DamagedHelmet's displays, a lit window) on an object that still needs light; a light
@@ -122,6 +122,88 @@ void environment_mean(const image *map, float out[3])
     }
     for (int k = 0; k < 3; k++)
         out[k] = wsum > 0 ? (float)(sum[k] / wsum) : 0;
+}
+
+/* ---- cube maps ---------------------------------------------------------------------------- */
+
+/* Face and (s, t) in [0, 1]^2 of direction d: Vulkan's cube map face selection (the major
+ * axis; sc, tc by its table), then s mirrored (the faces are pictures seen from inside). */
+static int cube_face(const float d[3], float *s, float *t)
+{
+    float ax = fabsf(d[0]), ay = fabsf(d[1]), az = fabsf(d[2]), sc, tc, ma;
+    int face;
+    if (ax >= ay && ax >= az) {
+        face = d[0] >= 0 ? 0 : 1;
+        sc = d[0] >= 0 ? -d[2] : d[2];
+        tc = -d[1];
+        ma = ax;
+    } else if (ay >= az) {
+        face = d[1] >= 0 ? 2 : 3;
+        sc = d[0];
+        tc = d[1] >= 0 ? d[2] : -d[2];
+        ma = ay;
+    } else {
+        face = d[2] >= 0 ? 4 : 5;
+        sc = d[2] >= 0 ? d[0] : -d[0];
+        tc = -d[1];
+        ma = az;
+    }
+    *s = 1 - 0.5f * (sc / ma + 1);
+    *t = 0.5f * (tc / ma + 1);
+    return face;
+}
+
+/* Bilinear lookup in one face, clamped at its edges. */
+static void face_lookup(const float *f, int size, float s, float t, float out[3])
+{
+    float x = s * size - 0.5f, y = t * size - 0.5f;
+    int x0 = (int)floorf(x), y0 = (int)floorf(y);
+    float fx = x - x0, fy = y - y0;
+    for (int k = 0; k < 3; k++)
+        out[k] = 0;
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            int xi = x0 + i < 0 ? 0 : x0 + i >= size ? size - 1 : x0 + i;
+            int yj = y0 + j < 0 ? 0 : y0 + j >= size ? size - 1 : y0 + j;
+            float w = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
+            const float *p = f + ((size_t)yj * size + xi) * 3;
+            for (int k = 0; k < 3; k++)
+                out[k] += w * p[k];
+        }
+}
+
+void environment_from_cube(image *out, int out_width, const float *const faces[6], int size, const float rotation[4])
+{
+    static const char *const rgb[3] = {"R", "G", "B"};
+    int w = out_width, h = out_width / 2;
+    image_create(out, w, h, 3, rgb);
+    /* q^-1 d for a unit quaternion: d - 2w (v x d) + 2 v x (v x d), v = -(x, y, z) */
+    float qx = -rotation[0], qy = -rotation[1], qz = -rotation[2], qw = rotation[3];
+    float n = sqrtf(qx * qx + qy * qy + qz * qz + qw * qw);
+    qx /= n, qy /= n, qz /= n, qw /= n;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            float sum[3] = {0, 0, 0};
+            for (int sy = 0; sy < 2; sy++)
+                for (int sx = 0; sx < 2; sx++) {
+                    /* path.comp's lat-long mapping (+Y up, v = 0 at the zenith) */
+                    float theta = (float)M_PI * (y + 0.25f + 0.5f * sy) / h;
+                    float phi = ((x + 0.25f + 0.5f * sx) / w - 0.5f) * 2 * (float)M_PI;
+                    float d[3] = {sinf(theta) * cosf(phi), cosf(theta), sinf(theta) * sinf(phi)};
+                    float c1[3] = {qy * d[2] - qz * d[1], qz * d[0] - qx * d[2], qx * d[1] - qy * d[0]};
+                    float c2[3] = {qy * c1[2] - qz * c1[1], qz * c1[0] - qx * c1[2], qx * c1[1] - qy * c1[0]};
+                    float r[3];
+                    for (int k = 0; k < 3; k++)
+                        r[k] = d[k] + 2 * qw * c1[k] + 2 * c2[k];
+                    float s, t, v[3];
+                    int f = cube_face(r, &s, &t);
+                    face_lookup(faces[f], size, s, t, v);
+                    for (int k = 0; k < 3; k++)
+                        sum[k] += 0.25f * v[k];
+                }
+            for (int k = 0; k < 3; k++)
+                out->planes[k][(size_t)y * w + x] = sum[k];
+        }
 }
 
 /* ---- Radiance .hdr ---------------------------------------------------------------------- */

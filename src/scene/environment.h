@@ -16,8 +16,8 @@
 #include "image.h"
 #include "scene.h"
 
-/* Whether the scene brings light of its own: a punctual light, or an emissive material
- * brighter than 1 (core glTF's emissive range is a glow, not a light source). */
+/* Whether the scene brings light of its own: a punctual light, an image-based light
+ * (scene.environment), or an emissive material brighter than 1 (core glTF's emissive range is a glow, not a light source). */
 bool env_scene_has_light(const scene *sc);
 
 /* The studio environment: a lat-long map (R, G, B) of a soft grey room, brighter above, a
@@ -29,6 +29,15 @@ void environment_studio_key(GnLight *out);
 
 /* Reads a Radiance RGBE (.hdr) file into R, G, B float planes (stb_image). */
 bool environment_read_hdr(image *out, const char *path);
+
+/* A cube map as a lat-long map of out_width x out_width/2 (R, G, B): the radiance from
+ * direction d is the cube's at q^-1 d, q = rotation (x, y, z, w), the cube turned by q.
+ * faces: +X, -X, +Y, -Y, +Z, -Z, each size x size RGB floats, rows top to bottom, each the
+ * picture seen from the cube's centre looking along its axis in glTF's right-handed frame
+ * (+Y up in the side faces; -Z up in +Y's, +Z up in -Y's): Vulkan's cube map faces mirrored
+ * left to right, as EXT_lights_image_based stores them. Each lat-long texel averages 2x2
+ * bilinear lookups. */
+void environment_from_cube(image *out, int out_width, const float *const faces[6], int size, const float rotation[4]);
 
 /* Mean radiance over the sphere of a lat-long map (solid-angle weighted). */
 void environment_mean(const image *map, float out[3]);

@@ -84,6 +84,14 @@ struct MaterialDraft {
 };
 
 /* One load. */
+/* An EXT_lights_image_based light as the JSON check read it (gltf_environment.cpp). */
+struct Ibl {
+    std::string name;
+    float intensity = 1, rotation[4] = {0, 0, 0, 1};
+    int size = 0, mips = 0;
+    int faces[6] = {-1, -1, -1, -1, -1, -1}; /* the images of mip 0 */
+};
+
 struct Ctx {
     const char *path;
     tinygltf::Model m;
@@ -105,6 +113,9 @@ struct Ctx {
     std::string base_dir;                    /* the folder as tinygltf joins URIs to it */
     std::vector<std::string> access_errors;  /* files the confined loader refused */
     std::vector<MaterialDraft> materials;    /* per glTF material, read with the document */
+    std::map<int, int> image_channels;       /* decoded image -> its channels in the file */
+    std::vector<Ibl> ibls;                   /* EXT_lights_image_based lights, read with the document */
+    std::vector<int> scene_ibl;              /* per glTF scene: the index of its light, or -1 */
 };
 
 /* ---- scene_gltf.cpp: the load, its settings and its messages ------------------------------- */
@@ -180,6 +191,14 @@ bool select_variant(Ctx &c);
  * its anisotropy texture's or 0; -1 when it needs none. */
 int material_tangent_set(const Ctx &c, uint32_t material);
 void load_images_and_textures(Ctx &c, scene *out);
+
+/* ---- gltf_environment.cpp: the file's image-based light (EXT_lights_image_based) ---------- */
+struct Doc;
+/* Checks root extensions.EXT_lights_image_based and each scene's reference into c.ibls, c.scene_ibl. */
+void check_ibl(Doc &d);
+/* Bakes the drawn scene's image-based light into out->environment (after
+ * load_images_and_textures: its faces are out->images); false on a bad face. */
+bool bake_environment(Ctx &c, scene *out);
 void load_materials(Ctx &c, scene *out);
 
 } // namespace gltf

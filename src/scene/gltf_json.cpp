@@ -288,6 +288,7 @@ bool check_document(Ctx &c, const uint8_t *json, size_t n, bool glb)
         return true;
     Doc doc(c, root, glb);
     doc.check();
+    check_ibl(doc);
     return !c.failed;
 }
 

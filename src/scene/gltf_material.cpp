@@ -85,6 +85,10 @@ const Extension EXTENSIONS[] = {
      nullptr},
     {"EXT_mesh_gpu_instancing", SCENE_UNSUPPORTED, "the instances are not drawn, only the node's own mesh", false,
      nullptr},
+    {"EXT_lights_image_based", SCENE_PARTLY,
+     "the scene's cube map (its sharpest level) lights it as the environment unless --env; the prefiltered levels "
+     "and irradiance coefficients, made for rasterizers, are not needed by the path tracer",
+     false, nullptr},
     {"KHR_xmp_json_ld", SCENE_UNSUPPORTED, "metadata: nothing in it is rendered", false, nullptr},
     {"KHR_xmp", SCENE_UNSUPPORTED, "metadata (KHR_xmp_json_ld's draft): nothing in it is rendered", false, nullptr},
 };
@@ -152,6 +156,7 @@ std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned c
     auto seen = c.decoded.find(key);
     if (seen != c.decoded.end()) {
         c.image_alias[idx] = seen->second;
+        c.image_channels[idx] = c.image_channels[seen->second];
         return "";
     }
     int w = 0, h = 0, comp = 0;
@@ -168,6 +173,7 @@ std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned c
     }
     c.texels += uint64_t(w) * uint64_t(h);
     c.decoded[key] = idx;
+    c.image_channels[idx] = comp;
     std::string err, warn_text;
     if (!tinygltf::LoadImageData(img, idx, &err, &warn_text, 0, 0, bytes, int(size), nullptr))
         return err.empty() ? "cannot decode" : err;

@@ -28,6 +28,7 @@ void scene_destroy(scene *s)
     free(s->images);
     free(s->textures);
     free(s->cameras);
+    image_destroy(&s->environment);
     memset(s, 0, sizeof *s);
 }
 

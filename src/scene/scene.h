@@ -12,6 +12,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "image.h"
 #include "shared.h"
 
 typedef struct scene_camera {
@@ -99,6 +100,9 @@ typedef struct scene {
 
     float bounds_min[3], bounds_max[3]; /* of all triangles; min > max when empty */
     float ambient[3];           /* global ambient light of the Phong model (default 0) */
+    image environment;          /* the file's image-based light (EXT_lights_image_based) as a
+                                   lat-long map; num_channels 0 without one */
+    char environment_what[96];  /* how it was made, for messages ("light 0 'Studio', 6 faces of 256x256") */
     bool vertex_colors;         /* some mesh has COLOR_0 (GnVertex.color; 1 elsewhere) */
 } scene;
 

@@ -279,6 +279,8 @@ bool load(scene *out, const char *path, int scene_index)
     if (!c.limit_error.empty()) /* images in buffer views are decoded only now */
         return fail(c, "%s", c.limit_error.c_str());
     load_materials(c, out);
+    if (!bake_environment(c, out))
+        return false;
     bake_cameras(c, cams, out);
     list_extensions(c, out);
     bake_lights(c, lights, out);
