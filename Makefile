@@ -110,7 +110,7 @@ FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
 	echo 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n) { return 0; }' | \
 	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
 
-.PHONY: all deps test-deps run test check-layers unit regress bench clean install shaders docs-images \
+.PHONY: device-check all deps test-deps run test check-layers unit regress bench clean install shaders docs-images \
 	fuzz fuzz-deps fuzz-targets fuzz-run fuzz-partials test-farm bench-peer denoiser denoiser-if-possible \
 	bench-denoise
 all: $(GONIO) build/gonio
@@ -226,6 +226,11 @@ unit: $(UNIT)
 
 bench: all
 	@tests/bench.sh $(GONIO)
+
+# On a machine with a real Vulkan GPU: a short regression subset on it and its benchmarks,
+# in one call (tests/device/run.sh; DEVICE=N picks the device).
+device-check:
+	@tests/device/run.sh
 
 # gonio beside Mitsuba 3 on scenes it did not shape (tests/peer, docs/performance.md):
 # Mitsuba, Dr.Jit and a libLLVM for it come from PyPI into build/peer/venv (tests/peer/env.sh);
