@@ -156,6 +156,11 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
 #define GN_MAT_UNLIT 2u
 #define GN_MAT_MASK 4u    /* glTF alphaMode MASK: cut away where alpha < alpha_cutoff */
 #define GN_MAT_BLEND 8u   /* glTF alphaMode BLEND: stochastic transparency, opacity alpha */
+/* KHR_materials_pbrSpecularGlossiness, read into the metallic-roughness fields (metallic 0,
+ * F0 the specular colour at ior 0, the base colour the diffuse one): at a point, roughness =
+ * 1 - glossiness and the base colour times 1 - max(specular colour), after the textures
+ * (glsl/lib/material.glsl: material_eval) */
+#define GN_MAT_SPEC_GLOSS 16u
 
 /* GnFrame.flags */
 #define GN_FRAME_AOV 1u       /* write normal/albedo/depth sums */
