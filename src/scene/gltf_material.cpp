@@ -143,6 +143,8 @@ bool check_extensions(Ctx &c)
     for (const auto &e : c.m.extensionsRequired)
         if (!supported(find_extension(e)))
             fail(c, "requires unsupported extension %s%s", e.c_str(), why_not(find_extension(e)).c_str());
+    if (c.failed) /* refused: the refusal only, no "(ignored)" for the same names in extensionsUsed */
+        return false;
     std::vector<std::string> warned; /* one warning each, however often the file lists it */
     for (const auto &e : c.m.extensionsUsed)
         if (!supported(find_extension(e)) && std::find(warned.begin(), warned.end(), e) == warned.end()) {
