@@ -37,6 +37,8 @@ GnFeatures material_features(const GnMaterial *m)
         f |= GN_FEAT_UNLIT;
     if (m->flags & (GN_MAT_MASK | GN_MAT_BLEND))
         f |= GN_FEAT_ALPHA;
+    if (!(m->flags & GN_MAT_DOUBLE_SIDED))
+        f |= GN_FEAT_CULL;
     if (luminance(&m->emissive.x) > 0)
         f |= GN_FEAT_EMISSIVE;
     if (m->brdf == BRDF_GLTF) {
