@@ -6,7 +6,7 @@
 // compiles to its own lean kernel.
 #extension GL_GOOGLE_include_directive : require
 
-// Specialised on GN_FEAT_ALPHA only (src/render/render.c: kernel_features): the rest is always on.
+// Specialised on GN_FEAT_ALPHA and GN_FEAT_CULL only (src/render/render.c: kernel_features): the rest is always on.
 #define GN_HAS(f) (((FEATURES & (f).x) | (FEATURES_HI & (f).y)) != 0u)
 #include "shared.h"
 layout(constant_id = GN_SPEC_FEATURES) const uint FEATURES = 0xffffffffu;    // GN_FEAT_* bits 0-31
@@ -65,7 +65,7 @@ void main()
     camera_ray(vec2(px) + jitter, o, d, tnear);
     rng_pixel = pixel;
     rng_sample = push.sample_index;
-    Hit h = trace_visible(o, d, tnear, 1e30, false, frame.traversal_budget, DIM_ALPHA);
+    Hit h = trace_visible(o, d, tnear, 1e30, false, true, frame.traversal_budget, DIM_ALPHA);
 
     vec3 color = vec3(0.0);
     vec3 normal = vec3(0.0), albedo = vec3(0.0);

@@ -74,7 +74,7 @@ bool suspended; // this lane's walk stopped unfinished: the path waits for the n
 void trace_begin(float tmin, float tmax)
 {
     walk_start(tmax);
-    if (GN_HAS(GN_FEAT_ALPHA)) {
+    if (GN_HAS(GN_FEAT_ALPHA) || GN_HAS(GN_FEAT_CULL)) {
         tr_lo = tmin;
         tr_max = tmax;
         tr_k = 0u;
@@ -82,22 +82,22 @@ void trace_begin(float tmin, float tmax)
 }
 
 // Goes on with the ray of trace_begin where `on`; the same hit as trace_visible(o, d, tmin, tmax, any_hit,
-// dim) once the walk is over, whatever number of calls that took.
-Hit trace_resume(bool on, vec3 o, vec3 d, float tmin, bool any_hit, uint dim)
+// cull, dim) once the walk is over, whatever number of calls that took.
+Hit trace_resume(bool on, vec3 o, vec3 d, float tmin, bool any_hit, bool cull, uint dim)
 {
-    // (without surfaces cut away tr_lo is the ray's own tmin: one value less kept live)
-    if (!GN_HAS(GN_FEAT_ALPHA))
+    // (without crossings tr_lo is the ray's own tmin: one value less kept live)
+    if (!GN_HAS(GN_FEAT_ALPHA) && !GN_HAS(GN_FEAT_CULL))
         tr_lo = tmin;
     bool alpha = GN_HAS(GN_FEAT_ALPHA) && (frame.flags & GN_FRAME_ALPHA) != 0u;
+    cull = cull && GN_HAS(GN_FEAT_CULL) && (frame.flags & GN_FRAME_CULL) != 0u;
     RayPre r = ray_pre(o, d);
     // (off: the loop conditions see GN_INVALID, so no visit, and the lane's walk is kept)
     uint node = walk.node;
     walk.node = on ? node : GN_INVALID;
-    bvh_walk(r, tr_lo, any_hit && !alpha, 1u << 30);
-    if (GN_HAS(GN_FEAT_ALPHA)) {
-        while (on && alpha && walk.node == GN_INVALID && walk.hit.tri != GN_INVALID &&
-               rng_uniform4(rng_pixel, rng_sample, dim + (tr_k & (DIM_ALPHA_RAY - 1u)), frame.seed).x >=
-                   surface_opacity(walk.hit.tri, walk.hit.u, walk.hit.v)) {
+    bvh_walk(r, tr_lo, any_hit && !alpha && !cull, 1u << 30);
+    if (GN_HAS(GN_FEAT_ALPHA) || GN_HAS(GN_FEAT_CULL)) {
+        while (on && (alpha || cull) && walk.node == GN_INVALID && walk.hit.tri != GN_INVALID &&
+               surface_passed(walk.hit, d, alpha, cull, dim + (tr_k & (DIM_ALPHA_RAY - 1u)))) {
             // (t > the hit's own t: the watertight test gives the same t for the same ray and
             // triangle, so the surface just crossed is not found again)
             uint steps = walk.hit.steps;
@@ -619,7 +619,7 @@ void main()
             if (phase == PHASE_RAY) {
             Hit h;
             if (RETRACE == 0u) {
-                h = trace_resume(true, o, d, tmin, false, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
+                h = trace_resume(true, o, d, tmin, false, depth == 0u, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
             } else {
                 // A lane whose ray leaves the scene ends its path and walks its next path's
                 // camera ray at once, up to RETRACE times, so that fewer lanes idle through
@@ -629,7 +629,7 @@ void main()
                 for (uint k = 0u; again; k++) {
                     if (LOOP_CAP > 0u && k > 0u) // (a pass counts as a vertex: its walk's loop tests and this loop's)
                         loop_left -= min(loop_left, frame.loop_overhead);
-                    h = trace_resume(true, o, d, tmin, false, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
+                    h = trace_resume(true, o, d, tmin, false, depth == 0u, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
                     again = !suspended && h.tri == GN_INVALID && k < RETRACE && taken + 1u < samples;
                     if (again) {
                         path_miss(h, light_only, bsdf_only);
@@ -737,7 +737,7 @@ void main()
             }
             }
             if (phase == PHASE_SHADOW) {
-                Hit sh = trace_resume(true, so, sd, 0.0, true, DIM_ALPHA + DIM_ALPHA_RAY * (2u * depth + 1u));
+                Hit sh = trace_resume(true, so, sd, 0.0, true, false, DIM_ALPHA + DIM_ALPHA_RAY * (2u * depth + 1u));
                 if (suspended)
                     break;
                 if (sh.tri == GN_INVALID)

@@ -314,23 +314,36 @@ uint rng_pixel = 0u, rng_sample = 0u;
 #define DIM_ALPHA 0x40000000u // the alpha tests' dimensions: DIM_ALPHA + 4096 ray + crossing
 #define DIM_ALPHA_RAY 4096u
 
-// bvh_trace within `budget` node visits in all, on the surfaces not cut away: the walk is
-// left as it is (docs/architecture.md) and, when the hit's material is MASK or BLEND and the
-// surface is cut there (a uniform number >= its opacity), the same ray goes on from just past
-// the hit, without a bounce. Shadow rays then need the nearest hit too: a ray that took any
-// hit and went on past it would skip the surfaces before it. Without GN_FEAT_ALPHA (opaque
-// scenes) this is bvh_trace. A ray that runs out of budget on the way says so (truncated).
-Hit trace_visible(vec3 o, vec3 d, float tmin, float tmax, bool any_hit, uint budget, uint dim)
+// Whether the ray of direction d goes on through hit h, its k-th crossing (dim: the random
+// dimension of that crossing): a back face of a single-sided material where `cull` (camera
+// rays), or a surface cut away there (MASK or BLEND, a uniform number >= its opacity) where
+// `alpha`.
+bool surface_passed(Hit h, vec3 d, bool alpha, bool cull, uint dim)
+{
+    if (GN_HAS(GN_FEAT_CULL) && cull && surface_culled(h.tri, d))
+        return true;
+    return GN_HAS(GN_FEAT_ALPHA) && alpha &&
+           rng_uniform4(rng_pixel, rng_sample, dim, frame.seed).x >= surface_opacity(h.tri, h.u, h.v);
+}
+
+// bvh_trace within `budget` node visits in all, on the surfaces the ray sees: the walk is
+// left as it is (docs/architecture.md) and, when the ray passes the surface it hit
+// (surface_passed: a back face of a single-sided material on a camera ray, `cull`; a surface
+// cut away), the same ray goes on from just past the hit, without a bounce. Shadow rays through
+// surfaces cut away need the nearest hit too: a ray that took any hit and went on past it would
+// skip the surfaces before it. Without GN_FEAT_ALPHA and GN_FEAT_CULL this is bvh_trace. A ray
+// that runs out of budget on the way says so (truncated).
+Hit trace_visible(vec3 o, vec3 d, float tmin, float tmax, bool any_hit, bool cull, uint budget, uint dim)
 {
     bool alpha = GN_HAS(GN_FEAT_ALPHA) && (frame.flags & GN_FRAME_ALPHA) != 0u;
+    cull = cull && GN_HAS(GN_FEAT_CULL) && (frame.flags & GN_FRAME_CULL) != 0u;
     RayPre r = ray_pre(o, d);
     walk_start(tmax);
-    bvh_walk(r, tmin, any_hit && !alpha, budget);
-    if (GN_HAS(GN_FEAT_ALPHA)) {
+    bvh_walk(r, tmin, any_hit && !alpha && !cull, budget);
+    if (GN_HAS(GN_FEAT_ALPHA) || GN_HAS(GN_FEAT_CULL)) {
         uint steps = walk.hit.steps, k = 0u;
-        while (alpha && walk.hit.tri != GN_INVALID && !walk.hit.truncated &&
-               rng_uniform4(rng_pixel, rng_sample, dim + (k & (DIM_ALPHA_RAY - 1u)), frame.seed).x >=
-                   surface_opacity(walk.hit.tri, walk.hit.u, walk.hit.v)) {
+        while ((alpha || cull) && walk.hit.tri != GN_INVALID && !walk.hit.truncated &&
+               surface_passed(walk.hit, d, alpha, cull, dim + (k & (DIM_ALPHA_RAY - 1u)))) {
             // (t > the hit's own t: the watertight test gives the same t for the same ray and
             // triangle, so the surface just crossed is not found again)
             float t = walk.hit.t;

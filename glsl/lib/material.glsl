@@ -77,6 +77,14 @@ Shading material_eval(GnMaterial m, MaterialHit h)
     Shading s;
     s.m = m;
     GN_MATERIAL(GN_MAT_NO_PARAM, MATERIAL_APPLY_TEX, GN_MAT_NO_FIELD)
+    // KHR_materials_pbrSpecularGlossiness (src/scene/gltf_material.cpp: read_spec_gloss): the
+    // model's inputs from the textured specular colour (F0) and glossiness: alpha =
+    // (1 - glossiness)^2 and c_diff = diffuse (1 - max(specular))
+    if ((m.flags & GN_MAT_SPEC_GLOSS) != 0u) {
+        vec3 f0 = s.m.specular_color;
+        s.m.roughness = 1.0 - s.m.glossiness;
+        s.m.base_color.rgb *= 1.0 - max(f0.r, max(f0.g, f0.b));
+    }
     s.m.base_color *= h.color;
     s.model_color = m.brdf == BRDF_CONDUCTOR ? m.base_color.rgb : s.m.base_color.rgb;
     s.n = h.n;

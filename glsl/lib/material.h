@@ -59,7 +59,7 @@
     PARAM(normal_scale, float, 15, "", "normalTexture.scale", 1, -GN_INF, GN_INF, CLAMP, GN_FEAT_NONE, NO_BRDF) \
     PARAM(occlusion_strength, float, 16, "", "occlusionTexture.strength", 1, 0, 1, CLAMP, GN_FEAT_NONE, NO_BRDF) \
     PARAM(alpha_cutoff, float, 17, "", "alphaCutoff", 0.5f, 0, GN_INF, CLAMP, GN_FEAT_NONE, NO_BRDF) \
-    /* GN_MAT_*: doubleSided, alphaMode, KHR_materials_unlit */ \
+    /* GN_MAT_*: doubleSided, alphaMode, KHR_materials_unlit, _pbrSpecularGlossiness */ \
     FIELD(flags, uint, 18) \
     /* the BRDF model (brdf_models.h): 0 = glTF */ \
     FIELD(brdf, uint, 19) \
@@ -81,7 +81,9 @@
     FIELD(phong_ambient, vec3, 32) \
     FIELD(phong_shininess, float, 35) \
     FIELD(phong_diffuse, vec3, 36) \
-    FIELD(phong_pad0, float, 39) \
+    /* KHR_materials_pbrSpecularGlossiness: RGB the specular colour (F0), A the glossiness (GN_MAT_SPEC_GLOSS) */ \
+    TEX(tex_spec_gloss, 39, "KHR_materials_pbrSpecularGlossiness", "specularGlossinessTexture", \
+        SRGB, GN_FEAT_TEXTURES, USES2(specular_color, rgb, glossiness, a)) \
     FIELD(phong_specular, vec3, 40) \
     FIELD(phong_pad1, float, 43) \
     FIELD(phong_emission, vec3, 44) \
@@ -129,7 +131,9 @@
     PARAM(anisotropy_rotation, float, 69, "KHR_materials_anisotropy", "anisotropyRotation", \
         0, -GN_INF, GN_INF, ANGLE, GN_FEAT_NONE, BRDF("anisotropy-rotation", 0, -6.2832f, 6.2832f)) \
     TEX(tex_anisotropy, 70, "KHR_materials_anisotropy", "anisotropyTexture", LINEAR, GN_FEAT_ANISO, SPECIAL) \
-    FIELD(anisotropy_pad0, float, 71) \
+    /* KHR_materials_pbrSpecularGlossiness: roughness = 1 - glossiness (GN_MAT_SPEC_GLOSS) */ \
+    PARAM(glossiness, float, 71, "KHR_materials_pbrSpecularGlossiness", "glossinessFactor", \
+        1, 0, 1, CLAMP, GN_FEAT_NONE, NO_BRDF) \
     /* KHR_materials_iridescence: the film's thickness is mix(min, max, texture G), max without one (thicknesses up \
      * to 1 mm and indices up to 100 keep its phase finite) */ \
     PARAM(iridescence, float, 72, "KHR_materials_iridescence", "iridescenceFactor", \

@@ -43,7 +43,7 @@ bool shadowed(vec3 p, vec3 ng, vec3 wi, float dist, uint dim)
         return false;
     // Offset scaled to the position's magnitude, so the ray does not hit its own triangle.
     float eps = 1e-4 * max(1.0, max(abs(p.x), max(abs(p.y), abs(p.z))));
-    Hit h = trace_visible(p + ng * eps, wi, 0.0, dist * (1.0 - 1e-4), true, frame.traversal_budget, dim);
+    Hit h = trace_visible(p + ng * eps, wi, 0.0, dist * (1.0 - 1e-4), true, false, frame.traversal_budget, dim);
     return h.tri != GN_INVALID;
 }
 

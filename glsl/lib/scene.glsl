@@ -273,6 +273,19 @@ float surface_opacity(uint tri, float u, float v)
     return clamp(alpha, 0.0, 1.0);
 }
 
+// ---- single-sided materials (doubleSided false) ---------------------------------------------
+// Whether a ray of direction d that hits triangle tri sees its back (the side its winding does
+// not call front, as surface_at decides) and its material is single-sided: a camera ray goes on
+// through it, as a rasterizer culls it (docs/path-tracing.md, "Single-sided materials").
+bool surface_culled(uint tri, vec3 d)
+{
+    GnPrim pr = prim_at(tri);
+    if ((material_at(pr.material).flags & GN_MAT_DOUBLE_SIDED) != 0u)
+        return false;
+    vec3 a = vertex_at(pr.i0).position, b = vertex_at(pr.i1).position, c = vertex_at(pr.i2).position;
+    return !(dot(cross(b - a, c - a), d) < 0.0);
+}
+
 // The pixel of this invocation. lavapipe runs a work group as SIMD groups of 8 consecutive
 // invocations; laid out as 4x2 blocks of the 8x8 tile (not rows of 8), the rays of a SIMD
 // group start closer together and walk more of the same nodes.

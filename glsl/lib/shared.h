@@ -94,8 +94,9 @@ typedef uint32_t uint;
     X(F, walk.hit.t, true) X(F, walk.hit.u, true) X(F, walk.hit.v, true)                     \
     X(U, walk.hit.tri, true) X(U, walk.hit.steps, true) X(U, walk.node, true)                \
     X(I, walk.sp, true)                                                                      \
-    X(U, tr_k, GN_HAS(GN_FEAT_ALPHA)) X(F, tr_lo, GN_HAS(GN_FEAT_ALPHA))                     \
-    X(F, tr_max, GN_HAS(GN_FEAT_ALPHA))                                                      \
+    X(U, tr_k, GN_HAS(GN_FEAT_ALPHA) || GN_HAS(GN_FEAT_CULL))                                \
+    X(F, tr_lo, GN_HAS(GN_FEAT_ALPHA) || GN_HAS(GN_FEAT_CULL))                               \
+    X(F, tr_max, GN_HAS(GN_FEAT_ALPHA) || GN_HAS(GN_FEAT_CULL))                              \
     X(M, media, GN_HAS(GN_FEAT_VOLUME)) X(U, media_n, GN_HAS(GN_FEAT_VOLUME))                \
     X(U, channel, GN_HAS(GN_FEAT_VOLUME)) X(V, seg_from, GN_HAS(GN_FEAT_VOLUME))
 #define GN_PS_WORDS_U 1u
@@ -156,6 +157,11 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
 #define GN_MAT_UNLIT 2u
 #define GN_MAT_MASK 4u    /* glTF alphaMode MASK: cut away where alpha < alpha_cutoff */
 #define GN_MAT_BLEND 8u   /* glTF alphaMode BLEND: stochastic transparency, opacity alpha */
+/* KHR_materials_pbrSpecularGlossiness, read into the metallic-roughness fields (metallic 0,
+ * F0 the specular colour at ior 0, the base colour the diffuse one): at a point, roughness =
+ * 1 - glossiness and the base colour times 1 - max(specular colour), after the textures
+ * (glsl/lib/material.glsl: material_eval) */
+#define GN_MAT_SPEC_GLOSS 16u
 
 /* GnFrame.flags */
 #define GN_FRAME_AOV 1u       /* write normal/albedo/depth sums */
@@ -166,6 +172,7 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
 #define GN_FRAME_VERTEX_COLOR 32u /* the scene has vertex colours (GnVertex.color) */
 #define GN_FRAME_ALPHA 64u     /* the scene has MASK or BLEND materials (surfaces cut away) */
 #define GN_FRAME_VARIANCE 128u /* path: write the squares' sums (GN_BIND_SQUARES; else a dummy) */
+#define GN_FRAME_CULL 256u     /* the scene has single-sided materials (camera rays pass their backs) */
 
 /* GnEmitter.prim: a triangle (GnPrim index), a punctual light (this bit | GnLight index),
  * or the environment (GN_INVALID). */
@@ -224,6 +231,8 @@ typedef uint64_t GnFeatures;
 #define GN_FEAT_LAYERS GN_FEAT(29)    /* KHR_materials_clearcoat, _sheen, _iridescence, _diffuse_transmission (brdf_material.glsl: bsdf_layers) */
 #define GN_FEAT_VOLUME GN_FEAT(30)    /* KHR_materials_volume media, _dispersion */
 #define GN_FEAT_ANISO GN_FEAT(31)     /* KHR_materials_anisotropy */
+#define GN_FEAT_CULL GN_FEAT(32)      /* single-sided materials (doubleSided false): camera rays pass their
+                                       * back faces (glsl/lib/bvh.glsl: trace_visible) */
 /* (GN_FEAT_LOBES, every lobe a BRDF model can build: brdf_models.h, from its table) */
 #define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
 

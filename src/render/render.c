@@ -253,7 +253,8 @@ bool frame_setup(renderer *r, const render_settings *s, const int region[4], GnF
     frame->flags = (s->aov & RENDER_AOV_GPU ? GN_FRAME_AOV : 0u) | (!s->no_shadows ? GN_FRAME_SHADOWS : 0u) |
                    (s->aov & RENDER_AOV_VARIANCE ? GN_FRAME_VARIANCE : 0u) |
                    (r->sc->vertex_colors ? GN_FRAME_VERTEX_COLOR : 0u) |
-                   (r->material_features & GN_FEAT_ALPHA ? GN_FRAME_ALPHA : 0u);
+                   (r->material_features & GN_FEAT_ALPHA ? GN_FRAME_ALPHA : 0u) |
+                   (r->material_features & GN_FEAT_CULL ? GN_FRAME_CULL : 0u);
     frame->env_color = (vec3){s->env[0], s->env[1], s->env[2]};
     frame->env_cos = (float)cos(s->env_rotation * M_PI / 180);
     frame->env_sin = (float)-sin(s->env_rotation * M_PI / 180);

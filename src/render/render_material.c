@@ -37,6 +37,8 @@ GnFeatures material_features(const GnMaterial *m)
         f |= GN_FEAT_UNLIT;
     if (m->flags & (GN_MAT_MASK | GN_MAT_BLEND))
         f |= GN_FEAT_ALPHA;
+    if (!(m->flags & GN_MAT_DOUBLE_SIDED))
+        f |= GN_FEAT_CULL;
     if (luminance(&m->emissive.x) > 0)
         f |= GN_FEAT_EMISSIVE;
     if (m->brdf == BRDF_GLTF) {
@@ -46,6 +48,9 @@ GnFeatures material_features(const GnMaterial *m)
         bool mr = m->tex_mr != GN_INVALID;
         float metal_hi = lobes_clamp01(m->metallic), metal_lo = mr ? 0 : metal_hi;
         float rough_hi = lobes_clamp01(m->roughness), rough_lo = mr ? 0 : rough_hi;
+        /* KHR_materials_pbrSpecularGlossiness: roughness 1 - glossiness x the texture's A */
+        if ((m->flags & GN_MAT_SPEC_GLOSS) && m->tex_spec_gloss != GN_INVALID)
+            rough_hi = 1;
         float t = lobes_clamp01(m->transmission); /* (its texture: down to 0, where the glass is none) */
         bool smooth = lobes_smooth(lobes_gltf_alpha(rough_lo)), rough = !lobes_smooth(lobes_gltf_alpha(rough_hi));
         bool glass = lobes_gltf_glass(metal_lo, t) > 0;
@@ -112,6 +117,9 @@ static void apply_setting(GnMaterial *m, const brdf_setting *st)
     m->brdf_params = st->m.brdf_params;
     m->brdf = st->model->id;
     copy_params((float *)m, st->v, st->model);
+    /* a specular-glossiness material's roughness is 1 - glossiness at a point (material_eval) */
+    if (m->flags & GN_MAT_SPEC_GLOSS)
+        m->glossiness = 1 - m->roughness;
 }
 
 /* A setting of `model` that starts from m: its colour is the material's base colour (but a

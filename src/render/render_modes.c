@@ -14,7 +14,7 @@ const render_mode_info render_modes[GN_MODE_COUNT] = {GN_MODES(MODE_ENTRY)};
 
 static const render_kernel kernels[] = {
     [GN_KERNEL_PATH] = {"path", spv_path, sizeof spv_path, GN_FEAT_ALL, true},
-    [GN_KERNEL_LOCAL] = {"local", spv_local, sizeof spv_local, GN_FEAT_ALPHA | GN_FEAT_TEX_TRANSFORM | GN_FEAT_UV1,
+    [GN_KERNEL_LOCAL] = {"local", spv_local, sizeof spv_local, GN_FEAT_ALPHA | GN_FEAT_CULL | GN_FEAT_TEX_TRANSFORM | GN_FEAT_UV1,
                          false},
 };
 

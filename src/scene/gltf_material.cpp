@@ -51,6 +51,41 @@ void read_volume(Doc &, const Json &, const std::string &, MaterialDraft &m) { m
 
 void read_unlit(Doc &, const Json &, const std::string &, MaterialDraft &m) { m.g.flags |= GN_MAT_UNLIT; }
 
+/* A factor and a textureInfo of an extension object that are no rows of the table (they fill
+ * the core's): the rows' reader, its checks and messages. */
+bool read_param(Doc &d, const Json &o, std::string p, const std::string &what, const char *json, int n, float *out,
+                double lo, double hi, int rule);
+void read_texture(Doc &d, const Json &o, std::string p, const std::string &what, const char *json, TextureRef &t);
+
+/* The specular-glossiness model read into the metallic-roughness record, as the extension
+ * defines its inputs: c_diff = diffuse (1 - max(specular)), F0 = specular, alpha =
+ * (1 - glossiness)^2. The record: base colour the diffuse colour (diffuseFactor x
+ * diffuseTexture), metallic 0, the dielectric's F0 = min(((ior-1)/(ior+1))^2 specular_color,
+ * 1) specular with ior 0 and specular 1, so F0 = specular_color = specularFactor x the sRGB RGB
+ * of specularGlossinessTexture and F90 = 1 (KHR_materials_specular's own conversion of this
+ * model), and glossiness = glossinessFactor x its A (the table's rows). The two rules that are
+ * no product of texels, roughness = 1 - glossiness and c_diff, are GN_MAT_SPEC_GLOSS's
+ * (material_eval at a point; roughness here from the factor). The file's metallic-roughness
+ * values and KHR_materials_specular's and _ior's are its fallback for viewers without the
+ * extension: replaced. */
+void read_spec_gloss(Doc &d, const Json &e, const std::string &p, MaterialDraft &m)
+{
+    float diffuse[4] = {1, 1, 1, 1}, specular[3] = {1, 1, 1};
+    read_param(d, e, p, m.what, "diffuseFactor", 4, diffuse, 0, 1, GN_MAT_RULE_CLAMP);
+    read_param(d, e, p, m.what, "specularFactor", 3, specular, 0, 1, GN_MAT_RULE_CLAMP);
+    m.g.flags |= GN_MAT_SPEC_GLOSS;
+    m.g.base_color = vec4{diffuse[0], diffuse[1], diffuse[2], diffuse[3]};
+    m.g.specular_color = vec3{specular[0], specular[1], specular[2]};
+    m.g.specular = 1;
+    m.g.ior = 0;
+    m.g.metallic = 0;
+    m.g.roughness = 1 - m.g.glossiness;
+    for (size_t slot : {GN_MAT_WORD(tex_base), GN_MAT_WORD(tex_mr), GN_MAT_WORD(tex_specular),
+                          GN_MAT_WORD(tex_specular_color)})
+        m.tex[slot] = TextureRef();
+    read_texture(d, e, p, m.what, "diffuseTexture", m.tex[GN_MAT_WORD(tex_base)]);
+}
+
 const Extension EXTENSIONS[] = {
     {"KHR_materials_emissive_strength", SCENE_SUPPORTED, "emissiveStrength scales emissiveFactor", true,
      read_emissive_strength},
@@ -69,6 +104,10 @@ const Extension EXTENSIONS[] = {
     {"KHR_materials_iridescence", SCENE_SUPPORTED, "a thin film over the base's Fresnel factor", true, nullptr},
     {"KHR_materials_diffuse_transmission", SCENE_SUPPORTED, "a Lambert lobe through the surface", true, nullptr},
     {"KHR_materials_unlit", SCENE_SUPPORTED, "the base colour is the radiance", true, read_unlit},
+    {"KHR_materials_pbrSpecularGlossiness", SCENE_SUPPORTED,
+     "read as metallic-roughness: the diffuse colour times 1 - max(specular) the base colour, specular the F0, "
+     "roughness 1 - glossiness",
+     true, read_spec_gloss},
     {"KHR_texture_transform", SCENE_SUPPORTED, "offset, rotation, scale and texCoord of every texture slot", false,
      nullptr},
     {"KHR_materials_variants", SCENE_SUPPORTED, "the variant that --variant names", false, nullptr},
@@ -77,8 +116,6 @@ const Extension EXTENSIONS[] = {
     {"KHR_mesh_quantization", SCENE_SUPPORTED, "integer vertex attributes", false, nullptr},
     {"KHR_draco_mesh_compression", SCENE_SUPPORTED, "decoded by Draco", false, nullptr},
     {"EXT_meshopt_compression", SCENE_SUPPORTED, "decoded by meshoptimizer", false, nullptr},
-    {"KHR_materials_pbrSpecularGlossiness", SCENE_UNSUPPORTED,
-     "the specular-glossiness workflow is not read: the materials' metallic-roughness values are", false, nullptr},
     {"KHR_texture_basisu", SCENE_UNSUPPORTED, "KTX2 images are not decoded: a texture's PNG or JPEG source is", false,
      nullptr},
     {"EXT_texture_webp", SCENE_UNSUPPORTED, "WebP images are not decoded: a texture's PNG or JPEG source is", false,
@@ -110,6 +147,8 @@ bool check_extensions(Ctx &c)
     for (const auto &e : c.m.extensionsRequired)
         if (!supported(find_extension(e)))
             fail(c, "requires unsupported extension %s%s", e.c_str(), why_not(find_extension(e)).c_str());
+    if (c.failed) /* refused: the refusal only, no "(ignored)" for the same names in extensionsUsed */
+        return false;
     std::vector<std::string> warned; /* one warning each, however often the file lists it */
     for (const auto &e : c.m.extensionsUsed)
         if (!supported(find_extension(e)) && std::find(warned.begin(), warned.end(), e) == warned.end()) {

@@ -159,9 +159,15 @@ void scene_phong_from_pbr(GnMaterial *m)
     const float base[3] = {m->base_color.x, m->base_color.y, m->base_color.z};
     const float tint[3] = {m->specular_color.x, m->specular_color.y, m->specular_color.z};
     float diffuse[3], specular[3];
+    /* the dielectric's F0 factor: 0.04 at glTF's ior 1.5, 1 at KHR_materials_ior's 0 (as
+     * KHR_materials_pbrSpecularGlossiness is read); the specular-glossiness diffuse colour
+     * is times 1 - max(F0) (GN_MAT_SPEC_GLOSS) */
+    float r = (m->ior - 1) / (m->ior + 1), f0 = r * r, kd = 1;
+    if (m->flags & GN_MAT_SPEC_GLOSS)
+        kd = 1 - fmaxf(tint[0], fmaxf(tint[1], tint[2]));
     for (int k = 0; k < 3; k++) {
-        diffuse[k] = base[k] * (1 - m->metallic) * (1 - m->transmission);
-        specular[k] = mixf(0.04f * tint[k] * m->specular, base[k], m->metallic);
+        diffuse[k] = kd * base[k] * (1 - m->metallic) * (1 - m->transmission);
+        specular[k] = mixf(fminf(f0 * tint[k], 1) * m->specular, base[k], m->metallic);
     }
     m->phong_diffuse = (vec3){diffuse[0], diffuse[1], diffuse[2]};
     m->phong_ambient = m->phong_diffuse;

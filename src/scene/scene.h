@@ -193,9 +193,10 @@ void scene_material_default(GnMaterial *m);
 
 /* Classic (OpenGL 1.x) Phong parameters from the metallic-roughness ones:
  *   diffuse   = base_color.rgb * (1 - metallic) * (1 - transmission)
- *   specular  = mix(0.04 * specular_color * specular, base_color.rgb, metallic)
- *               (the glTF dielectric F0 of 0.04, tinted by KHR_materials_specular; metals
- *               reflect their base colour)
+ *               (and * (1 - max(specular_color)) for GN_MAT_SPEC_GLOSS, specular-glossiness)
+ *   specular  = mix(min(F0 * specular_color, 1) * specular, base_color.rgb, metallic)
+ *               (the dielectric F0 = ((ior - 1) / (ior + 1))^2, 0.04 at glTF's 1.5, tinted by
+ *               KHR_materials_specular; metals reflect their base colour)
  *   shininess = clamp(2 / alpha^2 - 2, 1, 10000), alpha = roughness^2 (the Blinn-Phong
  *               exponent matching a Beckmann lobe of roughness alpha, Walter et al. 2007)
  *   ambient   = diffuse (OpenGL's convention that ambient tracks the diffuse colour; the

@@ -285,3 +285,116 @@ TEST(material, texture_slots_as_specified)
     }
     rmdir(dir);
 }
+
+/* ---- KHR_materials_pbrSpecularGlossiness against its specification ----------------------- */
+
+/* Spec-gloss materials read by the loader and evaluated by material_eval at both texels give
+ * the inputs the extension defines, computed here from its text: c_diff = diffuse.rgb (1 -
+ * max(specular)), F0 = specular, alpha = (1 - glossiness)^2, with diffuse = diffuseFactor x
+ * diffuseTexture (sRGB RGB, linear A the coverage) and specular, glossiness = specularFactor,
+ * glossinessFactor x specularGlossinessTexture (sRGB RGB, linear A). The metallic-roughness
+ * record must say the same through glTF's and KHR_materials_specular's formulas: the base
+ * colour is the diffuse weight, metallic 0, the dielectric's F0 = min(((ior-1)/(ior+1))^2
+ * specular_color, 1) specular, F90 = specular, alpha = roughness^2. Material 1 has only
+ * factors; material 2 also a metallic-roughness fallback and KHR_materials_specular values,
+ * which the extension's values replace. */
+TEST(material, spec_gloss_as_specified)
+{
+    static const struct {
+        float diffuse[4], specular[3], gloss;
+        bool textured;
+    } sg[] = {{{0.9f, 0.8f, 0.7f, 0.6f}, {0.5f, 0.6f, 0.4f}, 0.8f, true},
+              {{0.5f, 0.4f, 0.3f, 1}, {0.2f, 0.1f, 0.05f}, 0.3f, false},
+              {{0.6f, 0.6f, 0.6f, 1}, {0.04f, 0.04f, 0.04f}, 0.5f, false}};
+    static const float tri[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    char dir[] = "/tmp/gonio_specgloss_test_XXXXXX", file[4200], json[8192];
+    size_t len = 0;
+    FILE *f;
+    if (!mkdtemp(dir)) {
+        CHECKF(0, "no temporary folder");
+        return;
+    }
+    snprintf(file, sizeof file, "%s/tri.bin", dir);
+    CHECK((f = fopen(file, "wb")) && fwrite(tri, sizeof tri, 1, f) == 1 && !fclose(f));
+    snprintf(file, sizeof file, "%s/tex.png", dir);
+    CHECK(image_write_png(file, &texels[0][0], 2, 1));
+#define OUT(...) (len += (size_t)snprintf(json + len, sizeof json - len, __VA_ARGS__))
+    OUT("{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_materials_pbrSpecularGlossiness\","
+        "\"KHR_materials_specular\"],\"extensionsRequired\":[\"KHR_materials_pbrSpecularGlossiness\"],"
+        "\"buffers\":[{\"uri\":\"tri.bin\",\"byteLength\":36}],\"bufferViews\":[{\"buffer\":0,\"byteLength\":36}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"min\":[0,0,0],"
+        "\"max\":[1,1,0]}],\"images\":[{\"uri\":\"tex.png\"}],\"samplers\":[{\"magFilter\":9728,\"minFilter\":9728}],"
+        "\"textures\":[{\"source\":0,\"sampler\":0}],\"meshes\":[{\"primitives\":[");
+    for (int i = 0; i < 3; i++)
+        OUT("%s{\"attributes\":{\"POSITION\":0},\"material\":%d}", i ? "," : "", i);
+    OUT("]}],\"nodes\":[{\"mesh\":0}],\"materials\":[");
+    for (int i = 0; i < 3; i++) {
+        OUT("%s{", i ? "," : "");
+        if (i == 2)
+            OUT("\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.1,0.2,0.3,1],\"metallicFactor\":1,"
+                "\"roughnessFactor\":0.2,\"metallicRoughnessTexture\":{\"index\":0}},");
+        OUT("\"extensions\":{");
+        if (i == 2)
+            OUT("\"KHR_materials_specular\":{\"specularFactor\":0.5,\"specularColorFactor\":[0.2,0.4,0.6]},");
+        OUT("\"KHR_materials_pbrSpecularGlossiness\":{\"diffuseFactor\":[%.9g,%.9g,%.9g,%.9g],"
+            "\"specularFactor\":[%.9g,%.9g,%.9g],\"glossinessFactor\":%.9g",
+            sg[i].diffuse[0], sg[i].diffuse[1], sg[i].diffuse[2], sg[i].diffuse[3], sg[i].specular[0], sg[i].specular[1],
+            sg[i].specular[2], sg[i].gloss);
+        if (sg[i].textured)
+            OUT(",\"diffuseTexture\":{\"index\":0},\"specularGlossinessTexture\":{\"index\":0}");
+        OUT("}}}");
+    }
+    OUT("]}");
+#undef OUT
+    snprintf(file, sizeof file, "%s/scene.gltf", dir);
+    CHECK(len < sizeof json && (f = fopen(file, "w")) && fputs(json, f) >= 0 && !fclose(f));
+    scene sc;
+    bool loaded = scene_load(&sc, file);
+    CHECKF(loaded, "%s does not load", file);
+    if (loaded && sc.num_materials == 3) {
+        material_query q[6];
+        material_result r[6];
+        memset(q, 0, sizeof q);
+        for (int i = 0; i < 6; i++)
+            q[i] = (material_query){{i % 2 ? 0.75f : 0.25f, 0.5f, 0, 0}, (uint32_t)(i / 2), 0, 0, 0};
+        if (run_materials(sc.materials, sc.num_materials, &sc, q, 6, MATERIAL_TEST_EVAL, r)) {
+            for (int i = 0; i < 6; i++) {
+                const GnMaterial *m = &r[i].m;
+                int k = i / 2;
+                const uint8_t *t = texels[i % 2];
+                double diffuse[4], specular[3], gloss = sg[k].gloss * (sg[k].textured ? t[3] / 255.0 : 1);
+                for (int c = 0; c < 4; c++)
+                    diffuse[c] = sg[k].diffuse[c] * (sg[k].textured ? c < 3 ? srgb_to_linear(t[c] / 255.0) : t[3] / 255.0 : 1);
+                for (int c = 0; c < 3; c++)
+                    specular[c] = sg[k].specular[c] * (sg[k].textured ? srgb_to_linear(t[c] / 255.0) : 1);
+                double smax = fmax(specular[0], fmax(specular[1], specular[2]));
+                double want_alpha = (1 - gloss) * (1 - gloss), alpha = (double)m->roughness * m->roughness;
+                double r0 = (m->ior - 1.0) / (m->ior + 1.0), f0_scale = r0 * r0;
+                const float *base = &m->base_color.x, *tint = &m->specular_color.x;
+                for (int c = 0; c < 3; c++) {
+                    double want = diffuse[c] * (1 - smax), got = base[c];
+                    CHECKF(fabs(got - want) <= 1e-6, "material %d texel %d: c_diff[%d] %.7g, not %.7g", k, i % 2, c, got, want);
+                    double f0 = fmin(f0_scale * tint[c], 1) * m->specular;
+                    CHECKF(fabs(f0 - specular[c]) <= 1e-6, "material %d texel %d: F0[%d] %.7g, not %.7g", k, i % 2, c, f0,
+                           specular[c]);
+                }
+                CHECKF(fabs(m->base_color.w - diffuse[3]) <= 1e-6, "material %d texel %d: alpha %.7g, not %.7g", k, i % 2,
+                       m->base_color.w, diffuse[3]);
+                CHECKF(m->metallic == 0 && m->specular == 1, "material %d: metallic %g, F90 %g: not a dielectric of F90 1",
+                       k, m->metallic, m->specular);
+                CHECKF(fabs(alpha - want_alpha) <= 1e-6, "material %d texel %d: alpha %.7g, not %.7g", k, i % 2, alpha,
+                       want_alpha);
+            }
+        }
+        CHECK(sc.materials[2].tex_mr == GN_INVALID && sc.materials[2].tex_base == GN_INVALID);
+    } else if (loaded) {
+        CHECKF(0, "%u materials, not 3", sc.num_materials);
+    }
+    if (loaded)
+        scene_destroy(&sc);
+    for (int k = 0; k < 3; k++) {
+        snprintf(file, sizeof file, "%s/%s", dir, (const char *[]){"tri.bin", "tex.png", "scene.gltf"}[k]);
+        remove(file);
+    }
+    rmdir(dir);
+}

@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# sides.sh: single-sided materials (glTF doubleSided false, the default). Camera rays do not
+# see the back of a single-sided triangle; other rays see both sides (docs/path-tracing.md,
+# "Single-sided materials"). A red quad turned away from the camera, in front of a green
+# double-sided one, shows the green one (path and the local modes); double-sided, or turned
+# toward the camera, it hides it. A large single-sided quad behind the camera, its back to the
+# scene, still shades the green quad from the environment (the bounce rays see its back): the
+# quad renders darker than without it.
+. "$(dirname "$0")/../lib.sh"
+G=$GONIO
+command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
+
+# gen.py OUT.gltf QUAD...: QUAD = z,half-size,r,g,b,double(0|1),facing(+1|-1): a square at
+# depth z facing +z or -z by its winding and normals; an orthographic camera at z = 5 looks
+# down -z.
+cat >"$tmp/gen.py" <<'PY'
+import base64, json, struct, sys
+out, quads = sys.argv[1], [list(map(float, q.split(","))) for q in sys.argv[2:]]
+blob, views, accs, meshes, mats, nodes = b"", [], [], [], [], []
+for i, (z, s, r, g, b, double, facing) in enumerate(quads):
+    corners = [(-s, -s), (s, -s), (s, s), (-s, s)]
+    if facing < 0:
+        corners.reverse()
+    pos = [c for x, y in corners for c in (x, y, z)]
+    data = struct.pack("<12f", *pos) + struct.pack("<12f", *[0, 0, facing] * 4) + struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    base = len(blob)
+    blob += data  # (108 bytes: every view stays 4-aligned)
+    for k, (off, n) in enumerate([(0, 48), (48, 48), (96, 12)]):
+        views.append({"buffer": 0, "byteOffset": base + off, "byteLength": n})
+    v = len(views) - 3
+    accs += [{"bufferView": v, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-s, -s, z], "max": [s, s, z]},
+             {"bufferView": v + 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+             {"bufferView": v + 2, "componentType": 5123, "count": 6, "type": "SCALAR"}]
+    meshes.append({"primitives": [{"attributes": {"POSITION": v, "NORMAL": v + 1}, "indices": v + 2, "material": i}]})
+    mats.append({"pbrMetallicRoughness": {"baseColorFactor": [r, g, b, 1], "metallicFactor": 0, "roughnessFactor": 1},
+                 "doubleSided": double > 0})
+    nodes.append({"mesh": i})
+nodes.append({"camera": 0, "translation": [0, 0, 5]})
+doc = {"asset": {"version": "2.0"},
+       "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+       "bufferViews": views, "accessors": accs, "meshes": meshes, "materials": mats,
+       "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 100}}],
+       "nodes": nodes, "scenes": [{"nodes": list(range(len(nodes)))}], "scene": 0}
+json.dump(doc, open(out, "w"))
+PY
+# centre.py IMAGE.exr TOOLDIR: the mean R G B of the 4x4 pixels at the centre
+cat >"$tmp/centre.py" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[2])
+import exrtool
+hdr, ch = exrtool.read(sys.argv[1])
+R, G, B = (ch[c][1] for c in "RGB")
+w = 16; h = len(R) // w
+px = [y * w + x for y in range(h // 2 - 2, h // 2 + 2) for x in range(w // 2 - 2, w // 2 + 2)]
+print(" ".join("%.5f" % (sum(C[i] for i in px) / len(px)) for C in (R, G, B)))
+PY
+T=$(dirname "$0")/../tool
+GREEN=-1,1,0.1,0.8,0.1,1,1
+RED_AWAY=0,0.5,0.8,0.1,0.1,0,-1
+RED_AWAY_DOUBLE=0,0.5,0.8,0.1,0.1,1,-1
+RED_TOWARD=0,0.5,0.8,0.1,0.1,0,1
+python3 "$tmp/gen.py" "$tmp/away.gltf" $GREEN $RED_AWAY &&
+    python3 "$tmp/gen.py" "$tmp/double.gltf" $GREEN $RED_AWAY_DOUBLE &&
+    python3 "$tmp/gen.py" "$tmp/toward.gltf" $GREEN $RED_TOWARD &&
+    python3 "$tmp/gen.py" "$tmp/open.gltf" $GREEN &&
+    python3 "$tmp/gen.py" "$tmp/roof.gltf" $GREEN 6,20,0.5,0.5,0.5,0,1 || fail "scenes"
+
+# colour SCENE MODE: "green" or "red", the colour at the centre
+colour() {
+    "$G" render "$tmp/$1.gltf" --mode $2 --spp 8 --size 16x16 --env 1 --compression none --quiet -o "$tmp/$1-$2.exr" ||
+        return 1
+    python3 "$tmp/centre.py" "$tmp/$1-$2.exr" "$T" | awk '{print ($2 > 2 * $1 ? "green" : $1 > 2 * $2 ? "red" : "neither")}'
+}
+for mode in path albedo phong; do
+    got=$(colour away $mode)
+    [ "$got" = green ] && pass || fail "$mode: a single-sided quad turned away hides what is behind it ($got at the centre)"
+    got=$(colour double $mode)
+    [ "$got" = red ] && pass || fail "$mode: the same quad double-sided is not seen ($got at the centre)"
+    got=$(colour toward $mode)
+    [ "$got" = red ] && pass || fail "$mode: a single-sided quad turned toward the camera is not seen ($got at the centre)"
+done
+# bounce rays see a back face: the roof behind the camera (its back to the scene) shades the
+# green quad from the environment above it
+lum() {
+    "$G" render "$tmp/$1.gltf" --spp 64 --size 16x16 --env 1 --compression none --quiet -o "$tmp/$1.exr" &&
+        python3 "$tmp/centre.py" "$tmp/$1.exr" "$T" | awk '{print 0.2126 * $1 + 0.7152 * $2 + 0.0722 * $3}'
+}
+open=$(lum open) roof=$(lum roof)
+if awk -v o="$open" -v r="$roof" 'BEGIN {exit !(o > 0.2 && r != "" && r > 0 && r < 0.6 * o)}'; then pass; else
+    fail "the back of a single-sided roof does not shade the quad under it (open sky $open, roofed $roof)"
+fi
+finish
