@@ -449,6 +449,7 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
         gpu_buffer_create_storage(g, &r->vcolor, NULL, 16);
     }
     gpu_buffer_create(g, &r->status, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+    gpu_buffer_create_texels(g, &r->instances, NULL, 16);
     free(prims);
     free(image_offset);
     free(texels);
@@ -472,7 +473,7 @@ void renderer_destroy(renderer *r)
     gpu_buffer *bufs[] = {&r->frame, &r->nodes, &r->tris, &r->prims, &r->vertices,
                           &r->materials, &r->lights, &r->texels, &r->textures, &r->emitters,
                           &r->vcolor, &r->status, &r->accum, &r->aov,
-                          &r->squares, &r->env, &r->pstate};
+                          &r->squares, &r->env, &r->pstate, &r->instances};
     if (r->g) {
         for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
             gpu_buffer_destroy(r->g, bufs[i]);
@@ -613,6 +614,7 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
         {GN_BIND_SQUARES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->squares},
         {GN_BIND_ENV, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->env},
         {GN_BIND_PSTATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->pstate},
+        {GN_BIND_INSTANCES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->instances},
     };
     memcpy(b, all, sizeof all);
     return sizeof all / sizeof *all;
@@ -1042,10 +1044,12 @@ const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode
     spec->values[1] = kernel_features(r, mode);
     spec->values[2] = walk_regs(r);
     spec->values[3] = 0; /* the loop cap: only the path kernel's (renderer_pipeline) */
+    spec->values[4] = 0; /* INSTANCES */
     for (uint32_t i = 0; i < 4; i++)
         spec->entries[i] = (VkSpecializationMapEntry){i, i * (uint32_t)sizeof(uint32_t), sizeof(uint32_t)};
+    spec->entries[4] = (VkSpecializationMapEntry){GN_SPEC_INSTANCES, 4 * (uint32_t)sizeof(uint32_t), sizeof(uint32_t)};
     assert(spec->entries[2].constantID == GN_SPEC_WALK_REGS && spec->entries[3].constantID == GN_SPEC_LOOP_CAP);
-    spec->info = (VkSpecializationInfo){4, spec->entries, sizeof spec->values, spec->values};
+    spec->info = (VkSpecializationInfo){5, spec->entries, sizeof spec->values, spec->values};
     return &spec->info;
 }
 

@@ -83,7 +83,7 @@ typedef struct renderer {
     uint32_t num_lights, num_emitters;
     uint32_t num_area_emitters; /* the emitter table's triangles, before its punctual lights */
     gpu_buffer frame, nodes, tris, prims, vertices, materials, lights, texels, textures,
-        emitters, vcolor, status;
+        emitters, vcolor, status, instances;
     gpu_buffer accum, aov;  /* sized for the current image */
     gpu_pipeline pipelines[GN_MODE_COUNT]; /* created on first use */
     gpu_pipeline vertex_pass; /* Gouraud's per-vertex lighting (glsl/kernels/vertex.comp) */
@@ -131,8 +131,8 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
 /* Specialization constants of the render kernels: constant 0 = mode (or a kernel's own
  * variant); constant 1 = the GN_FEAT_* set (the path kernel reads it; others ignore it). */
 typedef struct renderer_spec {
-    uint32_t values[4];
-    VkSpecializationMapEntry entries[4];
+    uint32_t values[5];
+    VkSpecializationMapEntry entries[5];
     VkSpecializationInfo info;
 } renderer_spec;
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec);

@@ -34,7 +34,7 @@ typedef struct inst_scene {
     float lo[3], hi[3];      /* world bounds of the flattened triangles */
 } inst_scene;
 
-static uint64_t inst_rng_next(uint64_t *s)
+static inline uint64_t inst_rng_next(uint64_t *s)
 {
     uint64_t z = (*s += 0x9e3779b97f4a7c15ull);
     z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
@@ -42,10 +42,10 @@ static uint64_t inst_rng_next(uint64_t *s)
     return z ^ (z >> 31);
 }
 
-static double inst_rng_unit(uint64_t *s) { return (double)(inst_rng_next(s) >> 11) * 0x1p-53; }
+static inline double inst_rng_unit(uint64_t *s) { return (double)(inst_rng_next(s) >> 11) * 0x1p-53; }
 
 /* A random rotation (a uniform unit quaternion's matrix). */
-static void inst_rotation(uint64_t *rng, double r[3][3])
+static inline void inst_rotation(uint64_t *rng, double r[3][3])
 {
     double q[4], len = 0;
     for (int k = 0; k < 4; k++) {
@@ -62,7 +62,7 @@ static void inst_rotation(uint64_t *rng, double r[3][3])
 
 /* T R1 S R2 (row-major 3x4): a shear from the non-uniform scale S between two rotations, a
  * mirror when `mirror` (one axis of S negative), translated within +-spread. */
-static void inst_transform(uint64_t *rng, bool mirror, double spread, float out[12])
+static inline void inst_transform(uint64_t *rng, bool mirror, double spread, float out[12])
 {
     double r1[3][3], r2[3][3], s[3], m[3][3];
     inst_rotation(rng, r1);
@@ -85,7 +85,7 @@ static void inst_transform(uint64_t *rng, bool mirror, double spread, float out[
 }
 
 /* world = M p, in double, rounded once */
-static void inst_apply(const float m[12], const float p[3], float out[3])
+static inline void inst_apply(const float m[12], const float p[3], float out[3])
 {
     for (int r = 0; r < 3; r++)
         out[r] = (float)((double)m[4 * r] * p[0] + (double)m[4 * r + 1] * p[1] +
@@ -93,7 +93,7 @@ static void inst_apply(const float m[12], const float p[3], float out[3])
 }
 
 /* The flattened triangles of the current transforms. */
-static void inst_flatten(inst_scene *s)
+static inline void inst_flatten(inst_scene *s)
 {
     uint32_t t = 0;
     for (int k = 0; k < 3; k++)
@@ -117,16 +117,17 @@ static void inst_flatten(inst_scene *s)
 }
 
 /* n instances of three meshes (a soup with slivers and degenerate triangles, a sphere, quads
- * that pair), a quarter of them mirrored, spread over +-spread, and the top tree over them. */
-static bool inst_scene_make(inst_scene *s, uint32_t n, double spread, uint64_t seed)
+ * that pair; small: a few triangles each, for trees shallow enough for the walk's stack in
+ * registers), a quarter of them mirrored, spread over +-spread, and the top tree over them. */
+static inline bool inst_scene_make(inst_scene *s, uint32_t n, double spread, uint64_t seed, bool small)
 {
     const float lo[3] = {-1, -1, -1}, hi[3] = {1, 1, 1}, c[3] = {0.1f, 0, -0.1f};
     uint64_t rng = seed;
     memset(s, 0, sizeof *s);
     s->num_meshes = 3;
-    s->mesh[0] = meshgen_random_triangles(150, seed, lo, hi);
-    s->mesh[1] = meshgen_uv_sphere(c, 0.8f, 16, 8);
-    s->mesh[2] = meshgen_quad_soup(40, seed + 1, lo, hi);
+    s->mesh[0] = meshgen_random_triangles(small ? 12 : 150, seed, lo, hi);
+    s->mesh[1] = small ? meshgen_uv_sphere(c, 0.8f, 4, 3) : meshgen_uv_sphere(c, 0.8f, 16, 8);
+    s->mesh[2] = meshgen_quad_soup(small ? 6 : 40, seed + 1, lo, hi);
     for (uint32_t m = 0; m < s->num_meshes; m++)
         if (!bvh_build(&s->tree[m], s->mesh[m].positions, 3, s->mesh[m].indices, s->mesh[m].num_triangles))
             return false;
@@ -150,7 +151,7 @@ static bool inst_scene_make(inst_scene *s, uint32_t n, double spread, uint64_t s
                          NULL, n, "test instances");
 }
 
-static void inst_scene_destroy(inst_scene *s)
+static inline void inst_scene_destroy(inst_scene *s)
 {
     bvh_top_destroy(&s->top);
     for (uint32_t m = 0; m < s->num_meshes; m++) {
@@ -168,7 +169,7 @@ static void inst_scene_destroy(inst_scene *s)
 }
 
 /* The flattened triangle of a two-level hit (its GPU-array slot and instance). */
-static uint32_t inst_flat_triangle(const inst_scene *s, uint32_t slot, uint32_t inst)
+static inline uint32_t inst_flat_triangle(const inst_scene *s, uint32_t slot, uint32_t inst)
 {
     const GnInstance *g = &s->top.instances[inst];
     return s->first_tri[inst] + s->tree[g->mesh].tri_index[slot - g->prim_base];
@@ -176,7 +177,7 @@ static uint32_t inst_flat_triangle(const inst_scene *s, uint32_t slot, uint32_t 
 
 /* The world point of a two-level hit: the mesh triangle's corners in the walk's order
  * (tri_rotation) at its barycentrics, transformed. */
-static void inst_hit_point(const inst_scene *s, uint32_t slot, uint32_t inst, float u, float v, float out[3])
+static inline void inst_hit_point(const inst_scene *s, uint32_t slot, uint32_t inst, float u, float v, float out[3])
 {
     const GnInstance *g = &s->top.instances[inst];
     const bvh *b = &s->tree[g->mesh];
@@ -194,7 +195,7 @@ static void inst_hit_point(const inst_scene *s, uint32_t slot, uint32_t inst, fl
 
 /* How far inside flattened triangle tri the point o + t d lies: the least distance to an
  * edge's line, in double, negative outside. Within rounding of 0 either answer is right. */
-static double inst_edge_margin(const inst_scene *s, uint32_t tri, const float o[3], const float d[3], double t)
+static inline double inst_edge_margin(const inst_scene *s, uint32_t tri, const float o[3], const float d[3], double t)
 {
     const float *a = s->positions + 9 * (size_t)tri, *b = a + 3, *c = a + 6;
     double p[3], e1[3], e2[3], ep[3], n[3], nn = 0, w[3], len[3] = {0, 0, 0};

@@ -869,7 +869,7 @@ static void check_instance_rays(const inst_scene *s, int num_rays, uint64_t seed
 TEST(bvh, instances)
 {
     inst_scene s;
-    CHECK(inst_scene_make(&s, 60, 4.0, 3));
+    CHECK(inst_scene_make(&s, 60, 4.0, 3, false));
     check_top_structure(&s);
     check_instance_rays(&s, 4000, 5);
     printf("    %u instances of %u meshes: %u triangles placed, %u stored; top tree %u nodes, depth %u, "
@@ -884,11 +884,11 @@ TEST(bvh, instances)
     check_instance_rays(&s, 2000, 6);
     /* a single instance (the top tree is one leaf) and coincident instances (no SAH plane) */
     inst_scene_destroy(&s);
-    CHECK(inst_scene_make(&s, 1, 1.0, 9));
+    CHECK(inst_scene_make(&s, 1, 1.0, 9, false));
     check_top_structure(&s);
     check_instance_rays(&s, 500, 8);
     inst_scene_destroy(&s);
-    CHECK(inst_scene_make(&s, 30, 0.0, 10));
+    CHECK(inst_scene_make(&s, 30, 0.0, 10, false));
     for (uint32_t i = 1; i < s.num_instances; i++)
         memcpy(s.to_world[i], s.to_world[0], sizeof s.to_world[0]);
     inst_flatten(&s);
