@@ -75,6 +75,7 @@ const char *render_mode_help(void)
  * Cornell box): one light per emissive material at the power-weighted centroid. A flat
  * emitter of area A and radiance L has radiant intensity L A cos(theta), a GN_LIGHT_COSINE;
  * one whose normals disagree is treated as isotropic with the same power (pi L A / 4 pi). */
+static void instanced_emission(const scene *sc, uint32_t m, double *area, double c[3], double an[3]);
 static uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap)
 {
     uint32_t n = 0;
@@ -98,6 +99,7 @@ static uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap)
                 an[k] += 0.5 * cr[k];
             }
         }
+        instanced_emission(sc, m, &area, c, an);
         if (area <= 0)
             continue;
         GnLight *l = &out[n++];
@@ -123,6 +125,53 @@ static uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap)
 }
 
 static double luminance(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+/* Does instanced mesh m have a triangle of material `material`? */
+static bool mesh_has_material(const scene_instanced_mesh *m, uint32_t material)
+{
+    for (uint32_t t = 0; t < m->num_triangles; t++)
+        if (m->tri_material[t] == material)
+            return true;
+    return false;
+}
+
+/* emissive_lights' sums over the instances' triangles of material m: area, area-weighted
+ * centroid and area vector (the cross products as the corners are stored, turned by a
+ * mirroring instance, whose front is the other side: GN_INSTANCE_MIRROR). */
+static void instanced_emission(const scene *sc, uint32_t m, double *area, double c[3], double an[3])
+{
+    for (uint32_t j = 0; j < sc->num_instanced_meshes; j++) {
+        const scene_instanced_mesh *im = &sc->instanced_meshes[j];
+        if (!mesh_has_material(im, m))
+            continue;
+        for (uint32_t i = 0; i < sc->num_instances; i++) {
+            const scene_instance *in = &sc->instances[i];
+            const float *w = in->to_world;
+            double det = w[0] * (w[5] * w[10] - w[6] * w[9]) - w[1] * (w[4] * w[10] - w[6] * w[8]) +
+                         w[2] * (w[4] * w[9] - w[5] * w[8]);
+            if (in->mesh != j)
+                continue;
+            for (uint32_t t = 0; t < im->num_triangles; t++) {
+                double cr[3], p[3] = {0, 0, 0};
+                if (im->tri_material[t] != m)
+                    continue;
+                scene_instance_triangle_cross(sc, i, t, cr);
+                double a = 0.5 * sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+                for (int k = 0; k < 3; k++) {
+                    const float *q = &im->vertices[im->indices[3 * t + k]].position.x;
+                    for (int r = 0; r < 3; r++)
+                        p[r] += (w[4 * r] * (double)q[0] + w[4 * r + 1] * (double)q[1] + w[4 * r + 2] * (double)q[2] +
+                                 w[4 * r + 3]) / 3.0;
+                }
+                *area += a;
+                for (int k = 0; k < 3; k++) {
+                    c[k] += a * p[k];
+                    an[k] += (det < 0 ? -0.5 : 0.5) * cr[k];
+                }
+            }
+        }
+    }
+}
 
 /* Squared radius of the scene's bounding sphere (1 when empty): the area through which
  * distant lights (directional, environment) reach the scene. */
@@ -161,7 +210,10 @@ static uint32_t path_samples(const renderer *r)
      * image short enough for a display watchdog. */
     if (!loop_capped(r->g))
         return GN_PATH_SAMPLES / 2;
-    double per_path = 16.0 * (r->tree.sah_cost > 1 ? r->tree.sah_cost : 1) * 3 * 2;
+    double sah = r->geo.world.sah_cost; /* (two levels: the top tree's and the costliest mesh's) */
+    for (uint32_t m = 0; r->geo.two_levels && m < r->geo.num_meshes; m++)
+        sah = fmax(sah, r->geo.top.tree.sah_cost + r->geo.meshes[m].sah_cost);
+    double per_path = 16.0 * (sah > 1 ? sah : 1) * 3 * 2;
     double n = floor(30000.0 / per_path);
     return n < 1 ? 1u : n > GN_PATH_SAMPLES ? GN_PATH_SAMPLES : (uint32_t)n;
 }
@@ -254,14 +306,76 @@ static uint32_t material_features(const GnMaterial *m)
  * triangle (so picking one and then a uniform point has area density lum(L) sides / total),
  * 4 I for a point light, 2 (1 - cos outer) I for a spot, E r^2 for a directional light.
  * renderer_begin adds the environment and normalises. */
+/* With instances, each instance's emissive triangles, their areas in world space (a scale
+ * changes them), and in r->emitter_instance the instance of each; returns the count. */
+static uint32_t instanced_emitters(renderer *r, uint32_t n)
+{
+    const render_geometry *geo = &r->geo;
+    for (uint32_t i = 0; i < geo->top.num_instances; i++) {
+        const GnInstance *in = &geo->top.instances[i];
+        uint32_t first = in->prim_base, slots = geo->meshes[in->mesh].num_slots;
+        for (uint32_t j = first; j < first + slots; j++) {
+            uint32_t mesh;
+            if (render_geometry_triangle(geo, j, &mesh) == GN_INVALID) /* the missing B of a lone triangle */
+                continue;
+            const GnPrim *pr = &geo->prims[j];
+            const GnMaterial *m = &r->sc->materials[pr->material];
+            double lum = luminance(&m->emissive.x), p[3][3];
+            if (lum <= 0 || (m->flags & GN_MAT_UNLIT))
+                continue;
+            const uint32_t v[3] = {pr->i0, pr->i1, pr->i2};
+            for (int k = 0; k < 3; k++) {
+                const float *q = &geo->vertices[v[k]].position.x;
+                for (int c = 0; c < 3; c++) {
+                    const float *w = &in->to_world[c].x;
+                    p[k][c] = w[0] * (double)q[0] + w[1] * (double)q[1] + w[2] * (double)q[2] + w[3];
+                }
+            }
+            double e1[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
+            double e2[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+            double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+            double area = 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+            if (!(area > 0))
+                continue;
+            r->emitter_table[n] = (GnEmitter){j, (float)area, 0, 0};
+            r->emitter_instance[n] = i;
+            r->emitter_weight[n++] = lum * area * (m->flags & GN_MAT_DOUBLE_SIDED ? 2 : 1);
+        }
+    }
+    return n;
+}
+
+/* The light table's triangle entries at most: each instance's emissive triangles (counted
+ * without their areas), or the scene's slots. */
+static uint64_t emitter_room(const renderer *r)
+{
+    if (!r->geo.two_levels)
+        return r->geo.num_slots;
+    uint64_t n = 0;
+    uint32_t *per_mesh = util_calloc(r->geo.num_meshes, sizeof *per_mesh);
+    for (uint32_t m = 0; m < r->geo.num_meshes; m++)
+        for (uint32_t j = 0; j < r->geo.meshes[m].num_slots; j++) {
+            const GnPrim *pr = &r->geo.prims[2 * r->geo.top.pair_base[m] + j];
+            per_mesh[m] += r->geo.meshes[m].tri_index[j] != GN_INVALID &&
+                           luminance(&r->sc->materials[pr->material].emissive.x) > 0;
+        }
+    for (uint32_t i = 0; i < r->geo.top.num_instances; i++)
+        n += per_mesh[r->geo.top.instances[i].mesh];
+    free(per_mesh);
+    return n;
+}
+
 static void build_emitters(renderer *r, const GnPrim *prims)
 {
     const scene *sc = r->sc;
-    uint32_t cap = r->tree.num_slots + sc->num_lights + 1, n = 0;
+    uint32_t cap = (uint32_t)emitter_room(r) + sc->num_lights + 1, n = 0;
     r->emitter_table = util_calloc(cap, sizeof *r->emitter_table);
     r->emitter_weight = util_calloc(cap, sizeof *r->emitter_weight);
-    for (uint32_t i = 0; i < r->tree.num_slots; i++) {
-        if (r->tree.tri_index[i] == GN_INVALID) /* the missing B of a lone triangle */
+    r->emitter_instance = r->geo.two_levels ? util_calloc(cap, sizeof *r->emitter_instance) : NULL;
+    if (r->geo.two_levels)
+        n = instanced_emitters(r, n);
+    for (uint32_t i = 0; i < r->geo.num_slots && !r->geo.two_levels; i++) {
+        if (r->geo.world.tri_index[i] == GN_INVALID) /* the missing B of a lone triangle */
             continue;
         const GnMaterial *m = &sc->materials[prims[i].material];
         const vec3 *p0 = &sc->vertices[prims[i].i0].position, *p1 = &sc->vertices[prims[i].i1].position,
@@ -285,10 +399,13 @@ static void build_emitters(renderer *r, const GnPrim *prims)
                                                                          : scene_radius2(sc);
         if (w <= 0)
             continue;
+        if (r->emitter_instance)
+            r->emitter_instance[n] = GN_INVALID;
         r->emitter_table[n] = (GnEmitter){GN_EMITTER_LIGHT | i, 0, 0, 0};
         r->emitter_weight[n++] = w;
     }
     r->num_emitters = n;
+    r->emitter_cap = cap;
 }
 
 /* Whether `count` texels fit one texel buffer (maxTexelBufferElements); an error naming
@@ -333,14 +450,52 @@ static bool scene_fits(renderer *r)
                    sc->images[largest].height, limit, name);
         return false;
     }
-    /* RGBA32UI texels: 16 bytes each */
-    return texels_fit(r, "the BVH nodes", (uint64_t)r->tree.num_nodes * sizeof(GnBvhNode) / 16) &&
-           texels_fit(r, "the BVH triangles", (uint64_t)r->tree.num_pairs * sizeof(GnTriPair) / 16) &&
-           texels_fit(r, "the triangles' shading data", (uint64_t)r->tree.num_slots) &&
-           texels_fit(r, "the vertices", (uint64_t)sc->num_vertices * sizeof(GnVertex) / 16) &&
+    /* RGBA32UI texels: 16 bytes each (the light table: with instances, twice) */
+    const render_geometry *geo = &r->geo;
+    return texels_fit(r, "the BVH nodes", (uint64_t)geo->num_nodes * sizeof(GnBvhNode) / 16) &&
+           texels_fit(r, "the BVH triangles", (uint64_t)geo->num_pairs * sizeof(GnTriPair) / 16) &&
+           texels_fit(r, "the triangles' shading data", (uint64_t)geo->num_slots) &&
+           texels_fit(r, "the vertices", (uint64_t)geo->num_vertices * sizeof(GnVertex) / 16) &&
            texels_fit(r, "the materials", (uint64_t)sc->num_materials * sizeof(GnMaterial) / 16) &&
            texels_fit(r, "the texture table", (uint64_t)sc->num_textures + 1) &&
-           texels_fit(r, "the light table", (uint64_t)r->tree.num_slots + sc->num_lights + 1);
+           texels_fit(r, "the instances", (uint64_t)geo->top.num_instances * sizeof(GnInstance) / 16) &&
+           texels_fit(r, "the light table", (emitter_room(r) + sc->num_lights + 1) * (geo->two_levels ? 2 : 1));
+}
+
+/* Gouraud's colours with instances: each instance's copy of its mesh's vertices, the
+ * instances one after the other (GnInstance.vcolor_offset: where its copy starts, less its
+ * mesh's first vertex). Sets the offsets; returns the count. */
+static uint64_t gouraud_vertices(renderer *r)
+{
+    uint64_t n = 0;
+    for (uint32_t i = 0; i < r->geo.top.num_instances; i++) {
+        GnInstance *in = &r->geo.top.instances[i];
+        in->vcolor_offset = (uint32_t)n - r->geo.vertex_base[in->mesh]; /* (uint arithmetic) */
+        n += r->geo.mesh_vertices[in->mesh];
+    }
+    return n;
+}
+
+/* The vertex pass's inputs with instances: [2j].w each copy's material (from its mesh's
+ * triangles), [2j + 1].w its instance (glsl/kernels/vertex.comp). */
+static void gouraud_materials(renderer *r, vec4 *vcolor)
+{
+    const render_geometry *geo = &r->geo;
+    for (uint32_t i = 0; i < geo->top.num_instances; i++) {
+        const GnInstance *in = &geo->top.instances[i];
+        uint32_t first = in->prim_base, slots = geo->meshes[in->mesh].num_slots;
+        for (uint32_t j = first; j < first + slots; j++) {
+            uint32_t mesh;
+            if (render_geometry_triangle(geo, j, &mesh) == GN_INVALID)
+                continue;
+            const GnPrim *pr = &geo->prims[j];
+            const uint32_t v[3] = {pr->i0, pr->i1, pr->i2};
+            for (int k = 0; k < 3; k++)
+                memcpy(&vcolor[2 * (size_t)(v[k] + in->vcolor_offset)].w, &pr->material, 4);
+        }
+        for (uint32_t k = 0; k < geo->mesh_vertices[in->mesh]; k++)
+            memcpy(&vcolor[2 * ((size_t)geo->vertex_base[in->mesh] + in->vcolor_offset + k) + 1].w, &i, 4);
+    }
 }
 
 bool renderer_create(renderer *r, gpu *g, const scene *sc)
@@ -355,15 +510,7 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
     memset(r, 0, sizeof *r);
     r->g = g;
     r->sc = sc;
-    if (!bvh_build(&r->tree, &sc->vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc->indices,
-                   sc->num_triangles)) {
-        util_error("%s: no triangles to render", sc->path);
-        r->failed = true;
-        return false;
-    }
-    if (r->tree.num_tris > GN_BVH_FIRST) { /* leaves index their first triangle in 27 bits */
-        util_error("%s: %u triangles, more than the %u a BVH leaf can index", sc->path, sc->num_triangles,
-                   GN_BVH_FIRST);
+    if (!render_geometry_build(&r->geo, sc)) {
         r->failed = true;
         return false;
     }
@@ -385,16 +532,7 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
     r->path_samples = path_samples(r);
     r->path_features = r->material_features;
 
-    /* in BVH order, each triangle's corners in the order the walk's test takes them (a
-     * rotation: the winding stays), so the walk's barycentrics apply as they are */
-    prims = util_calloc(r->tree.num_slots, sizeof *prims);
-    for (uint32_t i = 0; i < r->tree.num_slots; i++) {
-        uint32_t t = r->tree.tri_index[i], k = r->tree.tri_rotation[i];
-        if (t == GN_INVALID)
-            continue;
-        prims[i] = (GnPrim){sc->indices[3 * t + k], sc->indices[3 * t + (k + 1) % 3],
-                            sc->indices[3 * t + (k + 2) % 3], sc->tri_material[t]};
-    }
+    prims = r->geo.prims; /* (render_geometry.c: BVH order, corners in the walk's order) */
 
     image_offset = util_calloc(sc->num_images + 1, sizeof *image_offset);
     total_texels = sheen_prefix(r);
@@ -423,24 +561,38 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
 
     gpu_buffer_create(g, &r->frame, sizeof(GnFrame), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       GPU_MEMORY_HOST);
-    gpu_buffer_create_texels(g, &r->nodes, r->tree.nodes, sizeof(GnBvhNode) * r->tree.num_nodes);
-    gpu_buffer_create_texels(g, &r->tris, r->tree.pairs, sizeof(GnTriPair) * r->tree.num_pairs);
-    gpu_buffer_create_texels(g, &r->prims, prims, sizeof(GnPrim) * r->tree.num_slots);
-    gpu_buffer_create_texels(g, &r->vertices, sc->vertices, sizeof(GnVertex) * sc->num_vertices);
+    gpu_buffer_create_texels(g, &r->nodes, r->geo.nodes, sizeof(GnBvhNode) * r->geo.num_nodes);
+    gpu_buffer_create_texels(g, &r->tris, r->geo.pairs, sizeof(GnTriPair) * r->geo.num_pairs);
+    gpu_buffer_create_texels(g, &r->prims, prims, sizeof(GnPrim) * r->geo.num_slots);
+    gpu_buffer_create_texels(g, &r->vertices, r->geo.vertices, sizeof(GnVertex) * r->geo.num_vertices);
     gpu_buffer_create_texels(g, &r->materials, sc->materials, sizeof(GnMaterial) * sc->num_materials);
     gpu_buffer_create_storage(g, &r->lights, lights, sizeof(GnLight) * r->num_lights);
     gpu_buffer_create_texels_as(g, &r->texels, texels, sizeof(uint32_t) * (total_texels + 1),
                                 VK_FORMAT_R32_UINT);
     gpu_buffer_create_texels(g, &r->textures, tex, sizeof(GnTexture) * (sc->num_textures + 1));
     build_emitters(r, prims);
-    gpu_buffer_create_texels(g, &r->emitters, NULL, sizeof(GnEmitter) * (r->num_emitters + 1));
+    if (r->geo.two_levels) { /* the table, then each entry's instance (GnFrame.emitter_instances) */
+        uvec4 *inst = util_calloc(r->emitter_cap, sizeof *inst);
+        for (uint32_t i = 0; i < r->num_emitters; i++)
+            inst[i].x = r->emitter_instance[i];
+        gpu_buffer_create_texels(g, &r->emitters, NULL, 2 * sizeof(GnEmitter) * r->emitter_cap);
+        gpu_buffer_upload(g, &r->emitters, inst, sizeof *inst * r->emitter_cap, sizeof(GnEmitter) * r->emitter_cap);
+        free(inst);
+    } else {
+        gpu_buffer_create_texels(g, &r->emitters, NULL, sizeof(GnEmitter) * (r->num_emitters + 1));
+    }
     gpu_buffer_create_texels_as(g, &r->env, NULL, 16, VK_FORMAT_R32_UINT);
     /* Gouraud colours, two sides per vertex; the material of each vertex rides in the bits of
-     * the first one's w for glsl/kernels/vertex.comp (a vertex belongs to one glTF primitive). */
-    r->vcolor_bytes = 2 * sizeof *vcolor * (VkDeviceSize)sc->num_vertices;
+     * the first one's w for glsl/kernels/vertex.comp (a vertex belongs to one glTF primitive).
+     * With instances each has its own copy of its mesh's vertices (gouraud_vertices). */
+    uint64_t nv = r->geo.two_levels ? gouraud_vertices(r) : sc->num_vertices;
+    r->vcolor_bytes = 2 * sizeof *vcolor * (VkDeviceSize)nv;
+    r->vcolor_count = (uint32_t)(nv < UINT32_MAX ? nv : UINT32_MAX);
     if (r->vcolor_bytes <= gpu_storage_limit(g, NULL)) {
-        vcolor = util_calloc(2 * (size_t)sc->num_vertices, sizeof *vcolor);
-        for (uint32_t t = 0; t < sc->num_triangles; t++)
+        vcolor = util_calloc(2 * (size_t)nv, sizeof *vcolor);
+        if (r->geo.two_levels)
+            gouraud_materials(r, vcolor);
+        for (uint32_t t = 0; t < sc->num_triangles && !r->geo.two_levels; t++)
             for (int k = 0; k < 3; k++)
                 memcpy(&vcolor[2 * (size_t)sc->indices[3 * t + k]].w, &sc->tri_material[t], 4);
         gpu_buffer_create_storage(g, &r->vcolor, vcolor, r->vcolor_bytes);
@@ -449,8 +601,10 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
         gpu_buffer_create_storage(g, &r->vcolor, NULL, 16);
     }
     gpu_buffer_create(g, &r->status, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
-    gpu_buffer_create_texels(g, &r->instances, NULL, 16);
-    free(prims);
+    if (r->geo.two_levels)
+        gpu_buffer_create_texels(g, &r->instances, r->geo.top.instances, sizeof(GnInstance) * r->geo.top.num_instances);
+    else
+        gpu_buffer_create_texels(g, &r->instances, NULL, 16);
     free(image_offset);
     free(texels);
     free(tex);
@@ -481,10 +635,11 @@ void renderer_destroy(renderer *r)
             gpu_pipeline_destroy(r->g, &r->pipelines[i]);
         gpu_pipeline_destroy(r->g, &r->vertex_pass);
     }
-    bvh_destroy(&r->tree);
+    render_geometry_destroy(&r->geo);
     free_bands(r);
     free(r->emitter_table);
     free(r->emitter_weight);
+    free(r->emitter_instance);
     memset(r, 0, sizeof *r);
 }
 
@@ -627,7 +782,7 @@ static bool light_vertices(renderer *r)
 {
     VkCommandBuffer cmd;
     const uint32_t max_x = gpu_max_groups(r->g, 0), max_y = gpu_max_groups(r->g, 1);
-    const uint32_t groups = (r->sc->num_vertices + 63) / 64;
+    const uint32_t groups = (r->vcolor_count + 63) / 64;
     const uint32_t groups_x = groups < max_x ? groups : max_x;
     const uint32_t groups_y = groups_x ? (groups + groups_x - 1) / groups_x : 0;
     const char *limit;
@@ -635,21 +790,24 @@ static bool light_vertices(renderer *r)
     if (r->vcolor_bytes > bytes) {
         util_error("%s: --mode gouraud: the %u vertices' colours need %llu bytes, more than one "
                    "storage buffer may hold on this device (%s: %llu)", r->sc->path,
-                   r->sc->num_vertices, (unsigned long long)r->vcolor_bytes, limit,
+                   r->vcolor_count, (unsigned long long)r->vcolor_bytes, limit,
                    (unsigned long long)bytes);
         return false;
     }
     if (groups_y > max_y) {
         util_error("%s: --mode gouraud: the %u vertices need %u work groups, more than this device "
-                   "dispatches (maxComputeWorkGroupCount %u x %u)", r->sc->path, r->sc->num_vertices,
+                   "dispatches (maxComputeWorkGroupCount %u x %u)", r->sc->path, r->vcolor_count,
                    groups, max_x, max_y);
         return false;
     }
     if (!r->vertex_pass.pipeline) {
         gpu_binding b[GN_BIND_COUNT];
+        const uint32_t instances = r->geo.two_levels;
+        const VkSpecializationMapEntry entry = {GN_SPEC_INSTANCES, 0, sizeof instances};
+        const VkSpecializationInfo spec = {1, &entry, sizeof instances, &instances};
         gpu_pipeline_desc pd = {
             .name = "vertex", .code = spv_vertex, .code_size = sizeof spv_vertex,
-            .local_size = {64, 1, 1}, .push_size = sizeof(GnPush),
+            .local_size = {64, 1, 1}, .push_size = sizeof(GnPush), .specialization = &spec,
             .bindings = b, .num_bindings = renderer_bindings(r, b)};
         gpu_pipeline_create(r->g, &r->vertex_pass, &pd);
     }
@@ -812,6 +970,7 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
         gpu_buffer_upload(r->g, &r->emitters, r->emitter_table, sizeof(GnEmitter) * n, 0);
     frame->num_emitters = n;
     frame->emitter_power = (float)total;
+    frame->emitter_instances = r->geo.two_levels ? r->emitter_cap : 0;
     frame->env_select = env > 0 ? (float)(env / total) : 0;
     frame->flags |= s->strategy;
     r->path_features = r->material_features | (s->aov & RENDER_AOV_GPU ? GN_FEAT_AOV : 0u) |
@@ -888,10 +1047,11 @@ static VkDeviceSize squares_pixel_bytes(uint32_t aov) { return aov & RENDER_AOV_
 static uint32_t walk_regs(const renderer *r);
 static uint32_t state_stride(const renderer *r, uint32_t mode)
 {
-    uint32_t regs = walk_regs(r), stack = r->tree.depth + 2 < GN_WALK_STACK ? r->tree.depth + 2 : GN_WALK_STACK;
+    uint32_t regs = walk_regs(r), stack = r->geo.depth + 2 < GN_WALK_STACK ? r->geo.depth + 2 : GN_WALK_STACK;
     if (mode != GN_MODE_PATH || !loop_capped(r->g))
         return 0;
-    return GN_PATH_STATE_WORDS + (regs ? regs : stack);
+    /* (with instances, two words more: the hit's instance and the walk's, path_save) */
+    return GN_PATH_STATE_WORDS + (regs ? regs : stack) + (r->geo.two_levels ? 2 : 0);
 }
 
 static int band_rows(const renderer *r, int w, int h, uint32_t aov, uint32_t mode, char *why,
@@ -1035,7 +1195,7 @@ static uint32_t walk_regs(const renderer *r)
     const char *array = getenv("GONIO_WALK_ARRAY");
     if (array && !strcmp(array, "1"))
         return 0;
-    return r->tree.depth <= GN_WALK_REGS_MAX ? r->tree.depth : 0;
+    return r->geo.depth <= GN_WALK_REGS_MAX ? r->geo.depth : 0;
 }
 
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec)
@@ -1044,7 +1204,7 @@ const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode
     spec->values[1] = kernel_features(r, mode);
     spec->values[2] = walk_regs(r);
     spec->values[3] = 0; /* the loop cap: only the path kernel's (renderer_pipeline) */
-    spec->values[4] = 0; /* INSTANCES */
+    spec->values[4] = r->geo.two_levels; /* INSTANCES */
     for (uint32_t i = 0; i < 4; i++)
         spec->entries[i] = (VkSpecializationMapEntry){i, i * (uint32_t)sizeof(uint32_t), sizeof(uint32_t)};
     spec->entries[4] = (VkSpecializationMapEntry){GN_SPEC_INSTANCES, 4 * (uint32_t)sizeof(uint32_t), sizeof(uint32_t)};

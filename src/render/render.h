@@ -13,6 +13,7 @@
 
 #include "bvh.h"
 #include "gpu.h"
+#include "render_geometry.h"
 #include "image.h"
 #include "scene.h"
 
@@ -79,7 +80,7 @@ typedef struct render_stats {
 typedef struct renderer {
     gpu *g;
     const scene *sc;
-    bvh tree;
+    render_geometry geo;    /* the trees and the arrays the walk reads */
     uint32_t num_lights, num_emitters;
     uint32_t num_area_emitters; /* the emitter table's triangles, before its punctual lights */
     gpu_buffer frame, nodes, tris, prims, vertices, materials, lights, texels, textures,
@@ -93,6 +94,9 @@ typedef struct renderer {
     uint32_t state_stride;    /* words a pixel of pstate (frame_setup), 0 without a cap */
     GnEmitter *emitter_table; /* path: lights, then a slot for the environment */
     double *emitter_weight;   /* their selection weights (flux / pi) */
+    uint32_t *emitter_instance; /* with instances: each entry's instance (GN_INVALID: a light) */
+    uint32_t emitter_cap;     /* the table's room (with instances, where the instances follow) */
+    uint32_t vcolor_count;    /* Gouraud's vertices: the scene's, or every instance's copies */
     const image *env_source;  /* the map now in `env` */
     double env_weight;        /* its selection weight */
     int width, height;

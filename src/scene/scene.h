@@ -35,6 +35,29 @@ typedef struct scene_texture {
     float transform[6]; /* the rows of KHR_texture_transform's matrix (GnTexture.row0, row1) */
 } scene_texture;
 
+/* A mesh drawn by instances (scene_instance): one the scene places several times (several
+ * nodes use it, or EXT_mesh_gpu_instancing), kept once in its own object space instead of
+ * once per placement in world space; the renderer builds its BVH once (src/render/
+ * render_geometry.c). Its vertices are as the loader makes a baked mesh's before the
+ * transform (normals normalised, tangents generated where a material needs them). */
+typedef struct scene_instanced_mesh {
+    uint32_t num_vertices;
+    GnVertex *vertices;         /* object space */
+    uint32_t num_triangles;
+    uint32_t *indices;          /* 3 per triangle, into vertices */
+    uint32_t *tri_material;     /* per triangle, into materials */
+    uint32_t gltf_mesh;         /* the glTF mesh */
+    float bounds_min[3], bounds_max[3]; /* of its triangles, object space */
+} scene_instanced_mesh;
+
+/* One placement of an instanced mesh: its object-to-world transform, 3x4 row-major (as
+ * GnInstance.to_world), invertible (the loader bakes a mesh a singular transform flattens). */
+typedef struct scene_instance {
+    float to_world[12];
+    uint32_t mesh;              /* into instanced_meshes */
+    uint32_t node;              /* the glTF node that places it */
+} scene_instance;
+
 /* Raw `extras: {"gonio": {...}}` of a material, kept for the integrators that read them. */
 typedef struct scene_material_extras {
     char brdf[32];              /* "" when absent */
@@ -54,6 +77,13 @@ typedef struct scene {
     uint32_t num_triangles;
     uint32_t *indices;          /* 3 per triangle, into vertices */
     uint32_t *tri_material;     /* per triangle, into materials */
+
+    /* Meshes placed by instances, besides the triangles above (which are the meshes used
+     * once, baked into world space); none in most scenes. */
+    uint32_t num_instanced_meshes;
+    scene_instanced_mesh *instanced_meshes;
+    uint32_t num_instances;
+    scene_instance *instances;
 
     uint32_t num_meshes;        /* glTF mesh primitives drawn (after instancing by nodes) */
     uint32_t num_gltf_meshes;   /* glTF meshes in the file */
@@ -100,11 +130,16 @@ typedef struct scene {
 bool scene_load(scene *out, const char *path);
 
 /* Limits of a decoded scene, checked before anything is allocated, with the numbers in the
- * error: triangles and vertices after instancing (about 300 bytes each through loading and
- * the BVH build: 5 GB at the limit), and texels of all images together (RGBA8; images with
+ * error: triangles and vertices stored (the meshes used once after baking them into world
+ * space, and each instanced mesh once; about 300 bytes each through loading and the BVH
+ * build: 5 GB at the limit), and texels of all images together (RGBA8; images with
  * the same bytes are decoded once and count once). */
 #define SCENE_MAX_TRIANGLES (1u << 24)
 #define SCENE_MAX_TEXELS (1ull << 28)
+/* Instances (each about 300 bytes through loading and the top tree's build: 300 MB at the
+ * limit). The triangles they place do not count against SCENE_MAX_TRIANGLES: a mesh placed
+ * by instances is kept once. */
+#define SCENE_MAX_INSTANCES (1u << 20)
 /* The same for the glTF scene of index scene_index (-1: the file's default scene, else its
  * first, else every node without a parent); an index the file lacks is an error. */
 bool scene_load_scene(scene *out, const char *path, int scene_index);
@@ -144,14 +179,40 @@ void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *
  * its normal. */
 void scene_triangle_cross(const scene *s, uint32_t t, double out[3]);
 
-/* Recomputes bounds_min/bounds_max from the triangles. */
+/* Recomputes bounds_min/bounds_max from the triangles, and from the instances: the box of
+ * each one's mesh bounds transformed (so a turned instance may widen them a little). Also
+ * each instanced mesh's own bounds. */
 void scene_compute_bounds(scene *s);
+
+/* The triangles the scene places: the world's and, for each instance, its mesh's. */
+uint64_t scene_placed_triangles(const scene *s);
+/* Instance i's world box (its mesh's bounds transformed, as scene_compute_bounds takes them). */
+void scene_instance_box(const scene *s, uint32_t i, float lo[3], float hi[3]);
+/* Triangle t of instanced mesh m, transformed by instance i's transform: its corners' cross
+ * product, in double (twice its world area along its normal; for a mirroring instance the
+ * direction is that of the corners as stored, see GN_INSTANCE_MIRROR). */
+void scene_instance_triangle_cross(const scene *s, uint32_t i, uint32_t t, double out[3]);
+/* Are a and b the same geometry and materials, up to the instances' transforms (the same
+ * triangles, vertices, materials, instanced meshes and instances of the same meshes and
+ * nodes)? Then one's BVHs serve the other with only the top tree rebuilt (an animated frame;
+ * lights and cameras may differ). */
+bool scene_same_geometry(const scene *a, const scene *b);
 
 /* Removes every triangle with a corner whose position is not finite or has a coordinate
  * beyond 1e15 in magnitude (such values overflow ray-box tests in float), compacting indices
- * and tri_material, and zeroes those vertices (no triangle refers to them any more). Returns
- * the number of triangles removed; prints nothing (the caller warns once). */
+ * and tri_material, and zeroes those vertices (no triangle refers to them any more); the same
+ * in the instanced meshes, and removes instances whose world box goes beyond 1e15 and the
+ * meshes left without triangles or instances. Returns the number of triangles removed (an
+ * instance's, once); prints nothing (the caller warns once). */
 uint32_t scene_drop_invalid_triangles(scene *s);
+/* The same on one set of arrays. */
+uint32_t scene_drop_invalid_triangles_of(GnVertex *vertices, uint32_t num_vertices, uint32_t *indices,
+                                         uint32_t *tri_material, uint32_t *num_triangles);
+/* (src/scene/scene_instances.c: the instanced meshes' and instances' parts of
+ * scene_drop_invalid_triangles, scene_compute_bounds and scene_destroy) */
+uint32_t scene_drop_invalid_instanced(scene *s);
+void scene_bound_instances(scene *s);
+void scene_free_instances(scene *s);
 
 /* Default material, as glTF 2.0 specifies for primitives without one (white, metallic 1,
  * roughness 1), with the Phong parameters derived as scene_phong_from_pbr does. */

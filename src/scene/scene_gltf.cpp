@@ -55,7 +55,8 @@ const char *const SUPPORTED_EXTENSIONS[] = {
     "KHR_texture_transform",      "KHR_mesh_quantization",           "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",    "KHR_materials_variants",          "KHR_materials_volume",
     "KHR_materials_dispersion",   "KHR_materials_clearcoat",         "KHR_materials_sheen",
-    "KHR_materials_anisotropy",   "KHR_materials_iridescence",       "KHR_materials_diffuse_transmission"};
+    "KHR_materials_anisotropy",   "KHR_materials_iridescence",       "KHR_materials_diffuse_transmission",
+    "EXT_mesh_gpu_instancing"};
 
 using Json = nlohmann::json;
 
@@ -75,6 +76,7 @@ struct Prim {                 /* one triangle primitive of a glTF mesh, in the m
 struct Instance {
     int node, mesh;
     Mat world;
+    bool gpu = false; /* one of EXT_mesh_gpu_instancing's instances */
 };
 
 struct Ctx {
@@ -817,6 +819,24 @@ bool animate(Ctx &c, std::vector<Pose> &pose)
     return true;
 }
 
+/* T R S as a matrix: translation t, rotation by the unit quaternion q (x, y, z, w), scale s. */
+Mat trs_matrix(const double t[3], const double q[4], const double s[3])
+{
+    double x = q[0], y = q[1], z = q[2], w = q[3];
+    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w),
+                         2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
+                         2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)};
+    Mat out{};
+    for (int col = 0; col < 3; col++)
+        for (int row = 0; row < 3; row++)
+            out[size_t(col * 4 + row)] = r[col * 3 + row] * s[col];
+    out[12] = t[0];
+    out[13] = t[1];
+    out[14] = t[2];
+    out[15] = 1;
+    return out;
+}
+
 bool node_local(Ctx &c, int i, Mat &out, const Pose *pose = nullptr)
 {
     const auto &n = c.m.nodes[size_t(i)];
@@ -845,18 +865,8 @@ bool node_local(Ctx &c, int i, Mat &out, const Pose *pose = nullptr)
         return fail(c, "%s: rotation is not a unit quaternion (length %g)", what.c_str(), len);
     if (std::fabs(len - 1) > 1e-3)
         warn(c, "%s: rotation is not a unit quaternion (length %g, normalised)", what.c_str(), len);
-    double x = q[0] / len, y = q[1] / len, z = q[2] / len, w = q[3] / len;
-    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w),
-                         2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
-                         2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)};
-    out = Mat{};
-    for (int col = 0; col < 3; col++)
-        for (int row = 0; row < 3; row++)
-            out[size_t(col * 4 + row)] = r[col * 3 + row] * s[col];
-    out[12] = t[0];
-    out[13] = t[1];
-    out[14] = t[2];
-    out[15] = 1;
+    const double u[4] = {q[0] / len, q[1] / len, q[2] / len, q[3] / len};
+    out = trs_matrix(t, u, s);
     return true;
 }
 
@@ -1452,6 +1462,56 @@ bool load_meshes(Ctx &c)
 }
 
 /* Walks the default scene (scene 0 without one; every parentless node without scenes). */
+/* EXT_mesh_gpu_instancing (checked with the document: Doc::check_gpu_instancing): node i's mesh
+ * placed once by each instance's T R S (absent attributes: none, the identity, one), after
+ * the node's own world transform. The node's mesh is drawn only by them. */
+bool gpu_instances(Ctx &c, int i, const Mat &world, std::vector<Instance> &inst)
+{
+    const auto &n = c.m.nodes[size_t(i)];
+    const tinygltf::Value &attrs = n.extensions.at("EXT_mesh_gpu_instancing").Get("attributes");
+    const char *names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+    std::vector<double> v[3];
+    size_t count = 0;
+    for (int k = 0; k < 3; k++)
+        if (attrs.Has(names[k])) {
+            int a = attrs.Get(names[k]).GetNumberAsInt();
+            count = c.m.accessors[size_t(a)].count;
+            if (inst.size() + count > SCENE_MAX_INSTANCES)
+                return fail(c, "%s: EXT_mesh_gpu_instancing places %zu instances, more than the %u a scene may have",
+                            label("node", i, n.name).c_str(), inst.size() + count, SCENE_MAX_INSTANCES);
+            v[k] = read_accessor(c, a);
+        }
+    std::string what = label("node", i, n.name) + ": EXT_mesh_gpu_instancing";
+    size_t not_unit = 0;
+    for (size_t j = 0; j < count; j++) {
+        double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s3[3] = {1, 1, 1};
+        if (!v[0].empty())
+            std::copy(&v[0][3 * j], &v[0][3 * j + 3], t);
+        if (!v[1].empty())
+            std::copy(&v[1][4 * j], &v[1][4 * j + 4], q);
+        if (!v[2].empty())
+            std::copy(&v[2][3 * j], &v[2][3 * j + 3], s3);
+        double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        for (int k = 0; k < 3; k++)
+            if (!std::isfinite(t[k]) || !std::isfinite(s3[k]))
+                return fail(c, "%s: instance %zu: its translation or scale is not finite", what.c_str(), j);
+        if (!(len > 1e-6) || !std::isfinite(len))
+            return fail(c, "%s: instance %zu: rotation is not a unit quaternion (length %g)", what.c_str(), j, len);
+        not_unit += std::fabs(len - 1) > 1e-3; /* (a quantized one is unit to its rounding: 1e-3 > 2^-8) */
+        for (double &x : q)
+            x /= len;
+        Mat w = mat_mul(world, trs_matrix(t, q, s3));
+        if (!mat_finite(w))
+            return fail(c, "%s: instance %zu: world transform is not finite", what.c_str(), j);
+        Instance it{i, n.mesh, w};
+        it.gpu = true;
+        inst.push_back(it);
+    }
+    if (not_unit)
+        warn(c, "%s: %zu instance rotation(s) are not unit quaternions (normalised)", what.c_str(), not_unit);
+    return true;
+}
+
 bool collect_instances(Ctx &c, std::vector<Instance> &inst, std::vector<Instance> &cams, std::vector<Instance> &lights)
 {
     const auto &m = c.m;
@@ -1491,8 +1551,12 @@ bool collect_instances(Ctx &c, std::vector<Instance> &inst, std::vector<Instance
                 warn(c, "skins are not supported (skinned meshes drawn in their bind pose)");
                 c.warned_skin = true;
             }
-            if (n.mesh >= 0)
+            if (n.mesh >= 0 && n.extensions.count("EXT_mesh_gpu_instancing")) {
+                if (!gpu_instances(c, it.node, it.world, inst))
+                    return false;
+            } else if (n.mesh >= 0) {
                 inst.push_back({it.node, n.mesh, it.world});
+            }
             if (n.camera >= 0 && c.camera_ok[size_t(n.camera)])
                 cams.push_back(it);
             int light = node_light(n);
@@ -1522,92 +1586,194 @@ bool normalize3(double v[3])
     return true;
 }
 
+/* Mesh `mesh`'s primitives transformed by w into vertices, indices and tri_material, from
+ * vertex vbase (the indices' base too) and triangle tbase. */
+void bake_mesh(Ctx &c, int mesh, const Mat &w, GnVertex *vertices, uint32_t *indices, uint32_t *tri_material,
+               uint32_t vbase, uint32_t tbase, bool &colors)
+{
+    /* Normals go through the cofactor matrix, det * inverse transpose: defined even for a
+     * singular matrix; multiplied by sign(det) so mirroring keeps them pointing out. */
+    double a[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++)
+            a[r][k] = w[size_t(k * 4 + r)];
+    double cof[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++) {
+            int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+            cof[r][k] = a[r1][k1] * a[r2][k2] - a[r1][k2] * a[r2][k1];
+        }
+    double det = a[0][0] * cof[0][0] + a[0][1] * cof[0][1] + a[0][2] * cof[0][2];
+    double sgn = det < 0 ? -1 : 1;
+    uint32_t default_material = uint32_t(c.m.materials.size());
+    for (const Prim &p : c.meshes[size_t(mesh)]) {
+        size_t pv = p.pos.size() / 3;
+        for (size_t v = 0; v < pv; v++) {
+            GnVertex &o = vertices[vbase + v];
+            const float *q = &p.pos[v * 3];
+            double x[3];
+            for (int r = 0; r < 3; r++)
+                x[r] = a[r][0] * q[0] + a[r][1] * q[1] + a[r][2] * q[2] + w[size_t(12 + r)];
+            o.position = vec3{float(x[0]), float(x[1]), float(x[2])};
+            const float *nn = &p.nrm[v * 3];
+            double n[3];
+            for (int r = 0; r < 3; r++)
+                n[r] = sgn * (cof[r][0] * nn[0] + cof[r][1] * nn[1] + cof[r][2] * nn[2]);
+            if (!normalize3(n)) { /* a scale that flattens the mesh to a line: never hit */
+                n[0] = n[1] = 0;
+                n[2] = 1;
+            }
+            o.normal = vec3{float(n[0]), float(n[1]), float(n[2])};
+            if (!p.uv.empty()) {
+                o.u = p.uv[v * 2];
+                o.v = p.uv[v * 2 + 1];
+            }
+            if (!p.uv1.empty()) {
+                o.u1 = p.uv1[v * 2];
+                o.v1 = p.uv1[v * 2 + 1];
+            }
+            if (!p.col.empty()) {
+                o.color = vec4{p.col[v * 4], p.col[v * 4 + 1], p.col[v * 4 + 2], p.col[v * 4 + 3]};
+                colors = true;
+            } else {
+                o.color = vec4{1, 1, 1, 1};
+            }
+            if (!p.tan.empty()) {
+                const double t0[3] = {p.tan[v * 4], p.tan[v * 4 + 1], p.tan[v * 4 + 2]};
+                double t[3];
+                xform_dir(w, t0, t);
+                if (normalize3(t))
+                    o.tangent = vec4{float(t[0]), float(t[1]), float(t[2]), float(p.tan[v * 4 + 3] * sgn)};
+            }
+        }
+        size_t pt = p.idx.size() / 3;
+        for (size_t t = 0; t < pt; t++) {
+            uint32_t *dst = &indices[(tbase + t) * 3];
+            dst[0] = vbase + p.idx[t * 3];
+            dst[1] = vbase + p.idx[t * 3 + (det < 0 ? 2 : 1)]; /* mirrored: keep front faces */
+            dst[2] = vbase + p.idx[t * 3 + (det < 0 ? 1 : 2)];
+            tri_material[tbase + t] = p.material == GN_INVALID ? default_material : p.material;
+        }
+        vbase += uint32_t(pv);
+        tbase += uint32_t(pt);
+    }
+}
+
+/* w as an instance's transform (scene_instance: 3x4, row-major, float); false when that is
+ * not invertible in float (a scale that flattens the mesh: then it is baked, which the
+ * cofactor normals allow). */
+bool instance_transform(const Mat &w, float out[12])
+{
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 4; k++)
+            out[4 * r + k] = float(w[size_t(k * 4 + r)]);
+    double a[3][3], c[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++)
+            a[r][k] = out[4 * r + k];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++) {
+            int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+            c[r][k] = a[r1][k1] * a[r2][k2] - a[r1][k2] * a[r2][k1];
+        }
+    double det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+    if (!(det != 0) || !std::isfinite(det))
+        return false;
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++)
+            if (!std::isfinite(float(c[k][r] / det)))
+                return false;
+    return true;
+}
+
+/* The instances' geometry: a mesh that several nodes use, or that EXT_mesh_gpu_instancing
+ * places, is kept once in its own space (scene_instanced_mesh) and placed by instances; the
+ * others, and placements whose transform is not invertible, are baked into world space. */
 bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
 {
-    uint64_t nv = 0, nt = 0, np = 0;
-    for (const auto &in : inst)
-        for (const Prim &p : c.meshes[size_t(in.mesh)]) {
-            nv += p.pos.size() / 3;
-            nt += p.idx.size() / 3;
-            np++;
+    std::vector<uint32_t> uses(c.meshes.size(), 0), imesh(c.meshes.size(), GN_INVALID);
+    std::vector<bool> gpu(c.meshes.size(), false);
+    std::vector<float> xf(12 * inst.size());
+    std::vector<bool> placed(inst.size(), false);
+    for (const auto &in : inst) {
+        uses[size_t(in.mesh)]++;
+        gpu[size_t(in.mesh)] = gpu[size_t(in.mesh)] || in.gpu;
+    }
+    uint64_t nv = 0, nt = 0, np = 0, ni = 0;
+    uint32_t meshes = 0;
+    for (size_t i = 0; i < inst.size(); i++) {
+        size_t m = size_t(inst[i].mesh);
+        uint64_t mv = 0, mt = 0;
+        for (const Prim &p : c.meshes[m]) {
+            mv += p.pos.size() / 3;
+            mt += p.idx.size() / 3;
         }
+        np += c.meshes[m].size();
+        placed[i] = (uses[m] > 1 || gpu[m]) && mt > 0 && instance_transform(inst[i].world, &xf[12 * i]);
+        if (!placed[i]) {
+            nv += mv;
+            nt += mt;
+            continue;
+        }
+        ni++;
+        if (imesh[m] == GN_INVALID) { /* its first placement: the mesh is stored, once */
+            imesh[m] = meshes++;
+            nv += mv;
+            nt += mt;
+        }
+    }
     if (nv > MAX_SCENE || nt > MAX_SCENE)
         return fail(c, "scene too large: %llu triangles and %llu vertices after instancing; the limit is %zu each",
                     (unsigned long long)nt, (unsigned long long)nv, MAX_SCENE);
-    out->num_vertices = uint32_t(nv);
-    out->num_triangles = uint32_t(nt);
+    if (ni > SCENE_MAX_INSTANCES)
+        return fail(c, "scene too large: %llu instances; the limit is %u", (unsigned long long)ni, SCENE_MAX_INSTANCES);
+    uint64_t wv = 0, wt = 0;
+    for (size_t i = 0; i < inst.size(); i++)
+        for (const Prim &p : c.meshes[size_t(inst[i].mesh)])
+            if (!placed[i]) {
+                wv += p.pos.size() / 3;
+                wt += p.idx.size() / 3;
+            }
+    out->num_vertices = uint32_t(wv);
+    out->num_triangles = uint32_t(wt);
     out->num_meshes = uint32_t(np);
-    out->vertices = static_cast<GnVertex *>(util_calloc(nv, sizeof(GnVertex)));
-    out->indices = static_cast<uint32_t *>(util_calloc(nt * 3, sizeof(uint32_t)));
-    out->tri_material = static_cast<uint32_t *>(util_calloc(nt, sizeof(uint32_t)));
-    uint32_t vbase = 0, tbase = 0, default_material = uint32_t(c.m.materials.size());
-    for (const auto &in : inst) {
-        const Mat &w = in.world;
-        /* Normals go through the cofactor matrix, det * inverse transpose: defined even for a
-         * singular matrix; multiplied by sign(det) so mirroring keeps them pointing out. */
-        double a[3][3];
-        for (int r = 0; r < 3; r++)
-            for (int k = 0; k < 3; k++)
-                a[r][k] = w[size_t(k * 4 + r)];
-        double cof[3][3];
-        for (int r = 0; r < 3; r++)
-            for (int k = 0; k < 3; k++) {
-                int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-                cof[r][k] = a[r1][k1] * a[r2][k2] - a[r1][k2] * a[r2][k1];
+    out->vertices = static_cast<GnVertex *>(util_calloc(wv, sizeof(GnVertex)));
+    out->indices = static_cast<uint32_t *>(util_calloc(wt * 3, sizeof(uint32_t)));
+    out->tri_material = static_cast<uint32_t *>(util_calloc(wt, sizeof(uint32_t)));
+    out->num_instanced_meshes = meshes;
+    out->instanced_meshes = static_cast<scene_instanced_mesh *>(util_calloc(meshes, sizeof(scene_instanced_mesh)));
+    out->num_instances = uint32_t(ni);
+    out->instances = static_cast<scene_instance *>(util_calloc(ni, sizeof(scene_instance)));
+    uint32_t vbase = 0, tbase = 0, k = 0;
+    Mat id{};
+    id[0] = id[5] = id[10] = id[15] = 1;
+    for (size_t i = 0; i < inst.size(); i++) {
+        const Instance &in = inst[i];
+        if (!placed[i]) {
+            bake_mesh(c, in.mesh, in.world, out->vertices, out->indices, out->tri_material, vbase, tbase, out->vertex_colors);
+            for (const Prim &p : c.meshes[size_t(in.mesh)]) {
+                vbase += uint32_t(p.pos.size() / 3);
+                tbase += uint32_t(p.idx.size() / 3);
             }
-        double det = a[0][0] * cof[0][0] + a[0][1] * cof[0][1] + a[0][2] * cof[0][2];
-        double sgn = det < 0 ? -1 : 1;
-        for (const Prim &p : c.meshes[size_t(in.mesh)]) {
-            size_t pv = p.pos.size() / 3;
-            for (size_t v = 0; v < pv; v++) {
-                GnVertex &o = out->vertices[vbase + v];
-                const float *q = &p.pos[v * 3];
-                double x[3];
-                for (int r = 0; r < 3; r++)
-                    x[r] = a[r][0] * q[0] + a[r][1] * q[1] + a[r][2] * q[2] + w[size_t(12 + r)];
-                o.position = vec3{float(x[0]), float(x[1]), float(x[2])};
-                const float *nn = &p.nrm[v * 3];
-                double n[3];
-                for (int r = 0; r < 3; r++)
-                    n[r] = sgn * (cof[r][0] * nn[0] + cof[r][1] * nn[1] + cof[r][2] * nn[2]);
-                if (!normalize3(n)) { /* a scale that flattens the mesh to a line: never hit */
-                    n[0] = n[1] = 0;
-                    n[2] = 1;
-                }
-                o.normal = vec3{float(n[0]), float(n[1]), float(n[2])};
-                if (!p.uv.empty()) {
-                    o.u = p.uv[v * 2];
-                    o.v = p.uv[v * 2 + 1];
-                }
-                if (!p.uv1.empty()) {
-                    o.u1 = p.uv1[v * 2];
-                    o.v1 = p.uv1[v * 2 + 1];
-                }
-                if (!p.col.empty()) {
-                    o.color = vec4{p.col[v * 4], p.col[v * 4 + 1], p.col[v * 4 + 2], p.col[v * 4 + 3]};
-                    out->vertex_colors = true;
-                } else {
-                    o.color = vec4{1, 1, 1, 1};
-                }
-                if (!p.tan.empty()) {
-                    const double t0[3] = {p.tan[v * 4], p.tan[v * 4 + 1], p.tan[v * 4 + 2]};
-                    double t[3];
-                    xform_dir(w, t0, t);
-                    if (normalize3(t))
-                        o.tangent = vec4{float(t[0]), float(t[1]), float(t[2]), float(p.tan[v * 4 + 3] * sgn)};
-                }
-            }
-            size_t pt = p.idx.size() / 3;
-            for (size_t t = 0; t < pt; t++) {
-                uint32_t *dst = &out->indices[(tbase + t) * 3];
-                dst[0] = vbase + p.idx[t * 3];
-                dst[1] = vbase + p.idx[t * 3 + (det < 0 ? 2 : 1)]; /* mirrored: keep front faces */
-                dst[2] = vbase + p.idx[t * 3 + (det < 0 ? 1 : 2)];
-                out->tri_material[tbase + t] = p.material == GN_INVALID ? default_material : p.material;
-            }
-            vbase += uint32_t(pv);
-            tbase += uint32_t(pt);
+            continue;
         }
+        uint32_t m = imesh[size_t(in.mesh)];
+        scene_instanced_mesh &im = out->instanced_meshes[m];
+        if (!im.vertices) { /* the mesh's data, once, in its own space */
+            for (const Prim &p : c.meshes[size_t(in.mesh)]) {
+                im.num_vertices += uint32_t(p.pos.size() / 3);
+                im.num_triangles += uint32_t(p.idx.size() / 3);
+            }
+            im.gltf_mesh = uint32_t(in.mesh);
+            im.vertices = static_cast<GnVertex *>(util_calloc(im.num_vertices, sizeof(GnVertex)));
+            im.indices = static_cast<uint32_t *>(util_calloc(3 * size_t(im.num_triangles), sizeof(uint32_t)));
+            im.tri_material = static_cast<uint32_t *>(util_calloc(im.num_triangles, sizeof(uint32_t)));
+            bake_mesh(c, in.mesh, id, im.vertices, im.indices, im.tri_material, 0, 0, out->vertex_colors);
+        }
+        scene_instance &o = out->instances[k++];
+        memcpy(o.to_world, &xf[12 * i], sizeof o.to_world);
+        o.mesh = m;
+        o.node = uint32_t(in.node);
     }
     return true;
 }
@@ -2143,6 +2309,9 @@ void load_materials(Ctx &c, scene *out)
     bool need_default = false;
     for (uint32_t t = 0; t < out->num_triangles; t++)
         need_default |= out->tri_material[t] == n;
+    for (uint32_t m = 0; m < out->num_instanced_meshes; m++)
+        for (uint32_t t = 0; t < out->instanced_meshes[m].num_triangles; t++)
+            need_default |= out->instanced_meshes[m].tri_material[t] == n;
     out->num_materials = uint32_t(n + (need_default ? 1 : 0));
     out->materials = static_cast<GnMaterial *>(util_calloc(out->num_materials, sizeof(GnMaterial)));
     out->material_extras = static_cast<scene_material_extras *>(util_calloc(out->num_materials, sizeof(scene_material_extras)));
@@ -2487,6 +2656,7 @@ struct Doc {
     void check_accessor(const Json &a, const std::string &p);
     void check_primitive(const Json &pr, const std::string &p);
     void check_node(const Json &n, const std::string &p);
+    void check_gpu_instancing(const Json &n, const Json &e, const std::string &p);
     void check_material(const Json &m, const std::string &p);
     void texture_info(const Json &o, const char *key, const std::string &path);
 };
@@ -2601,6 +2771,62 @@ void Doc::check_node(const Json &n, const std::string &p)
         }
         if (const Json *l = member(*lp, "light", at(at(p, "extensions"), "KHR_lights_punctual"), true))
             index(*l, at(at(at(p, "extensions"), "KHR_lights_punctual"), "light"), "KHR_lights_punctual lights", nl);
+    }
+    if (const Json *gi = ext ? object(*ext, "EXT_mesh_gpu_instancing", at(p, "extensions")) : nullptr)
+        check_gpu_instancing(n, *gi, at(at(p, "extensions"), "EXT_mesh_gpu_instancing"));
+}
+
+/* EXT_mesh_gpu_instancing: on a node with a mesh, attributes naming accessors: TRANSLATION
+ * and SCALE of VEC3 floats, ROTATION of VEC4 floats or normalized integers (a quaternion),
+ * the application's own (named _...) anything; all of one count, the number of instances. */
+void Doc::check_gpu_instancing(const Json &n, const Json &e, const std::string &p)
+{
+    if (!n.count("mesh"))
+        error(p, "is on a node without a mesh (the extension instances the node's mesh)");
+    const Json *attrs = object(e, "attributes", p, true);
+    if (!attrs)
+        return;
+    std::string ap = at(p, "attributes"), first;
+    if (attrs->empty())
+        error(ap, "has no attributes (the instances need TRANSLATION, ROTATION or SCALE)");
+    int64_t count = -1;
+    const Json *accessors = root.count("accessors") ? &root.at("accessors") : nullptr;
+    for (auto it = attrs->begin(); it != attrs->end(); ++it) {
+        std::string name = key_of(it.key()), kp = at(ap, name.c_str());
+        int64_t a = index(it.value(), kp, "accessors", count_of("accessors"));
+        if (a < 0 || !accessors || !(*accessors)[size_t(a)].is_object())
+            continue;
+        const Json &acc = (*accessors)[size_t(a)];
+        auto field = [&](const char *key) -> const Json * { auto f = acc.find(key); return f != acc.end() ? &*f : nullptr; };
+        const Json *type = field("type"), *ct = field("componentType"), *norm = field("normalized"), *cnt = field("count");
+        if (!type || !type->is_string() || !ct || !ct->is_number_integer() || !cnt || !cnt->is_number_integer())
+            continue; /* (check_accessor reports it) */
+        std::string t = type->get<std::string>();
+        int64_t c = ct->get<int64_t>();
+        bool normalized = norm && norm->is_boolean() && norm->get<bool>();
+        bool is_float = c == TINYGLTF_COMPONENT_TYPE_FLOAT;
+        if (name == "TRANSLATION" || name == "SCALE") {
+            if (t != "VEC3" || !is_float)
+                error(kp, "accessor %lld is %s of component type %lld; %s must be VEC3 of floats (5126)", (long long)a,
+                      t.c_str(), (long long)c, name.c_str());
+        } else if (name == "ROTATION") {
+            bool quantized = normalized && (c == TINYGLTF_COMPONENT_TYPE_BYTE || c == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                            c == TINYGLTF_COMPONENT_TYPE_SHORT || c == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+            if (t != "VEC4" || !(is_float || quantized))
+                error(kp, "accessor %lld is %s of component type %lld%s; ROTATION must be VEC4 of floats or of "
+                      "normalized integers", (long long)a, t.c_str(), (long long)c, normalized ? " (normalized)" : "");
+        } else if (name.empty() || name[0] != '_') {
+            error(kp, "is not an attribute of the extension (TRANSLATION, ROTATION, SCALE, or an application's "
+                  "own, named with a leading _)");
+        }
+        int64_t k = cnt->get<int64_t>();
+        if (count < 0) {
+            count = k;
+            first = name;
+        } else if (k != count) {
+            error(kp, "accessor %lld has %lld elements, %s's has %lld: each attribute has one per instance",
+                  (long long)a, (long long)k, first.c_str(), (long long)count);
+        }
     }
 }
 
@@ -2961,7 +3187,7 @@ bool load(scene *out, const char *path, int scene_index)
     uint32_t dropped = scene_drop_invalid_triangles(out);
     if (dropped)
         warn(c, "dropped %u triangle(s) with non-finite or huge (|x| > 1e15) vertex positions", dropped);
-    if (out->num_triangles == 0)
+    if (out->num_triangles == 0 && out->num_instances == 0)
         return fail(c, "no triangles");
     scene_compute_bounds(out);
     return true;
