@@ -13,7 +13,9 @@ emissive quad placed twice with scales that change its area, the scene's only li
 
 Also written: inst-short.gltf (the ROTATION accessor as normalized signed shorts, the
 quantized form the extension allows) and bad-*.gltf, each with one error in the extension,
-whose message must name the JSON path (bad.txt lists file, path)."""
+whose message must name the JSON path (bad.txt lists file, path).
+
+instances.py flatten IN.gltf OUT.gltf: any file, flattened (below)."""
 import base64
 import json
 import math
@@ -21,6 +23,65 @@ import os
 import struct
 import sys
 import zlib
+
+
+def flatten(src, dst):
+    """instances.py flatten IN.gltf OUT.gltf: IN with every EXT_mesh_gpu_instancing instance a
+    child node of its own (its T R S) and every use of a mesh a mesh of its own, the buffers
+    embedded: the same scene with nothing instanced."""
+    d = json.load(open(src))
+    bufs = []
+    for b in d["buffers"]:
+        uri = b["uri"]
+        if uri.startswith("data:"):
+            bufs.append(base64.b64decode(uri.split(",", 1)[1]))
+        else:
+            bufs.append(open(os.path.join(os.path.dirname(src), uri), "rb").read())
+        b["uri"] = "data:application/octet-stream;base64," + base64.b64encode(bufs[-1]).decode()
+
+    def read(a):
+        acc = d["accessors"][a]
+        n = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[acc["type"]]
+        fmt, size, scale = {5126: ("f", 4, None), 5120: ("b", 1, 127.0), 5121: ("B", 1, 255.0),
+                            5122: ("h", 2, 32767.0), 5123: ("H", 2, 65535.0)}[acc["componentType"]]
+        v = d["bufferViews"][acc["bufferView"]]
+        stride = v.get("byteStride", n * size)
+        base = v.get("byteOffset", 0) + acc.get("byteOffset", 0)
+        data = bufs[v["buffer"]]
+        out = []
+        for i in range(acc["count"]):
+            e = list(struct.unpack_from("<%d%s" % (n, fmt), data, base + i * stride))
+            out.append([max(x / scale, -1.0) for x in e] if scale and acc.get("normalized") else e)
+        return out
+
+    for i, node in enumerate(list(d["nodes"])):
+        ext = node.get("extensions", {}).pop("EXT_mesh_gpu_instancing", None)
+        if ext is None:
+            continue
+        attrs = ext["attributes"]
+        cols = {k: read(a) for k, a in attrs.items() if k in ("TRANSLATION", "ROTATION", "SCALE")}
+        count = len(next(iter(cols.values())))
+        for j in range(count):
+            child = {"mesh": node["mesh"]}
+            for k, key in (("TRANSLATION", "translation"), ("ROTATION", "rotation"), ("SCALE", "scale")):
+                if k in cols:
+                    child[key] = cols[k][j]
+            d["nodes"].append(child)
+            node.setdefault("children", []).append(len(d["nodes"]) - 1)
+        del node["mesh"]
+    for node in d["nodes"]:  # every use of a mesh: a mesh of its own on the same accessors
+        if "mesh" in node:
+            d["meshes"].append(json.loads(json.dumps(d["meshes"][node["mesh"]])))
+            node["mesh"] = len(d["meshes"]) - 1
+    for k in ("extensionsUsed", "extensionsRequired"):
+        if k in d:
+            d[k] = [e for e in d[k] if e != "EXT_mesh_gpu_instancing"]
+    json.dump(d, open(dst, "w"))
+
+
+if sys.argv[1] == "flatten":
+    flatten(sys.argv[2], sys.argv[3])
+    sys.exit(0)
 
 out = sys.argv[1]
 os.makedirs(out, exist_ok=True)
