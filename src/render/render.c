@@ -498,6 +498,30 @@ static void gouraud_materials(renderer *r, vec4 *vcolor)
     }
 }
 
+/* The lights r uploads: the scene's punctual ones, or stand-ins for its emissive meshes in
+ * the local modes (emissive_lights); sets r->num_lights. */
+static GnLight *scene_lights(renderer *r)
+{
+    const scene *sc = r->sc;
+    GnLight *lights = util_calloc(sc->num_lights + 16, sizeof *lights);
+    if (sc->num_lights)
+        memcpy(lights, sc->lights, sizeof *lights * sc->num_lights);
+    r->num_lights = sc->num_lights ? sc->num_lights : emissive_lights(sc, lights, 16);
+    return lights;
+}
+
+/* With instances, the light table's entries' instances, after the table (GnFrame.emitter_instances). */
+static void upload_emitter_instances(renderer *r)
+{
+    if (!r->geo.two_levels)
+        return;
+    uvec4 *inst = util_calloc(r->emitter_cap, sizeof *inst);
+    for (uint32_t i = 0; i < r->num_emitters; i++)
+        inst[i].x = r->emitter_instance[i];
+    gpu_buffer_upload(r->g, &r->emitters, inst, sizeof *inst * r->emitter_cap, sizeof(GnEmitter) * r->emitter_cap);
+    free(inst);
+}
+
 bool renderer_create(renderer *r, gpu *g, const scene *sc)
 {
     double t0 = util_now();
@@ -554,10 +578,7 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
                              sc->textures[i].flags, {t[0], t[1], t[2]}, 0, {t[3], t[4], t[5]}, 0};
     }
 
-    lights = util_calloc(sc->num_lights + 16, sizeof *lights);
-    if (sc->num_lights)
-        memcpy(lights, sc->lights, sizeof *lights * sc->num_lights);
-    r->num_lights = sc->num_lights ? sc->num_lights : emissive_lights(sc, lights, 16);
+    lights = scene_lights(r);
 
     gpu_buffer_create(g, &r->frame, sizeof(GnFrame), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       GPU_MEMORY_HOST);
@@ -572,12 +593,8 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
     gpu_buffer_create_texels(g, &r->textures, tex, sizeof(GnTexture) * (sc->num_textures + 1));
     build_emitters(r, prims);
     if (r->geo.two_levels) { /* the table, then each entry's instance (GnFrame.emitter_instances) */
-        uvec4 *inst = util_calloc(r->emitter_cap, sizeof *inst);
-        for (uint32_t i = 0; i < r->num_emitters; i++)
-            inst[i].x = r->emitter_instance[i];
         gpu_buffer_create_texels(g, &r->emitters, NULL, 2 * sizeof(GnEmitter) * r->emitter_cap);
-        gpu_buffer_upload(g, &r->emitters, inst, sizeof *inst * r->emitter_cap, sizeof(GnEmitter) * r->emitter_cap);
-        free(inst);
+        upload_emitter_instances(r);
     } else {
         gpu_buffer_create_texels(g, &r->emitters, NULL, sizeof(GnEmitter) * (r->num_emitters + 1));
     }
@@ -609,6 +626,42 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
     free(texels);
     free(tex);
     free(lights);
+    r->setup_seconds = util_now() - t0;
+    return true;
+}
+
+bool renderer_update(renderer *r, const scene *sc)
+{
+    double t0 = util_now();
+    if (r->failed)
+        return false;
+    r->sc = sc;
+    if (!render_geometry_update(&r->geo, sc)) {
+        r->failed = true;
+        return false;
+    }
+    if (r->geo.two_levels) { /* the top tree's nodes lead the array; the instances' transforms */
+        gpu_buffer_upload(r->g, &r->nodes, r->geo.nodes, sizeof(GnBvhNode) * r->geo.top.tree.num_nodes, 0);
+        gpu_buffer_upload(r->g, &r->instances, r->geo.top.instances, sizeof(GnInstance) * r->geo.top.num_instances, 0);
+    }
+    uint32_t before = r->num_lights;
+    GnLight *lights = scene_lights(r);
+    if (r->num_lights <= before) {
+        gpu_buffer_upload(r->g, &r->lights, lights, sizeof(GnLight) * r->num_lights, 0);
+    } else { /* (more of the stand-ins for emissive meshes than before: a new buffer) */
+        gpu_buffer_destroy(r->g, &r->lights);
+        gpu_buffer_create_storage(r->g, &r->lights, lights, sizeof(GnLight) * r->num_lights);
+        for (uint32_t i = 0; i < GN_MODE_COUNT; i++) /* their descriptor sets name the old buffer */
+            gpu_pipeline_destroy(r->g, &r->pipelines[i]);
+        gpu_pipeline_destroy(r->g, &r->vertex_pass);
+    }
+    free(lights);
+    free(r->emitter_table);
+    free(r->emitter_weight);
+    free(r->emitter_instance);
+    build_emitters(r, r->geo.prims); /* (the same room: the same triangles and lights) */
+    upload_emitter_instances(r);
+    r->env_source = NULL; /* the environment's weight follows the scene's bounds */
     r->setup_seconds = util_now() - t0;
     return true;
 }
@@ -892,10 +945,14 @@ static bool upload_env_map(renderer *r, const image *map)
         marg[y] = total > 0 ? (float)(acc / total) : (float)(y + 1) / h;
     }
     marg[h - 1] = 1;
-    gpu_buffer_destroy(r->g, &r->env);
-    gpu_buffer_create_texels_as(r->g, &r->env, data, words * 4, VK_FORMAT_R32_UINT);
-    for (uint32_t i = 0; i < GN_MODE_COUNT; i++) /* their descriptor sets name the old buffer */
-        gpu_pipeline_destroy(r->g, &r->pipelines[i]);
+    if (r->env.buffer && r->env.size == words * 4) { /* (the same map again: an animation's next frame) */
+        gpu_buffer_upload(r->g, &r->env, data, words * 4, 0);
+    } else {
+        gpu_buffer_destroy(r->g, &r->env);
+        gpu_buffer_create_texels_as(r->g, &r->env, data, words * 4, VK_FORMAT_R32_UINT);
+        for (uint32_t i = 0; i < GN_MODE_COUNT; i++) /* their descriptor sets name the old buffer */
+            gpu_pipeline_destroy(r->g, &r->pipelines[i]);
+    }
     /* mean L over the sphere = sum(L sin dtheta dphi) / 4 pi, dtheta dphi = 2 pi^2 / n */
     r->env_weight = scene_radius2(r->sc) * 2 * M_PI * M_PI * total / (double)n;
     r->env_source = map;

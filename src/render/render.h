@@ -119,6 +119,12 @@ typedef struct renderer {
  * marked failed, so that renderer_begin and renderer_render return false too. */
 bool renderer_create(renderer *r, gpu *g, const scene *sc);
 void renderer_destroy(renderer *r); /* accepts a zeroed struct */
+/* sc is r's scene at another time of its animation: the same geometry and materials
+ * (scene_same_geometry), other instance transforms, lights and cameras; r renders sc from
+ * now on. Only the top tree over the instances is rebuilt (render_geometry_update), and the
+ * lights and the light table are made again; the kernels stay. setup_seconds becomes the
+ * time this took. False (the renderer then failed) when the tree cannot be built. */
+bool renderer_update(renderer *r, const scene *sc);
 
 /* The camera for settings->camera (or the framing one) as the GPU wants it. Returns false
  * (with an error) if the index is out of range. */

@@ -159,6 +159,13 @@ void scene_select_variant(const char *name);
  * the nodes' own transforms. */
 void scene_animation_time(double seconds);
 
+/* Loads that follow keep a mesh that an animation moves (its node's or a parent's
+ * translation, rotation or scale) in its own space, placed by an instance, as they keep
+ * shared meshes: the frames of an animation then differ only in their instances'
+ * transforms (scene_same_geometry), and a renderer moves them by rebuilding only the top
+ * tree (renderer_update). False (the default): such a mesh is baked like any other. */
+void scene_instance_animated(bool on);
+
 /* Frees everything; accepts a zeroed struct. */
 void scene_destroy(scene *s);
 

@@ -76,7 +76,8 @@ struct Prim {                 /* one triangle primitive of a glTF mesh, in the m
 struct Instance {
     int node, mesh;
     Mat world;
-    bool gpu = false; /* one of EXT_mesh_gpu_instancing's instances */
+    bool gpu = false;    /* one of EXT_mesh_gpu_instancing's instances */
+    bool moving = false; /* an animation moves the node or one above it */
 };
 
 struct Ctx {
@@ -85,6 +86,7 @@ struct Ctx {
     bool failed = false;
     std::map<int, std::string> image_errors; /* decode failures reported by the image callback */
     std::vector<Mat> local;                  /* per node */
+    std::vector<bool> animated;              /* per node: an animation sets its T, R or S */
     std::vector<bool> camera_ok, light_ok;   /* per glTF camera / light: values usable */
     std::vector<std::vector<Prim>> meshes;   /* per glTF mesh */
     std::vector<uint32_t> image_map, texture_map; /* glTF index -> scene index or GN_INVALID */
@@ -103,6 +105,7 @@ struct Ctx {
 
 bool allow_outside_files = false; /* scene_allow_outside_files */
 std::string variant;              /* scene_select_variant */
+bool instance_animated = false;   /* scene_instance_animated */
 
 void vreport(const Ctx &c, bool error, const char *fmt, va_list ap)
 {
@@ -892,6 +895,7 @@ bool check_nodes_and_scenes(Ctx &c)
         const auto &n = m.nodes[i];
         std::string what = label("node", int(i), n.name);
         bool animated = pose[i].has[0] || pose[i].has[1] || pose[i].has[2];
+        c.animated.push_back(animated);
         if (animated && !n.matrix.empty())
             warn(c, "%s has a matrix and is animated: the matrix wins (glTF forbids the two)", what.c_str());
         node_local(c, int(i), c.local[i], animated ? &pose[i] : nullptr);
@@ -1545,6 +1549,7 @@ bool collect_instances(Ctx &c, std::vector<Instance> &inst, std::vector<Instance
             }
             visited[size_t(it.node)] = true;
             it.world = mat_mul(it.world, c.local[size_t(it.node)]);
+            it.moving = it.moving || (size_t(it.node) < c.animated.size() && c.animated[size_t(it.node)]);
             if (!mat_finite(it.world))
                 return fail(c, "%s: world transform is not finite", label("node", it.node, n.name).c_str());
             if (n.skin >= 0 && !c.warned_skin) {
@@ -1552,18 +1557,26 @@ bool collect_instances(Ctx &c, std::vector<Instance> &inst, std::vector<Instance
                 c.warned_skin = true;
             }
             if (n.mesh >= 0 && n.extensions.count("EXT_mesh_gpu_instancing")) {
+                size_t first = inst.size();
                 if (!gpu_instances(c, it.node, it.world, inst))
                     return false;
+                for (size_t k = first; k < inst.size(); k++)
+                    inst[k].moving = it.moving;
             } else if (n.mesh >= 0) {
-                inst.push_back({it.node, n.mesh, it.world});
+                Instance mi{it.node, n.mesh, it.world};
+                mi.moving = it.moving;
+                inst.push_back(mi);
             }
             if (n.camera >= 0 && c.camera_ok[size_t(n.camera)])
                 cams.push_back(it);
             int light = node_light(n);
             if (light >= 0 && c.light_ok[size_t(light)])
                 lights.push_back(it);
-            for (auto ch = n.children.rbegin(); ch != n.children.rend(); ++ch)
-                stack.push_back({*ch, -1, it.world});
+            for (auto ch = n.children.rbegin(); ch != n.children.rend(); ++ch) {
+                Instance next{*ch, -1, it.world};
+                next.moving = it.moving;
+                stack.push_back(next);
+            }
         }
     }
     return true; /* pre-order, children in file order (pushed reversed) */
@@ -1687,8 +1700,9 @@ bool instance_transform(const Mat &w, float out[12])
 }
 
 /* The instances' geometry: a mesh that several nodes use, or that EXT_mesh_gpu_instancing
- * places, is kept once in its own space (scene_instanced_mesh) and placed by instances; the
- * others, and placements whose transform is not invertible, are baked into world space. */
+ * places, or (scene_instance_animated) that an animation moves, is kept once in its own
+ * space (scene_instanced_mesh) and placed by instances; the others, and placements whose
+ * transform is not invertible, are baked into world space. */
 bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
 {
     std::vector<uint32_t> uses(c.meshes.size(), 0), imesh(c.meshes.size(), GN_INVALID);
@@ -1709,7 +1723,8 @@ bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
             mt += p.idx.size() / 3;
         }
         np += c.meshes[m].size();
-        placed[i] = (uses[m] > 1 || gpu[m]) && mt > 0 && instance_transform(inst[i].world, &xf[12 * i]);
+        placed[i] = (uses[m] > 1 || gpu[m] || (instance_animated && inst[i].moving)) && mt > 0 &&
+                    instance_transform(inst[i].world, &xf[12 * i]);
         if (!placed[i]) {
             nv += mv;
             nt += mt;
@@ -3205,6 +3220,8 @@ void scene_animation_time(double seconds)
 void scene_allow_outside_files(bool allow) { allow_outside_files = allow; }
 
 void scene_select_variant(const char *name) { variant = name ? name : ""; }
+
+void scene_instance_animated(bool on) { instance_animated = on; }
 
 bool scene_load_scene(scene *out, const char *path, int scene_index)
 {

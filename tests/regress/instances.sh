@@ -60,6 +60,19 @@ else
     fail "interrupted paths (render failed)"; sed 's/^/    /' "$tmp/cap.err"
 fi
 
+# An animation (--frames): a frame that only moves instances keeps the trees and kernels of the
+# frame before and rebuilds only the top tree (a mesh used once that the animation moves is
+# an instance for --frames); each frame is the one --frame renders alone
+check "--frames renders" "$G" render "$tmp/inst-anim.gltf" --camera 0 --size 32x32 --spp 1 --mode phong --fps 1 \
+    --frames 0-2 -o "$tmp/fr_%d.exr"
+check "... frames 1 and 2 rebuild only the top tree" \
+    test "$(grep -c 'frame [12]: the same geometry, moved: the top tree over 20 instances rebuilt' "$tmp/out")" = 2
+for k in 0 2; do
+    "$G" render "$tmp/inst-anim.gltf" --camera 0 --size 32x32 --spp 1 --mode phong --fps 1 --frame $k -o "$tmp/one_$k.exr" --quiet
+    check "... frame $k = --frame $k" "$G" diff "$tmp/fr_$k.exr" "$tmp/one_$k.exr" --max-rmse 1e-3 --quiet
+done
+check "... and the frames differ" sh -c "! '$G' diff '$tmp/fr_0.exr' '$tmp/fr_2.exr' --max-rmse 1e-2 --quiet"
+
 # A Khronos sample: 125 instances of a cube, like its flattened self
 S=$A/SimpleInstancing/glTF/SimpleInstancing.gltf
 if [ -f "$S" ]; then

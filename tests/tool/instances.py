@@ -12,7 +12,8 @@ EXT_mesh_gpu_instancing under a turned parent; an alpha-masked checker quad plac
 emissive quad placed twice with scales that change its area, the scene's only light.
 
 Also written: inst-short.gltf (the ROTATION accessor as normalized signed shorts, the
-quantized form the extension allows) and bad-*.gltf, each with one error in the extension,
+quantized form the extension allows), inst-anim.gltf (inst.gltf animated: a parent of
+instances turns, an instance and a mesh used once move) and bad-*.gltf, each with one error in the extension,
 whose message must name the JSON path (bad.txt lists file, path).
 
 instances.py flatten IN.gltf OUT.gltf: any file, flattened (below)."""
@@ -306,6 +307,42 @@ def save(d, name):
 save(build(False), "inst.gltf")
 save(build(True), "flat.gltf")
 save(build(False, short_rotation=True), "inst-short.gltf")
+
+
+def animated():
+    """inst.gltf, animated over 2 s: the cubes' parent turns, a lamp and the ground (a mesh used
+    once: baked, or for --frames an instance) move."""
+    d = build(False)
+    names = {n.get("name"): i for i, n in enumerate(d["nodes"])}
+    raw = bytearray(base64.b64decode(d["buffers"][0]["uri"].split(",", 1)[1]))
+
+    def acc(values, type_):
+        while len(raw) % 4:
+            raw.append(0)
+        data = struct.pack("<%df" % len(values), *values)
+        d["bufferViews"].append({"buffer": 0, "byteOffset": len(raw), "byteLength": len(data)})
+        raw.extend(data)
+        n = {"SCALAR": 1, "VEC3": 3, "VEC4": 4}[type_]
+        a = {"bufferView": len(d["bufferViews"]) - 1, "componentType": 5126, "count": len(values) // n, "type": type_}
+        if type_ == "SCALAR":
+            a["min"], a["max"] = [min(values)], [max(values)]
+        d["accessors"].append(a)
+        return len(d["accessors"]) - 1
+
+    t = acc([0.0, 1.0, 2.0], "SCALAR")
+    tracks = [("cubes", "rotation", acc(quat((0, 1, 0), -12) + quat((0, 1, 0), 10) + quat((0, 1, 0), 40), "VEC4")),
+              ("lamp 1", "translation", acc([-0.8, 3.6, 0.8, -0.2, 3.4, 0.9, 0.4, 3.6, 0.5], "VEC3")),
+              ("ground", "translation", acc([0, 0, 0, 0, -0.1, 0.2, 0, -0.2, 0], "VEC3"))]
+    d["animations"] = [{"name": "move", "samplers": [{"input": t, "output": o, "interpolation": "LINEAR"}
+                                                     for _, _, o in tracks],
+                        "channels": [{"sampler": k, "target": {"node": names[n], "path": p}}
+                                     for k, (n, p, _) in enumerate(tracks)]}]
+    d["buffers"][0] = {"byteLength": len(raw),
+                       "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(raw)).decode()}
+    return d
+
+
+save(animated(), "inst-anim.gltf")
 
 # ---- files with one error in the extension: the message names the JSON path -----------------
 base = build(False)
