@@ -224,7 +224,7 @@ static void teapot_grid(int n, gltf_write_node *teapot, gltf_write_node *camera,
     teapot->instance_translation = t;
     teapot->instance_rotation = q;
     teapot->instance_scale = sc;
-    const double yaw = 30 * M_PI / 180, pitch = 35 * M_PI / 180, dist = 1.1 * 4.0 * side + 6;
+    const double yaw = 30 * M_PI / 180, pitch = 25 * M_PI / 180, dist = 0.35 * 4.0 * side + 6;
     camera->translation[0] = (float)(dist * cos(pitch) * sin(yaw));
     camera->translation[1] = (float)(dist * sin(pitch));
     camera->translation[2] = (float)(dist * cos(pitch) * cos(yaw));

@@ -306,29 +306,47 @@ static uint32_t material_features(const GnMaterial *m)
  * triangle (so picking one and then a uniform point has area density lum(L) sides / total),
  * 4 I for a point light, 2 (1 - cos outer) I for a spot, E r^2 for a directional light.
  * renderer_begin adds the environment and normalises. */
+/* With two levels: each mesh's emissive triangles, as GPU slots (*count: how many), listed
+ * once so that placing them costs only the instances' emitters. */
+static uint32_t *emissive_slots(const renderer *r, uint32_t *first, uint32_t *count)
+{
+    const render_geometry *geo = &r->geo;
+    uint32_t n = 0;
+    uint32_t *list = util_calloc(geo->num_slots + 1, sizeof *list);
+    for (uint32_t m = 0; m < geo->num_meshes; m++) {
+        uint32_t base = 2 * geo->top.pair_base[m];
+        first[m] = n;
+        for (uint32_t j = 0; j < geo->meshes[m].num_slots; j++) {
+            const GnMaterial *mat = &r->sc->materials[geo->prims[base + j].material];
+            if (geo->meshes[m].tri_index[j] != GN_INVALID && luminance(&mat->emissive.x) > 0 &&
+                !(mat->flags & GN_MAT_UNLIT))
+                list[n++] = base + j;
+        }
+        count[m] = n - first[m];
+    }
+    return list;
+}
+
 /* With instances, each instance's emissive triangles, their areas in world space (a scale
  * changes them), and in r->emitter_instance the instance of each; returns the count. */
 static uint32_t instanced_emitters(renderer *r, uint32_t n)
 {
     const render_geometry *geo = &r->geo;
+    uint32_t *first = util_calloc(geo->num_meshes, sizeof *first), *count = util_calloc(geo->num_meshes, sizeof *count);
+    uint32_t *slots = emissive_slots(r, first, count);
     for (uint32_t i = 0; i < geo->top.num_instances; i++) {
         const GnInstance *in = &geo->top.instances[i];
-        uint32_t first = in->prim_base, slots = geo->meshes[in->mesh].num_slots;
-        for (uint32_t j = first; j < first + slots; j++) {
-            uint32_t mesh;
-            if (render_geometry_triangle(geo, j, &mesh) == GN_INVALID) /* the missing B of a lone triangle */
-                continue;
+        for (uint32_t k = first[in->mesh]; k < first[in->mesh] + count[in->mesh]; k++) {
+            uint32_t j = slots[k];
             const GnPrim *pr = &geo->prims[j];
             const GnMaterial *m = &r->sc->materials[pr->material];
             double lum = luminance(&m->emissive.x), p[3][3];
-            if (lum <= 0 || (m->flags & GN_MAT_UNLIT))
-                continue;
             const uint32_t v[3] = {pr->i0, pr->i1, pr->i2};
-            for (int k = 0; k < 3; k++) {
-                const float *q = &geo->vertices[v[k]].position.x;
+            for (int c3 = 0; c3 < 3; c3++) {
+                const float *q = &geo->vertices[v[c3]].position.x;
                 for (int c = 0; c < 3; c++) {
                     const float *w = &in->to_world[c].x;
-                    p[k][c] = w[0] * (double)q[0] + w[1] * (double)q[1] + w[2] * (double)q[2] + w[3];
+                    p[c3][c] = w[0] * (double)q[0] + w[1] * (double)q[1] + w[2] * (double)q[2] + w[3];
                 }
             }
             double e1[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
@@ -342,6 +360,9 @@ static uint32_t instanced_emitters(renderer *r, uint32_t n)
             r->emitter_weight[n++] = lum * area * (m->flags & GN_MAT_DOUBLE_SIDED ? 2 : 1);
         }
     }
+    free(slots);
+    free(first);
+    free(count);
     return n;
 }
 
@@ -352,16 +373,12 @@ static uint64_t emitter_room(const renderer *r)
     if (!r->geo.two_levels)
         return r->geo.num_slots;
     uint64_t n = 0;
-    uint32_t *per_mesh = util_calloc(r->geo.num_meshes, sizeof *per_mesh);
-    for (uint32_t m = 0; m < r->geo.num_meshes; m++)
-        for (uint32_t j = 0; j < r->geo.meshes[m].num_slots; j++) {
-            const GnPrim *pr = &r->geo.prims[2 * r->geo.top.pair_base[m] + j];
-            per_mesh[m] += r->geo.meshes[m].tri_index[j] != GN_INVALID &&
-                           luminance(&r->sc->materials[pr->material].emissive.x) > 0;
-        }
+    uint32_t *first = util_calloc(r->geo.num_meshes, sizeof *first), *count = util_calloc(r->geo.num_meshes, sizeof *count);
+    free(emissive_slots(r, first, count));
     for (uint32_t i = 0; i < r->geo.top.num_instances; i++)
-        n += per_mesh[r->geo.top.instances[i].mesh];
-    free(per_mesh);
+        n += count[r->geo.top.instances[i].mesh];
+    free(first);
+    free(count);
     return n;
 }
 
