@@ -27,6 +27,10 @@ if [ -d "$A" ]; then
 else
     echo "note: $A is absent: the scene fuzzer starts from scenes/ only"
 fi
+# instances: shared meshes, EXT_mesh_gpu_instancing (floats, normalized shorts, wrong ones)
+if python3 tests/tool/instances.py "$tmp/instances" >/dev/null 2>&1; then
+    for f in "$tmp"/instances/*.gltf; do link "$tmp/seed-scene" "$f"; done
+fi
 for c in none rle zips zip piz pxr24 b44 b44a; do
     "$GONIO" render scenes/cornell.gltf -o "$tmp/seed-exr/$c.exr" --size 19x13 --spp 1 --quiet --compression $c --aov normal,depth
     "$GONIO" render scenes/cornell.gltf -o "$tmp/seed-exr/$c-half.exr" --size 19x13 --spp 1 --quiet --compression $c --half
