@@ -5,6 +5,7 @@
 
 #include "bvh.h"
 #include "cli.h"
+#include "image_decode.h"
 #include "scene.h"
 #include "util.h"
 
@@ -98,6 +99,21 @@ static void print_films(const scene *sc)
     }
 }
 
+/* The images' encodings (WebP: EXT_texture_webp, KTX2: KHR_texture_basisu), one count each. */
+static void print_image_formats(const scene *sc)
+{
+    uint32_t count[TEXTURE_FORMAT_COUNT] = {0};
+    for (uint32_t i = 0; i < sc->num_images; i++)
+        count[sc->images[i].format < TEXTURE_FORMAT_COUNT ? sc->images[i].format : TEXTURE_FORMAT_UNKNOWN]++;
+    if (!sc->num_images)
+        return;
+    printf("image formats ");
+    for (int f = 0, n = 0; f < TEXTURE_FORMAT_COUNT; f++)
+        if (count[f])
+            printf("%s %u %s", n++ ? "," : "", count[f], texture_format_name((texture_format)f));
+    printf("\n");
+}
+
 int cmd_info(int argc, char **argv)
 {
     bool outside = false;
@@ -115,7 +131,8 @@ int cmd_info(int argc, char **argv)
                  "(KHR_materials_anisotropy): strength, rotation and whether a texture sets them;\n"
                  "and one line per material with an iridescent film (KHR_materials_iridescence:\n"
                  "factor, film IOR, thickness) or a diffuse transmission\n"
-                 "(KHR_materials_diffuse_transmission: factor, colour).\n",
+                 "(KHR_materials_diffuse_transmission: factor, colour); the images' formats (PNG,\n"
+                 "JPEG, WebP for EXT_texture_webp, KTX2 for KHR_texture_basisu).\n",
         CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given"};
     cli_args args;
     scene sc = {0};
@@ -139,6 +156,7 @@ int cmd_info(int argc, char **argv)
     for (uint32_t i = 0; i < sc.num_variants; i++)
         printf("variant %-6u \"%s\"\n", i, shown(sc.variant_names[i]));
     printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
+    print_image_formats(&sc);
     printf("lights         %u\n", sc.num_lights);
     print_emitters(&sc);
     print_media(&sc);

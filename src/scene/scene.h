@@ -25,6 +25,7 @@ typedef struct scene_camera {
 typedef struct scene_image {
     uint32_t width, height;
     uint8_t *rgba8; /* width * height * 4 bytes, rows top to bottom, as stored in the file */
+    uint32_t format; /* the file's encoding: texture_format (image_decode.h) */
 } scene_image;
 
 /* A material's use of an image (GnTexture): one per glTF texture, plus one per texture

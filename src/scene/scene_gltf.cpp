@@ -33,6 +33,7 @@ extern "C" {
 #include "util.h"
 }
 #include "gltf_decompress.h"
+#include "image_decode.h"
 
 namespace {
 
@@ -55,7 +56,8 @@ const char *const SUPPORTED_EXTENSIONS[] = {
     "KHR_texture_transform",      "KHR_mesh_quantization",           "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",    "KHR_materials_variants",          "KHR_materials_volume",
     "KHR_materials_dispersion",   "KHR_materials_clearcoat",         "KHR_materials_sheen",
-    "KHR_materials_anisotropy",   "KHR_materials_iridescence",       "KHR_materials_diffuse_transmission"};
+    "KHR_materials_anisotropy",   "KHR_materials_iridescence",       "KHR_materials_diffuse_transmission",
+    "EXT_texture_webp"}; /* and KHR_texture_basisu where built with Basis Universal (check_asset) */
 
 using Json = nlohmann::json;
 
@@ -90,6 +92,7 @@ struct Ctx {
     size_t textures_room = 0;                /* textures_out->textures' allocated entries */
     std::map<std::pair<uint32_t, size_t>, int> decoded; /* (crc32, size) of image bytes -> first image */
     std::map<int, int> image_alias;          /* image -> the earlier image with the same bytes */
+    std::map<int, texture_format> image_formats; /* image -> the format of its bytes, once read */
     uint64_t texels = 0;                     /* of the images decoded so far */
     std::string limit_error;                 /* a SCENE_MAX_* limit exceeded while decoding */
     bool warned_skin = false, warned_targets = false;
@@ -248,16 +251,28 @@ bool check_json_text(Ctx &c, const uint8_t *s, size_t n)
     return true;
 }
 
-/* Decodes PNG or JPEG, the formats glTF 2.0 allows. Anything else is refused before stb_image
- * sees it: its other decoders are not needed, and the 16-bit PNM path of the stb bundled with
- * tinygltf 2.7 overflows its buffer. On failure returns the reason. */
+/* The texel budget exceeded by image idx of w x h: the load fails with this message. */
+std::string too_large(Ctx &c, int idx, uint64_t w, uint64_t h)
+{
+    char msg[256];
+    snprintf(msg, sizeof msg, "images too large: %llu texels with image %d (%llux%llu), the limit is %llu",
+             (unsigned long long)(c.texels + w * h), idx, (unsigned long long)w, (unsigned long long)h,
+             (unsigned long long)SCENE_MAX_TEXELS);
+    if (c.limit_error.empty())
+        c.limit_error = msg;
+    return msg;
+}
+
+/* Decodes PNG or JPEG, the formats glTF 2.0 allows, through tinygltf's stb, and WebP and KTX2
+ * (EXT_texture_webp, KHR_texture_basisu) through image_decode.h. Anything else is refused
+ * before stb_image sees it: its other decoders are not needed, and the 16-bit PNM path of the
+ * stb bundled with tinygltf 2.7 overflows its buffer. On failure returns the reason. */
 std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned char *bytes, size_t size)
 {
-    static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-    bool is_png = size >= 8 && memcmp(bytes, png, 8) == 0;
-    bool is_jpeg = size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
-    if (!is_png && !is_jpeg)
-        return "not a PNG or JPEG image";
+    texture_format format = texture_format_of(bytes, size);
+    if (format == TEXTURE_FORMAT_UNKNOWN)
+        return "not a PNG, JPEG, WebP or KTX2 image" +
+               (img->mimeType.empty() ? std::string() : " (its mimeType says " + img->mimeType.substr(0, 40) + ")");
     if (size > size_t(INT32_MAX))
         return "image data too large";
     /* The same bytes are decoded once (a file listing one PNG 500 times decoded it 500 times). */
@@ -267,18 +282,35 @@ std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned c
         c.image_alias[idx] = seen->second;
         return "";
     }
+    c.image_formats[idx] = format;
+    /* ---- WebP and KTX2 (image_decode.h) ---- */
+    if (format == TEXTURE_FORMAT_WEBP || format == TEXTURE_FORMAT_KTX2) {
+        uint8_t *rgba = nullptr;
+        uint32_t w = 0, h = 0;
+        char why[512];
+        switch (image_decode(bytes, size, img->mimeType.c_str(), SCENE_MAX_TEXELS - c.texels, &rgba, &w, &h, why,
+                             sizeof why)) {
+        case IMAGE_TOO_LARGE: return too_large(c, idx, w, h);
+        case IMAGE_BAD: return why;
+        case IMAGE_DECODED: break;
+        }
+        c.texels += uint64_t(w) * h;
+        c.decoded[key] = idx;
+        img->width = int(w);
+        img->height = int(h);
+        img->component = 4;
+        img->bits = 8;
+        img->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+        img->image.assign(rgba, rgba + size_t(w) * h * 4);
+        free(rgba);
+        return "";
+    }
+    /* ---- end of WebP and KTX2 ---- */
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(bytes, int(size), &w, &h, &comp))
         return "cannot decode";
-    if (c.texels + uint64_t(w) * uint64_t(h) > SCENE_MAX_TEXELS) {
-        char msg[256];
-        snprintf(msg, sizeof msg, "images too large: %llu texels with image %d (%dx%d), the limit is %llu",
-                 (unsigned long long)(c.texels + uint64_t(w) * uint64_t(h)), idx, w, h,
-                 (unsigned long long)SCENE_MAX_TEXELS);
-        if (c.limit_error.empty())
-            c.limit_error = msg;
-        return msg;
-    }
+    if (c.texels + uint64_t(w) * uint64_t(h) > SCENE_MAX_TEXELS)
+        return too_large(c, idx, uint64_t(w), uint64_t(h));
     c.texels += uint64_t(w) * uint64_t(h);
     c.decoded[key] = idx;
     std::string err, warn_text;
@@ -1041,10 +1073,13 @@ bool check_asset(Ctx &c)
         for (const char *s : SUPPORTED_EXTENSIONS)
             if (e == s)
                 return true;
-        return false;
+        return e == "KHR_texture_basisu" && image_decode_has_ktx2();
     };
     for (const auto &e : m.extensionsRequired)
-        if (!supported(e))
+        if (e == "KHR_texture_basisu" && !supported(e))
+            fail(c, "requires unsupported extension %s (this gonio was built without Basis Universal: %s)", e.c_str(),
+                 image_decode_ktx2_missing());
+        else if (!supported(e))
             fail(c, "requires unsupported extension %s", e.c_str());
     std::vector<std::string> warned; /* one warning each, however often the file lists it */
     for (const auto &e : m.extensionsUsed)
@@ -1779,6 +1814,33 @@ uint32_t filter_mode(Ctx &c, size_t sampler, int mag, int min)
     return mag == TINYGLTF_TEXTURE_FILTER_NEAREST ? GN_TEX_NEAREST : 0u;
 }
 
+/* ---- KHR_texture_basisu, EXT_texture_webp: the image a texture reads ---- */
+/* The extension's source (a KTX2 or WebP image; the JSON checks made it an index into
+ * images) where its image decoded; else the core source, the optional fallback (a file that
+ * requires the extension may omit it); -1 when there is neither. */
+int texture_source(Ctx &c, size_t i)
+{
+    const auto &t = c.m.textures[i];
+    for (const char *name : {"KHR_texture_basisu", "EXT_texture_webp"}) {
+        auto e = t.extensions.find(name);
+        if (e == t.extensions.end() || !e->second.IsObject() || !e->second.Has("source"))
+            continue;
+        int s = e->second.Get("source").GetNumberAsInt();
+        if (s < 0 || size_t(s) >= c.m.images.size())
+            continue;
+        if (c.image_map[size_t(s)] != GN_INVALID)
+            return s;
+        if (t.source >= 0 && c.image_map[size_t(t.source)] != GN_INVALID) {
+            warn(c, "texture %zu: its %s image %d is unusable; its fallback, image %d, is used instead", i, name, s,
+                 t.source);
+            return t.source;
+        }
+        return s; /* unusable and no fallback: ignored, as the image's warning says */
+    }
+    return t.source;
+}
+/* ---- end of KHR_texture_basisu, EXT_texture_webp ---- */
+
 void load_images_and_textures(Ctx &c, scene *out)
 {
     const auto &m = c.m;
@@ -1797,6 +1859,7 @@ void load_images_and_textures(Ctx &c, scene *out)
                  img.uri.empty() ? "" : " ", img.uri.substr(0, 200).c_str(), why.c_str());
             continue;
         }
+        out->images[out->num_images].format = uint32_t(c.image_formats[int(i)]);
         c.image_map[i] = out->num_images++;
         std::vector<unsigned char>().swap(c.m.images[i].image); /* keep one copy at a time */
     }
@@ -1809,11 +1872,12 @@ void load_images_and_textures(Ctx &c, scene *out)
     c.texture_map.assign(m.textures.size(), GN_INVALID);
     for (size_t i = 0; i < m.textures.size(); i++) {
         const auto &t = m.textures[i];
-        if (t.source < 0) {
+        int source = texture_source(c, i);
+        if (source < 0) {
             warn(c, "texture %zu has no image source (ignored)", i);
             continue;
         }
-        if (c.image_map[size_t(t.source)] == GN_INVALID)
+        if (c.image_map[size_t(source)] == GN_INVALID)
             continue;
         uint32_t flags = 0;
         if (t.sampler >= 0) {
@@ -1821,7 +1885,7 @@ void load_images_and_textures(Ctx &c, scene *out)
             flags = wrap_mode(c, size_t(t.sampler), s.wrapS) | wrap_mode(c, size_t(t.sampler), s.wrapT) << 2 |
                     filter_mode(c, size_t(t.sampler), s.magFilter, s.minFilter);
         }
-        out->textures[out->num_textures] = scene_texture{c.image_map[size_t(t.source)], flags, {1, 0, 0, 0, 1, 0}};
+        out->textures[out->num_textures] = scene_texture{c.image_map[size_t(source)], flags, {1, 0, 0, 0, 1, 0}};
         c.texture_map[i] = out->num_textures++;
     }
 }
@@ -2794,6 +2858,12 @@ void Doc::check()
     each(root, "textures", "", [&](const Json &t, const std::string &p, size_t) {
         index(t, "sampler", p, "samplers");
         index(t, "source", p, "images");
+        /* KHR_texture_basisu, EXT_texture_webp: the image to read (the core source is then the
+         * fallback, which a file requiring the extension may omit) */
+        if (const Json *ext = object(t, "extensions", p))
+            for (const char *name : {"KHR_texture_basisu", "EXT_texture_webp"})
+                if (const Json *e = object(*ext, name, at(p, "extensions")))
+                    index(*e, "source", at(at(p, "extensions"), name), "images", true);
     });
     each(root, "materials", "", [&](const Json &m, const std::string &p, size_t) { check_material(m, p); });
     each(root, "skins", "", [&](const Json &, const std::string &, size_t) {}); /* only node.skin is read */
