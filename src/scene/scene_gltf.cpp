@@ -288,13 +288,13 @@ std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned c
         uint8_t *rgba = nullptr;
         uint32_t w = 0, h = 0;
         char why[512];
-        switch (image_decode(bytes, size, img->mimeType.c_str(), SCENE_MAX_TEXELS - c.texels, &rgba, &w, &h, why,
-                             sizeof why)) {
-        case IMAGE_TOO_LARGE: return too_large(c, idx, w, h);
-        case IMAGE_BAD: return why;
-        case IMAGE_DECODED: break;
-        }
-        c.texels += uint64_t(w) * h;
+        image_decode_status st = image_decode(bytes, size, img->mimeType.c_str(), SCENE_MAX_TEXELS - c.texels, &rgba,
+                                              &w, &h, why, sizeof why);
+        if (st == IMAGE_TOO_LARGE)
+            return too_large(c, idx, w, h);
+        c.texels += uint64_t(w) * h; /* the declared size, decoded or not, as stb's images count */
+        if (st == IMAGE_BAD)
+            return why;
         c.decoded[key] = idx;
         img->width = int(w);
         img->height = int(h);
