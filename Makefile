@@ -226,9 +226,10 @@ bench-peer: all
 	@if ! $(PEER_DEPS_CHECK); then ( $(call apt_install,$(DEB_PEER)) ) || true; fi
 	@tests/peer/run.sh $(GONIO) $(PEER_ARGS)
 
-# libFuzzer targets over scene_load and image_read_exr (tests/fuzz); fuzz-run runs each for
-# FUZZ_TIME seconds from seeds of $GONIO_ASSETS and EXRs gonio writes (tests/fuzz/run.sh).
-FUZZ_TARGETS := build/fuzz/fuzz_scene build/fuzz/fuzz_exr build/fuzz/fuzz_merge
+# libFuzzer targets over scene_load, image_read_exr, gonio merge and the WebP and KTX2
+# decoders (tests/fuzz); fuzz-run runs each for FUZZ_TIME seconds from seeds of
+# $GONIO_ASSETS, EXRs gonio writes and textures the tests' encoders write (tests/fuzz/run.sh).
+FUZZ_TARGETS := build/fuzz/fuzz_scene build/fuzz/fuzz_exr build/fuzz/fuzz_merge build/fuzz/fuzz_image
 FUZZ_TIME ?= 60
 fuzz: fuzz-deps
 	@$(MAKE) --no-print-directory config=fuzz CC=clang CXX=clang++ fuzz-targets
@@ -236,8 +237,8 @@ fuzz-targets: $(FUZZ_TARGETS)
 .SECONDARY: $(FUZZ_TARGETS:build/fuzz/%=$(BUILD)/tests/fuzz/%.o)
 build/fuzz/fuzz_%: $(BUILD)/tests/fuzz/fuzz_%.o $(LIB_OBJ) $(BASISU_LIB) | deps
 	$(CXX) $(LDFLAGS) -fsanitize=fuzzer -o $@ $^ $(PKG_LIBS) $(LIBS_EXTRA) -lm
-fuzz-run: fuzz all test-deps
-	@GONIO=$(GONIO) FUZZ_TIME=$(FUZZ_TIME) tests/fuzz/run.sh $(FUZZ_TARGETS)
+fuzz-run: fuzz all $(TESTTOOL) test-deps
+	@GONIO=$(GONIO) TESTTOOL=$(TESTTOOL) FUZZ_TIME=$(FUZZ_TIME) tests/fuzz/run.sh $(FUZZ_TARGETS)
 
 # PARTIALS damaged resumable partials and tiles through the sanitizer build's gonio
 # (tests/fuzz/partials.sh): no crash, hang, sanitizer report, or NaN written with exit 0.

@@ -177,6 +177,19 @@ else
     check "... saying why" grep -q "needs_basisu.gltf: requires unsupported extension KHR_texture_basisu (this gonio was built without Basis Universal" "$tmp/last"
 fi
 
+# Images in a GLB's binary chunk, with their mimeType (decoded once the buffer views are
+# checked, where files named by a uri are decoded as tinygltf reads them).
+glb_case() { # glb_case NAME TOL DESCRIPTION IMAGE [FALLBACK]
+    python3 "$(dirname "$0")/../tool/texture_glb.py" "$tmp/$1.glb" "${@:4}"
+    check "$3: renders" "$G" render "$tmp/$1.glb" --mode albedo --spp 1 --size ${N}x$N --quiet --compression none -o "$tmp/$1.exr"
+    check "$3: no warning" test ! -s "$tmp/out"
+    check "$3: the image's texels" python3 "$tmp/probe.py" "$tmp/$1.exr" "$2" "$(dirname "$0")/../tool" $N
+}
+glb_case glb_webp 0 "GLB: WebP in the binary chunk, extension required" "$tmp/blocks.webp"
+if [ $KTX2 = 1 ]; then
+    glb_case glb_ktx2 1 "GLB: KTX2 UASTC + Zstandard in the binary chunk, a PNG fallback" "$tmp/blocks-uastc-zstd.ktx2" "$tmp/fallback.png"
+fi
+
 # ---- damaged images: a clear message naming the file, the image and the problem ------------
 # (gonio info loads a scene as render does, and says the same, without a device)
 head -c $(($(wc -c <"$tmp/grad.webp") / 2)) "$tmp/grad.webp" >"$tmp/trunc.webp"
