@@ -23,6 +23,7 @@ mkdir -p "$dir"
 
 # without(REASON): the build goes on without KTX2 support.
 without() {
+    set -- "$(printf '%s' "$1" | tr -d '"\\\n' | head -c 300)" # a C string's contents
     echo "gonio: building without KTX2 (Basis Universal) support: $1" >&2
     printf '# written by deps/basisu.sh\nBASISU :=\n' >"$dir/gonio_basisu.mk"
     printf '/* written by deps/basisu.sh */\n#define GONIO_BASISU 0\n#define GONIO_BASISU_MISSING "%s"\n' \
@@ -53,7 +54,7 @@ EOF
     # Offline first: a crate cargo already holds needs no network.
     meta=$(cargo metadata --format-version 1 --manifest-path "$dir/fetch/Cargo.toml" --offline 2>/dev/null) ||
         meta=$(timeout 600 cargo metadata --format-version 1 --manifest-path "$dir/fetch/Cargo.toml" 2>"$dir/fetch/cargo.log") ||
-        without "cargo could not fetch the crate $CRATE $CRATE_VERSION ($(tail -n 1 "$dir/fetch/cargo.log"))"
+        without "cargo could not fetch the crate $CRATE $CRATE_VERSION ($(grep -m 1 'error' "$dir/fetch/cargo.log" || tail -n 1 "$dir/fetch/cargo.log"))"
     manifest=$(printf '%s' "$meta" | grep -o "\"manifest_path\":\"[^\"]*/$CRATE-$CRATE_VERSION/Cargo.toml\"" | head -n 1 |
         sed 's/^"manifest_path":"//; s/"$//')
     src=$(dirname "$manifest")/vendor/basis_universal
