@@ -95,12 +95,13 @@ BASISU_DEFS := -DBASISD_SUPPORT_KTX2=1 -DBASISD_SUPPORT_KTX2_ZSTD=1 -DBASISU_SUP
 CPPFLAGS += $(BASISU_DEFS) -isystem $(BASISU_DIR)/src/transcoder -isystem $(BASISU_DIR)/src/encoder
 # The project's flags less -Werror and -Wextra, and less the warnings GCC 12 finds in the
 # vendor's code (unused values and parameters, memsets of classes, misleading indentation,
-# sign comparisons and an enum in a conditional in its miniz copy, a maybe-uninitialized):
+# sign comparisons and an enum in a conditional in its miniz copy, a maybe-uninitialized;
+# -Wno-unknown-warning-option: clang, make fuzz's compiler, lacks two of these options):
 # the code is not ours to change, and they would stop or flood the build. Strict aliasing off
 # as the vendor's build has it: its block code type-puns.
 BASISU_CXXFLAGS = $(filter-out -Werror -Wextra,$(CXXFLAGS)) -Wno-unused-local-typedefs -Wno-unused-value \
 	-Wno-unused-variable -Wno-class-memaccess -Wno-misleading-indentation -Wno-sign-compare \
-	-Wno-maybe-uninitialized -fno-strict-aliasing -DNDEBUG
+	-Wno-maybe-uninitialized -Wno-unknown-warning-option -fno-strict-aliasing -DNDEBUG
 BASISU_LIB := $(BUILD)/basisu/libbasisu_transcoder.a
 BASISU_ENC_LIB := $(BUILD)/basisu/libbasisu_encoder.a
 BASISU_ENC_OBJ := $(patsubst $(BASISU_DIR)/src/%.cpp,$(BUILD)/basisu/%.o,$(wildcard $(BASISU_DIR)/src/encoder/*.cpp))

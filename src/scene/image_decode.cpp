@@ -14,6 +14,7 @@
 #include <cstring>
 #include <mutex>
 #include <new>
+#include <vector>
 
 #if GONIO_BASISU
 #include <basisu_transcoder.h>
@@ -160,6 +161,10 @@ image_decode_status decode_ktx2(const uint8_t *b, size_t size, uint64_t max_texe
         if (model != 166)
             return bad(why, n, "KTX2: colour model %u with supercompression %u (must be UASTC, 166; ETC1S comes "
                        "with BasisLZ)", model, scheme);
+        /* KTX2 aligns a level of 16-byte blocks to 16 bytes; the transcoder reads them in place. */
+        if (scheme == 0 && off0 % 16)
+            return bad(why, n, "KTX2: level 0 starts at byte %llu, not a multiple of 16 as KTX2 aligns UASTC blocks",
+                       (unsigned long long)off0);
         /* Zstandard inflates level 0 to raw0 bytes: exactly the blocks, 16 bytes each. */
         uint64_t data = scheme == 2 ? raw0 : len0;
         if (data != blocks * 16)
@@ -173,6 +178,13 @@ image_decode_status decode_ktx2(const uint8_t *b, size_t size, uint64_t max_texe
     if (size > UINT32_MAX)
         return bad(why, n, "KTX2: %zu bytes, more than Basis Universal reads", size);
 #if GONIO_BASISU
+    /* The transcoder reads UASTC blocks as structs: the file goes where new aligns it when
+     * the bytes are not (an image in a GLB's buffer view may start at any byte). */
+    std::vector<uint8_t> copy;
+    if (reinterpret_cast<uintptr_t>(b) % 16) {
+        copy.assign(b, b + size);
+        b = copy.data();
+    }
     std::call_once(basisu_once, basist::basisu_transcoder_init);
     basist::ktx2_transcoder t;
     if (!t.init(b, uint32_t(size)))
