@@ -117,7 +117,8 @@ image_decode_status decode_ktx2(const uint8_t *b, size_t size, uint64_t max_texe
         return bad(why, n, "KTX2: truncated (%zu bytes; the header alone is %zu)", size, KTX2_HEADER);
     uint32_t vk_format = le32(b + 12), type_size = le32(b + 16), w = le32(b + 20), h = le32(b + 24),
              depth = le32(b + 28), layers = le32(b + 32), faces = le32(b + 36), levels = le32(b + 40),
-             scheme = le32(b + 44), dfd_off = le32(b + 48), dfd_len = le32(b + 52);
+             scheme = le32(b + 44), dfd_off = le32(b + 48), dfd_len = le32(b + 52), kvd_off = le32(b + 56),
+             kvd_len = le32(b + 60);
     uint64_t sgd_off = le64(b + 64), sgd_len = le64(b + 72);
     if (w < 1 || h < 1)
         return bad(why, n, "KTX2: image size %ux%u (a 2D texture has both)", w, h);
@@ -142,10 +143,18 @@ image_decode_status decode_ktx2(const uint8_t *b, size_t size, uint64_t max_texe
     if (!within(KTX2_HEADER, uint64_t(levels) * KTX2_LEVEL, size))
         return bad(why, n, "KTX2: truncated (%zu bytes; the level index ends at byte %llu)", size,
                    (unsigned long long)(KTX2_HEADER + uint64_t(levels) * KTX2_LEVEL));
+    /* Every range the file gives, in 64 bits: the transcoder adds some in 32 (a key/value
+     * length of 2^32 - 14 wrapped around and it copied 128 KiB past the end of the file). */
+    for (uint32_t l = 0; l < levels; l++) {
+        uint64_t off = le64(b + KTX2_HEADER + KTX2_LEVEL * l), len = le64(b + KTX2_HEADER + KTX2_LEVEL * l + 8);
+        if (!within(off, len, size) || len == 0)
+            return bad(why, n, "KTX2: level %u's %llu bytes at byte %llu do not lie within the file's %zu bytes", l,
+                       (unsigned long long)len, (unsigned long long)off, size);
+    }
     uint64_t off0 = le64(b + KTX2_HEADER), len0 = le64(b + KTX2_HEADER + 8), raw0 = le64(b + KTX2_HEADER + 16);
-    if (!within(off0, len0, size) || len0 == 0)
-        return bad(why, n, "KTX2: level 0's %llu bytes at byte %llu do not lie within the file's %zu bytes",
-                   (unsigned long long)len0, (unsigned long long)off0, size);
+    if (kvd_len && !within(kvd_off, kvd_len, size))
+        return bad(why, n, "KTX2: the key/value data (%u bytes at byte %u) does not lie within the file's %zu bytes",
+                   kvd_len, kvd_off, size);
     if (dfd_len < 16 || !within(dfd_off, dfd_len, size))
         return bad(why, n, "KTX2: the data format descriptor (%u bytes at byte %u) does not lie within the "
                    "file's %zu bytes", dfd_len, dfd_off, size);
@@ -303,11 +312,11 @@ extern "C" const char *image_decode_versions(void)
     static char line[256];
     int v = WebPGetDecoderVersion();
 #if GONIO_BASISU
-    snprintf(line, sizeof line, "libwebp %d.%d.%d, Basis Universal %s (crate %s)", v >> 16 & 255, v >> 8 & 255,
-             v & 255, GONIO_BASISU_VERSION, GONIO_BASISU_CRATE);
+    snprintf(line, sizeof line, "stb_image (PNG, JPEG), libwebp %d.%d.%d (WebP), Basis Universal %s (KTX2; crate %s)",
+             v >> 16 & 255, v >> 8 & 255, v & 255, GONIO_BASISU_VERSION, GONIO_BASISU_CRATE);
 #else
-    snprintf(line, sizeof line, "libwebp %d.%d.%d, no Basis Universal (%s)", v >> 16 & 255, v >> 8 & 255, v & 255,
-             GONIO_BASISU_MISSING);
+    snprintf(line, sizeof line, "stb_image (PNG, JPEG), libwebp %d.%d.%d (WebP), no Basis Universal for KTX2 (%s)",
+             v >> 16 & 255, v >> 8 & 255, v & 255, GONIO_BASISU_MISSING);
 #endif
     return line;
 }

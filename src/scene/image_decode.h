@@ -51,7 +51,8 @@ image_decode_status image_decode(const uint8_t *bytes, size_t size, const char *
  * image_decode_ktx2_missing says why. */
 bool image_decode_has_ktx2(void);
 const char *image_decode_ktx2_missing(void);
-/* The decoders' versions, one line: "libwebp 1.2.4, Basis Universal 1.16 (crate ...)". */
+/* The image decoders and their versions, one line: "stb_image (PNG, JPEG), libwebp 1.2.4
+ * (WebP), Basis Universal 1.16 (KTX2; crate ...)", or why Basis Universal is missing. */
 const char *image_decode_versions(void);
 
 #ifdef __cplusplus

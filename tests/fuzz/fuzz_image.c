@@ -4,7 +4,9 @@
  * headers and data rather than into signatures that fail at once. The texel budget is a
  * small one, so declared sizes past it are refused and those within it decoded. Any input
  * must give an image or a reason, never a crash, a sanitizer report, a leak or a hang. */
-#include "fuzz_common.h"
+#include <stdlib.h>
+#include <string.h>
+
 #include "image_decode.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

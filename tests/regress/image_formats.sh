@@ -25,7 +25,7 @@ command -v cwebp >/dev/null || skip_all "cwebp (Debian's webp) is needed to writ
 KTX2=1
 if ! "$G" --version | grep -q "Basis Universal [0-9]"; then
     KTX2=0
-    echo "  note: this gonio has no Basis Universal ($("$G" --version | sed -n 's/.*no Basis Universal //p')): KTX2 rendering is skipped"
+    echo "  note: this gonio has no Basis Universal ($("$G" --version | sed -n 's/.*no Basis Universal for KTX2 (\(.*\))$/\1/p')): KTX2 decoding and rendering are skipped"
 fi
 N=48
 EXR="python3 $(dirname "$0")/../tool/exrtool.py"
@@ -224,6 +224,7 @@ put("levels.ktx2", 40, "<I", 9)           # levelCount 9 for a 16x16 image
 put("scheme.ktx2", 44, "<I", 3)           # supercompression 3
 put("level0.ktx2", 80, "<Q", 1 << 62)     # level 0's offset far past the end
 put("sgd.ktx2", 72, "<Q", (1 << 64) - 1)  # global data that wraps around
+put("kvd.ktx2", 60, "<I", (1 << 32) - 14)  # key/value data that wraps around in 32 bits (the fuzzer's find)
 put("huge.ktx2", 20, "<Q", 65536 | 65536 << 32) # width and height 65536: 2^32 texels declared
 b = bytearray(good); b[len(b) // 2:] = bytes(len(b) - len(b) // 2); open(d + "/zeroed.ktx2", "wb").write(bytes(b))
 u = open(d + "/blocks-uastc.ktx2", "rb").read()  # UASTC's level moved one byte on (the fuzzer's find)
@@ -231,7 +232,8 @@ off = struct.unpack_from("<Q", u, 80)[0]
 b = bytearray(u[:off] + b"\0" + u[off:]); struct.pack_into("<Q", b, 80, off + 1); open(d + "/misaligned.ktx2", "wb").write(bytes(b))
 PY
     for f in vkformat:"vkFormat 37" cube:"cube map" levels:"levelCount 9" scheme:"supercompression scheme 3" \
-        level0:"level 0's" sgd:"BasisLZ global data" zeroed:"Basis Universal cannot" misaligned:"not a multiple of 16"; do
+        level0:"level 0's" sgd:"BasisLZ global data" zeroed:"Basis Universal cannot" misaligned:"not a multiple of 16" \
+        kvd:"key/value data"; do
         k=${f%%:*} want=${f#*:}
         scene "bad_$k" "{\"images\": [\"$k.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU, \"required\": $BASISU}"
         "$G" info "$tmp/bad_$k.gltf" >/dev/null 2>"$tmp/bad_$k.txt"
