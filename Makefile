@@ -88,9 +88,13 @@ BASISU_LIB :=
 BASISU_ENC_LIB :=
 ifeq ($(BASISU),1)
 # KTX2 with Zstandard (Debian's libzstd), neither SSE kernels nor OpenCL (the encoder's
-# options, unused by the transcoder). NDEBUG: the vendor's assert(0)s sit on paths that then
-# return an error, which hostile files reach; asserting would turn them into aborts.
-BASISU_DEFS := -DBASISD_SUPPORT_KTX2=1 -DBASISD_SUPPORT_KTX2_ZSTD=1 -DBASISU_SUPPORT_SSE=0 -DBASISU_SUPPORT_OPENCL=0
+# options, unused by the transcoder), and UASTC's bits read a byte at a time: the vendor's
+# x86 default reads 16-bit words at odd addresses, undefined behaviour that UBSan stops on
+# (its own switch for this knows clang's UBSan, not GCC's). NDEBUG: the vendor's assert(0)s
+# sit on paths that then return an error, which hostile files reach; asserting would turn
+# them into aborts.
+BASISU_DEFS := -DBASISD_SUPPORT_KTX2=1 -DBASISD_SUPPORT_KTX2_ZSTD=1 -DBASISU_SUPPORT_SSE=0 -DBASISU_SUPPORT_OPENCL=0 \
+	-DBASISD_USE_UNALIGNED_WORD_READS=0
 # -isystem: the vendor headers' warnings are not the project's (see BASISU_CXXFLAGS).
 CPPFLAGS += $(BASISU_DEFS) -isystem $(BASISU_DIR)/src/transcoder -isystem $(BASISU_DIR)/src/encoder
 # The project's flags less -Werror and -Wextra, and less the warnings GCC 12 finds in the
