@@ -172,7 +172,8 @@ static bool same_render(const char *a, const char *b)
     "Inputs rendered with --crop are placed by their EXR data windows: tiles assemble into\n" \
     "the frame (or the region they cover), and at every pixel the inputs covering it are\n" \
     "combined; every pixel must get the same number of samples (no holes, no uneven\n" \
-    "overlaps). The sum.* channels of --resumable renders are left out.\n" \
+    "overlaps). The sum.* channels of --resumable renders are left out. Denoised renders\n" \
+    "(render --denoise, gonio denoise) are refused: their pixels are no mean of samples.\n" \
     "\n" \
     "The inputs must be one render: the same frame size and channels, and the same gonio:scene\n" \
     "(a hash of the scene's content), gonio:size, gonio:mode, gonio:camera and options of the\n" \
@@ -191,14 +192,14 @@ int cmd_merge(int argc, char **argv)
     image_exr_options exr = IMAGE_EXR_DEFAULTS;
     const cli_option options[] = {
         {"-o, --output", "FILE", "the merged OpenEXR (a .exr name; written atomically)", CLI_STRING, CLI_AS(const char *, &out_path),
-         0, 0, NULL, NULL},
-        {"--force", NULL, "merge inputs that share a seed", CLI_FLAG, CLI_AS(bool, &force), 0, 0, NULL, NULL},
+         0, 0, NULL, NULL, "*.exr"},
+        {"--force", NULL, "merge inputs that share a seed", CLI_FLAG, CLI_AS(bool, &force), 0, 0, NULL, NULL, NULL},
         CLI_OPT_EXR_HALF(&exr.half),
         CLI_OPT_EXR_COMPRESSION(&exr.compression),
     };
     const cli_command cmd = {
         .name = "merge", .synopsis = "A.exr B.exr ... -o OUT.exr [--force] [--half] [--compression C]",
-        .intro = MERGE_INTRO, CLI_OPTIONS(options), .max_args = -1};
+        .intro = MERGE_INTRO, CLI_OPTIONS(options), .max_args = -1, .complete_args = "*.exr"};
     cli_args args;
     if ((rc = cli_parse(&cmd, argc, argv, &args)) >= 0)
         return rc;
@@ -231,6 +232,15 @@ int cmd_merge(int argc, char **argv)
         double s;
         if (!image_read_exr(&imgs[i], inputs[i]) || !read_spp(inputs[i], &spp[i]))
             goto done;
+        {
+            /* A denoised file's R, G, B are no mean of samples (render --denoise, gonio denoise). */
+            char dn[256];
+            if (image_exr_attr_string(inputs[i], "gonio:denoiser", dn, sizeof dn)) {
+                util_error("%s: is denoised (gonio:denoiser '%s'): its R, G, B are not a mean of samples; merge "
+                           "renders made without --denoise, then denoise the merge (gonio denoise)", inputs[i], dn);
+                goto done;
+            }
+        }
         if (!image_inside_frame(&imgs[i])) {
             util_error("%s: its data window (%d,%d)+%dx%d lies outside its %dx%d display window: not a tile "
                        "of a render", inputs[i], imgs[i].x0, imgs[i].y0, imgs[i].width, imgs[i].height,

@@ -57,6 +57,19 @@ int image_channel(const image *img, const char *name)
     return -1;
 }
 
+void image_remove_channel(image *img, int c)
+{
+    assert(c >= 0 && c < img->num_channels);
+    free(img->planes[c]);
+    for (int k = c; k + 1 < img->num_channels; k++) {
+        memcpy(img->names[k], img->names[k + 1], sizeof img->names[k]);
+        img->planes[k] = img->planes[k + 1];
+    }
+    img->num_channels--;
+    img->planes[img->num_channels] = NULL;
+    img->names[img->num_channels][0] = 0;
+}
+
 /* ---- OpenEXR ------------------------------------------------------------------------- */
 
 /* OpenEXR reports details (which chunk, which attribute) only through this callback; the
@@ -153,6 +166,12 @@ bool image_exr_compression_from_name(const char *name, int *out)
             return true;
         }
     return false;
+}
+
+const char *image_exr_compression_list(void)
+{
+    static char list[128];
+    return list[0] ? list : util_join(list, sizeof list, exr_compression_names, EXR_WRITABLE_COMPRESSIONS);
 }
 
 /* B44 packs HALF channels only; the rest of a chunk is stored as is, channel by channel, so
@@ -527,6 +546,71 @@ bool image_exr_size(const char *path, int *width, int *height)
     return ok;
 }
 
+/* The attributes OpenEXR requires of every file, which the writer sets itself. */
+static bool exr_required_attr(const char *name)
+{
+    static const char *const names[] = {"channels", "compression", "dataWindow", "displayWindow", "lineOrder",
+                                        "pixelAspectRatio", "screenWindowCenter", "screenWindowWidth", "tiles",
+                                        "type", "name", "version", "chunkCount"};
+    for (size_t k = 0; k < sizeof names / sizeof *names; k++)
+        if (!strcmp(name, names[k]))
+            return true;
+    return false;
+}
+
+bool image_exr_attrs(const char *path, image_attr_list *out)
+{
+    exr_context_t ctx;
+    int32_t n = 0;
+    memset(out, 0, sizeof *out);
+    if (!exr_open(&ctx, path))
+        return false;
+    if (exr_get_attribute_count(ctx, 0, &n) != EXR_ERR_SUCCESS || n < 0)
+        n = 0;
+    out->attrs = util_calloc((size_t)n + 1, sizeof *out->attrs);
+    for (int32_t k = 0; k < n; k++) {
+        const exr_attribute_t *a;
+        image_attr *d = &out->attrs[out->count];
+        if (exr_get_attribute_by_index(ctx, 0, EXR_ATTR_LIST_FILE_ORDER, k, &a) != EXR_ERR_SUCCESS ||
+            exr_required_attr(a->name))
+            continue;
+        switch (a->type) {
+        case EXR_ATTR_STRING: {
+            char *s = util_malloc((size_t)a->string->length + 1);
+            memcpy(s, a->string->str ? a->string->str : "", (size_t)a->string->length);
+            s[a->string->length] = 0;
+            *d = (image_attr){NULL, IMAGE_ATTR_STRING, s, 0, 0, NULL};
+            break;
+        }
+        case EXR_ATTR_INT: *d = (image_attr){NULL, IMAGE_ATTR_INT, NULL, a->i, 0, NULL}; break;
+        case EXR_ATTR_FLOAT: *d = (image_attr){NULL, IMAGE_ATTR_DOUBLE, NULL, 0, a->f, NULL}; break;
+        case EXR_ATTR_DOUBLE: *d = (image_attr){NULL, IMAGE_ATTR_DOUBLE, NULL, 0, a->d, NULL}; break;
+        case EXR_ATTR_M44F: {
+            float *m = util_malloc(sizeof a->m44f->m);
+            memcpy(m, a->m44f->m, sizeof a->m44f->m);
+            *d = (image_attr){NULL, IMAGE_ATTR_M44F, NULL, 0, 0, m};
+            break;
+        }
+        default: continue; /* types the writer does not write */
+        }
+        d->name = strcpy(util_malloc(strlen(a->name) + 1), a->name);
+        out->count++;
+    }
+    exr_finish(&ctx);
+    return true;
+}
+
+void image_attr_list_destroy(image_attr_list *l)
+{
+    for (int k = 0; k < l->count; k++) {
+        free((char *)l->attrs[k].name);
+        free((char *)l->attrs[k].s);
+        free((float *)l->attrs[k].m);
+    }
+    free(l->attrs);
+    memset(l, 0, sizeof *l);
+}
+
 /* ---- 8-bit output and PNG ------------------------------------------------------------ */
 
 static uint8_t srgb8(float value, float scale, image_tonemap tm)
@@ -735,3 +819,9 @@ bool image_tonemap_from_name(const char *name, image_tonemap *out)
 }
 
 const char *image_tonemap_name(image_tonemap tm) { return tonemap_names[tm]; }
+
+const char *image_tonemap_list(void)
+{
+    static char list[64];
+    return list[0] ? list : util_join(list, sizeof list, tonemap_names, 3);
+}
