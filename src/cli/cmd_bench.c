@@ -264,26 +264,24 @@ int cmd_bench(int argc, char **argv)
     const double t_start = util_now();
     const char *path = NULL; /* the built-in Cornell box */
     int generate = 0;
-    float seconds = 3, env = 0;
+    float seconds = 3;
+    env_option env = {0};
     int device = -1, size[2] = {0, 0}, ref_w = 128, ref_h = 128, ref_spp = 512;
     bool validate = false, paths = false, denoise = false;
     reference_option ref = {&ref_w, &ref_h, &ref_spp};
     const cli_option options[] = {
         /* meshgen_bench_mesh's 16 spheres and ground need about 1000 triangles. */
         {"--generate", "N", "a procedural mesh of about N triangles (1000..50000000) instead of a scene",
-         CLI_INT, CLI_AS(int, &generate), 1000, 50000000, "a triangle count 1000..50000000", NULL},
-        {"--size", "WxH", "rays per pass (default 512x512; --paths: 256x256)", CLI_CALL, size, 0, 0,
-         "WxH", cli_take_size},
+         CLI_INT, CLI_AS(int, &generate), 1000, 50000000, "a triangle count 1000..50000000", NULL, NULL},
+        CLI_OPT_SIZE(size, "rays per pass (default 512x512; --paths: 256x256)"),
         {"--seconds", "S", "measure each rate for about S seconds (default 3)", CLI_FLOAT, CLI_AS(float, &seconds),
-         FLT_MIN, 1e6, "a number > 0", NULL},
-        {"--paths", NULL, "measure the path tracer", CLI_FLAG, CLI_AS(bool, &paths), 0, 0, NULL, NULL},
-        {"--env", "V", "--paths: constant environment radiance (default 0)", CLI_FLOAT, CLI_AS(float, &env), 0, 3e38,
-         "a radiance >= 0", NULL},
+         FLT_MIN, 1e6, "a number > 0", NULL, NULL},
+        {"--paths", NULL, "measure the path tracer", CLI_FLAG, CLI_AS(bool, &paths), 0, 0, NULL, NULL, NULL},
+        CLI_OPT_ENV(&env, "--paths: the environment, as gonio render's (default 0: black)"),
         {"--reference", "WxH:SPP", "--paths: the RMSE reference (default 128x128:512)", CLI_CALL, &ref,
-         0, 0, "WxH:SPP", take_reference},
-        {"--denoise", NULL, "--paths: also the time to each RMSE of the denoised image (render\n"
-                            "--denoise: OIDN guided by albedo and normal) and the speed-up",
-         CLI_FLAG, CLI_AS(bool, &denoise), 0, 0, NULL, NULL},
+         0, 0, "WxH:SPP", take_reference, NULL},
+        CLI_OPT_DENOISE(&denoise, "--paths: also the time to each RMSE of the denoised image (render\n"
+                                  "--denoise: OIDN guided by albedo and normal) and the speed-up"),
         CLI_OPT_DEVICE(&device),
         CLI_OPT_VALIDATE(&validate),
     };
@@ -300,7 +298,7 @@ int cmd_bench(int argc, char **argv)
             "progressive render's RMSE (linear RGB) against a high-spp reference (with the\n"
             "reference's own estimated noise removed) first falls below 0.05 and 0.02 (times count\n"
             "the passes, not the RMSE checks).\n",
-        CLI_OPTIONS(options), .max_args = 1};
+        CLI_OPTIONS(options), .max_args = 1, .complete_args = "*.gltf *.glb"};
     cli_args args;
     int rc;
     scene sc = {0};
@@ -371,11 +369,18 @@ int cmd_bench(int argc, char **argv)
     s.camera = sc.num_cameras ? 0 : -1;
     s.no_shadows = true;
     if (paths) {
-        bool ok;
+        bool ok, studio;
+        image env_map = {0};
         s.mode = GN_MODE_PATH;
         s.aov = RENDER_AOV_VARIANCE; /* the reference's own noise needs its squares */
-        s.env[0] = s.env[1] = s.env[2] = env;
+        if (env.given && !env_setup(&env, &sc, true, &env_map, &s, &studio)) {
+            renderer_destroy(&r);
+            scene_destroy(&sc);
+            gpu_destroy(&g);
+            return 1;
+        }
         ok = bench_paths(&r, &s, t_start, seconds, ref_w, ref_h, ref_spp, denoise);
+        image_destroy(&env_map);
         print_build(&sc);
         renderer_destroy(&r);
         scene_destroy(&sc);

@@ -196,28 +196,26 @@ int cmd_denoise(int argc, char **argv)
     const cli_option options[] = {
         {"-o, --output", "FILE", "the denoised image: .exr (layers as above) or .png (tonemapped\n"
                                  "sRGB); written atomically",
-         CLI_STRING, CLI_AS(const char *, &out_path), 0, 0, NULL, NULL},
-        {"--png", "FILE", "also write the denoised image as PNG", CLI_STRING, CLI_AS(const char *, &png_path), 0, 0,
-         NULL, NULL},
+         CLI_STRING, CLI_AS(const char *, &out_path), 0, 0, NULL, NULL, "*.exr *.png"},
+        CLI_OPT_PNG(&png_path, "also write the denoised image as PNG"),
         {"--beauty", "LAYER", "the layer to denoise (default: found as above)", CLI_STRING,
-         CLI_AS(const char *, &beauty_opt), 0, 0, NULL, NULL},
+         CLI_AS(const char *, &beauty_opt), 0, 0, NULL, NULL, NULL},
         {"--albedo", "LAYER|FILE|none", "the albedo guide (default: found as above)", CLI_STRING,
-         CLI_AS(const char *, &albedo_opt), 0, 0, NULL, NULL},
+         CLI_AS(const char *, &albedo_opt), 0, 0, NULL, NULL, "none *.exr"},
         {"--normal", "LAYER|FILE|none", "the normal guide (default: found as above)", CLI_STRING,
-         CLI_AS(const char *, &normal_opt), 0, 0, NULL, NULL},
+         CLI_AS(const char *, &normal_opt), 0, 0, NULL, NULL, "none *.exr"},
         {"--no-prefilter", NULL, "pass the guides as they are (noisy guides: OIDN's cleanAux off)",
-         CLI_FLAG, CLI_AS(bool, &no_prefilter), 0, 0, NULL, NULL},
+         CLI_FLAG, CLI_AS(bool, &no_prefilter), 0, 0, NULL, NULL, NULL},
         CLI_OPT_EXR_HALF(&exr.half),
         CLI_OPT_EXR_COMPRESSION(&exr.compression),
-        {"--exposure", "E", "PNG only: scale by 2^E before tonemapping (default 0)", CLI_FLOAT,
-         CLI_AS(float, &exposure), -1e6, 1e6, "a number", NULL},
-        {"--tonemap", "T", "PNG only: clamp (default), reinhard, aces", CLI_CALL, &tm, 0, 0,
-         "clamp, reinhard or aces", cli_take_tonemap},
+        CLI_OPT_EXPOSURE(&exposure, "PNG only: scale by 2^E before tonemapping (default 0)"),
+        CLI_OPT_TONEMAP(&tm, "PNG only: clamp (default), reinhard, aces"),
         CLI_OPT_QUIET(&quiet, "no summary line"),
     };
     const cli_command cmd = {.name = "denoise", .synopsis = "IN.exr -o OUT.exr|OUT.png [options]",
                              .intro = DENOISE_INTRO, CLI_OPTIONS(options), .epilog = DENOISE_EPILOG,
-                             .min_args = 1, .max_args = 1, .missing = "no input EXR given"};
+                             .min_args = 1, .max_args = 1, .missing = "no input EXR given",
+                             .complete_args = "*.exr"};
     cli_args args;
     int rc = cli_parse(&cmd, argc, argv, &args);
     const char *in_path, *exr_path = NULL, *png_o = NULL;

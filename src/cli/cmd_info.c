@@ -5,6 +5,7 @@
 
 #include "bvh.h"
 #include "cli.h"
+#include "image_decode.h"
 #include "render_geometry.h"
 #include "scene.h"
 #include "util.h"
@@ -19,8 +20,9 @@ static const char *shown(const char *name)
     return name[0] ? util_escape(name, b, sizeof buf[0]) : "(unnamed)";
 }
 
-/* The area lights as the path tracer sees them (render.c: build_emitters): triangles of
- * non-zero area whose material emits and is not unlit; prints the materials by name. */
+/* The area lights as the path tracer sees them (src/render/render_lights.c: build_emitters):
+ * triangles of non-zero area whose material emits and is not unlit; prints the materials by
+ * name. */
 static void print_emitters(const scene *sc)
 {
     uint32_t tris = 0, mats = 0;
@@ -113,6 +115,34 @@ static void print_films(const scene *sc)
     }
 }
 
+/* The images' encodings (WebP: EXT_texture_webp, KTX2: KHR_texture_basisu), one count each. */
+static void print_image_formats(const scene *sc)
+{
+    uint32_t count[TEXTURE_FORMAT_COUNT] = {0};
+    for (uint32_t i = 0; i < sc->num_images; i++)
+        count[sc->images[i].format < TEXTURE_FORMAT_COUNT ? sc->images[i].format : TEXTURE_FORMAT_UNKNOWN]++;
+    if (!sc->num_images)
+        return;
+    printf("image formats ");
+    for (int f = 0, n = 0; f < TEXTURE_FORMAT_COUNT; f++)
+        if (count[f])
+            printf("%s %u %s", n++ ? "," : "", count[f], texture_format_name((texture_format)f));
+    printf("\n");
+}
+
+/* The extensions the file lists, one line each: how gonio handles it (scene.h: scene_extension). */
+static void print_extensions(const scene *sc)
+{
+    static const char *const support[] = {[SCENE_UNSUPPORTED] = "unsupported (ignored)", [SCENE_PARTLY] = "partly",
+                                          [SCENE_SUPPORTED] = "supported"};
+    printf("extensions     %u\n", sc->num_extensions);
+    for (uint32_t i = 0; i < sc->num_extensions; i++) {
+        const scene_extension *e = &sc->extensions[i];
+        printf("extension      %s%s: %s: %s\n", shown(e->name), e->required ? " (required)" : "", support[e->support],
+               e->how);
+    }
+}
+
 int cmd_info(int argc, char **argv)
 {
     bool outside = false;
@@ -130,8 +160,12 @@ int cmd_info(int argc, char **argv)
                  "(KHR_materials_anisotropy): strength, rotation and whether a texture sets them;\n"
                  "and one line per material with an iridescent film (KHR_materials_iridescence:\n"
                  "factor, film IOR, thickness) or a diffuse transmission\n"
-                 "(KHR_materials_diffuse_transmission: factor, colour).\n",
-        CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given"};
+                 "(KHR_materials_diffuse_transmission: factor, colour); the images' formats (PNG,\n"
+                 "JPEG, WebP for EXT_texture_webp, KTX2 for KHR_texture_basisu); and one line per\n"
+                 "extension the file lists: whether gonio supports it, partly (and what it leaves out)\n"
+                 "or not (and why).\n",
+        CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given",
+        .complete_args = "*.gltf *.glb"};
     cli_args args;
     scene sc = {0};
     render_geometry geo;
@@ -168,7 +202,9 @@ int cmd_info(int argc, char **argv)
     printf("variants       %u\n", sc.num_variants);
     for (uint32_t i = 0; i < sc.num_variants; i++)
         printf("variant %-6u \"%s\"\n", i, shown(sc.variant_names[i]));
+    print_extensions(&sc);
     printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
+    print_image_formats(&sc);
     printf("lights         %u\n", sc.num_lights);
     print_emitters(&sc);
     print_media(&sc);

@@ -192,14 +192,14 @@ int cmd_merge(int argc, char **argv)
     image_exr_options exr = IMAGE_EXR_DEFAULTS;
     const cli_option options[] = {
         {"-o, --output", "FILE", "the merged OpenEXR (a .exr name; written atomically)", CLI_STRING, CLI_AS(const char *, &out_path),
-         0, 0, NULL, NULL},
-        {"--force", NULL, "merge inputs that share a seed", CLI_FLAG, CLI_AS(bool, &force), 0, 0, NULL, NULL},
+         0, 0, NULL, NULL, "*.exr"},
+        {"--force", NULL, "merge inputs that share a seed", CLI_FLAG, CLI_AS(bool, &force), 0, 0, NULL, NULL, NULL},
         CLI_OPT_EXR_HALF(&exr.half),
         CLI_OPT_EXR_COMPRESSION(&exr.compression),
     };
     const cli_command cmd = {
         .name = "merge", .synopsis = "A.exr B.exr ... -o OUT.exr [--force] [--half] [--compression C]",
-        .intro = MERGE_INTRO, CLI_OPTIONS(options), .max_args = -1};
+        .intro = MERGE_INTRO, CLI_OPTIONS(options), .max_args = -1, .complete_args = "*.exr"};
     cli_args args;
     if ((rc = cli_parse(&cmd, argc, argv, &args)) >= 0)
         return rc;

@@ -16,7 +16,9 @@
 #include "denoise.h"
 #include "environment.h"
 #include "image.h"
+#include "progress.h"
 #include "render.h"
+#include "render_material.h"
 #include "render_output.h"
 #include "scene.h"
 #include "util.h"
@@ -197,7 +199,7 @@ static bool check_resume(const char *path, const renderer *r, render_settings *s
     int region[4];
     double spp;
     uint32_t seed;
-    render_header_build(&h, r, s, &st, brdf);
+    render_header_build(&h, r, s, &st, brdf, cli_command_line());
     if (!image_read_exr(prev, path))
         return false;
     if (!image_exr_attr_double(path, "gonio:spp", &spp) || !(spp >= 1 && spp <= INT32_MAX && spp == floor(spp))) {
@@ -315,6 +317,7 @@ typedef struct render_job {
     camera_option cam;
     env_option env;
     crop_option crop;
+    int size[2];  /* --size */
     bool size_given, quiet, validate, resumable, outside, denoise;
     int frame;   /* --frame, -1 none */
     float fps;
@@ -327,14 +330,6 @@ typedef struct render_job {
 } render_job;
 
 /* CLI_CALL parsers of render's own values. */
-static bool take_size(const char *cmd, const char *opt, const char *val, void *dest)
-{
-    (void)cmd, (void)opt;
-    render_job *j = dest;
-    j->size_given = true;
-    return util_parse_size(val, &j->s.width, &j->s.height);
-}
-
 static bool take_crop(const char *cmd, const char *opt, const char *val, void *dest)
 {
     (void)cmd, (void)opt;
@@ -376,15 +371,25 @@ static bool take_brdf(const char *cmd, const char *opt, const char *val, void *d
     return brdf_spec_check(val);
 }
 
+/* --estimator: the names and their GnFrame strategy flags. */
+static const char *const estimator_names[] = {"mis", "light", "bsdf"};
+static const uint32_t estimator_flags[] = {0, GN_FRAME_LIGHT_ONLY, GN_FRAME_BSDF_ONLY};
+
 static bool take_estimator(const char *cmd, const char *opt, const char *val, void *dest)
 {
     (void)cmd, (void)opt;
-    uint32_t *strategy = dest;
-    if (!strcmp(val, "mis")) *strategy = 0;
-    else if (!strcmp(val, "light")) *strategy = GN_FRAME_LIGHT_ONLY;
-    else if (!strcmp(val, "bsdf")) *strategy = GN_FRAME_BSDF_ONLY;
-    else return false;
-    return true;
+    for (int i = 0; i < 3; i++)
+        if (!strcmp(val, estimator_names[i])) {
+            *(uint32_t *)dest = estimator_flags[i];
+            return true;
+        }
+    return false;
+}
+
+static const char *estimator_list(void)
+{
+    static char list[32];
+    return list[0] ? list : util_join(list, sizeof list, estimator_names, 3);
 }
 
 static int render_run(const render_job *job);
@@ -449,8 +454,7 @@ static int render_frames(const render_job *job)
 
 int cmd_render(int argc, char **argv)
 {
-    render_job j = {.s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .progress = true,
-                          .stop = &stop_requested},
+    render_job j = {.s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .stop = &stop_requested},
                     .frame = -1, .fps = 24, .at = -1, .device = -1, .scene_index = -1,
                     .tm = IMAGE_TONEMAP_CLAMP, .exr = IMAGE_EXR_DEFAULTS};
     bool no_shadows = false;
@@ -458,87 +462,83 @@ int cmd_render(int argc, char **argv)
         {"-o, --output", "FILE", "the image, in the format its name says: .exr linear float RGBA\n"
                                  "OpenEXR with the gonio:* header; .png the PNG --png writes\n"
                                  "(any other name is a usage error); written atomically",
-         CLI_STRING, CLI_AS(const char *, &j.out_path), 0, 0, NULL, NULL},
-        {"--png", "FILE", "also write a PNG: tonemapped sRGB; in modes depth, normal and\n"
-                          "cost a picture of the data: depth grey from white (nearest) to 20%\n"
-                          "grey (farthest visible), normals 0.5 n + 0.5, cost a viridis heat\n"
-                          "map up to the image's maximum (misses too: they walk the tree);\n"
-                          "the background of depth and normals black",
-         CLI_STRING, CLI_AS(const char *, &j.png_path), 0, 0, NULL, NULL},
-        {"--mode", "M", render_mode_help(), CLI_CALL, &j.s.mode, 0, 0, NULL, cli_take_mode},
-        {"--spp", "N", "samples per pixel (default 16)", CLI_INT, CLI_AS(int, &j.s.spp), 1, 1 << 24,
-         "an integer 1..16777216", NULL},
+         CLI_STRING, CLI_AS(const char *, &j.out_path), 0, 0, NULL, NULL, "*.exr *.png"},
+        CLI_OPT_PNG(&j.png_path, "also write a PNG: tonemapped sRGB; in modes depth, normal and\n"
+                                 "cost a picture of the data: depth grey from white (nearest) to 20%\n"
+                                 "grey (farthest visible), normals 0.5 n + 0.5, cost a viridis heat\n"
+                                 "map up to the image's maximum (misses too: they walk the tree);\n"
+                                 "the background of depth and normals black"),
+        CLI_OPT_MODE(&j.s.mode),
+        CLI_OPT_SPP(&j.s.spp, "samples per pixel (default 16)"),
         {"--time", "SECONDS", "render for this long instead of --spp", CLI_DOUBLE, CLI_AS(double, &j.s.time_limit), FLT_MIN,
-         3e38, "seconds > 0", NULL},
-        {"--size", "WxH", "image size (default 512 on the longer side, the camera's aspect)", CLI_CALL, &j,
-         0, 0, "WxH, e.g. 640x480 (1..16384)", take_size},
+         3e38, "seconds > 0", NULL, NULL},
+        CLI_OPT_SIZE(j.size, "image size (default 512 on the longer side, the camera's aspect)"),
         CAMERA_OPTIONS(&j.cam),
-        {"--scene", "N", "render the file's glTF scene N (default: its default scene)", CLI_INT, CLI_AS(int, &j.scene_index), 0, 1 << 20, "an index >= 0", NULL},
-        {"--variant", "NAME", "the materials of the file's KHR_materials_variants variant NAME\n"
-                              "(gonio info lists them; default: the file's own materials)",
-         CLI_CALL, NULL, 0, 0, NULL, cli_take_variant},
+        CLI_OPT_SCENE(&j.scene_index, "render the file's glTF scene N (default: its default scene)"),
+        CLI_OPT_VARIANT("the materials of the file's KHR_materials_variants variant NAME\n"
+                        "(gonio info lists them; default: the file's own materials)"),
         CLI_OPT_ALLOW_OUTSIDE_FILES(&j.outside),
-        {"--seed", "S", "random seed (default 0); renders with different seeds merge", CLI_U32, CLI_AS(uint32_t, &j.s.seed), 0,
-         4294967295.0, "an integer 0..4294967295", NULL},
+        CLI_OPT_SEED(&j.s.seed, "random seed (default 0); renders with different seeds merge"),
         {"--frame", "N", "the scene's glTF animations at frame N / --fps (all play at once:\n"
                          "node translation, rotation, scale; meshes, cameras, lights)",
-         CLI_INT, CLI_AS(int, &j.frame), 0, 1 << 24, "a frame number >= 0", NULL},
+         CLI_INT, CLI_AS(int, &j.frame), 0, 1 << 24, "a frame number >= 0", NULL, NULL},
         {"--fps", "F", "frames per second for --frame and --frames (default 24)", CLI_FLOAT, CLI_AS(float, &j.fps), FLT_MIN,
-         1e6, "frames per second > 0", NULL},
-        {"--at", "SECONDS", "the animations at this time", CLI_FLOAT, CLI_AS(float, &j.at), 0, 1e9, "seconds >= 0", NULL},
+         1e6, "frames per second > 0", NULL, NULL},
+        {"--at", "SECONDS", "the animations at this time", CLI_FLOAT, CLI_AS(float, &j.at), 0, 1e9, "seconds >= 0", NULL, NULL},
         {"--frames", "A-B", "render frames A to B, one file each: -o and --png are patterns\n"
                             "with one %d (e.g. out/frame_%04d.exr); stops at the first failure",
-         CLI_STRING, CLI_AS(const char *, &j.frames), 0, 0, NULL, NULL},
+         CLI_STRING, CLI_AS(const char *, &j.frames), 0, 0, NULL, NULL, NULL},
         {"--crop", "X0,Y0,X1,Y1", "render only pixels [X0, X1) x [Y0, Y1) of the image, each as the\n"
                                   "whole render has it, bit for bit: an EXR whose data window is the\n"
                                   "region of the full display window (gonio merge assembles tiles);\n"
                                   "values with a '.' are fractions of the size (0,0,0.5,0.5: the\n"
                                   "top-left quarter; pixel = ceil(fraction x size), as pbrt's)",
-         CLI_CALL, &j, 0, 0, "X0,Y0,X1,Y1 in pixels (integers) or fractions 0..1", take_crop},
+         CLI_CALL, &j, 0, 0, "X0,Y0,X1,Y1 in pixels (integers) or fractions 0..1", take_crop, NULL},
         {"--resumable", NULL, "EXR: also write the exact sums (sum.* channels, 32-bit float)\n"
                               "that --resume goes on from; SIGTERM always writes them",
-         CLI_FLAG, CLI_AS(bool, &j.resumable), 0, 0, NULL, NULL},
+         CLI_FLAG, CLI_AS(bool, &j.resumable), 0, 0, NULL, NULL, NULL},
         {"--resume", "FILE.exr", "go on from a --resumable render of the same scene, camera, crop,\n"
                                  "seed and options (checked): --spp is the total; the result is the\n"
                                  "render of --spp in one run, bit for bit",
-         CLI_STRING, CLI_AS(const char *, &j.resume_path), 0, 0, NULL, NULL},
-        {"--denoise", NULL, "path: denoise with Intel Open Image Denoise (RT filter), guided by\n"
-                            "the albedo and normal (rendered for it, written only as --aov\n"
-                            "says): the PNG and the EXR's R,G,B denoised, its noisy.R/G/B the\n"
-                            "render itself (make denoiser fetches the library; docs/denoise.md)",
-         CLI_FLAG, CLI_AS(bool, &j.denoise), 0, 0, NULL, NULL},
+         CLI_STRING, CLI_AS(const char *, &j.resume_path), 0, 0, NULL, NULL, "*.exr"},
+        CLI_OPT_DENOISE(&j.denoise, "path: denoise with Intel Open Image Denoise (RT filter), guided by\n"
+                                    "the albedo and normal (rendered for it, written only as --aov\n"
+                                    "says): the PNG and the EXR's R,G,B denoised, its noisy.R/G/B the\n"
+                                    "render itself (make denoiser fetches the library; docs/denoise.md)"),
         {"--aov", "LIST", "extra EXR channels, exactly those listed: any of normal (normal.XYZ),\n"
                           "albedo (albedo.RGB), depth (depth.Z, 0 on a miss), variance\n"
                           "(variance.RGB: of each pixel's mean), comma-separated",
-         CLI_CALL, &j.s.aov, 0, 0, NULL, take_aov},
+         CLI_CALL, &j.s.aov, 0, 0, NULL, take_aov, render_aov_list()},
         CLI_OPT_EXR_HALF(&j.exr.half),
         CLI_OPT_EXR_COMPRESSION(&j.exr.compression),
         ENV_OPTIONS(&j.env),
-        {"--max-depth", "N", "path: at most N bounces (default 0: unbounded, roulette ends paths)", CLI_INT, CLI_AS(int, &j.s.max_depth), 0, 1 << 20, "an integer >= 0", NULL},
+        CLI_OPT_MAX_DEPTH(&j.s.max_depth, "path: at most N bounces (default 0: unbounded, roulette ends paths)"),
         {"--brdf", "MODEL[:P=V]", "path: render every material with a BRDF model (see gonio brdf\n"
                                   "--list), e.g. --brdf torrance-sparrow:exponent=128:specular=0.5",
-         CLI_CALL, &j.brdf, 0, 0, "a model of gonio brdf --list", take_brdf},
+         CLI_CALL, &j.brdf, 0, 0, "a model of gonio brdf --list", take_brdf, cli_brdf_models()},
         {"--estimator", "E", "path: mis (default), light or bsdf: one strategy only (tests)", CLI_CALL,
-         &j.s.strategy, 0, 0, "mis, light or bsdf", take_estimator},
-        {"--no-shadows", NULL, "local modes: no shadow rays", CLI_FLAG, CLI_AS(bool, &no_shadows), 0, 0, NULL, NULL},
+         &j.s.strategy, 0, 0, NULL, take_estimator, estimator_list()},
+        CLI_OPT_NO_SHADOWS(&no_shadows),
         {"--ambient", "R,G,B | V", "local modes: the Phong model's global ambient light (default 0)", CLI_CALL,
-         &j.s, 0, 0, "R,G,B or one value >= 0", take_ambient},
-        {"--exposure", "E", "PNG only: scale by 2^E before tonemapping (default 0)", CLI_FLOAT, CLI_AS(float, &j.exposure),
-         -1e6, 1e6, "a number", NULL},
-        {"--tonemap", "T", "PNG only: clamp (default), reinhard, aces", CLI_CALL, &j.tm, 0, 0,
-         "clamp, reinhard or aces", cli_take_tonemap},
+         &j.s, 0, 0, "R,G,B or one value >= 0", take_ambient, NULL},
+        CLI_OPT_EXPOSURE(&j.exposure, "PNG only: scale by 2^E before tonemapping (default 0)"),
+        CLI_OPT_TONEMAP(&j.tm, "PNG only: clamp (default), reinhard, aces"),
         CLI_OPT_DEVICE(&j.device),
         CLI_OPT_VALIDATE(&j.validate),
         CLI_OPT_QUIET(&j.quiet, "no progress and no summary line"),
     };
     const cli_command command = {.name = "render", .synopsis = "SCENE.gltf|.glb -o OUT.exr|OUT.png [options]",
                                  CLI_OPTIONS(options), .epilog = RENDER_EPILOG, .min_args = 1, .max_args = 1,
-                                 .missing = "no scene given"};
+                                 .missing = "no scene given", .complete_args = "*.gltf *.glb"};
     cli_args args;
     int rc = cli_parse(&command, argc, argv, &args);
     if (rc >= 0)
         return rc;
     j.scene_path = args.arg[0];
+    if ((j.size_given = cli_given(&command, &args, "--size"))) {
+        j.s.width = j.size[0];
+        j.s.height = j.size[1];
+    }
     j.s.no_shadows = no_shadows;
     const char *out_path = j.out_path, *png_path = j.png_path, *exr_path = NULL;
     warn_inapplicable(&command, &args, &j.s, png_path, out_path);
@@ -623,7 +623,9 @@ static int render_run(const render_job *job)
         png_o = out_path;
     exr.exact_prefix = "sum"; /* sum.* and sum2.*: the state --resume needs exactly */
     util_set_quiet(quiet);
-    s.progress = !quiet;
+    cli_progress progress;
+    s.progress = quiet ? NULL : cli_progress_report;
+    s.progress_user = &progress;
     scene_allow_outside_files(job->outside);
     if ((out_path && !util_check_output(out_path)) || (png_path && !util_check_output(png_path)))
         return 1;
@@ -704,7 +706,7 @@ static int render_run(const render_job *job)
         bool ok = true;
         int region[4];
         denoise_info dn = {0};
-        render_header_build(&h, rp, &s, &st, brdf);
+        render_header_build(&h, rp, &s, &st, brdf, cli_command_line());
         if (at >= 0 && h.count + 2 <= RENDER_HEADER_MAX) { /* the animation's time, and frame */
             h.attrs[h.count++] = (image_attr){"gonio:time", IMAGE_ATTR_DOUBLE, NULL, 0, at, NULL};
             if (frame >= 0)

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "image_decode.h"
 #include "util.h"
 
 static const struct {
@@ -36,6 +37,23 @@ static void usage(FILE *f)
                "\nOptions take their value as --opt value or --opt=value.\n");
 }
 
+/* gonio __complete WORD... (completion/gonio; not in --help): what may stand in place of
+ * the last word after the others, one candidate a line (cli_complete). */
+static int complete(int n, char **words)
+{
+    if (n <= 1) { /* the command itself */
+        for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
+            printf("%s\n", commands[i].name);
+        printf("--help\n--version\n");
+        return 0;
+    }
+    cli_complete(words[n - 1]);
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
+        if (!strcmp(words[0], commands[i].name))
+            return commands[i].fn(n - 1, words);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     cli_set_command_line(argc, argv);
@@ -47,8 +65,10 @@ int main(int argc, char **argv)
         usage(stdout);
         return 0;
     }
+    if (!strcmp(argv[1], "__complete"))
+        return complete(argc - 2, argv + 2);
     if (!strcmp(argv[1], "--version")) {
-        printf("gonio %s\n", GONIO_VERSION);
+        printf("gonio %s\nimage decoders: %s\n", GONIO_VERSION, image_decode_versions());
         return 0;
     }
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)

@@ -347,7 +347,7 @@ static bool save_accumulated(preview *p)
      * view, so --camera FILE.exr renders it again). */
     render_header h;
     render_stats st = {.spp = p->spp};
-    render_header_build(&h, &p->r, &p->s, &st, NULL);
+    render_header_build(&h, &p->r, &p->s, &st, NULL, cli_command_line());
     if (p->spp == 0)
         return true;
     for (int n = 1;; n++) {
@@ -848,34 +848,26 @@ int cmd_preview(int argc, char **argv)
     bool no_shadows = false, quiet = false, outside = false, denoise = false;
     int scene_index = -1;
     const cli_option options[] = {
-        {"--mode", "M", render_mode_help(), CLI_CALL, &p->s.mode, 0, 0, NULL, cli_take_mode},
-        {"--spp", "N", "stop accumulating at N samples per pixel (default: never)", CLI_INT, CLI_AS(int, &p->max_spp), 1,
-         1 << 24, "an integer 1..16777216", NULL},
-        {"--size", "WxH", "initial window size (default 640 wide, the camera's aspect)", CLI_CALL, size, 0, 0,
-         "WxH, e.g. 640x480", cli_take_size},
+        CLI_OPT_MODE(&p->s.mode),
+        CLI_OPT_SPP(&p->max_spp, "stop accumulating at N samples per pixel (default: never)"),
+        CLI_OPT_SIZE(size, "initial window size (default 640 wide, the camera's aspect)"),
         CAMERA_OPTIONS(&cam),
-        {"--scene", "N", "show the file's glTF scene N (default: its default scene)", CLI_INT, CLI_AS(int, &scene_index),
-         0, 1 << 20, "an index >= 0", NULL},
-        {"--variant", "NAME", "the glTF KHR_materials_variants variant NAME's materials", CLI_CALL, NULL, 0, 0,
-         NULL, cli_take_variant},
+        CLI_OPT_SCENE(&scene_index, "show the file's glTF scene N (default: its default scene)"),
+        CLI_OPT_VARIANT("the glTF KHR_materials_variants variant NAME's materials"),
         CLI_OPT_ALLOW_OUTSIDE_FILES(&outside),
-        {"--seed", "S", "random seed (default 0)", CLI_U32, CLI_AS(uint32_t, &p->s.seed), 0, 4294967295.0,
-         "an integer 0..4294967295", NULL},
-        {"--max-depth", "N", "path tracer: maximum path length (default 0: roulette only)", CLI_INT, CLI_AS(int, &p->s.max_depth), 0, 1 << 16, "an integer >= 0", NULL},
+        CLI_OPT_SEED(&p->s.seed, "random seed (default 0)"),
+        CLI_OPT_MAX_DEPTH(&p->s.max_depth, "path tracer: maximum path length (default 0: roulette only)"),
         ENV_OPTIONS(&env),
-        {"--no-shadows", NULL, "local modes: no shadow rays", CLI_FLAG, CLI_AS(bool, &no_shadows), 0, 0, NULL, NULL},
-        {"--exposure", "E", "display scale 2^E (default 0)", CLI_FLOAT, CLI_AS(float, &p->exposure), -1e6, 1e6, "a number",
-         NULL},
-        {"--tonemap", "T", "clamp (default), reinhard, aces", CLI_CALL, &p->tonemap, 0, 0,
-         "clamp, reinhard or aces", cli_take_tonemap},
-        {"--denoise", NULL, "start with the denoised view (key N; OIDN, as render --denoise)", CLI_FLAG,
-         CLI_AS(bool, &denoise), 0, 0, NULL, NULL},
+        CLI_OPT_NO_SHADOWS(&no_shadows),
+        CLI_OPT_EXPOSURE(&p->exposure, "display scale 2^E (default 0)"),
+        CLI_OPT_TONEMAP(&p->tonemap, "clamp (default), reinhard, aces"),
+        CLI_OPT_DENOISE(&denoise, "start with the denoised view (key N; OIDN, as render --denoise)"),
         {"--prefix", "P", "P writes P-NNN.exr and P-NNN.png (default gonio-preview)", CLI_STRING, CLI_AS(const char *, &p->prefix),
-         0, 0, NULL, NULL},
+         0, 0, NULL, NULL, NULL},
         {"--frames", "N", "quit after N frames (scripts, tests)", CLI_INT, CLI_AS(int, &max_frames), 1, 1 << 30,
-         "an integer >= 1", NULL},
+         "an integer >= 1", NULL, NULL},
         {"--screenshot", "FILE", "on quitting, write what the window shows as PNG", CLI_STRING, CLI_AS(const char *, &screenshot), 0,
-         0, NULL, NULL},
+         0, NULL, NULL, "*.png"},
         CLI_OPT_DEVICE(&device),
         CLI_OPT_VALIDATE(&validate),
         CLI_OPT_QUIET(&quiet, "no informational messages"),
@@ -883,7 +875,7 @@ int cmd_preview(int argc, char **argv)
     const cli_command command = {.name = "preview", .synopsis = "SCENE.gltf|.glb [options]",
                                  .intro = "Opens a window and shows the render converging; press H in it for the keys.\n",
                                  CLI_OPTIONS(options), .epilog = keys_help(), .min_args = 1, .max_args = 1,
-                                 .missing = "no scene given"};
+                                 .missing = "no scene given", .complete_args = "*.gltf *.glb"};
     cli_args args;
     int rc = cli_parse(&command, argc, argv, &args);
     if (rc >= 0)

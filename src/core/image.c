@@ -168,6 +168,12 @@ bool image_exr_compression_from_name(const char *name, int *out)
     return false;
 }
 
+const char *image_exr_compression_list(void)
+{
+    static char list[128];
+    return list[0] ? list : util_join(list, sizeof list, exr_compression_names, EXR_WRITABLE_COMPRESSIONS);
+}
+
 /* B44 packs HALF channels only; the rest of a chunk is stored as is, channel by channel, so
  * a chunk of float channels comes out exactly as large as the data. OpenEXR's rule (its C++
  * library follows it) is that a chunk that does not shrink is stored uncompressed, and a
@@ -813,3 +819,9 @@ bool image_tonemap_from_name(const char *name, image_tonemap *out)
 }
 
 const char *image_tonemap_name(image_tonemap tm) { return tonemap_names[tm]; }
+
+const char *image_tonemap_list(void)
+{
+    static char list[64];
+    return list[0] ? list : util_join(list, sizeof list, tonemap_names, 3);
+}

@@ -61,6 +61,8 @@ typedef struct image_exr_options {
  * (pxr24 is lossy for float channels, b44/b44a for half ones and keep float ones whole).
  * False for any other name. */
 bool image_exr_compression_from_name(const char *name, int *out);
+/* The names image_exr_compression_from_name takes, ", "-separated. */
+const char *image_exr_compression_list(void);
 /* Writes every channel as 32-bit float (or half, opt->half) with opt->compression (NULL:
  * IMAGE_EXR_DEFAULTS) and the given header attributes; the data window is the image, at
  * (x0, y0) of a full_width x full_height display window when full_width > 0. Written to a temporary file beside
@@ -99,6 +101,8 @@ typedef enum image_tonemap { IMAGE_TONEMAP_CLAMP, IMAGE_TONEMAP_ACES, IMAGE_TONE
 /* "clamp", "aces", "reinhard" <-> image_tonemap; false for an unknown name. */
 bool image_tonemap_from_name(const char *name, image_tonemap *out);
 const char *image_tonemap_name(image_tonemap tm);
+/* Every tonemap's name, ", "-separated. */
+const char *image_tonemap_list(void);
 
 /* Linear RGB planes -> 8-bit sRGB RGBA (alpha 255): scale by 2^exposure, tonemap, sRGB
  * transfer function, round. NaN maps to 0. */

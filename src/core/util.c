@@ -214,11 +214,20 @@ bool util_parse_size(const char *s, int *w, int *h)
     if (!x)
         return false;
     *x = 0;
-    if (!util_parse_int(buf, 1, 16384, &lw) || !util_parse_int(x + 1, 1, 16384, &lh))
+    if (!util_parse_int(buf, 1, UTIL_SIZE_MAX, &lw) || !util_parse_int(x + 1, 1, UTIL_SIZE_MAX, &lh))
         return false;
     *w = (int)lw;
     *h = (int)lh;
     return true;
+}
+
+const char *util_join(char *buf, size_t cap, const char *const *names, int n)
+{
+    size_t len = 0;
+    buf[0] = 0;
+    for (int i = 0; i < n && len < cap; i++)
+        len += (size_t)snprintf(buf + len, cap - len, "%s%s", i ? ", " : "", names[i]);
+    return buf;
 }
 
 /* O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer, forever. It is

@@ -12,6 +12,9 @@
 #include <stdint.h>
 #include <stdio.h>
 
+/* The program's version (gonio --version, the gonio:version of what it writes). */
+#define GONIO_VERSION "0.1.0"
+
 #if defined(__GNUC__)
 #define UTIL_PRINTF(a, b) __attribute__((format(printf, a, b)))
 #else
@@ -52,8 +55,14 @@ bool util_parse_int(const char *s, long min, long max, long *out);
 bool util_parse_float(const char *s, float *out);
 /* "R,G,B" or one value V (= V,V,V), each finite and >= 0: a colour or a radiance. */
 bool util_parse_rgb(const char *s, float out[3]);
-/* "WxH" -> width, height (each 1..16384). */
+/* "WxH" -> width, height (each 1..UTIL_SIZE_MAX). */
+#define UTIL_SIZE_MAX 16384
 bool util_parse_size(const char *s, int *w, int *h);
+/* names[0..n) joined by ", " into buf (cut short at cap); returns buf. */
+const char *util_join(char *buf, size_t cap, const char *const *names, int n);
+/* A macro's value as a string literal: UTIL_STRING(UTIL_SIZE_MAX) is "16384". */
+#define UTIL_STRING(x) UTIL_STRING_(x)
+#define UTIL_STRING_(x) #x
 
 /* Inputs: only regular files are read. A FIFO, a device, a directory or a socket is refused
  * with an error naming the path, without blocking (a FIFO with no writer would otherwise

@@ -1,4 +1,4 @@
-/* brdf.c: the table of BRDF models (docs/brdf.md, glsl/lib/brdf.glsl) with their parameters,
+/* brdf.c: the table of BRDF models (docs/brdf.md, glsl/lib/brdf_*.glsl) with their parameters,
  * strict `--PARAM VALUE` parsing, and the runner of the BRDF test kernel. */
 #include "brdf.h"
 
@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "brdf_test.h" /* spv_brdf_test, generated from glsl/kernels/brdf_test.comp */
+#include "scene.h"
 #include "util.h"
 
 #define P(slot) (BRDF_SLOT_PARAMS + (slot))
@@ -39,6 +40,8 @@ void brdf_setting_init(brdf_setting *s, const brdf_model *m)
 {
     memset(s, 0, sizeof *s);
     s->model = m;
+    scene_material_default(&s->m);
+    s->m.brdf = m->id;
     for (int i = 0; i < m->num_params; i++)
         memcpy(&s->v[m->params[i].slot], m->params[i].def, sizeof(float) * (size_t)m->params[i].count);
 }
@@ -173,21 +176,14 @@ bool brdf_spec_check(const char *spec)
 bool brdf_setting_two_sided(const brdf_setting *s)
 {
     return s->model->id == BRDF_DIELECTRIC ||
-           (s->model->id == BRDF_GLTF && (s->v[BRDF_SLOT_EXTRA + 3] > 0 || s->v[BRDF_SLOT_DT + 3] > 0));
+           (s->model->id == BRDF_GLTF && (s->m.transmission > 0 || s->m.diffuse_transmission > 0));
 }
 
 void brdf_setting_to_query(const brdf_setting *s, BrdfQuery *q)
 {
-    const float *v = s->v;
-    q->model = s->model->id;
-    q->color = (vec3){v[0], v[1], v[2]};
-    q->params = (vec4){v[3], v[4], v[5], v[6]};
-    q->extra = (vec4){v[7], v[8], v[9], v[10]};
-    q->layer = (vec4){v[11], v[12], v[13], v[BRDF_SLOT_COAT_TILT]};
-    q->sheen = (vec4){v[14], v[15], v[16], 0};
-    q->aniso = (vec4){v[BRDF_SLOT_ANISO], v[BRDF_SLOT_ANISO + 1], 0, 0};
-    q->irid = (vec4){v[BRDF_SLOT_IRID], v[BRDF_SLOT_IRID + 1], v[BRDF_SLOT_IRID + 2], 0};
-    q->dt = (vec4){v[BRDF_SLOT_DT], v[BRDF_SLOT_DT + 1], v[BRDF_SLOT_DT + 2], v[BRDF_SLOT_DT + 3]};
+    q->material = s->m;
+    q->material.brdf = s->model->id;
+    q->coat_tilt = s->coat_tilt;
 }
 
 static void format_setting(char *out, size_t cap, const brdf_setting *s, bool changed_only)
