@@ -8,7 +8,9 @@
  *   render_accum.c    accumulation: buffers and bands, resolve, sums and --resume
  *   render_limits.c   device limits and llvmpipe's loop cap
  *   render_gouraud.c  Gouraud's vertex pass
- *   render_material.c what the renderer derives from materials (features, --brdf overrides) */
+ *   render_material.c what the renderer derives from materials (features, --brdf overrides)
+ * and, with its own interface (render_geometry.h), render_geometry.c: the scene's trees and
+ * GPU arrays, one level or two (instances). */
 #ifndef GONIO_RENDER_INTERNAL_H
 #define GONIO_RENDER_INTERNAL_H
 

@@ -1,7 +1,10 @@
 /* gltf_geometry.cpp: the geometry of a glTF file: accessors read (sparse, normalised), the
  * node hierarchy's transforms, primitives as triangles (strips and fans, flat normals, vertex
- * colours, MikkTSpace tangents for the materials that need them), instances of the scene's
- * meshes, cameras and lights baked into world space; normals with the cofactor matrix (the
+ * colours, MikkTSpace tangents for the materials that need them), the placements of the
+ * scene's meshes (nodes, and EXT_mesh_gpu_instancing's instances): a mesh placed once baked
+ * into world space, one placed several times kept once in its own space with an instance
+ * per placement (scene_instanced_mesh, scene_instance); cameras and lights baked into world
+ * space; normals with the cofactor matrix (the
  * inverse transpose up to det, Lengyel, "Mathematics for 3D Game Programming and Computer
  * Graphics", 3rd ed., 4.5). */
 #include "gltf_internal.h"

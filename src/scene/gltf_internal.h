@@ -153,7 +153,7 @@ void check_lights(Ctx &c);
 bool check_animations(Ctx &c);
 bool animate(Ctx &c, std::vector<Pose> &pose);
 
-/* ---- gltf_geometry.cpp: accessors, nodes, primitives, instances in world space ------------- */
+/* ---- gltf_geometry.cpp: accessors, nodes, primitives, meshes baked or kept with instances - */
 size_t comp_size(int ct);
 size_t num_comps(const tinygltf::Accessor &a);
 const char *type_name(int type);
