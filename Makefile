@@ -7,6 +7,7 @@
 # is printed and make stops.
 
 config ?= release
+.DEFAULT_GOAL := all
 PREFIX ?= /usr/local
 BUILD := build/$(config)
 
@@ -19,7 +20,7 @@ ifeq ($(origin CXX),default)
 CXX := g++
 endif
 
-PKGS := vulkan glfw3 OpenEXR tinygltf nlohmann_json libpng zlib stb draco
+PKGS := vulkan glfw3 OpenEXR tinygltf nlohmann_json libpng zlib stb draco libwebp libzstd
 # meshoptimizer ships no pkg-config file (Debian 12): linked by name.
 LIBS_EXTRA := -lmeshoptimizer
 WARN := -Wall -Wextra -Wshadow -Werror
@@ -82,6 +83,55 @@ SHADERS := $(wildcard glsl/kernels/*.comp tests/kernels/*.comp)
 SPV_HDR := $(patsubst %.comp,$(BUILD)/spv/%.h,$(notdir $(SHADERS)))
 vpath %.comp glsl/kernels tests/kernels
 
+# ---- Basis Universal (KHR_texture_basisu's KTX2 textures) --------------------------------
+# No Debian package has it: deps/basisu.sh fetches the crate basis-universal-sys with cargo,
+# once, and unpacks its C++ sources into build/basisu/src (shared by every config; the build is
+# offline after that). It writes gonio_basisu.mk, which make includes and re-reads once made
+# (BASISU is 1 when the sources are there), and gonio_basisu.h with the versions or the reason
+# they are missing: without them gonio builds without KTX2 support and says why. The sources
+# compile into $(BUILD)/basisu: the transcoder into every program, the encoder (the tests'
+# writer of KTX2 files, testtool ktx2) into testtool only.
+BASISU_DIR := build/basisu
+ifeq ($(filter clean,$(MAKECMDGOALS)),)
+-include $(BASISU_DIR)/gonio_basisu.mk
+endif
+$(BASISU_DIR)/gonio_basisu.mk: deps/basisu.sh
+	@deps/basisu.sh $(BASISU_DIR)
+CPPFLAGS += -I$(BASISU_DIR)
+BASISU_LIB :=
+BASISU_ENC_LIB :=
+ifeq ($(BASISU),1)
+# KTX2 with Zstandard (Debian's libzstd), neither SSE kernels nor OpenCL (the encoder's
+# options, unused by the transcoder), and UASTC's bits read a byte at a time: the vendor's
+# x86 default reads 16-bit words at odd addresses, undefined behaviour that UBSan stops on
+# (its own switch for this knows clang's UBSan, not GCC's). NDEBUG: the vendor's assert(0)s
+# sit on paths that then return an error, which hostile files reach; asserting would turn
+# them into aborts.
+BASISU_DEFS := -DBASISD_SUPPORT_KTX2=1 -DBASISD_SUPPORT_KTX2_ZSTD=1 -DBASISU_SUPPORT_SSE=0 -DBASISU_SUPPORT_OPENCL=0 \
+	-DBASISD_USE_UNALIGNED_WORD_READS=0
+# -isystem: the vendor headers' warnings are not the project's (see BASISU_CXXFLAGS).
+CPPFLAGS += $(BASISU_DEFS) -isystem $(BASISU_DIR)/src/transcoder -isystem $(BASISU_DIR)/src/encoder
+# The project's flags less -Werror and -Wextra, and less the warnings GCC 12 finds in the
+# vendor's code (unused values and parameters, memsets of classes, misleading indentation,
+# sign comparisons and an enum in a conditional in its miniz copy, a maybe-uninitialized;
+# -Wno-unknown-warning-option: clang, make fuzz's compiler, lacks two of these options):
+# the code is not ours to change, and they would stop or flood the build. Strict aliasing off
+# as the vendor's build has it: its block code type-puns.
+BASISU_CXXFLAGS = $(filter-out -Werror -Wextra,$(CXXFLAGS)) -Wno-unused-local-typedefs -Wno-unused-value \
+	-Wno-unused-variable -Wno-class-memaccess -Wno-misleading-indentation -Wno-sign-compare \
+	-Wno-maybe-uninitialized -Wno-unknown-warning-option -fno-strict-aliasing -DNDEBUG
+BASISU_LIB := $(BUILD)/basisu/libbasisu_transcoder.a
+BASISU_ENC_LIB := $(BUILD)/basisu/libbasisu_encoder.a
+BASISU_ENC_OBJ := $(patsubst $(BASISU_DIR)/src/%.cpp,$(BUILD)/basisu/%.o,$(wildcard $(BASISU_DIR)/src/encoder/*.cpp))
+$(BUILD)/basisu/%.o: $(BASISU_DIR)/src/%.cpp | deps
+	@mkdir -p $(dir $@)
+	$(CXX) $(BASISU_DEFS) $(BASISU_CXXFLAGS) -c -o $@ $<
+$(BASISU_LIB): $(BUILD)/basisu/transcoder/basisu_transcoder.o
+	ar rcs $@ $^
+$(BASISU_ENC_LIB): $(BASISU_ENC_OBJ)
+	ar rcs $@ $^
+endif
+
 GONIO := $(BUILD)/gonio
 UNIT := $(BUILD)/unit_tests
 TESTTOOL := $(BUILD)/testtool
@@ -91,17 +141,18 @@ TESTTOOL := $(BUILD)/testtool
 # the document itself (tinygltf's package does not depend on it).
 DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
 	libopenexr-dev libtinygltf-dev nlohmann-json3-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers help2man \
-	libdraco-dev libmeshoptimizer-dev
+	libdraco-dev libmeshoptimizer-dev libwebp-dev libzstd-dev
 # man-db: tests/regress/cli.sh renders the installed man page with man -l.
+# webp: cwebp, the tests' encoder of WebP textures (tests/regress/image_formats.sh).
 # libmagickcore-6.q16-6-extra: ImageMagick's EXR coder (only a recommendation of imagemagick,
 # which --no-install-recommends leaves out); tests/regress/diff.sh writes EXRs with it.
 DEB_TEST := vulkan-validationlayers openexr xvfb xauth imagemagick libmagickcore-6.q16-6-extra \
-	x11-apps xdotool man-db
+	x11-apps xdotool man-db webp
 DEPS_CHECK = { command -v glslangValidator && command -v spirv-val && command -v pkg-config \
 	&& command -v help2man && pkg-config --exists $(PKGS) && ls /usr/include/meshoptimizer.h && ls /usr/share/vulkan/icd.d/lvp_icd*.json; } >/dev/null 2>&1
 TEST_DEPS_CHECK = { ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json \
 	&& command -v exrheader && command -v xvfb-run && command -v xauth && command -v import \
-	&& command -v xwd && command -v xdotool && command -v man \
+	&& command -v xwd && command -v xdotool && command -v man && command -v cwebp \
 	&& convert -list format | grep -q 'EXR.*rw'; } >/dev/null 2>&1
 
 # make fuzz only: clang and its libFuzzer runtime (Debian 12's clang is clang-14).
@@ -139,13 +190,13 @@ fuzz-deps: deps
 build/gonio: $(GONIO)
 	@ln -sf $(config)/gonio build/gonio
 
-$(GONIO): $(MAIN_OBJ) $(LIB_OBJ) | deps
+$(GONIO): $(MAIN_OBJ) $(LIB_OBJ) $(BASISU_LIB) | deps
 	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) $(LIBS_EXTRA) -lm
 
-$(UNIT): $(TEST_OBJ) $(LIB_OBJ) | deps
+$(UNIT): $(TEST_OBJ) $(LIB_OBJ) $(BASISU_LIB) | deps
 	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) $(LIBS_EXTRA) -lm
 
-$(TESTTOOL): $(TOOL_OBJ) $(LIB_OBJ) | deps
+$(TESTTOOL): $(TOOL_OBJ) $(LIB_OBJ) $(BASISU_ENC_LIB) $(BASISU_LIB) | deps
 	$(CXX) $(LDFLAGS) -o $@ $^ $(PKG_LIBS) $(LIBS_EXTRA) -lm
 
 $(BUILD)/%.o: %.c | deps $(SPV_HDR)
@@ -241,18 +292,19 @@ bench-peer: all
 	@if ! $(PEER_DEPS_CHECK); then ( $(call apt_install,$(DEB_PEER)) ) || true; fi
 	@tests/peer/run.sh $(GONIO) $(PEER_ARGS)
 
-# libFuzzer targets over scene_load and image_read_exr (tests/fuzz); fuzz-run runs each for
-# FUZZ_TIME seconds from seeds of $GONIO_ASSETS and EXRs gonio writes (tests/fuzz/run.sh).
-FUZZ_TARGETS := build/fuzz/fuzz_scene build/fuzz/fuzz_exr build/fuzz/fuzz_merge
+# libFuzzer targets over scene_load, image_read_exr, gonio merge and the WebP and KTX2
+# decoders (tests/fuzz); fuzz-run runs each for FUZZ_TIME seconds from seeds of
+# $GONIO_ASSETS, EXRs gonio writes and textures the tests' encoders write (tests/fuzz/run.sh).
+FUZZ_TARGETS := build/fuzz/fuzz_scene build/fuzz/fuzz_exr build/fuzz/fuzz_merge build/fuzz/fuzz_image
 FUZZ_TIME ?= 60
 fuzz: fuzz-deps
 	@$(MAKE) --no-print-directory config=fuzz CC=clang CXX=clang++ fuzz-targets
 fuzz-targets: $(FUZZ_TARGETS)
 .SECONDARY: $(FUZZ_TARGETS:build/fuzz/%=$(BUILD)/tests/fuzz/%.o)
-build/fuzz/fuzz_%: $(BUILD)/tests/fuzz/fuzz_%.o $(LIB_OBJ) | deps
+build/fuzz/fuzz_%: $(BUILD)/tests/fuzz/fuzz_%.o $(LIB_OBJ) $(BASISU_LIB) | deps
 	$(CXX) $(LDFLAGS) -fsanitize=fuzzer -o $@ $^ $(PKG_LIBS) $(LIBS_EXTRA) -lm
-fuzz-run: fuzz all test-deps
-	@GONIO=$(GONIO) FUZZ_TIME=$(FUZZ_TIME) tests/fuzz/run.sh $(FUZZ_TARGETS)
+fuzz-run: fuzz all $(TESTTOOL) test-deps
+	@GONIO=$(GONIO) TESTTOOL=$(TESTTOOL) FUZZ_TIME=$(FUZZ_TIME) tests/fuzz/run.sh $(FUZZ_TARGETS)
 
 # PARTIALS damaged resumable partials and tiles through the sanitizer build's gonio
 # (tests/fuzz/partials.sh): no crash, hang, sanitizer report, or NaN written with exit 0.

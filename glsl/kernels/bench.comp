@@ -32,7 +32,7 @@ void main()
             return;
         }
         vec3 c0, c1, c2;
-        tri_corners(h.tri, c0, c1, c2);
+        tri_corners(h.tri, h.inst, c0, c1, c2);
         vec3 n = normalize(cross(c1 - c0, c2 - c0));
         if (dot(n, d) > 0.0) n = -n;
         vec2 u = rand2(pixel, push.sample_index, 1u);

@@ -27,26 +27,35 @@ layout(push_constant) uniform PushBlock { GnPush push; };
 // interpolated with the hit's barycentrics. Each vertex has a colour per side (vcolor[2i]
 // lit with its normal, vcolor[2i+1] with the opposite one); the side is the one per-pixel
 // shading would light, where the interpolated normal faces the viewer (see surface_at).
+// An instance's vertices have colours of their own: vertex i's at i + GnInstance.vcolor_offset.
 vec3 gouraud_color(Hit h, vec3 d)
 {
     GnPrim pr = prim_at(h.tri);
     GnVertex a = vertex_at(pr.i0), b = vertex_at(pr.i1), c = vertex_at(pr.i2);
+    uint k = 0u; // (uint arithmetic: the offset may be "negative")
+    if (INSTANCES != 0u && h.inst != GN_INVALID) {
+        InstanceXf x = instance_xf(h.inst);
+        a = xf_vertex(x, a);
+        b = xf_vertex(x, b);
+        c = xf_vertex(x, c);
+        k = texelFetch(instance_texels, int(8u * h.inst + 7u)).x;
+    }
     float w = 1.0 - h.u - h.v;
     vec3 ng = cross(b.position - a.position, c.position - a.position);
     vec3 n = w * a.normal + h.u * b.normal + h.v * c.normal;
     uint side = dot(n, ng) * dot(ng, d) > 0.0 ? 1u : 0u; // n and the viewer on opposite sides
-    return w * vcolor[2u * pr.i0 + side].rgb + h.u * vcolor[2u * pr.i1 + side].rgb +
-           h.v * vcolor[2u * pr.i2 + side].rgb;
+    return w * vcolor[2u * (pr.i0 + k) + side].rgb + h.u * vcolor[2u * (pr.i1 + k) + side].rgb +
+           h.v * vcolor[2u * (pr.i2 + k) + side].rgb;
 }
 
 // Flat shading: the face normal, lit once at the centroid and seen from there, so the
 // whole triangle has one colour.
 vec3 flat_color(Hit h, vec3 d)
 {
-    GnPrim pr = prim_at(h.tri);
-    vec3 center = (vertex_at(pr.i0).position + vertex_at(pr.i1).position +
-                  vertex_at(pr.i2).position) / 3.0;
-    Surface s = surface_at(h.tri, 0.0, 1.0 / 3.0, 1.0 / 3.0, center, d);
+    vec3 c0, c1, c2;
+    tri_corners(h.tri, h.inst, c0, c1, c2);
+    vec3 center = (c0 + c1 + c2) / 3.0;
+    Surface s = surface_at(h.tri, h.inst, 0.0, 1.0 / 3.0, 1.0 / 3.0, center, d);
     return phong_shade(center, s.ng, s.ng, s.uv, s.vcolor, s.material,
                        camera_view(center));
 }
@@ -71,7 +80,7 @@ void main()
     vec3 normal = vec3(0.0), albedo = vec3(0.0);
     float depth = 0.0;
     if (h.tri != GN_INVALID) {
-        Surface s = surface_at(h.tri, h.t, h.u, h.v, o, d);
+        Surface s = surface_at(h.tri, h.inst, h.t, h.u, h.v, o, d);
         normal = s.sh.n;
         albedo = s.sh.m.base_color.rgb;
         depth = h.t * dot(d, frame.camera.forward);

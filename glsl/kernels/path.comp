@@ -268,11 +268,15 @@ LightSample light_sample(vec3 p, vec3 u)
         s.pdf = e.pdf;
         s.delta = true;
     } else if (GN_HAS(GN_FEAT_EMISSIVE)) {
+        // (with instances the table lists each instance's triangles, the instance after the table)
+        uint inst = INSTANCES != 0u ? texelFetch(emitter_texels, int(frame.emitter_instances + lo)).x : GN_INVALID;
         vec3 c0, c1, c2;
-        tri_corners(e.prim, c0, c1, c2);
+        tri_corners(e.prim, inst, c0, c1, c2);
         float su = sqrt(u.y), b1 = 1.0 - su, b2 = u.z * su;
         vec3 q = (1.0 - b1 - b2) * c0 + b1 * c1 + b2 * c2;
         vec3 ng = normalize(cross(c1 - c0, c2 - c0));
+        if (instance_mirrors(inst))
+            ng = -ng;
         vec3 to = q - p;
         float d2 = dot(to, to);
         s.dist = sqrt(d2);
@@ -552,6 +556,10 @@ void path_save(uint behind)
         for (int k = 1; k < walk.sp; k++)
             pstate[ps_base + GN_PATH_STATE_WORDS + uint(k)] = walk.stack[k];
     }
+    if (INSTANCES != 0u) { // the instances' two words close a pixel's state, after the stack
+        pstate[ps_base + frame.state_stride - 2u] = walk.hit.inst;
+        pstate[ps_base + frame.state_stride - 1u] = walk.inst;
+    }
 }
 
 void path_load()
@@ -567,6 +575,8 @@ void path_load()
         for (int k = 1; k < walk.sp; k++)
             walk.stack[k] = pstate[ps_base + GN_PATH_STATE_WORDS + uint(k)];
     }
+    walk.hit.inst = INSTANCES != 0u ? pstate[ps_base + frame.state_stride - 2u] : GN_INVALID;
+    walk.inst = INSTANCES != 0u ? pstate[ps_base + frame.state_stride - 1u] : GN_INVALID;
     sample_now = push.sample_index - pstate_behind;
     rng_sample = sample_now;
     ended = false;
@@ -648,7 +658,7 @@ void main()
                 path_miss(h, light_only, bsdf_only);
                 break;
             }
-            Surface s = surface_at(h.tri, h.t, h.u, h.v, o, d);
+            Surface s = surface_at(h.tri, h.inst, h.t, h.u, h.v, o, d);
             GnMaterial m = material_at(s.material);
             covered = covered || depth == 0u;
             if (GN_HAS(GN_FEAT_AOV) && depth == 0u) {

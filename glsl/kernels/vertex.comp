@@ -8,6 +8,8 @@
 // side (two-sided lighting: open meshes show both). The host stores the vertex's material
 // index in the bits of vcolor[2i].w; this pass writes .rgb only. One dispatch per side
 // (push.pass_flags = 0 or 1) keeps one invocation's shadow rays within the loop budget.
+// With instances (INSTANCES), each instance's vertices have colours of their own, at
+// GnInstance.vcolor_offset past the mesh's: the host puts the instance in [2i + 1].w.
 // The dispatch is 2D when the vertices need more work groups than one axis may have
 // (maxComputeWorkGroupCount[0]: 65,535 on lavapipe, 4.2 M vertices): rows of groups.
 #extension GL_GOOGLE_include_directive : require
@@ -25,7 +27,13 @@ void main()
     uint side = push.pass_flags;
     if (i >= uint(vcolor.length()) / 2u)
         return;
-    GnVertex a = vertex_at(i);
+    GnVertex a;
+    if (INSTANCES != 0u) { // an instance's copy of its mesh's vertex (its index rides in [2i + 1].w)
+        uint inst = floatBitsToUint(vcolor[2u * i + 1u].w);
+        a = xf_vertex(instance_xf(inst), vertex_at(i - texelFetch(instance_texels, int(8u * inst + 7u)).x));
+    } else {
+        a = vertex_at(i);
+    }
     rng_pixel = i; // the BLEND test's random numbers in the shadow rays: per vertex
     rng_sample = side;
     uint material = floatBitsToUint(vcolor[2u * i].w);

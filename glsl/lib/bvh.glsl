@@ -52,6 +52,7 @@ struct Hit {
     uint tri;       // BVH-order triangle (GnPrim order), GN_INVALID on a miss
     uint steps;     // GnBvhNode visits
     bool truncated; // the budget ran out: the result may be wrong
+    uint inst;      // INSTANCES: the instance hit (GnInstance); else GN_INVALID
 };
 
 // Per-ray constants of the watertight test. The paper permutes the axes (kx, ky, kz) and
@@ -61,6 +62,7 @@ struct Hit {
 // transformed by the same arithmetic, so shared edges stay watertight.
 struct RayPre {
     vec3 o;
+    vec3 d;         // (kept for the instances' transforms)
     vec3 inv;       // 1 / d, with zero components replaced by a huge finite value
     bvec3 neg;      // inv < 0: a box's near plane on that axis is its max
     vec3 sx, sy, sz;
@@ -70,6 +72,7 @@ RayPre ray_pre(vec3 o, vec3 d)
 {
     RayPre r;
     r.o = o;
+    r.d = d;
     vec3 ad = abs(d);
     int kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
     int kx = kz == 2 ? 0 : kz + 1;
@@ -164,13 +167,29 @@ float box_enter(RayPre r, vec3 bmin, vec3 bmax, float tmin, float tmax)
 // A walk's position: a child index as GnBvhNode stores it (glsl/lib/shared.h): an inner node's
 // index, or a leaf with GN_BVH_LEAF set and its count and first triangle packed.
 uint walk_leaf_first(uint entry) { return entry & GN_BVH_FIRST; }
-uint walk_leaf_last(uint entry) { return walk_leaf_first(entry) + ((entry >> GN_BVH_COUNT_SHIFT) & 15u); }
+uint walk_leaf_last(uint entry) { return walk_leaf_first(entry) + ((entry >> GN_BVH_COUNT_SHIFT) & GN_BVH_COUNT_MASK); }
+
+// ---- instances (INSTANCES != 0) -----------------------------------------------------------
+// The ray r in instance i's object space: its world-to-object rows (GnInstance.to_object)
+// applied to the origin and the direction, which is not renormalised, so that a hit has the
+// same t in both spaces (src/accel/bvh.c: bvh_instance_ray, the same arithmetic).
+RayPre instance_ray(RayPre r, uint i)
+{
+    vec4 r0 = texel_f(instance_texels, 8u * i), r1 = texel_f(instance_texels, 8u * i + 1u);
+    vec4 r2 = texel_f(instance_texels, 8u * i + 2u);
+    return ray_pre(vec3(dot(r0.xyz, r.o) + r0.w, dot(r1.xyz, r.o) + r1.w, dot(r2.xyz, r.o) + r2.w),
+                   vec3(dot(r0.xyz, r.d), dot(r1.xyz, r.d), dot(r2.xyz, r.d)));
+}
+
+// The root node of instance i's mesh (GnInstance.root).
+uint instance_root(uint i) { return texelFetch(instance_texels, int(8u * i + 3u)).x; }
 
 // The state of a walk, so one that runs out of budget can be resumed later (the unit tests
 // resume walks across dispatches to get exact answers on meshes beyond llvmpipe's loop cap).
 struct Walk {
     Hit hit;
     uint node;      // next child index to visit, GN_INVALID when the walk is over
+    uint inst;      // INSTANCES: the instance whose mesh the walk is in, GN_INVALID: the top tree
     int sp;         // stack entries in use, the sentinel included
     // stack[0] is a sentinel (GN_INVALID: popping it ends the walk), stack[1, sp) the nodes
     // put off for later; bvh_walk writes stack[sp] on every node visit, so a full stack
@@ -189,8 +208,9 @@ Walk walk;
 void walk_start(float tmax)
 {
     walk.hit.t = tmax; walk.hit.u = 0.0; walk.hit.v = 0.0; walk.hit.tri = GN_INVALID;
-    walk.hit.steps = 0u; walk.hit.truncated = false;
+    walk.hit.steps = 0u; walk.hit.truncated = false; walk.hit.inst = GN_INVALID;
     walk.node = 0u;
+    walk.inst = GN_INVALID;
     walk.sp = 1; // (unused with WALK_REGS > 0)
     if (WALK_REGS == 0u)
         walk.stack[0] = GN_INVALID;
@@ -224,11 +244,21 @@ void walk_regs_update(bool push, bool pop, uint x)
 // counted in node visits: lim is the step count at which the lane's passes are spent, less
 // the other passes (leaves, loop tests) as they come, so the node loop's test stays one
 // comparison.
+//
+// With INSTANCES the top tree's leaves are instances (glsl/lib/shared.h). Reaching one, the
+// walk goes on at its mesh's root with the ray in the instance's space (rc: r transformed)
+// and puts GN_BVH_RETURN on the stack below the mesh's entries; popping it, the mesh done,
+// the walk is back in the top tree with r. Both are leaf-like entries, so the node loop
+// does not change: only the leaf part does, and a walk stopped in a mesh resumes there
+// (w.inst; rc is recomputed from r).
 void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
 {
 #define w walk
     uint end = w.hit.steps + budget, lim = w.hit.steps + loop_left;
     w.hit.truncated = false;
+    RayPre rc = r;
+    if (INSTANCES != 0u && w.inst != GN_INVALID)
+        rc = instance_ray(r, w.inst);
     // No early returns and no breaks: llvmpipe masks every later statement of a loop body
     // again after either, so the loop conditions end the walk. An index without
     // GN_BVH_LEAF is an inner node (GN_INVALID has that bit set too).
@@ -239,8 +269,8 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
             w.hit.steps++;
             GnBvhNode n = bvh_node(w.node);
             // (an empty child b has an inverted box: box_enter misses it)
-            float ea = box_enter(r, n.a_min, n.a_max, tmin, w.hit.t);
-            float eb = box_enter(r, n.b_min, n.b_max, tmin, w.hit.t);
+            float ea = box_enter(rc, n.a_min, n.a_max, tmin, w.hit.t);
+            float eb = box_enter(rc, n.b_min, n.b_max, tmin, w.hit.t);
             uint ca = n.a_index, cb = n.b_index;
             bool hit_a = ea < 1e38, hit_b = eb < 1e38, both = hit_a && hit_b;
             // Both: go to the nearer (a on a tie), keep the farther; one: go there; none: pop.
@@ -265,13 +295,23 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
         // An inner node here: the budget (or llvmpipe's loop cap) ended the loop above early.
         w.hit.truncated = (w.node & GN_BVH_LEAF) == 0u;
         bool leaf = !w.hit.truncated && w.node != GN_INVALID;
+        // Instances: an instance leaf is entered, the marker below a mesh's entries left.
+        bool enter = false, leave = false;
+        if (INSTANCES != 0u) {
+            bool instance = leaf && (w.node & GN_BVH_INSTANCE) != 0u;
+            leave = instance && w.node == GN_BVH_RETURN;
+            enter = instance && !leave;
+            leaf = leaf && !instance;
+        }
         uint last = walk_leaf_last(w.node), i = walk_leaf_first(w.node), i0 = i;
         for (; leaf && i <= last && !(any_hit && w.hit.tri != GN_INVALID); i++) {
             GnTriPair q = bvh_pair(i);
             float t, u, v;
             uint which;
-            if (pair_intersect(r, q, tmin, w.hit.t, t, u, v, which)) {
+            if (pair_intersect(rc, q, tmin, w.hit.t, t, u, v, which)) {
                 w.hit.t = t; w.hit.u = u; w.hit.v = v; w.hit.tri = 2u * i + which;
+                if (INSTANCES != 0u)
+                    w.hit.inst = w.inst;
             }
         }
         // (+ 3: the tests that ended the two loops, and this pass of the enclosing one)
@@ -279,11 +319,25 @@ void bvh_walk(RayPre r, float tmin, bool any_hit, uint budget)
             lim -= min(lim, (leaf ? i - i0 : 0u) + 3u);
         bool found = any_hit && w.hit.tri != GN_INVALID; // any hit: the walk is over
         uint top = WALK_REGS > 0u ? w.regs[0] : w.stack[w.sp - 1]; // read by every lane, as above
-        if (WALK_REGS > 0u)
-            walk_regs_update(false, leaf, 0u);
-        else if (leaf)
+        bool pop = leaf || leave;
+        if (WALK_REGS > 0u) {
+            walk_regs_update(enter, pop, GN_BVH_RETURN);
+        } else if (INSTANCES != 0u) { // (written by every lane, as in the node loop)
+            w.stack[w.sp] = GN_BVH_RETURN;
+            w.sp = enter ? w.sp + 1 : pop ? max(w.sp - 1, 1) : w.sp;
+        } else if (leaf) {
             w.sp = max(w.sp - 1, 1);
-        if (leaf)
+        }
+        if (INSTANCES != 0u && enter) {
+            w.inst = walk_leaf_first(w.node);
+            rc = instance_ray(r, w.inst);
+            w.node = instance_root(w.inst);
+        }
+        if (INSTANCES != 0u && leave) {
+            w.inst = GN_INVALID;
+            rc = r;
+        }
+        if (pop)
             w.node = found ? GN_INVALID : top;
     }
     // The loop ends with the walk over, or else because llvmpipe's loop cap stopped it: the

@@ -32,6 +32,7 @@ layout(binding = GN_BIND_MATERIALS) uniform utextureBuffer material_texels;
 layout(std430, binding = GN_BIND_LIGHTS) readonly buffer LightBlock { GnLight lights[]; };
 layout(binding = GN_BIND_TEXELS) uniform utextureBuffer texels; // R32UI: one RGBA8 texel each
 layout(binding = GN_BIND_TEXTURES) uniform utextureBuffer texture_texels; // GnTexture[]
+layout(binding = GN_BIND_INSTANCES) uniform utextureBuffer instance_texels; // GnInstance[] (bvh.glsl: INSTANCES)
 
 #define PI GN_PI // (the name path.comp and bench.comp use)
 
@@ -51,14 +52,74 @@ GnVertex vertex_at(uint i)
                     texel_f(vertex_texels, 5u * i + 3u), e.x, e.y, e.z, e.w);
 }
 
+// ---- instances -------------------------------------------------------------------------------
+// INSTANCES != 0: the scene has two levels (glsl/lib/shared.h: a top tree over instances of
+// meshes, each in its own object space); 0 (scenes without instances): one tree over world-
+// space triangles, and all that instances need compiles away (the host sets it:
+// src/render/render.c). A hit in an instance has its mesh's vertices, which shading moves to
+// world space as the loader bakes a mesh used once (src/scene: positions by the transform,
+// normals by its inverse transpose, tangents by the transform with their sign mirrored, each
+// renormalised), so an instance is shaded as its flattened copy would be.
+layout(constant_id = GN_SPEC_INSTANCES) const uint INSTANCES = 0u;
+
+struct InstanceXf {
+    vec4 w0, w1, w2;   // object to world (GnInstance.to_world), rows
+    vec3 o0, o1, o2;   // world to object's 3x3 (to_object), rows: normals go by its transpose
+    bool mirror;       // GN_INSTANCE_MIRROR
+};
+
+InstanceXf instance_xf(uint i)
+{
+    InstanceXf x;
+    x.o0 = texel_f(instance_texels, 8u * i).xyz;
+    x.o1 = texel_f(instance_texels, 8u * i + 1u).xyz;
+    x.o2 = texel_f(instance_texels, 8u * i + 2u).xyz;
+    x.mirror = (texelFetch(instance_texels, int(8u * i + 3u)).w & GN_INSTANCE_MIRROR) != 0u;
+    x.w0 = texel_f(instance_texels, 8u * i + 4u);
+    x.w1 = texel_f(instance_texels, 8u * i + 5u);
+    x.w2 = texel_f(instance_texels, 8u * i + 6u);
+    return x;
+}
+
+vec3 xf_point(InstanceXf x, vec3 p)
+{
+    return vec3(dot(x.w0.xyz, p) + x.w0.w, dot(x.w1.xyz, p) + x.w1.w, dot(x.w2.xyz, p) + x.w2.w);
+}
+
+GnVertex xf_vertex(InstanceXf x, GnVertex a)
+{
+    a.position = xf_point(x, a.position);
+    a.normal = normalize(x.o0 * a.normal.x + x.o1 * a.normal.y + x.o2 * a.normal.z);
+    vec3 t = vec3(dot(x.w0.xyz, a.tangent.xyz), dot(x.w1.xyz, a.tangent.xyz), dot(x.w2.xyz, a.tangent.xyz));
+    if (dot(t, t) > 0.0) // (a mesh without tangents keeps its zeros)
+        a.tangent = vec4(normalize(t), x.mirror ? -a.tangent.w : a.tangent.w);
+    return a;
+}
+
 // The corners of BVH-order triangle i (the walk's GnTriPairs hold them too, but a pair has
-// no index by triangle).
-void tri_corners(uint i, out vec3 a, out vec3 b, out vec3 c)
+// no index by triangle), in world space: inst is its instance (GN_INVALID: none). With a
+// mirroring instance the corners' winding is the opposite of the world's (instance_mirrors).
+void tri_corners(uint i, uint inst, out vec3 a, out vec3 b, out vec3 c)
 {
     GnPrim pr = prim_at(i);
     a = vertex_at(pr.i0).position; // (the unused texels of a vertex are never fetched)
     b = vertex_at(pr.i1).position;
     c = vertex_at(pr.i2).position;
+    if (INSTANCES != 0u && inst != GN_INVALID) {
+        InstanceXf x = instance_xf(inst);
+        a = xf_point(x, a);
+        b = xf_point(x, b);
+        c = xf_point(x, c);
+    }
+}
+
+// Does instance inst mirror (a negative determinant)? Then the front of its triangles (glTF:
+// counter-clockwise in world space) is the side their corners' cross product points away
+// from. False without instances.
+bool instance_mirrors(uint inst)
+{
+    return INSTANCES != 0u && inst != GN_INVALID &&
+           (texelFetch(instance_texels, int(8u * inst + 3u)).w & GN_INSTANCE_MIRROR) != 0u;
 }
 
 // Does the scene have vertex colours (glTF COLOR_0)? Without, GnVertex.color is not read.
@@ -213,16 +274,27 @@ struct Surface {
                       // turned to ng's side and bent by shading_normal_valid
 };
 
-// tri: BVH-order triangle index; (u, v): barycentrics of v1 and v2; d: ray direction.
-Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
+// tri: BVH-order triangle index; inst: its instance (Hit.inst); (u, v): barycentrics of v1
+// and v2; d: ray direction.
+Surface surface_at(uint tri, uint inst, float t, float u, float v, vec3 o, vec3 d)
 {
     Surface s;
     GnPrim pr = prim_at(tri);
     GnVertex a = vertex_at(pr.i0), b = vertex_at(pr.i1), c = vertex_at(pr.i2);
+    bool mirror = false;
+    if (INSTANCES != 0u && inst != GN_INVALID) {
+        InstanceXf x = instance_xf(inst);
+        a = xf_vertex(x, a);
+        b = xf_vertex(x, b);
+        c = xf_vertex(x, c);
+        mirror = x.mirror;
+    }
     float w = 1.0 - u - v;
     s.p = o + t * d;
     vec3 e1 = b.position - a.position, e2 = c.position - a.position;
     vec3 ng = normalize(cross(e1, e2));
+    if (mirror) // (the loader reverses a mirrored mesh's corners: the same front)
+        ng = -ng;
     s.front = dot(ng, d) < 0.0;
     vec3 n = w * a.normal + u * b.normal + v * c.normal;
     n = dot(n, n) > 1e-20 ? normalize(n) : ng;

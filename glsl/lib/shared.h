@@ -61,7 +61,8 @@ typedef uint32_t uint;
 #define GN_BIND_SQUARES 14u  /* vec4[] per pixel: sum of squared radiance samples (variance) */
 #define GN_BIND_ENV 15u      /* float[]: environment map and its sampling tables (path.comp) */
 #define GN_BIND_PSTATE 16u   /* uint[]: per pixel, a path left unfinished by the loop cap (path.comp) */
-#define GN_BIND_COUNT 17u
+#define GN_BIND_INSTANCES 17u /* GnInstance[] (RGBA32UI texels; a one-texel dummy in scenes without instances) */
+#define GN_BIND_COUNT 18u
 
 /* Work-group size of the 2D image kernels: 8x8 matches lavapipe's 8-wide SIMD rows and is a
  * good default for GPUs (64 threads = 2 warps / 1 wavefront). */
@@ -79,9 +80,15 @@ typedef uint32_t uint;
 /* The path kernel's loop passes per SIMD group before its walks stop (specialization constant
  * 3; 0: none; glsl/lib/bvh.glsl: LOOP_CAP), set below llvmpipe's loop cap. */
 #define GN_SPEC_LOOP_CAP 3u
+/* The kernels that walk the scene are specialised on whether it has instances (specialization
+ * constant 5, INSTANCES in glsl/lib/bvh.glsl; 0: one tree over world-space triangles, as
+ * without it): the two-level walk and the instances' transforms compile away for scenes
+ * without them. */
+#define GN_SPEC_INSTANCES 5u
 /* A path's saved state (glsl/kernels/path.comp: path_save, path_load; GN_BIND_PSTATE,
  * GnFrame.state_stride words a pixel): word 0, the pixel's samples still to take, then the
- * fields of GN_PATH_STATE in order, then the walk's stack. A row X(kind, variable, when) is a
+ * fields of GN_PATH_STATE in order, then the walk's stack; with instances, the last two words
+ * of the stride are the hit's instance and the walk's. A row X(kind, variable, when) is a
  * variable of the kernel, saved and loaded where the kernel's condition `when` holds (the
  * host only counts the words). Kinds: U a uint, I an int, F a float, B a bool (a word each),
  * V a vec3 (three), M the media stack (GN_MEDIA_MAX). A field of the path is one row here. */
@@ -249,10 +256,19 @@ typedef uint64_t GnFeatures;
  *                                     box is inverted (min FLT_MAX, max -FLT_MAX), so the
  *                                     walk's slab test never enters it and needs no check
  * Leaves hold at most GN_BVH_MAX_LEAF pairs and scenes at most 2^26 triangles
- * (src/scene/scene.h: SCENE_MAX_TRIANGLES), so first fits in 27 bits. */
+ * (src/scene/scene.h: SCENE_MAX_TRIANGLES), so first fits in 27 bits.
+ * Two levels (a scene with instances, GN_SPEC_INSTANCES): the top tree's nodes come first
+ * (node 0 is its root), then each mesh's tree, its indices offset to their place in the
+ * node and pair arrays. A top-level leaf is one instance: a_count 1, a_index GN_BVH_LEAF |
+ * GN_BVH_INSTANCE | its GnInstance index. The walk goes on at that instance's mesh's root
+ * with the ray in the mesh's space, and first puts GN_BVH_RETURN on its stack: popping
+ * it, once the mesh's tree is done, brings the walk back to world space. */
 #define GN_BVH_LEAF 0x80000000u
+#define GN_BVH_INSTANCE 0x40000000u
 #define GN_BVH_COUNT_SHIFT 27
+#define GN_BVH_COUNT_MASK 7u
 #define GN_BVH_FIRST 0x07ffffffu
+#define GN_BVH_RETURN (GN_BVH_LEAF | GN_BVH_INSTANCE | GN_BVH_FIRST) /* (so at most 2^27 - 1 instances) */
 /* A slab test's far distance is scaled by this, so rounding never loses a box the triangle
  * test hits: 1 + 2 gamma(3) (Ize 2013; gamma(n) = n u / (1 - n u), u = 2^-24) is just above
  * 1 + 3 ulp, so 1 + 4 ulp (src/accel/bvh.c and glsl/lib/bvh.glsl, one value). */
@@ -283,6 +299,27 @@ GN_STRUCT(GnBvhNode) {
 GN_STRUCT(GnTriPair) {
     vec3 p0; vec3 p1; vec3 p2; vec3 p3;
 } GN_END(GnTriPair); /* 48 bytes */
+
+/* An instance of a mesh (a bottom-level tree, in its own object space) in a scene with two
+ * levels, shaped as a Vulkan acceleration-structure instance is (VkAccelerationStructure-
+ * InstanceKHR): to_world is its 3x4 row-major object-to-world transform (the VkTransform-
+ * MatrixKHR), mesh the bottom-level tree (the BLAS), custom the user's number for it
+ * (instanceCustomIndex: gonio keeps the glTF node), flags GN_INSTANCE_*. The walk reads
+ * to_object (the inverse, world to object) and root, its tree's root node; shading reads
+ * to_world and to_object (normals by the inverse transpose). vcolor_offset: the Gouraud
+ * colour of its vertex i is vcolor[2 (i + vcolor_offset)] (uint arithmetic); prim_base: its
+ * mesh's first GnPrim (so a hit's GnPrim is prim_base + the triangle's place in the mesh's
+ * own tree order, as a ray query's primitive index would give it). Eight RGBA32UI texels. */
+GN_STRUCT(GnInstance) {
+    vec4 to_object[3];
+    uint root; uint mesh; uint custom; uint flags;
+    vec4 to_world[3];
+    uint vcolor_offset; uint prim_base; uint pad0; uint pad1;
+} GN_END(GnInstance); /* 128 bytes */
+/* GnInstance.flags: the transform's determinant is negative, so it mirrors: a triangle's
+ * front (glTF: counter-clockwise in world space) is the side its object-space winding calls
+ * back (Vulkan: VK_GEOMETRY_INSTANCE_TRIANGLE_FLIP_FACING_BIT_KHR). */
+#define GN_INSTANCE_MIRROR 1u
 
 /* Shading data of a triangle, in BVH order (2 per GnTriPair; the walk's hits count in it),
  * corners in the order the walk's test takes them (GnTriPair). */
@@ -377,7 +414,9 @@ GN_STRUCT(GnFrame) {
     uint crop_x; uint crop_y;            /* the region's top-left pixel in the whole image */
     uint crop_width; uint crop_height;   /* the region's size: the dispatch and the buffers */
     uint loop_overhead; uint state_stride; /* path, LOOP_CAP > 0: loop passes a vertex costs besides its walks; words per pixel of GN_BIND_PSTATE */
-    uint pad0; uint pad1;                /* (std430 rounds the struct to 16 bytes) */
+    uint emitter_instances;              /* path, with instances: the first texel of GN_BIND_EMITTERS after the
+                                            table, where emitter i's instance is texel + i (.x); 0 without */
+    uint pad1;                           /* (std430 rounds the struct to 16 bytes) */
 } GN_END(GnFrame); /* 192 bytes */
 
 /* Per-dispatch values (push constants). */
@@ -413,8 +452,12 @@ GN_STRUCT(GnDisplayPush) {
 #endif
 #include <stddef.h>
 GN_STATIC_ASSERT(sizeof(GnBvhNode) == 64, "GnBvhNode layout");
-GN_STATIC_ASSERT(((GN_BVH_MAX_LEAF - 1) << GN_BVH_COUNT_SHIFT & ~(GN_BVH_LEAF | GN_BVH_FIRST)) ==
-                     (GN_BVH_MAX_LEAF - 1) << GN_BVH_COUNT_SHIFT, "a leaf's count fits its bits");
+GN_STATIC_ASSERT(GN_BVH_MAX_LEAF - 1 <= GN_BVH_COUNT_MASK &&
+                     (GN_BVH_COUNT_MASK << GN_BVH_COUNT_SHIFT & (GN_BVH_LEAF | GN_BVH_INSTANCE | GN_BVH_FIRST)) == 0,
+                 "a leaf's count fits its bits, apart from the instance bit");
+GN_STATIC_ASSERT(sizeof(GnInstance) == 128 && offsetof(GnInstance, root) == 48 &&
+                     offsetof(GnInstance, to_world) == 64 && offsetof(GnInstance, vcolor_offset) == 112,
+                 "GnInstance layout");
 GN_STATIC_ASSERT(offsetof(GnBvhNode, b_min) == 32, "GnBvhNode layout");
 GN_STATIC_ASSERT(sizeof(GnTriPair) == 48, "GnTriPair layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");

@@ -145,13 +145,13 @@ static bool leaf_hit(const bvh *b, const ray *r, uint32_t first, uint32_t count,
         const float *p0 = &q->p0.x, *p1 = &q->p1.x, *p2 = &q->p2.x, *p3 = &q->p3.x;
         float t, u, v;
         if (tri_hit(r, p0, p1, p2, tmin, hit->t, &t, &u, &v)) {
-            *hit = (bvh_hit){t, u, v, 2 * i};
+            *hit = (bvh_hit){t, u, v, 2 * i, GN_INVALID};
             found = true;
             if (any_hit)
                 break;
         }
         if (b->tri_index[2 * i + 1] != GN_INVALID && tri_hit(r, p0, p2, p3, tmin, hit->t, &t, &u, &v)) {
-            *hit = (bvh_hit){t, u, v, 2 * i + 1};
+            *hit = (bvh_hit){t, u, v, 2 * i + 1, GN_INVALID};
             found = true;
             if (any_hit)
                 break;
@@ -173,10 +173,36 @@ static bool leaf_hit(const bvh *b, const ray *r, uint32_t first, uint32_t count,
  * are not steps. Any-hit walks stop at the first triangle hit. The GPU walk differs in
  * order only: it postpones leaves (pushing them like nodes) and tests them between runs of
  * node visits, which suits SIMD lanes that execute both sides of every branch. */
-static bvh_hit traverse(const bvh *b, const float org[3], const float dir[3], float tmin,
-                        float tmax, bool any_hit, uint32_t *steps)
+static bvh_hit traverse(const bvh *b, const bvh_top *top, const float org[3], const float dir[3],
+                        float tmin, float tmax, bool any_hit, uint32_t *steps);
+
+/* A leaf child [first, first + count) of a node, entered by the ray: its triangle pairs, or
+ * (top != NULL: b is the top tree) the instance its index names, whose mesh's tree is walked
+ * with the ray in the instance's space, from here to the closest hit so far (the same t on
+ * both sides of the transform). *steps counts that walk's node visits. */
+static bool leaf_visit(const bvh *b, const bvh_top *top, const ray *r, const float org[3],
+                       const float dir[3], uint32_t index, uint32_t count, float tmin, bool any_hit,
+                       bvh_hit *hit, uint32_t *steps)
 {
-    bvh_hit hit = {tmax, 0, 0, GN_INVALID};
+    if (!top)
+        return leaf_hit(b, r, index & GN_BVH_FIRST, count, tmin, any_hit, hit);
+    uint32_t i = index & GN_BVH_FIRST, s = 0;
+    const GnInstance *g = &top->instances[i];
+    float o[3], d[3];
+    assert((index & GN_BVH_INSTANCE) && count == 1);
+    bvh_instance_ray(g, org, dir, o, d);
+    bvh_hit h = traverse(&top->meshes[g->mesh], NULL, o, d, tmin, hit->t, any_hit, &s);
+    *steps += s;
+    if (h.tri == GN_INVALID)
+        return false;
+    *hit = (bvh_hit){h.t, h.u, h.v, 2 * top->pair_base[g->mesh] + h.tri, i};
+    return true;
+}
+
+static bvh_hit traverse(const bvh *b, const bvh_top *top, const float org[3], const float dir[3],
+                        float tmin, float tmax, bool any_hit, uint32_t *steps)
+{
+    bvh_hit hit = {tmax, 0, 0, GN_INVALID, GN_INVALID};
     uint32_t stack_node[BVH_MAX_DEPTH], sp = 0, node = 0, nsteps = 0;
     float stack_t[BVH_MAX_DEPTH];
     ray r;
@@ -191,14 +217,14 @@ static bvh_hit traverse(const bvh *b, const float org[3], const float dir[3], fl
         bool hb = n->b_index != GN_INVALID &&
                   box_enter(&r, &n->b_min, &n->b_max, tmin, hit.t, &eb);
         if (ha && n->a_count > 0) {
-            if (leaf_hit(b, &r, n->a_index & GN_BVH_FIRST, n->a_count, tmin, any_hit, &hit) &&
+            if (leaf_visit(b, top, &r, org, dir, n->a_index, n->a_count, tmin, any_hit, &hit, &nsteps) &&
                 any_hit)
                 break;
             ha = false;
         }
         if (hb && n->b_count > 0) {
             if (eb <= hit.t &&
-                leaf_hit(b, &r, n->b_index & GN_BVH_FIRST, n->b_count, tmin, any_hit, &hit) &&
+                leaf_visit(b, top, &r, org, dir, n->b_index, n->b_count, tmin, any_hit, &hit, &nsteps) &&
                 any_hit)
                 break;
             hb = false;
@@ -229,26 +255,46 @@ static bvh_hit traverse(const bvh *b, const float org[3], const float dir[3], fl
 bvh_hit bvh_intersect(const bvh *b, const float org[3], const float dir[3], float tmin,
                       float tmax, uint32_t *steps)
 {
-    return traverse(b, org, dir, tmin, tmax, false, steps);
+    return traverse(b, NULL, org, dir, tmin, tmax, false, steps);
 }
 
 bool bvh_occluded(const bvh *b, const float org[3], const float dir[3], float tmin, float tmax)
 {
-    return traverse(b, org, dir, tmin, tmax, true, NULL).tri != GN_INVALID;
+    return traverse(b, NULL, org, dir, tmin, tmax, true, NULL).tri != GN_INVALID;
+}
+
+bvh_hit bvh_top_intersect(const bvh_top *t, const float org[3], const float dir[3], float tmin,
+                          float tmax, uint32_t *steps)
+{
+    return traverse(&t->tree, t, org, dir, tmin, tmax, false, steps);
+}
+
+bool bvh_top_occluded(const bvh_top *t, const float org[3], const float dir[3], float tmin, float tmax)
+{
+    return traverse(&t->tree, t, org, dir, tmin, tmax, true, NULL).tri != GN_INVALID;
+}
+
+void bvh_instance_ray(const GnInstance *in, const float org[3], const float dir[3], float o[3], float d[3])
+{
+    for (int r = 0; r < 3; r++) {
+        const float *m = &in->to_object[r].x;
+        o[r] = m[0] * org[0] + m[1] * org[1] + m[2] * org[2] + m[3];
+        d[r] = m[0] * dir[0] + m[1] * dir[1] + m[2] * dir[2];
+    }
 }
 
 bvh_hit bvh_brute_force(const float *positions, size_t position_stride_floats,
                         const uint32_t *indices, uint32_t num_triangles, const float org[3],
                         const float dir[3], float tmin, float tmax)
 {
-    bvh_hit hit = {tmax, 0, 0, GN_INVALID};
+    bvh_hit hit = {tmax, 0, 0, GN_INVALID, GN_INVALID};
     for (uint32_t i = 0; i < num_triangles; i++) {
         const float *p[3];
         float t, u, v;
         for (int k = 0; k < 3; k++)
             p[k] = positions + (size_t)indices[3 * (size_t)i + k] * position_stride_floats;
         if (bvh_tri_intersect(org, dir, p[0], p[1], p[2], tmin, hit.t, &t, &u, &v))
-            hit = (bvh_hit){t, u, v, i};
+            hit = (bvh_hit){t, u, v, i, GN_INVALID};
     }
     return hit;
 }

@@ -5,6 +5,8 @@
 
 #include "bvh.h"
 #include "cli.h"
+#include "image_decode.h"
+#include "render_geometry.h"
 #include "scene.h"
 #include "util.h"
 
@@ -35,6 +37,20 @@ static void print_emitters(const scene *sc)
             continue;
         tris++;
         mats += count[sc->tri_material[t]]++ == 0;
+    }
+    for (uint32_t i = 0; i < sc->num_instances; i++) { /* each instance's, as placed */
+        const scene_instanced_mesh *im = &sc->instanced_meshes[sc->instances[i].mesh];
+        for (uint32_t t = 0; t < im->num_triangles; t++) {
+            const GnMaterial *m = &sc->materials[im->tri_material[t]];
+            double c[3];
+            if (!(m->emissive.x > 0 || m->emissive.y > 0 || m->emissive.z > 0) || (m->flags & GN_MAT_UNLIT))
+                continue;
+            scene_instance_triangle_cross(sc, i, t, c);
+            if (!(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > 0))
+                continue;
+            tris++;
+            mats += count[im->tri_material[t]]++ == 0;
+        }
     }
     printf("emissive       %u triangles in %u material(s)", tris, mats);
     for (uint32_t m = 0, n = 0; m < sc->num_materials; m++)
@@ -99,6 +115,21 @@ static void print_films(const scene *sc)
     }
 }
 
+/* The images' encodings (WebP: EXT_texture_webp, KTX2: KHR_texture_basisu), one count each. */
+static void print_image_formats(const scene *sc)
+{
+    uint32_t count[TEXTURE_FORMAT_COUNT] = {0};
+    for (uint32_t i = 0; i < sc->num_images; i++)
+        count[sc->images[i].format < TEXTURE_FORMAT_COUNT ? sc->images[i].format : TEXTURE_FORMAT_UNKNOWN]++;
+    if (!sc->num_images)
+        return;
+    printf("image formats ");
+    for (int f = 0, n = 0; f < TEXTURE_FORMAT_COUNT; f++)
+        if (count[f])
+            printf("%s %u %s", n++ ? "," : "", count[f], texture_format_name((texture_format)f));
+    printf("\n");
+}
+
 /* The extensions the file lists, one line each: how gonio handles it (scene.h: scene_extension). */
 static void print_extensions(const scene *sc)
 {
@@ -129,13 +160,15 @@ int cmd_info(int argc, char **argv)
                  "(KHR_materials_anisotropy): strength, rotation and whether a texture sets them;\n"
                  "and one line per material with an iridescent film (KHR_materials_iridescence:\n"
                  "factor, film IOR, thickness) or a diffuse transmission\n"
-                 "(KHR_materials_diffuse_transmission: factor, colour); and one line per extension the\n"
-                 "file lists: whether gonio supports it, partly (and what it leaves out) or not (and why).\n",
+                 "(KHR_materials_diffuse_transmission: factor, colour); the images' formats (PNG,\n"
+                 "JPEG, WebP for EXT_texture_webp, KTX2 for KHR_texture_basisu); and one line per\n"
+                 "extension the file lists: whether gonio supports it, partly (and what it leaves out)\n"
+                 "or not (and why).\n",
         CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given",
         .complete_args = "*.gltf *.glb"};
     cli_args args;
     scene sc = {0};
-    bvh b = {0};
+    render_geometry geo;
     int rc = cli_parse(&cmd, argc, argv, &args);
     if (rc >= 0)
         return rc;
@@ -143,11 +176,26 @@ int cmd_info(int argc, char **argv)
     scene_allow_outside_files(outside);
     if (!scene_load(&sc, path))
         return 1;
-    bvh_build(&b, &sc.vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc.indices,
-              sc.num_triangles);
+    if (!render_geometry_build(&geo, &sc)) {
+        scene_destroy(&sc);
+        return 1;
+    }
     printf("scene          %s\n", shown(path));
-    printf("triangles      %u\n", sc.num_triangles);
-    printf("vertices       %u\n", sc.num_vertices);
+    if (sc.num_instances) {
+        uint64_t stored = sc.num_triangles, verts = sc.num_vertices;
+        for (uint32_t m = 0; m < sc.num_instanced_meshes; m++) {
+            stored += sc.instanced_meshes[m].num_triangles;
+            verts += sc.instanced_meshes[m].num_vertices;
+        }
+        printf("triangles      %llu placed, %llu stored (%u in world space, the rest once per instanced mesh)\n",
+               (unsigned long long)scene_placed_triangles(&sc), (unsigned long long)stored, sc.num_triangles);
+        printf("vertices       %llu stored\n", (unsigned long long)verts);
+        printf("instances      %u of %u mesh(es) (meshes several nodes use, or EXT_mesh_gpu_instancing places)\n",
+               sc.num_instances, sc.num_instanced_meshes);
+    } else {
+        printf("triangles      %u\n", sc.num_triangles);
+        printf("vertices       %u\n", sc.num_vertices);
+    }
     printf("meshes         %u (primitive instances; %u glTF meshes, %u nodes)\n", sc.num_meshes,
            sc.num_gltf_meshes, sc.num_nodes);
     printf("materials      %u\n", sc.num_materials);
@@ -156,6 +204,7 @@ int cmd_info(int argc, char **argv)
         printf("variant %-6u \"%s\"\n", i, shown(sc.variant_names[i]));
     print_extensions(&sc);
     printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
+    print_image_formats(&sc);
     printf("lights         %u\n", sc.num_lights);
     if (sc.environment.num_channels)
         printf("environment    %s (a %dx%d lat-long map)\n", shown(sc.environment_what), sc.environment.width,
@@ -176,15 +225,46 @@ int cmd_info(int argc, char **argv)
     }
     printf("bounds         (%g, %g, %g) - (%g, %g, %g)\n", sc.bounds_min[0], sc.bounds_min[1],
            sc.bounds_min[2], sc.bounds_max[0], sc.bounds_max[1], sc.bounds_max[2]);
-    printf("bvh nodes      %u (%zu bytes each)\n", b.num_nodes, sizeof(GnBvhNode));
-    printf("bvh leaf prims %u (%u triangle pairs sharing an edge, %u single triangles)\n",
-           b.num_pairs, b.num_tris - b.num_pairs, 2 * b.num_pairs - b.num_tris);
-    printf("bvh depth      %u\n", b.depth);
-    printf("bvh max leaf   %u triangle pairs\n", b.max_leaf_size);
-    printf("bvh sah cost   %.2f\n", b.sah_cost);
-    printf("bvh build      %.2f ms (%.2f M triangles/s)\n", b.build_seconds * 1e3,
-           b.build_seconds > 0 ? sc.num_triangles / b.build_seconds * 1e-6 : 0.0);
-    bvh_destroy(&b);
+    render_geometry_bytes mem = render_geometry_size(&geo);
+    if (geo.two_levels) {
+        /* two levels (src/render/render_geometry.h): a tree per mesh, one over the instances */
+        uint32_t tris = 0, pairs = 0, leaf = 0, depth = 0;
+        double sah = 0;
+        for (uint32_t m = 0; m < geo.num_meshes; m++) {
+            const bvh *b = &geo.meshes[m];
+            tris += b->num_tris;
+            pairs += b->num_pairs;
+            leaf = b->max_leaf_size > leaf ? b->max_leaf_size : leaf;
+            depth = b->depth > depth ? b->depth : depth;
+            sah = b->sah_cost > sah ? b->sah_cost : sah;
+        }
+        printf("bvh trees      %u mesh tree(s)%s and a top tree over %u instances\n", geo.num_meshes,
+               geo.first_instance ? " (the first: the triangles in world space)" : "", geo.top.num_instances);
+        printf("bvh nodes      %u (%zu bytes each; the top tree's %u)\n", geo.num_nodes, sizeof(GnBvhNode),
+               geo.top.tree.num_nodes);
+        printf("bvh leaf prims %u (%u triangle pairs sharing an edge, %u single triangles)\n", pairs,
+               tris - pairs, 2 * pairs - tris);
+        printf("bvh depth      %u (stack entries of a walk: the top tree's %u levels, one to enter a mesh, "
+               "the deepest mesh tree's %u)\n", geo.depth, geo.top.tree.depth, depth);
+        printf("bvh max leaf   %u triangle pairs\n", leaf);
+        printf("bvh sah cost   %.2f (the top tree's; the costliest mesh tree's %.2f)\n", geo.top.tree.sah_cost, sah);
+        printf("bvh build      %.2f ms (%.2f M triangles/s; the top tree %.3f ms)\n", geo.build_seconds * 1e3,
+               geo.build_seconds > 0 ? tris / geo.build_seconds * 1e-6 : 0.0, geo.top_seconds * 1e3);
+    } else {
+        const bvh *b = &geo.world;
+        printf("bvh nodes      %u (%zu bytes each)\n", b->num_nodes, sizeof(GnBvhNode));
+        printf("bvh leaf prims %u (%u triangle pairs sharing an edge, %u single triangles)\n",
+               b->num_pairs, b->num_tris - b->num_pairs, 2 * b->num_pairs - b->num_tris);
+        printf("bvh depth      %u\n", b->depth);
+        printf("bvh max leaf   %u triangle pairs\n", b->max_leaf_size);
+        printf("bvh sah cost   %.2f\n", b->sah_cost);
+        printf("bvh build      %.2f ms (%.2f M triangles/s)\n", b->build_seconds * 1e3,
+               b->build_seconds > 0 ? sc.num_triangles / b->build_seconds * 1e-6 : 0.0);
+    }
+    printf("scene memory   %.3f MB (BVH nodes %.3f, triangle pairs %.3f, shading %.3f, vertices %.3f, instances "
+           "%.3f)\n", (mem.nodes + mem.pairs + mem.prims + mem.vertices + mem.instances) * 1e-6, mem.nodes * 1e-6,
+           mem.pairs * 1e-6, mem.prims * 1e-6, mem.vertices * 1e-6, mem.instances * 1e-6);
+    render_geometry_destroy(&geo);
     scene_destroy(&sc);
     return 0;
 }

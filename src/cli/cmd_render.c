@@ -299,6 +299,17 @@ static void warn_inapplicable(const cli_command *c, const cli_args *args, const 
     }
 }
 
+/* --frames: what a frame leaves to the next. The device, and the renderer with its scene while
+ * the frames differ only in the instances' transforms (scene_same_geometry: the loader keeps
+ * the meshes an animation moves as instances, scene_instance_animated), so that a frame
+ * rebuilds only the top tree (renderer_update) and compiles no kernel. */
+typedef struct frame_cache {
+    bool gpu_live, renderer_live;
+    gpu g;
+    renderer r;
+    scene sc;
+} frame_cache;
+
 /* Everything the command line says about one render (--frames: one per frame). */
 typedef struct render_job {
     const char *scene_path, *out_path, *png_path, *brdf, *crop_text, *resume_path, *frames;
@@ -315,6 +326,7 @@ typedef struct render_job {
     float exposure;
     image_tonemap tm;
     image_exr_options exr;
+    frame_cache *cache; /* --frames: kept from frame to frame; NULL: one render */
 } render_job;
 
 /* CLI_CALL parsers of render's own values. */
@@ -408,10 +420,13 @@ static int render_frames(const render_job *job)
     }
     if (job->frame >= 0 || job->at >= 0)
         return cli_usage_error("render", "--frames and %s exclude each other", job->frame >= 0 ? "--frame" : "--at");
+    frame_cache cache = {0};
+    scene_instance_animated(true);
     for (long f = a; f <= b && rc == 0 && !stop_requested; f++) {
         render_job one = *job;
         one.frames = NULL;
         one.frame = (int)f;
+        one.cache = &cache;
         for (int k = 0; k < 2; k++)
             if (outs[k] && !frame_name(outs[k], f, opts[k], names[k], sizeof names[k]))
                 return 2;
@@ -419,6 +434,13 @@ static int render_frames(const render_job *job)
         one.png_path = outs[1] ? names[1] : NULL;
         rc = render_run(&one);
     }
+    scene_instance_animated(false);
+    if (cache.renderer_live) {
+        renderer_destroy(&cache.r);
+        scene_destroy(&cache.sc);
+    }
+    if (cache.gpu_live && !cli_gpu_finish(&cache.g))
+        rc = rc ? rc : 1;
     return rc;
 }
 
@@ -588,8 +610,9 @@ static int render_run(const render_job *job)
     image_exr_options exr = job->exr;
     const char *exr_path = NULL, *png_o = NULL; /* -o as EXR or as PNG */
     scene sc = {0};
-    gpu g = {0};
-    renderer r = {0};
+    gpu own_g = {0}, *gp = &own_g;
+    renderer own_r = {0}, *rp = &own_r;
+    frame_cache *cache = job->cache;
     image img = {0};
     render_stats st;
     int rc = 1;
@@ -641,20 +664,49 @@ static int render_run(const render_job *job)
     camera_describe(&cam, &sc, camera_text, sizeof camera_text);
     s.camera_label = camera_text;
     s.env_label = studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none";
-    if (!cli_gpu_create(&g, device, job->validate)) {
+    if (cache && cache->gpu_live) {
+        gp = &cache->g;
+    } else if (!cli_gpu_create(gp, device, job->validate)) {
         scene_destroy(&sc);
         image_destroy(&env_map);
         return 1;
+    } else if (cache) { /* the first frame's device serves them all */
+        cache->g = *gp;
+        cache->gpu_live = true;
+        gp = &cache->g;
     }
     catch_signals(quiet);
-    renderer_create(&r, &g, &sc);
-    if ((!resume_path || check_resume(resume_path, &r, &s, brdf, &prev)) && renderer_render(&r, &s, &img, &st)) {
+    if (cache && cache->renderer_live && scene_same_geometry(&cache->sc, &sc)) {
+        /* the frame before's trees and kernels: only the instances moved */
+        scene_destroy(&cache->sc);
+        cache->sc = sc;
+        memset(&sc, 0, sizeof sc);
+        rp = &cache->r;
+        renderer_update(rp, &cache->sc);
+        if (!quiet)
+            fprintf(stderr, "gonio: frame %d: the same geometry, moved: the top tree over %u instances rebuilt "
+                            "and the lights updated in %.2f ms\n", frame, rp->geo.top.num_instances,
+                    rp->setup_seconds * 1e3);
+    } else if (cache) {
+        if (cache->renderer_live) {
+            renderer_destroy(&cache->r);
+            scene_destroy(&cache->sc);
+        }
+        cache->sc = sc;
+        memset(&sc, 0, sizeof sc);
+        renderer_create(&cache->r, gp, &cache->sc);
+        cache->renderer_live = true;
+        rp = &cache->r;
+    } else {
+        renderer_create(rp, gp, &sc);
+    }
+    if ((!resume_path || check_resume(resume_path, rp, &s, brdf, &prev)) && renderer_render(rp, &s, &img, &st)) {
         char seconds[32];
         render_header h;
         bool ok = true;
         int region[4];
         denoise_info dn = {0};
-        render_header_build(&h, &r, &s, &st, brdf, cli_command_line());
+        render_header_build(&h, rp, &s, &st, brdf, cli_command_line());
         if (at >= 0 && h.count + 2 <= RENDER_HEADER_MAX) { /* the animation's time, and frame */
             h.attrs[h.count++] = (image_attr){"gonio:time", IMAGE_ATTR_DOUBLE, NULL, 0, at, NULL};
             if (frame >= 0)
@@ -673,7 +725,7 @@ static int render_run(const render_job *job)
         }
         /* With --denoise the sums include the guides', so that --resume --denoise goes on. */
         if (ok && (resumable || stop_requested == SIGTERM))
-            renderer_sums(&r, st.spp, s.aov, &img);
+            renderer_sums(rp, st.spp, s.aov, &img);
         render_region(&s, region);
         if (s.crop_x1 > 0) { /* the region in the whole frame: OpenEXR's data window */
             img.x0 = region[0];
@@ -704,9 +756,11 @@ static int render_run(const render_job *job)
     image_destroy(&env_map);
     if (job->denoise)
         denoise_shutdown();
-    renderer_destroy(&r);
-    if (!cli_gpu_finish(&g))
-        rc = 1;
+    if (!cache) {
+        renderer_destroy(rp);
+        if (!cli_gpu_finish(gp))
+            rc = 1;
+    }
     scene_destroy(&sc);
     return rc;
 }

@@ -193,7 +193,33 @@ static bool write_cornell(const char *path)
  * whose Phong-equivalent exponent 2/alpha^2 - 2 (Walter et al. 2007) is 128, alpha =
  * roughness^2. The light: glLightfv(GL_POSITION, {1,1,1,0}), a directional light from
  * (1,1,1), i.e. shining along -(1,1,1)/sqrt(3): yaw 45 degrees, pitch asin(1/sqrt(3)). */
-static bool write_teapot(const char *path, int level)
+/* --instances N: the teapot placed N times by EXT_mesh_gpu_instancing, a square grid 4 units
+ * apart, each turned about +Y and scaled 0.8 to 1.2 (a golden-ratio sequence), seen from above
+ * one corner; the camera node is replaced. (gonio bench's scene of instances.) */
+static void teapot_grid(int n, gltf_write_node *teapot, gltf_write_node *camera, float **buf)
+{
+    int side = (int)ceil(sqrt((double)n));
+    float *t = *buf = util_malloc(10 * sizeof *t * (size_t)n), *q = t + 3 * (size_t)n, *sc = q + 4 * (size_t)n;
+    for (int i = 0; i < n; i++) {
+        double a = fmod(i * 0.6180339887, 1.0), angle = 2 * M_PI * a, scale = 0.8 + 0.4 * fmod(i * 0.7548776662, 1.0);
+        t[3 * i] = (float)(4.0 * (i % side - 0.5 * (side - 1)));
+        t[3 * i + 1] = 0;
+        t[3 * i + 2] = (float)(4.0 * (i / side - 0.5 * (side - 1)));
+        q[4 * i] = 0, q[4 * i + 1] = (float)sin(angle / 2), q[4 * i + 2] = 0, q[4 * i + 3] = (float)cos(angle / 2);
+        sc[3 * i] = sc[3 * i + 1] = sc[3 * i + 2] = (float)scale;
+    }
+    teapot->num_instances = (uint32_t)n;
+    teapot->instance_translation = t;
+    teapot->instance_rotation = q;
+    teapot->instance_scale = sc;
+    const double yaw = 30 * M_PI / 180, pitch = 25 * M_PI / 180, dist = 0.35 * 4.0 * side + 6;
+    camera->translation[0] = (float)(dist * cos(pitch) * sin(yaw));
+    camera->translation[1] = (float)(dist * sin(pitch));
+    camera->translation[2] = (float)(dist * cos(pitch) * cos(yaw));
+    yaw_pitch_quat(yaw, pitch, camera->rotation);
+}
+
+static bool write_teapot(const char *path, int level, int instances)
 {
     teapot_mesh t;
     bool ok;
@@ -221,12 +247,16 @@ static bool write_teapot(const char *path, int level)
                             .lights = &light, .num_lights = 1, .nodes = nodes, .num_nodes = 3};
     yaw_pitch_quat(M_PI / 4, asin(1 / sqrt(3.0)), nodes[1].rotation);
     yaw_pitch_quat(yaw, pitch, nodes[2].rotation);
+    float *grid = NULL;
+    if (instances > 0)
+        teapot_grid(instances, &nodes[0], &nodes[2], &grid);
     teapot_tessellate(&t, level);
     mesh = (gltf_write_mesh){.name = "teapot", .num_vertices = t.num_vertices,
                              .positions = t.positions, .normals = t.normals,
                              .num_indices = 3 * t.num_triangles, .indices = t.indices};
     ok = gltf_write_file(path, &desc);
     teapot_destroy(&t);
+    free(grid);
     return ok;
 }
 
@@ -234,7 +264,7 @@ static bool write_teapot(const char *path, int level)
 static int run(int argc, char **argv, bool teapot_command)
 {
     const char *out = NULL;
-    int level = SCENE_TEAPOT_LEVEL;
+    int level = SCENE_TEAPOT_LEVEL, instances = 0;
     const cli_option options[] = {
         {NULL, NULL, "  cornell             the Cornell box (published measurements, metres, one area light)\n"
                      "  teapot              the Utah teapot as in the classic OpenGL 1.x example\n",
@@ -245,12 +275,15 @@ static int run(int argc, char **argv, bool teapot_command)
         {"--level", "N", "teapot: N x N grid cells per Bezier patch, 1..256 (default 8);\n"
                          "64 N^2 - 8 N triangles",
          CLI_INT, CLI_AS(int, &level), 1, SCENE_TEAPOT_MAX_LEVEL, "an integer 1..256", NULL, NULL},
+        {"--instances", "N", "teapot: N teapots on a square grid, placed by EXT_mesh_gpu_instancing\n"
+                             "(one mesh, N transforms), seen from above a corner",
+         CLI_INT, CLI_AS(int, &instances), 1, 1 << 20, "an integer 1..1048576", NULL, NULL},
     };
     const cli_command cmd = {
         .name = teapot_command ? "teapot" : "scene",
-        .synopsis = teapot_command ? "[--level N] -o FILE.gltf|FILE.glb"
+        .synopsis = teapot_command ? "[--level N] [--instances N] -o FILE.gltf|FILE.glb"
                                    : "cornell -o FILE.gltf|FILE.glb\n"
-                                     "       gonio scene teapot [--level N] -o FILE.gltf|FILE.glb",
+                                     "       gonio scene teapot [--level N] [--instances N] -o FILE.gltf|FILE.glb",
         .intro = "Writes one of gonio's own scenes as a self-contained glTF 2.0 file.\n",
         /* gonio teapot has no scene names to list */
         .options = options + teapot_command, .num_options = (int)(sizeof options / sizeof *options) - teapot_command,
@@ -266,6 +299,8 @@ static int run(int argc, char **argv, bool teapot_command)
         return cli_usage_error(cmd.name, "unknown scene '%s' (cornell or teapot)", name);
     if (!teapot && cli_given(&cmd, &args, "--level"))
         return cli_usage_error(cmd.name, "--level is for the teapot");
+    if (!teapot && cli_given(&cmd, &args, "--instances"))
+        return cli_usage_error(cmd.name, "--instances is for the teapot");
     if (!out)
         return cli_usage_error(cmd.name, "missing -o FILE.gltf");
     {
@@ -275,7 +310,7 @@ static int run(int argc, char **argv, bool teapot_command)
     }
     if (!util_check_output(out))
         return 1;
-    return (teapot ? write_teapot(out, level) : write_cornell(out)) ? 0 : 1;
+    return (teapot ? write_teapot(out, level, instances) : write_cornell(out)) ? 0 : 1;
 }
 
 int cmd_scene(int argc, char **argv) { return run(argc, argv, false); }
@@ -293,7 +328,7 @@ bool cli_load_builtin_scene(scene *out, const char *name)
         return false;
     }
     snprintf(path, sizeof path, "%s/%s.gltf", dir, name);
-    ok = (!strcmp(name, "teapot") ? write_teapot(path, SCENE_TEAPOT_LEVEL) : write_cornell(path)) &&
+    ok = (!strcmp(name, "teapot") ? write_teapot(path, SCENE_TEAPOT_LEVEL, 0) : write_cornell(path)) &&
          scene_load(out, path);
     unlink(path);
     rmdir(dir);

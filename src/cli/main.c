@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "image_decode.h"
 #include "util.h"
 
 static const struct {
@@ -67,7 +68,7 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "__complete"))
         return complete(argc - 2, argv + 2);
     if (!strcmp(argv[1], "--version")) {
-        printf("gonio %s\n", GONIO_VERSION);
+        printf("gonio %s\nimage decoders: %s\n", GONIO_VERSION, image_decode_versions());
         return 0;
     }
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)

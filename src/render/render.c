@@ -26,15 +26,7 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
     memset(r, 0, sizeof *r);
     r->g = g;
     r->sc = sc;
-    if (!bvh_build(&r->tree, &sc->vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc->indices,
-                   sc->num_triangles)) {
-        util_error("%s: no triangles to render", sc->path);
-        r->failed = true;
-        return false;
-    }
-    if (r->tree.num_tris > GN_BVH_FIRST) { /* leaves index their first triangle in 27 bits */
-        util_error("%s: %u triangles, more than the %u a BVH leaf can index", sc->path, sc->num_triangles,
-                   GN_BVH_FIRST);
+    if (!render_geometry_build(&r->geo, sc)) {
         r->failed = true;
         return false;
     }
@@ -56,16 +48,7 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
     r->path_samples = path_samples(r);
     r->path_features = r->material_features;
 
-    /* in BVH order, each triangle's corners in the order the walk's test takes them (a
-     * rotation: the winding stays), so the walk's barycentrics apply as they are */
-    prims = util_calloc(r->tree.num_slots, sizeof *prims);
-    for (uint32_t i = 0; i < r->tree.num_slots; i++) {
-        uint32_t t = r->tree.tri_index[i], k = r->tree.tri_rotation[i];
-        if (t == GN_INVALID)
-            continue;
-        prims[i] = (GnPrim){sc->indices[3 * t + k], sc->indices[3 * t + (k + 1) % 3],
-                            sc->indices[3 * t + (k + 2) % 3], sc->tri_material[t]};
-    }
+    prims = r->geo.prims; /* (render_geometry.c: BVH order, corners in the walk's order) */
 
     image_offset = util_calloc(sc->num_images + 1, sizeof *image_offset);
     total_texels = sheen_prefix(r);
@@ -87,32 +70,73 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
                              sc->textures[i].flags, {t[0], t[1], t[2]}, 0, {t[3], t[4], t[5]}, 0};
     }
 
-    lights = util_calloc(sc->num_lights + 16, sizeof *lights);
-    if (sc->num_lights)
-        memcpy(lights, sc->lights, sizeof *lights * sc->num_lights);
-    r->num_lights = sc->num_lights ? sc->num_lights : emissive_lights(sc, lights, 16);
+    lights = scene_lights(r);
 
     gpu_buffer_create(g, &r->frame, sizeof(GnFrame), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       GPU_MEMORY_HOST);
-    gpu_buffer_create_texels(g, &r->nodes, r->tree.nodes, sizeof(GnBvhNode) * r->tree.num_nodes);
-    gpu_buffer_create_texels(g, &r->tris, r->tree.pairs, sizeof(GnTriPair) * r->tree.num_pairs);
-    gpu_buffer_create_texels(g, &r->prims, prims, sizeof(GnPrim) * r->tree.num_slots);
-    gpu_buffer_create_texels(g, &r->vertices, sc->vertices, sizeof(GnVertex) * sc->num_vertices);
+    gpu_buffer_create_texels(g, &r->nodes, r->geo.nodes, sizeof(GnBvhNode) * r->geo.num_nodes);
+    gpu_buffer_create_texels(g, &r->tris, r->geo.pairs, sizeof(GnTriPair) * r->geo.num_pairs);
+    gpu_buffer_create_texels(g, &r->prims, prims, sizeof(GnPrim) * r->geo.num_slots);
+    gpu_buffer_create_texels(g, &r->vertices, r->geo.vertices, sizeof(GnVertex) * r->geo.num_vertices);
     gpu_buffer_create_texels(g, &r->materials, sc->materials, sizeof(GnMaterial) * sc->num_materials);
     gpu_buffer_create_storage(g, &r->lights, lights, sizeof(GnLight) * r->num_lights);
     gpu_buffer_create_texels_as(g, &r->texels, texels, sizeof(uint32_t) * (total_texels + 1),
                                 VK_FORMAT_R32_UINT);
     gpu_buffer_create_texels(g, &r->textures, tex, sizeof(GnTexture) * (sc->num_textures + 1));
     build_emitters(r, prims);
-    gpu_buffer_create_texels(g, &r->emitters, NULL, sizeof(GnEmitter) * (r->num_emitters + 1));
+    if (r->geo.two_levels) { /* the table, then each entry's instance (GnFrame.emitter_instances) */
+        gpu_buffer_create_texels(g, &r->emitters, NULL, 2 * sizeof(GnEmitter) * r->emitter_cap);
+        upload_emitter_instances(r);
+    } else {
+        gpu_buffer_create_texels(g, &r->emitters, NULL, sizeof(GnEmitter) * (r->num_emitters + 1));
+    }
     gpu_buffer_create_texels_as(g, &r->env, NULL, 16, VK_FORMAT_R32_UINT);
     vertex_colors_create(r);
     gpu_buffer_create(g, &r->status, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
-    free(prims);
+    if (r->geo.two_levels)
+        gpu_buffer_create_texels(g, &r->instances, r->geo.top.instances, sizeof(GnInstance) * r->geo.top.num_instances);
+    else
+        gpu_buffer_create_texels(g, &r->instances, NULL, 16);
     free(image_offset);
     free(texels);
     free(tex);
     free(lights);
+    r->setup_seconds = util_now() - t0;
+    return true;
+}
+
+bool renderer_update(renderer *r, const scene *sc)
+{
+    double t0 = util_now();
+    if (r->failed)
+        return false;
+    r->sc = sc;
+    if (!render_geometry_update(&r->geo, sc)) {
+        r->failed = true;
+        return false;
+    }
+    if (r->geo.two_levels) { /* the top tree's nodes lead the array; the instances' transforms */
+        gpu_buffer_upload(r->g, &r->nodes, r->geo.nodes, sizeof(GnBvhNode) * r->geo.top.tree.num_nodes, 0);
+        gpu_buffer_upload(r->g, &r->instances, r->geo.top.instances, sizeof(GnInstance) * r->geo.top.num_instances, 0);
+    }
+    uint32_t before = r->num_lights;
+    GnLight *lights = scene_lights(r);
+    if (r->num_lights <= before) {
+        gpu_buffer_upload(r->g, &r->lights, lights, sizeof(GnLight) * r->num_lights, 0);
+    } else { /* (more of the stand-ins for emissive meshes than before: a new buffer) */
+        gpu_buffer_destroy(r->g, &r->lights);
+        gpu_buffer_create_storage(r->g, &r->lights, lights, sizeof(GnLight) * r->num_lights);
+        for (uint32_t i = 0; i < GN_MODE_COUNT; i++) /* their descriptor sets name the old buffer */
+            gpu_pipeline_destroy(r->g, &r->pipelines[i]);
+        gpu_pipeline_destroy(r->g, &r->vertex_pass);
+    }
+    free(lights);
+    free(r->emitter_table);
+    free(r->emitter_weight);
+    free(r->emitter_instance);
+    build_emitters(r, r->geo.prims); /* (the same room: the same triangles and lights) */
+    upload_emitter_instances(r);
+    r->env_source = NULL; /* the environment's weight follows the scene's bounds */
     r->setup_seconds = util_now() - t0;
     return true;
 }
@@ -122,7 +146,7 @@ void renderer_destroy(renderer *r)
     gpu_buffer *bufs[] = {&r->frame, &r->nodes, &r->tris, &r->prims, &r->vertices,
                           &r->materials, &r->lights, &r->texels, &r->textures, &r->emitters,
                           &r->vcolor, &r->status, &r->accum, &r->aov,
-                          &r->squares, &r->env, &r->pstate};
+                          &r->squares, &r->env, &r->pstate, &r->instances};
     if (r->g) {
         for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
             gpu_buffer_destroy(r->g, bufs[i]);
@@ -130,10 +154,11 @@ void renderer_destroy(renderer *r)
             gpu_pipeline_destroy(r->g, &r->pipelines[i]);
         gpu_pipeline_destroy(r->g, &r->vertex_pass);
     }
-    bvh_destroy(&r->tree);
+    render_geometry_destroy(&r->geo);
     free_bands(r);
     free(r->emitter_table);
     free(r->emitter_weight);
+    free(r->emitter_instance);
     memset(r, 0, sizeof *r);
 }
 
@@ -190,6 +215,7 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
         {GN_BIND_SQUARES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->squares},
         {GN_BIND_ENV, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->env},
         {GN_BIND_PSTATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->pstate},
+        {GN_BIND_INSTANCES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->instances},
     };
     memcpy(b, all, sizeof all);
     return sizeof all / sizeof *all;
@@ -311,12 +337,14 @@ const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode
     spec->values[2] = walk_regs(r);
     spec->values[3] = 0; /* the loop cap: only the path kernel's (renderer_pipeline) */
     spec->values[4] = (uint32_t)(kernel_features(r, mode) >> 32);
-    for (uint32_t i = 0; i < 5; i++)
+    spec->values[5] = r->geo.two_levels; /* INSTANCES */
+    for (uint32_t i = 0; i < 6; i++)
         spec->entries[i] = (VkSpecializationMapEntry){i, i * (uint32_t)sizeof(uint32_t), sizeof(uint32_t)};
     assert(spec->entries[GN_SPEC_FEATURES].constantID == GN_SPEC_FEATURES &&
            spec->entries[GN_SPEC_FEATURES_HI].constantID == GN_SPEC_FEATURES_HI &&
-           spec->entries[2].constantID == GN_SPEC_WALK_REGS && spec->entries[3].constantID == GN_SPEC_LOOP_CAP);
-    spec->info = (VkSpecializationInfo){5, spec->entries, sizeof spec->values, spec->values};
+           spec->entries[2].constantID == GN_SPEC_WALK_REGS && spec->entries[3].constantID == GN_SPEC_LOOP_CAP &&
+           spec->entries[5].constantID == GN_SPEC_INSTANCES);
+    spec->info = (VkSpecializationInfo){6, spec->entries, sizeof spec->values, spec->values};
     return &spec->info;
 }
 

@@ -13,6 +13,7 @@
 
 #include "bvh.h"
 #include "gpu.h"
+#include "render_geometry.h"
 #include "image.h"
 #include "scene.h"
 
@@ -96,11 +97,11 @@ typedef struct render_stats {
 typedef struct renderer {
     gpu *g;
     const scene *sc;
-    bvh tree;
+    render_geometry geo;    /* the trees and the arrays the walk reads */
     uint32_t num_lights, num_emitters;
     uint32_t num_area_emitters; /* the emitter table's triangles, before its punctual lights */
     gpu_buffer frame, nodes, tris, prims, vertices, materials, lights, texels, textures,
-        emitters, vcolor, status;
+        emitters, vcolor, status, instances;
     gpu_buffer accum, aov;  /* sized for the current image */
     gpu_pipeline pipelines[GN_MODE_COUNT]; /* created on first use */
     gpu_pipeline vertex_pass; /* Gouraud's per-vertex lighting (glsl/kernels/vertex.comp) */
@@ -110,6 +111,9 @@ typedef struct renderer {
     uint32_t state_stride;    /* words a pixel of pstate (frame_setup), 0 without a cap */
     GnEmitter *emitter_table; /* path: lights, then a slot for the environment */
     double *emitter_weight;   /* their selection weights (flux / pi) */
+    uint32_t *emitter_instance; /* with instances: each entry's instance (GN_INVALID: a light) */
+    uint32_t emitter_cap;     /* the table's room (with instances, where the instances follow) */
+    uint32_t vcolor_count;    /* Gouraud's vertices: the scene's, or every instance's copies */
     const image *env_source;  /* the map now in `env` */
     double env_weight;        /* its selection weight */
     int width, height;
@@ -132,6 +136,12 @@ typedef struct renderer {
  * marked failed, so that renderer_begin and renderer_render return false too. */
 bool renderer_create(renderer *r, gpu *g, const scene *sc);
 void renderer_destroy(renderer *r); /* accepts a zeroed struct */
+/* sc is r's scene at another time of its animation: the same geometry and materials
+ * (scene_same_geometry), other instance transforms, lights and cameras; r renders sc from
+ * now on. Only the top tree over the instances is rebuilt (render_geometry_update), and the
+ * lights and the light table are made again; the kernels stay. setup_seconds becomes the
+ * time this took. False (the renderer then failed) when the tree cannot be built. */
+bool renderer_update(renderer *r, const scene *sc);
 
 /* The camera for settings->camera (or the framing one) as the GPU wants it. Returns false
  * (with an error) if the index is out of range. */
@@ -149,8 +159,8 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
  * variant); constants GN_SPEC_FEATURES and GN_SPEC_FEATURES_HI = the GN_FEAT_* set's two words (the
  * path kernel reads them; others ignore them). */
 typedef struct renderer_spec {
-    uint32_t values[5];
-    VkSpecializationMapEntry entries[5];
+    uint32_t values[6];
+    VkSpecializationMapEntry entries[6];
     VkSpecializationInfo info;
 } renderer_spec;
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec);

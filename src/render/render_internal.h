@@ -8,7 +8,9 @@
  *   render_accum.c    accumulation: buffers and bands, resolve, sums and --resume
  *   render_limits.c   device limits and llvmpipe's loop cap
  *   render_gouraud.c  Gouraud's vertex pass
- *   render_material.c what the renderer derives from materials (features, --brdf overrides) */
+ *   render_material.c what the renderer derives from materials (features, --brdf overrides)
+ * and, with its own interface (render_geometry.h), render_geometry.c: the scene's trees and
+ * GPU arrays, one level or two (instances). */
 #ifndef GONIO_RENDER_INTERNAL_H
 #define GONIO_RENDER_INTERNAL_H
 
@@ -41,8 +43,17 @@ bool frame_setup(renderer *r, const render_settings *s, const int region[4], GnF
 /* The local modes' lights of a scene without punctual lights: one per emissive material
  * (at most cap); returns how many. */
 uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap);
-/* The path tracer's light table without the environment (renderer_create). */
+/* The path tracer's light table without the environment (renderer_create, renderer_update);
+ * with instances, each entry's instance in r->emitter_instance. */
 void build_emitters(renderer *r, const GnPrim *prims);
+/* The light table's triangle entries at most (build_emitters' room, scene_fits). */
+uint64_t emitter_room(const renderer *r);
+/* The lights r uploads: the scene's punctual ones, or emissive_lights' stand-ins; sets
+ * r->num_lights (the caller frees them). */
+GnLight *scene_lights(renderer *r);
+/* With instances, the light table's entries' instances, after the table in r->emitters
+ * (GnFrame.emitter_instances); nothing without. */
+void upload_emitter_instances(renderer *r);
 /* The path tracer's lights for s: the environment (a map uploaded when it is new) added to
  * the table, which is normalised and uploaded; frame's emitter and environment fields set,
  * *env the environment's selection weight (0: none). False (with an error) on a bad map. */

@@ -10,6 +10,53 @@
 #include "vec.h"
 
 
+/* Does instanced mesh m have a triangle of material `material`? */
+static bool mesh_has_material(const scene_instanced_mesh *m, uint32_t material)
+{
+    for (uint32_t t = 0; t < m->num_triangles; t++)
+        if (m->tri_material[t] == material)
+            return true;
+    return false;
+}
+
+/* emissive_lights' sums over the instances' triangles of material m: area, area-weighted
+ * centroid and area vector (the cross products as the corners are stored, turned by a
+ * mirroring instance, whose front is the other side: GN_INSTANCE_MIRROR). */
+static void instanced_emission(const scene *sc, uint32_t m, double *area, double c[3], double an[3])
+{
+    for (uint32_t j = 0; j < sc->num_instanced_meshes; j++) {
+        const scene_instanced_mesh *im = &sc->instanced_meshes[j];
+        if (!mesh_has_material(im, m))
+            continue;
+        for (uint32_t i = 0; i < sc->num_instances; i++) {
+            const scene_instance *in = &sc->instances[i];
+            const float *w = in->to_world;
+            double det = w[0] * (w[5] * w[10] - w[6] * w[9]) - w[1] * (w[4] * w[10] - w[6] * w[8]) +
+                         w[2] * (w[4] * w[9] - w[5] * w[8]);
+            if (in->mesh != j)
+                continue;
+            for (uint32_t t = 0; t < im->num_triangles; t++) {
+                double cr[3], p[3] = {0, 0, 0};
+                if (im->tri_material[t] != m)
+                    continue;
+                scene_instance_triangle_cross(sc, i, t, cr);
+                double a = 0.5 * vec_length_d(cr);
+                for (int k = 0; k < 3; k++) {
+                    const float *q = &im->vertices[im->indices[3 * t + k]].position.x;
+                    for (int r = 0; r < 3; r++)
+                        p[r] += (w[4 * r] * (double)q[0] + w[4 * r + 1] * (double)q[1] + w[4 * r + 2] * (double)q[2] +
+                                 w[4 * r + 3]) / 3.0;
+                }
+                *area += a;
+                for (int k = 0; k < 3; k++) {
+                    c[k] += a * p[k];
+                    an[k] += (det < 0 ? -0.5 : 0.5) * cr[k];
+                }
+            }
+        }
+    }
+}
+
 /* Emissive geometry as lights for the local modes when a scene has no punctual light (the
  * Cornell box): one light per emissive material at the power-weighted centroid. A flat
  * emitter of area A and radiance L has radiant intensity L A cos(theta), a GN_LIGHT_COSINE;
@@ -37,6 +84,7 @@ uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap)
                 an[k] += 0.5 * cr[k];
             }
         }
+        instanced_emission(sc, m, &area, c, an);
         if (area <= 0)
             continue;
         GnLight *l = &out[n++];
@@ -74,6 +122,82 @@ static double scene_radius2(const scene *sc)
     return r2 > 0 ? r2 : 1;
 }
 
+/* With two levels: each mesh's emissive triangles, as GPU slots (*count: how many), listed
+ * once so that placing them costs only the instances' emitters. */
+static uint32_t *emissive_slots(const renderer *r, uint32_t *first, uint32_t *count)
+{
+    const render_geometry *geo = &r->geo;
+    uint32_t n = 0;
+    uint32_t *list = util_calloc(geo->num_slots + 1, sizeof *list);
+    for (uint32_t m = 0; m < geo->num_meshes; m++) {
+        uint32_t base = 2 * geo->top.pair_base[m];
+        first[m] = n;
+        for (uint32_t j = 0; j < geo->meshes[m].num_slots; j++) {
+            const GnMaterial *mat = &r->sc->materials[geo->prims[base + j].material];
+            if (geo->meshes[m].tri_index[j] != GN_INVALID && vec_luminance(&mat->emissive.x) > 0 &&
+                !(mat->flags & GN_MAT_UNLIT))
+                list[n++] = base + j;
+        }
+        count[m] = n - first[m];
+    }
+    return list;
+}
+
+/* With instances, each instance's emissive triangles, their areas in world space (a scale
+ * changes them), and in r->emitter_instance the instance of each; returns the count. */
+static uint32_t instanced_emitters(renderer *r, uint32_t n)
+{
+    const render_geometry *geo = &r->geo;
+    uint32_t *first = util_calloc(geo->num_meshes, sizeof *first), *count = util_calloc(geo->num_meshes, sizeof *count);
+    uint32_t *slots = emissive_slots(r, first, count);
+    for (uint32_t i = 0; i < geo->top.num_instances; i++) {
+        const GnInstance *in = &geo->top.instances[i];
+        for (uint32_t k = first[in->mesh]; k < first[in->mesh] + count[in->mesh]; k++) {
+            uint32_t j = slots[k];
+            const GnPrim *pr = &geo->prims[j];
+            const GnMaterial *m = &r->sc->materials[pr->material];
+            double lum = vec_luminance(&m->emissive.x), p[3][3];
+            const uint32_t v[3] = {pr->i0, pr->i1, pr->i2};
+            for (int c3 = 0; c3 < 3; c3++) {
+                const float *q = &geo->vertices[v[c3]].position.x;
+                for (int c = 0; c < 3; c++) {
+                    const float *w = &in->to_world[c].x;
+                    p[c3][c] = w[0] * (double)q[0] + w[1] * (double)q[1] + w[2] * (double)q[2] + w[3];
+                }
+            }
+            double e1[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
+            double e2[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+            double c[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+            double area = 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+            if (!(area > 0))
+                continue;
+            r->emitter_table[n] = (GnEmitter){j, (float)area, 0, 0};
+            r->emitter_instance[n] = i;
+            r->emitter_weight[n++] = lum * area * (m->flags & GN_MAT_DOUBLE_SIDED ? 2 : 1);
+        }
+    }
+    free(slots);
+    free(first);
+    free(count);
+    return n;
+}
+
+/* The light table's triangle entries at most: each instance's emissive triangles (counted
+ * without their areas), or the scene's slots. */
+uint64_t emitter_room(const renderer *r)
+{
+    if (!r->geo.two_levels)
+        return r->geo.num_slots;
+    uint64_t n = 0;
+    uint32_t *first = util_calloc(r->geo.num_meshes, sizeof *first), *count = util_calloc(r->geo.num_meshes, sizeof *count);
+    free(emissive_slots(r, first, count));
+    for (uint32_t i = 0; i < r->geo.top.num_instances; i++)
+        n += count[r->geo.top.instances[i].mesh];
+    free(first);
+    free(count);
+    return n;
+}
+
 /* The path tracer's light table: each emissive triangle (BVH order) and punctual light with
  * a selection weight proportional to its power, flux / pi: L A per emitting side for a
  * triangle (so picking one and then a uniform point has area density lum(L) sides / total),
@@ -82,11 +206,14 @@ static double scene_radius2(const scene *sc)
 void build_emitters(renderer *r, const GnPrim *prims)
 {
     const scene *sc = r->sc;
-    uint32_t cap = r->tree.num_slots + sc->num_lights + 1, n = 0;
+    uint32_t cap = (uint32_t)emitter_room(r) + sc->num_lights + 1, n = 0;
     r->emitter_table = util_calloc(cap, sizeof *r->emitter_table);
     r->emitter_weight = util_calloc(cap, sizeof *r->emitter_weight);
-    for (uint32_t i = 0; i < r->tree.num_slots; i++) {
-        if (r->tree.tri_index[i] == GN_INVALID) /* the missing B of a lone triangle */
+    r->emitter_instance = r->geo.two_levels ? util_calloc(cap, sizeof *r->emitter_instance) : NULL;
+    if (r->geo.two_levels)
+        n = instanced_emitters(r, n);
+    for (uint32_t i = 0; i < r->geo.num_slots && !r->geo.two_levels; i++) {
+        if (r->geo.world.tri_index[i] == GN_INVALID) /* the missing B of a lone triangle */
             continue;
         const GnMaterial *m = &sc->materials[prims[i].material];
         const vec3 *p0 = &sc->vertices[prims[i].i0].position, *p1 = &sc->vertices[prims[i].i1].position,
@@ -110,10 +237,13 @@ void build_emitters(renderer *r, const GnPrim *prims)
                                                                          : scene_radius2(sc);
         if (w <= 0)
             continue;
+        if (r->emitter_instance)
+            r->emitter_instance[n] = GN_INVALID;
         r->emitter_table[n] = (GnEmitter){GN_EMITTER_LIGHT | i, 0, 0, 0};
         r->emitter_weight[n++] = w;
     }
     r->num_emitters = n;
+    r->emitter_cap = cap;
 }
 
 
@@ -188,10 +318,14 @@ static bool upload_env_map(renderer *r, const image *map)
         marg[y] = total > 0 ? (float)(acc / total) : (float)(y + 1) / h;
     }
     marg[h - 1] = 1;
-    gpu_buffer_destroy(r->g, &r->env);
-    gpu_buffer_create_texels_as(r->g, &r->env, data, words * 4, VK_FORMAT_R32_UINT);
-    for (uint32_t i = 0; i < GN_MODE_COUNT; i++) /* their descriptor sets name the old buffer */
-        gpu_pipeline_destroy(r->g, &r->pipelines[i]);
+    if (r->env.buffer && r->env.size == words * 4) { /* (the same map again: an animation's next frame) */
+        gpu_buffer_upload(r->g, &r->env, data, words * 4, 0);
+    } else {
+        gpu_buffer_destroy(r->g, &r->env);
+        gpu_buffer_create_texels_as(r->g, &r->env, data, words * 4, VK_FORMAT_R32_UINT);
+        for (uint32_t i = 0; i < GN_MODE_COUNT; i++) /* their descriptor sets name the old buffer */
+            gpu_pipeline_destroy(r->g, &r->pipelines[i]);
+    }
     /* mean L over the sphere = sum(L sin dtheta dphi) / 4 pi, dtheta dphi = 2 pi^2 / n */
     r->env_weight = scene_radius2(r->sc) * 2 * M_PI * M_PI * total / (double)n;
     r->env_source = map;
@@ -231,7 +365,32 @@ bool path_lights(renderer *r, const render_settings *s, GnFrame *frame, double *
         gpu_buffer_upload(r->g, &r->emitters, r->emitter_table, sizeof(GnEmitter) * n, 0);
     frame->num_emitters = n;
     frame->emitter_power = (float)total;
+    frame->emitter_instances = r->geo.two_levels ? r->emitter_cap : 0;
     frame->env_select = env > 0 ? (float)(env / total) : 0;
     *env_weight = env;
     return true;
+}
+
+/* The lights r uploads: the scene's punctual ones, or stand-ins for its emissive meshes in
+ * the local modes (emissive_lights); sets r->num_lights. */
+GnLight *scene_lights(renderer *r)
+{
+    const scene *sc = r->sc;
+    GnLight *lights = util_calloc(sc->num_lights + 16, sizeof *lights);
+    if (sc->num_lights)
+        memcpy(lights, sc->lights, sizeof *lights * sc->num_lights);
+    r->num_lights = sc->num_lights ? sc->num_lights : emissive_lights(sc, lights, 16);
+    return lights;
+}
+
+/* With instances, the light table's entries' instances, after the table (GnFrame.emitter_instances). */
+void upload_emitter_instances(renderer *r)
+{
+    if (!r->geo.two_levels)
+        return;
+    uvec4 *inst = util_calloc(r->emitter_cap, sizeof *inst);
+    for (uint32_t i = 0; i < r->num_emitters; i++)
+        inst[i].x = r->emitter_instance[i];
+    gpu_buffer_upload(r->g, &r->emitters, inst, sizeof *inst * r->emitter_cap, sizeof(GnEmitter) * r->emitter_cap);
+    free(inst);
 }

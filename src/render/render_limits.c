@@ -36,7 +36,10 @@ uint32_t path_samples(const renderer *r)
      * image short enough for a display watchdog. */
     if (!loop_capped(r->g))
         return GN_PATH_SAMPLES / 2;
-    double per_path = 16.0 * (r->tree.sah_cost > 1 ? r->tree.sah_cost : 1) * 3 * 2;
+    double sah = r->geo.world.sah_cost; /* (two levels: the top tree's and the costliest mesh's) */
+    for (uint32_t m = 0; r->geo.two_levels && m < r->geo.num_meshes; m++)
+        sah = fmax(sah, r->geo.top.tree.sah_cost + r->geo.meshes[m].sah_cost);
+    double per_path = 16.0 * (sah > 1 ? sah : 1) * 3 * 2;
     double n = floor(30000.0 / per_path);
     return n < 1 ? 1u : n > GN_PATH_SAMPLES ? GN_PATH_SAMPLES : (uint32_t)n;
 }
@@ -98,14 +101,16 @@ bool scene_fits(renderer *r)
                    sc->images[largest].height, limit, name);
         return false;
     }
-    /* RGBA32UI texels: 16 bytes each */
-    return texels_fit(r, "the BVH nodes", (uint64_t)r->tree.num_nodes * sizeof(GnBvhNode) / 16) &&
-           texels_fit(r, "the BVH triangles", (uint64_t)r->tree.num_pairs * sizeof(GnTriPair) / 16) &&
-           texels_fit(r, "the triangles' shading data", (uint64_t)r->tree.num_slots) &&
-           texels_fit(r, "the vertices", (uint64_t)sc->num_vertices * sizeof(GnVertex) / 16) &&
+    /* RGBA32UI texels: 16 bytes each (the light table: with instances, twice) */
+    const render_geometry *geo = &r->geo;
+    return texels_fit(r, "the BVH nodes", (uint64_t)geo->num_nodes * sizeof(GnBvhNode) / 16) &&
+           texels_fit(r, "the BVH triangles", (uint64_t)geo->num_pairs * sizeof(GnTriPair) / 16) &&
+           texels_fit(r, "the triangles' shading data", (uint64_t)geo->num_slots) &&
+           texels_fit(r, "the vertices", (uint64_t)geo->num_vertices * sizeof(GnVertex) / 16) &&
            texels_fit(r, "the materials", (uint64_t)sc->num_materials * sizeof(GnMaterial) / 16) &&
            texels_fit(r, "the texture table", (uint64_t)sc->num_textures + 1) &&
-           texels_fit(r, "the light table", (uint64_t)r->tree.num_slots + sc->num_lights + 1);
+           texels_fit(r, "the instances", (uint64_t)geo->top.num_instances * sizeof(GnInstance) / 16) &&
+           texels_fit(r, "the light table", (emitter_room(r) + sc->num_lights + 1) * (geo->two_levels ? 2 : 1));
 }
 
 /* The walk's stack in registers for trees of at most GN_WALK_REGS_MAX levels (a walk puts
@@ -116,7 +121,7 @@ uint32_t walk_regs(const renderer *r)
     const char *array = getenv("GONIO_WALK_ARRAY");
     if (array && !strcmp(array, "1"))
         return 0;
-    return r->tree.depth <= GN_WALK_REGS_MAX ? r->tree.depth : 0;
+    return r->geo.depth <= GN_WALK_REGS_MAX ? r->geo.depth : 0;
 }
 
 /* Words a pixel of the path kernel's saved state (glsl/kernels/path.comp: path_save) takes under a
@@ -124,10 +129,11 @@ uint32_t walk_regs(const renderer *r)
  * tree level (plus the sentinel). */
 uint32_t state_stride(const renderer *r, uint32_t mode)
 {
-    uint32_t regs = walk_regs(r), stack = r->tree.depth + 2 < GN_WALK_STACK ? r->tree.depth + 2 : GN_WALK_STACK;
+    uint32_t regs = walk_regs(r), stack = r->geo.depth + 2 < GN_WALK_STACK ? r->geo.depth + 2 : GN_WALK_STACK;
     if (mode != GN_MODE_PATH || !loop_capped(r->g))
         return 0;
-    return GN_PATH_STATE_WORDS + (regs ? regs : stack);
+    /* (with instances, two words more: the hit's instance and the walk's, path_save) */
+    return GN_PATH_STATE_WORDS + (regs ? regs : stack) + (r->geo.two_levels ? 2 : 0);
 }
 
 static uint32_t log2_up(uint32_t n)

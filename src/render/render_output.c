@@ -38,6 +38,13 @@ static uint32_t scene_crc(const scene *sc)
         c = crc(c, sc->images[i].rgba8, (size_t)sc->images[i].width * sc->images[i].height * 4);
     c = crc(c, sc->ambient, sizeof sc->ambient);
     c = crc(c, &sc->vertex_colors, sizeof sc->vertex_colors);
+    for (uint32_t m = 0; m < sc->num_instanced_meshes; m++) { /* (none: the crc scenes had before) */
+        const scene_instanced_mesh *im = &sc->instanced_meshes[m];
+        c = crc(c, im->vertices, sizeof *im->vertices * im->num_vertices);
+        c = crc(c, im->indices, sizeof *im->indices * 3 * (size_t)im->num_triangles);
+        c = crc(c, im->tri_material, sizeof *im->tri_material * im->num_triangles);
+    }
+    c = crc(c, sc->instances, sizeof *sc->instances * sc->num_instances);
     return (uint32_t)c;
 }
 

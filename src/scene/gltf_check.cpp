@@ -237,6 +237,7 @@ bool check_nodes_and_scenes(Ctx &c)
         const auto &n = m.nodes[i];
         std::string what = label("node", int(i), n.name);
         bool animated = pose[i].has[0] || pose[i].has[1] || pose[i].has[2];
+        c.animated.push_back(animated);
         if (animated && !n.matrix.empty())
             warn(c, "%s has a matrix and is animated: the matrix wins (glTF forbids the two)", what.c_str());
         node_local(c, int(i), c.local[i], animated ? &pose[i] : nullptr);

@@ -1,7 +1,10 @@
 /* gltf_geometry.cpp: the geometry of a glTF file: accessors read (sparse, normalised), the
  * node hierarchy's transforms, primitives as triangles (strips and fans, flat normals, vertex
- * colours, MikkTSpace tangents for the materials that need them), instances of the scene's
- * meshes, cameras and lights baked into world space; normals with the cofactor matrix (the
+ * colours, MikkTSpace tangents for the materials that need them), the placements of the
+ * scene's meshes (nodes, and EXT_mesh_gpu_instancing's instances): a mesh placed once baked
+ * into world space, one placed several times kept once in its own space with an instance
+ * per placement (scene_instanced_mesh, scene_instance); cameras and lights baked into world
+ * space; normals with the cofactor matrix (the
  * inverse transpose up to det, Lengyel, "Mathematics for 3D Game Programming and Computer
  * Graphics", 3rd ed., 4.5). */
 #include "gltf_internal.h"
@@ -166,6 +169,24 @@ bool mat_finite(const Mat &m)
     return true;
 }
 
+/* T R S as a matrix: translation t, rotation by the unit quaternion q (x, y, z, w), scale s. */
+Mat trs_matrix(const double t[3], const double q[4], const double s[3])
+{
+    double x = q[0], y = q[1], z = q[2], w = q[3];
+    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w),
+                         2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
+                         2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)};
+    Mat out{};
+    for (int col = 0; col < 3; col++)
+        for (int row = 0; row < 3; row++)
+            out[size_t(col * 4 + row)] = r[col * 3 + row] * s[col];
+    out[12] = t[0];
+    out[13] = t[1];
+    out[14] = t[2];
+    out[15] = 1;
+    return out;
+}
+
 bool node_local(Ctx &c, int i, Mat &out, const Pose *pose)
 {
     const auto &n = c.m.nodes[size_t(i)];
@@ -194,18 +215,8 @@ bool node_local(Ctx &c, int i, Mat &out, const Pose *pose)
         return fail(c, "%s: rotation is not a unit quaternion (length %g)", what.c_str(), len);
     if (std::fabs(len - 1) > 1e-3)
         warn(c, "%s: rotation is not a unit quaternion (length %g, normalised)", what.c_str(), len);
-    double x = q[0] / len, y = q[1] / len, z = q[2] / len, w = q[3] / len;
-    const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w),
-                         2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
-                         2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)};
-    out = Mat{};
-    for (int col = 0; col < 3; col++)
-        for (int row = 0; row < 3; row++)
-            out[size_t(col * 4 + row)] = r[col * 3 + row] * s[col];
-    out[12] = t[0];
-    out[13] = t[1];
-    out[14] = t[2];
-    out[15] = 1;
+    const double u[4] = {q[0] / len, q[1] / len, q[2] / len, q[3] / len};
+    out = trs_matrix(t, u, s);
     return true;
 }
 
@@ -496,6 +507,56 @@ bool load_meshes(Ctx &c)
 }
 
 /* Walks the default scene (scene 0 without one; every parentless node without scenes). */
+/* EXT_mesh_gpu_instancing (checked with the document: Doc::check_gpu_instancing): node i's mesh
+ * placed once by each instance's T R S (absent attributes: none, the identity, one), after
+ * the node's own world transform. The node's mesh is drawn only by them. */
+bool gpu_instances(Ctx &c, int i, const Mat &world, std::vector<Instance> &inst)
+{
+    const auto &n = c.m.nodes[size_t(i)];
+    const tinygltf::Value &attrs = n.extensions.at("EXT_mesh_gpu_instancing").Get("attributes");
+    const char *names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+    std::vector<double> v[3];
+    size_t count = 0;
+    for (int k = 0; k < 3; k++)
+        if (attrs.Has(names[k])) {
+            int a = attrs.Get(names[k]).GetNumberAsInt();
+            count = c.m.accessors[size_t(a)].count;
+            if (inst.size() + count > SCENE_MAX_INSTANCES)
+                return fail(c, "%s: EXT_mesh_gpu_instancing places %zu instances, more than the %u a scene may have",
+                            label("node", i, n.name).c_str(), inst.size() + count, SCENE_MAX_INSTANCES);
+            v[k] = read_accessor(c, a);
+        }
+    std::string what = label("node", i, n.name) + ": EXT_mesh_gpu_instancing";
+    size_t not_unit = 0;
+    for (size_t j = 0; j < count; j++) {
+        double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s3[3] = {1, 1, 1};
+        if (!v[0].empty())
+            std::copy(&v[0][3 * j], &v[0][3 * j + 3], t);
+        if (!v[1].empty())
+            std::copy(&v[1][4 * j], &v[1][4 * j + 4], q);
+        if (!v[2].empty())
+            std::copy(&v[2][3 * j], &v[2][3 * j + 3], s3);
+        double len = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        for (int k = 0; k < 3; k++)
+            if (!std::isfinite(t[k]) || !std::isfinite(s3[k]))
+                return fail(c, "%s: instance %zu: its translation or scale is not finite", what.c_str(), j);
+        if (!(len > 1e-6) || !std::isfinite(len))
+            return fail(c, "%s: instance %zu: rotation is not a unit quaternion (length %g)", what.c_str(), j, len);
+        not_unit += std::fabs(len - 1) > 1e-3; /* (a quantized one is unit to its rounding: 1e-3 > 2^-8) */
+        for (double &x : q)
+            x /= len;
+        Mat w = mat_mul(world, trs_matrix(t, q, s3));
+        if (!mat_finite(w))
+            return fail(c, "%s: instance %zu: world transform is not finite", what.c_str(), j);
+        Instance it{i, n.mesh, w};
+        it.gpu = true;
+        inst.push_back(it);
+    }
+    if (not_unit)
+        warn(c, "%s: %zu instance rotation(s) are not unit quaternions (normalised)", what.c_str(), not_unit);
+    return true;
+}
+
 bool collect_instances(Ctx &c, std::vector<Instance> &inst, std::vector<Instance> &cams, std::vector<Instance> &lights)
 {
     const auto &m = c.m;
@@ -529,21 +590,34 @@ bool collect_instances(Ctx &c, std::vector<Instance> &inst, std::vector<Instance
             }
             visited[size_t(it.node)] = true;
             it.world = mat_mul(it.world, c.local[size_t(it.node)]);
+            it.moving = it.moving || (size_t(it.node) < c.animated.size() && c.animated[size_t(it.node)]);
             if (!mat_finite(it.world))
                 return fail(c, "%s: world transform is not finite", label("node", it.node, n.name).c_str());
             if (n.skin >= 0 && !c.warned_skin) {
                 warn(c, "skins are not supported (skinned meshes drawn in their bind pose)");
                 c.warned_skin = true;
             }
-            if (n.mesh >= 0)
-                inst.push_back({it.node, n.mesh, it.world});
+            if (n.mesh >= 0 && n.extensions.count("EXT_mesh_gpu_instancing")) {
+                size_t first = inst.size();
+                if (!gpu_instances(c, it.node, it.world, inst))
+                    return false;
+                for (size_t k = first; k < inst.size(); k++)
+                    inst[k].moving = it.moving;
+            } else if (n.mesh >= 0) {
+                Instance mi{it.node, n.mesh, it.world};
+                mi.moving = it.moving;
+                inst.push_back(mi);
+            }
             if (n.camera >= 0 && c.camera_ok[size_t(n.camera)])
                 cams.push_back(it);
             int light = node_light(n);
             if (light >= 0 && c.light_ok[size_t(light)])
                 lights.push_back(it);
-            for (auto ch = n.children.rbegin(); ch != n.children.rend(); ++ch)
-                stack.push_back({*ch, -1, it.world});
+            for (auto ch = n.children.rbegin(); ch != n.children.rend(); ++ch) {
+                Instance next{*ch, -1, it.world};
+                next.moving = it.moving;
+                stack.push_back(next);
+            }
         }
     }
     return true; /* pre-order, children in file order (pushed reversed) */
@@ -566,92 +640,196 @@ bool normalize3(double v[3])
     return true;
 }
 
+/* Mesh `mesh`'s primitives transformed by w into vertices, indices and tri_material, from
+ * vertex vbase (the indices' base too) and triangle tbase. */
+void bake_mesh(Ctx &c, int mesh, const Mat &w, GnVertex *vertices, uint32_t *indices, uint32_t *tri_material,
+               uint32_t vbase, uint32_t tbase, bool &colors)
+{
+    /* Normals go through the cofactor matrix, det * inverse transpose: defined even for a
+     * singular matrix; multiplied by sign(det) so mirroring keeps them pointing out. */
+    double a[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++)
+            a[r][k] = w[size_t(k * 4 + r)];
+    double cof[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++) {
+            int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+            cof[r][k] = a[r1][k1] * a[r2][k2] - a[r1][k2] * a[r2][k1];
+        }
+    double det = a[0][0] * cof[0][0] + a[0][1] * cof[0][1] + a[0][2] * cof[0][2];
+    double sgn = det < 0 ? -1 : 1;
+    uint32_t default_material = uint32_t(c.m.materials.size());
+    for (const Prim &p : c.meshes[size_t(mesh)]) {
+        size_t pv = p.pos.size() / 3;
+        for (size_t v = 0; v < pv; v++) {
+            GnVertex &o = vertices[vbase + v];
+            const float *q = &p.pos[v * 3];
+            double x[3];
+            for (int r = 0; r < 3; r++)
+                x[r] = a[r][0] * q[0] + a[r][1] * q[1] + a[r][2] * q[2] + w[size_t(12 + r)];
+            o.position = vec3{float(x[0]), float(x[1]), float(x[2])};
+            const float *nn = &p.nrm[v * 3];
+            double n[3];
+            for (int r = 0; r < 3; r++)
+                n[r] = sgn * (cof[r][0] * nn[0] + cof[r][1] * nn[1] + cof[r][2] * nn[2]);
+            if (!normalize3(n)) { /* a scale that flattens the mesh to a line: never hit */
+                n[0] = n[1] = 0;
+                n[2] = 1;
+            }
+            o.normal = vec3{float(n[0]), float(n[1]), float(n[2])};
+            if (!p.uv.empty()) {
+                o.u = p.uv[v * 2];
+                o.v = p.uv[v * 2 + 1];
+            }
+            if (!p.uv1.empty()) {
+                o.u1 = p.uv1[v * 2];
+                o.v1 = p.uv1[v * 2 + 1];
+            }
+            if (!p.col.empty()) {
+                o.color = vec4{p.col[v * 4], p.col[v * 4 + 1], p.col[v * 4 + 2], p.col[v * 4 + 3]};
+                colors = true;
+            } else {
+                o.color = vec4{1, 1, 1, 1};
+            }
+            if (!p.tan.empty()) {
+                const double t0[3] = {p.tan[v * 4], p.tan[v * 4 + 1], p.tan[v * 4 + 2]};
+                double t[3];
+                xform_dir(w, t0, t);
+                if (normalize3(t))
+                    o.tangent = vec4{float(t[0]), float(t[1]), float(t[2]), float(p.tan[v * 4 + 3] * sgn)};
+            }
+        }
+        size_t pt = p.idx.size() / 3;
+        for (size_t t = 0; t < pt; t++) {
+            uint32_t *dst = &indices[(tbase + t) * 3];
+            dst[0] = vbase + p.idx[t * 3];
+            dst[1] = vbase + p.idx[t * 3 + (det < 0 ? 2 : 1)]; /* mirrored: keep front faces */
+            dst[2] = vbase + p.idx[t * 3 + (det < 0 ? 1 : 2)];
+            tri_material[tbase + t] = p.material == GN_INVALID ? default_material : p.material;
+        }
+        vbase += uint32_t(pv);
+        tbase += uint32_t(pt);
+    }
+}
+
+/* w as an instance's transform (scene_instance: 3x4, row-major, float); false when that is
+ * not invertible in float (a scale that flattens the mesh: then it is baked, which the
+ * cofactor normals allow). */
+bool instance_transform(const Mat &w, float out[12])
+{
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 4; k++)
+            out[4 * r + k] = float(w[size_t(k * 4 + r)]);
+    double a[3][3], c[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++)
+            a[r][k] = out[4 * r + k];
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++) {
+            int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+            c[r][k] = a[r1][k1] * a[r2][k2] - a[r1][k2] * a[r2][k1];
+        }
+    double det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+    if (!(det != 0) || !std::isfinite(det))
+        return false;
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++)
+            if (!std::isfinite(float(c[k][r] / det)))
+                return false;
+    return true;
+}
+
+/* The instances' geometry: a mesh that several nodes use, or that EXT_mesh_gpu_instancing
+ * places, or (scene_instance_animated) that an animation moves, is kept once in its own
+ * space (scene_instanced_mesh) and placed by instances; the others, and placements whose
+ * transform is not invertible, are baked into world space. */
 bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
 {
-    uint64_t nv = 0, nt = 0, np = 0;
-    for (const auto &in : inst)
-        for (const Prim &p : c.meshes[size_t(in.mesh)]) {
-            nv += p.pos.size() / 3;
-            nt += p.idx.size() / 3;
-            np++;
+    std::vector<uint32_t> uses(c.meshes.size(), 0), imesh(c.meshes.size(), GN_INVALID);
+    std::vector<bool> gpu(c.meshes.size(), false);
+    std::vector<float> xf(12 * inst.size());
+    std::vector<bool> placed(inst.size(), false);
+    for (const auto &in : inst) {
+        uses[size_t(in.mesh)]++;
+        gpu[size_t(in.mesh)] = gpu[size_t(in.mesh)] || in.gpu;
+    }
+    uint64_t nv = 0, nt = 0, np = 0, ni = 0;
+    uint32_t meshes = 0;
+    for (size_t i = 0; i < inst.size(); i++) {
+        size_t m = size_t(inst[i].mesh);
+        uint64_t mv = 0, mt = 0;
+        for (const Prim &p : c.meshes[m]) {
+            mv += p.pos.size() / 3;
+            mt += p.idx.size() / 3;
         }
+        np += c.meshes[m].size();
+        placed[i] = (uses[m] > 1 || gpu[m] || (instance_animated && inst[i].moving)) && mt > 0 &&
+                    instance_transform(inst[i].world, &xf[12 * i]);
+        if (!placed[i]) {
+            nv += mv;
+            nt += mt;
+            continue;
+        }
+        ni++;
+        if (imesh[m] == GN_INVALID) { /* its first placement: the mesh is stored, once */
+            imesh[m] = meshes++;
+            nv += mv;
+            nt += mt;
+        }
+    }
     if (nv > MAX_SCENE || nt > MAX_SCENE)
         return fail(c, "scene too large: %llu triangles and %llu vertices after instancing; the limit is %zu each",
                     (unsigned long long)nt, (unsigned long long)nv, MAX_SCENE);
-    out->num_vertices = uint32_t(nv);
-    out->num_triangles = uint32_t(nt);
+    if (ni > SCENE_MAX_INSTANCES)
+        return fail(c, "scene too large: %llu instances; the limit is %u", (unsigned long long)ni, SCENE_MAX_INSTANCES);
+    uint64_t wv = 0, wt = 0;
+    for (size_t i = 0; i < inst.size(); i++)
+        for (const Prim &p : c.meshes[size_t(inst[i].mesh)])
+            if (!placed[i]) {
+                wv += p.pos.size() / 3;
+                wt += p.idx.size() / 3;
+            }
+    out->num_vertices = uint32_t(wv);
+    out->num_triangles = uint32_t(wt);
     out->num_meshes = uint32_t(np);
-    out->vertices = static_cast<GnVertex *>(util_calloc(nv, sizeof(GnVertex)));
-    out->indices = static_cast<uint32_t *>(util_calloc(nt * 3, sizeof(uint32_t)));
-    out->tri_material = static_cast<uint32_t *>(util_calloc(nt, sizeof(uint32_t)));
-    uint32_t vbase = 0, tbase = 0, default_material = uint32_t(c.m.materials.size());
-    for (const auto &in : inst) {
-        const Mat &w = in.world;
-        /* Normals go through the cofactor matrix, det * inverse transpose: defined even for a
-         * singular matrix; multiplied by sign(det) so mirroring keeps them pointing out. */
-        double a[3][3];
-        for (int r = 0; r < 3; r++)
-            for (int k = 0; k < 3; k++)
-                a[r][k] = w[size_t(k * 4 + r)];
-        double cof[3][3];
-        for (int r = 0; r < 3; r++)
-            for (int k = 0; k < 3; k++) {
-                int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-                cof[r][k] = a[r1][k1] * a[r2][k2] - a[r1][k2] * a[r2][k1];
+    out->vertices = static_cast<GnVertex *>(util_calloc(wv, sizeof(GnVertex)));
+    out->indices = static_cast<uint32_t *>(util_calloc(wt * 3, sizeof(uint32_t)));
+    out->tri_material = static_cast<uint32_t *>(util_calloc(wt, sizeof(uint32_t)));
+    out->num_instanced_meshes = meshes;
+    out->instanced_meshes = static_cast<scene_instanced_mesh *>(util_calloc(meshes, sizeof(scene_instanced_mesh)));
+    out->num_instances = uint32_t(ni);
+    out->instances = static_cast<scene_instance *>(util_calloc(ni, sizeof(scene_instance)));
+    uint32_t vbase = 0, tbase = 0, k = 0;
+    Mat id{};
+    id[0] = id[5] = id[10] = id[15] = 1;
+    for (size_t i = 0; i < inst.size(); i++) {
+        const Instance &in = inst[i];
+        if (!placed[i]) {
+            bake_mesh(c, in.mesh, in.world, out->vertices, out->indices, out->tri_material, vbase, tbase, out->vertex_colors);
+            for (const Prim &p : c.meshes[size_t(in.mesh)]) {
+                vbase += uint32_t(p.pos.size() / 3);
+                tbase += uint32_t(p.idx.size() / 3);
             }
-        double det = a[0][0] * cof[0][0] + a[0][1] * cof[0][1] + a[0][2] * cof[0][2];
-        double sgn = det < 0 ? -1 : 1;
-        for (const Prim &p : c.meshes[size_t(in.mesh)]) {
-            size_t pv = p.pos.size() / 3;
-            for (size_t v = 0; v < pv; v++) {
-                GnVertex &o = out->vertices[vbase + v];
-                const float *q = &p.pos[v * 3];
-                double x[3];
-                for (int r = 0; r < 3; r++)
-                    x[r] = a[r][0] * q[0] + a[r][1] * q[1] + a[r][2] * q[2] + w[size_t(12 + r)];
-                o.position = vec3{float(x[0]), float(x[1]), float(x[2])};
-                const float *nn = &p.nrm[v * 3];
-                double n[3];
-                for (int r = 0; r < 3; r++)
-                    n[r] = sgn * (cof[r][0] * nn[0] + cof[r][1] * nn[1] + cof[r][2] * nn[2]);
-                if (!normalize3(n)) { /* a scale that flattens the mesh to a line: never hit */
-                    n[0] = n[1] = 0;
-                    n[2] = 1;
-                }
-                o.normal = vec3{float(n[0]), float(n[1]), float(n[2])};
-                if (!p.uv.empty()) {
-                    o.u = p.uv[v * 2];
-                    o.v = p.uv[v * 2 + 1];
-                }
-                if (!p.uv1.empty()) {
-                    o.u1 = p.uv1[v * 2];
-                    o.v1 = p.uv1[v * 2 + 1];
-                }
-                if (!p.col.empty()) {
-                    o.color = vec4{p.col[v * 4], p.col[v * 4 + 1], p.col[v * 4 + 2], p.col[v * 4 + 3]};
-                    out->vertex_colors = true;
-                } else {
-                    o.color = vec4{1, 1, 1, 1};
-                }
-                if (!p.tan.empty()) {
-                    const double t0[3] = {p.tan[v * 4], p.tan[v * 4 + 1], p.tan[v * 4 + 2]};
-                    double t[3];
-                    xform_dir(w, t0, t);
-                    if (normalize3(t))
-                        o.tangent = vec4{float(t[0]), float(t[1]), float(t[2]), float(p.tan[v * 4 + 3] * sgn)};
-                }
-            }
-            size_t pt = p.idx.size() / 3;
-            for (size_t t = 0; t < pt; t++) {
-                uint32_t *dst = &out->indices[(tbase + t) * 3];
-                dst[0] = vbase + p.idx[t * 3];
-                dst[1] = vbase + p.idx[t * 3 + (det < 0 ? 2 : 1)]; /* mirrored: keep front faces */
-                dst[2] = vbase + p.idx[t * 3 + (det < 0 ? 1 : 2)];
-                out->tri_material[tbase + t] = p.material == GN_INVALID ? default_material : p.material;
-            }
-            vbase += uint32_t(pv);
-            tbase += uint32_t(pt);
+            continue;
         }
+        uint32_t m = imesh[size_t(in.mesh)];
+        scene_instanced_mesh &im = out->instanced_meshes[m];
+        if (!im.vertices) { /* the mesh's data, once, in its own space */
+            for (const Prim &p : c.meshes[size_t(in.mesh)]) {
+                im.num_vertices += uint32_t(p.pos.size() / 3);
+                im.num_triangles += uint32_t(p.idx.size() / 3);
+            }
+            im.gltf_mesh = uint32_t(in.mesh);
+            im.vertices = static_cast<GnVertex *>(util_calloc(im.num_vertices, sizeof(GnVertex)));
+            im.indices = static_cast<uint32_t *>(util_calloc(3 * size_t(im.num_triangles), sizeof(uint32_t)));
+            im.tri_material = static_cast<uint32_t *>(util_calloc(im.num_triangles, sizeof(uint32_t)));
+            bake_mesh(c, in.mesh, id, im.vertices, im.indices, im.tri_material, 0, 0, out->vertex_colors);
+        }
+        scene_instance &o = out->instances[k++];
+        memcpy(o.to_world, &xf[12 * i], sizeof o.to_world);
+        o.mesh = m;
+        o.node = uint32_t(in.node);
     }
     return true;
 }

@@ -20,6 +20,8 @@
 #include <utility>
 #include <vector>
 
+#include "image_decode.h"
+
 extern "C" {
 #include "scene.h"
 #include "util.h"
@@ -58,6 +60,8 @@ struct Prim {                  /* one triangle primitive of a glTF mesh, in the 
 struct Instance {
     int node, mesh;
     Mat world;
+    bool gpu = false;    /* one of EXT_mesh_gpu_instancing's instances */
+    bool moving = false; /* an animation moves the node or one above it */
 };
 
 /* A node's animated properties at the animation time: which of T, R, S a channel set. */
@@ -98,6 +102,7 @@ struct Ctx {
     bool failed = false;
     std::map<int, std::string> image_errors; /* decode failures reported by the image callback */
     std::vector<Mat> local;                  /* per node */
+    std::vector<bool> animated;              /* per node: an animation sets its T, R or S */
     std::vector<bool> camera_ok, light_ok;   /* per glTF camera / light: values usable */
     std::vector<std::vector<Prim>> meshes;   /* per glTF mesh */
     std::vector<uint32_t> image_map, texture_map; /* glTF index -> scene index or GN_INVALID */
@@ -105,6 +110,7 @@ struct Ctx {
     size_t textures_room = 0;                /* textures_out->textures' allocated entries */
     std::map<std::pair<uint32_t, size_t>, int> decoded; /* (crc32, size) of image bytes -> first image */
     std::map<int, int> image_alias;          /* image -> the earlier image with the same bytes */
+    std::map<int, texture_format> image_formats; /* image -> the format of its bytes, once read */
     uint64_t texels = 0;                     /* of the images decoded so far */
     std::string limit_error;                 /* a SCENE_MAX_* limit exceeded while decoding */
     bool warned_skin = false, warned_targets = false;
@@ -121,6 +127,7 @@ struct Ctx {
 /* ---- scene_gltf.cpp: the load, its settings and its messages ------------------------------- */
 extern bool allow_outside_files; /* scene_allow_outside_files */
 extern std::string variant;      /* scene_select_variant */
+extern bool instance_animated;   /* scene_instance_animated */
 extern double anim_time;         /* scene_animation_time; < 0: the nodes' own transforms */
 /* Bad input: always returns false so checks read `if (bad) return fail(...)`. */
 bool fail(Ctx &c, const char *fmt, ...) UTIL_PRINTF(2, 3);
@@ -157,7 +164,7 @@ void check_lights(Ctx &c);
 bool check_animations(Ctx &c);
 bool animate(Ctx &c, std::vector<Pose> &pose);
 
-/* ---- gltf_geometry.cpp: accessors, nodes, primitives, instances in world space ------------- */
+/* ---- gltf_geometry.cpp: accessors, nodes, primitives, meshes baked or kept with instances - */
 size_t comp_size(int ct);
 size_t num_comps(const tinygltf::Accessor &a);
 const char *type_name(int type);

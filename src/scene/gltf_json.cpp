@@ -126,6 +126,62 @@ void Doc::check_node(const Json &n, const std::string &p)
         if (const Json *l = member(*lp, "light", at(at(p, "extensions"), "KHR_lights_punctual"), true))
             index(*l, at(at(at(p, "extensions"), "KHR_lights_punctual"), "light"), "KHR_lights_punctual lights", nl);
     }
+    if (const Json *gi = ext ? object(*ext, "EXT_mesh_gpu_instancing", at(p, "extensions")) : nullptr)
+        check_gpu_instancing(n, *gi, at(at(p, "extensions"), "EXT_mesh_gpu_instancing"));
+}
+
+/* EXT_mesh_gpu_instancing: on a node with a mesh, attributes naming accessors: TRANSLATION
+ * and SCALE of VEC3 floats, ROTATION of VEC4 floats or normalized integers (a quaternion),
+ * the application's own (named _...) anything; all of one count, the number of instances. */
+void Doc::check_gpu_instancing(const Json &n, const Json &e, const std::string &p)
+{
+    if (!n.count("mesh"))
+        error(p, "is on a node without a mesh (the extension instances the node's mesh)");
+    const Json *attrs = object(e, "attributes", p, true);
+    if (!attrs)
+        return;
+    std::string ap = at(p, "attributes"), first;
+    if (attrs->empty())
+        error(ap, "has no attributes (the instances need TRANSLATION, ROTATION or SCALE)");
+    int64_t count = -1;
+    const Json *accessors = root.count("accessors") ? &root.at("accessors") : nullptr;
+    for (auto it = attrs->begin(); it != attrs->end(); ++it) {
+        std::string name = key_of(it.key()), kp = at(ap, name.c_str());
+        int64_t a = index(it.value(), kp, "accessors", count_of("accessors"));
+        if (a < 0 || !accessors || !(*accessors)[size_t(a)].is_object())
+            continue;
+        const Json &acc = (*accessors)[size_t(a)];
+        auto field = [&](const char *key) -> const Json * { auto f = acc.find(key); return f != acc.end() ? &*f : nullptr; };
+        const Json *type = field("type"), *ct = field("componentType"), *norm = field("normalized"), *cnt = field("count");
+        if (!type || !type->is_string() || !ct || !ct->is_number_integer() || !cnt || !cnt->is_number_integer())
+            continue; /* (check_accessor reports it) */
+        std::string t = type->get<std::string>();
+        int64_t c = ct->get<int64_t>();
+        bool normalized = norm && norm->is_boolean() && norm->get<bool>();
+        bool is_float = c == TINYGLTF_COMPONENT_TYPE_FLOAT;
+        if (name == "TRANSLATION" || name == "SCALE") {
+            if (t != "VEC3" || !is_float)
+                error(kp, "accessor %lld is %s of component type %lld; %s must be VEC3 of floats (5126)", (long long)a,
+                      t.c_str(), (long long)c, name.c_str());
+        } else if (name == "ROTATION") {
+            bool quantized = normalized && (c == TINYGLTF_COMPONENT_TYPE_BYTE || c == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                            c == TINYGLTF_COMPONENT_TYPE_SHORT || c == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT);
+            if (t != "VEC4" || !(is_float || quantized))
+                error(kp, "accessor %lld is %s of component type %lld%s; ROTATION must be VEC4 of floats or of "
+                      "normalized integers", (long long)a, t.c_str(), (long long)c, normalized ? " (normalized)" : "");
+        } else if (name.empty() || name[0] != '_') {
+            error(kp, "is not an attribute of the extension (TRANSLATION, ROTATION, SCALE, or an application's "
+                  "own, named with a leading _)");
+        }
+        int64_t k = cnt->get<int64_t>();
+        if (count < 0) {
+            count = k;
+            first = name;
+        } else if (k != count) {
+            error(kp, "accessor %lld has %lld elements, %s's has %lld: each attribute has one per instance",
+                  (long long)a, (long long)k, first.c_str(), (long long)count);
+        }
+    }
 }
 
 void Doc::check()
@@ -247,6 +303,12 @@ void Doc::check()
     each(root, "textures", "", [&](const Json &t, const std::string &p, size_t) {
         index(t, "sampler", p, "samplers");
         index(t, "source", p, "images");
+        /* KHR_texture_basisu, EXT_texture_webp: the image to read (the core source is then the
+         * fallback, which a file requiring the extension may omit) */
+        if (const Json *ext = object(t, "extensions", p))
+            for (const char *name : {"KHR_texture_basisu", "EXT_texture_webp"})
+                if (const Json *e = object(*ext, name, at(p, "extensions")))
+                    index(*e, "source", at(at(p, "extensions"), name), "images", true);
     });
     materials_read(c, root);
     each(root, "materials", "", [&](const Json &m, const std::string &p, size_t i) { material_read(*this, m, p, i); });

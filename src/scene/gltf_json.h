@@ -232,6 +232,7 @@ struct Doc {
     void check_accessor(const Json &a, const std::string &p);
     void check_primitive(const Json &pr, const std::string &p);
     void check_node(const Json &n, const std::string &p);
+    void check_gpu_instancing(const Json &n, const Json &e, const std::string &p);
 };
 
 /* ---- gltf_material.cpp: the materials, read and checked by the material table ------------- */

@@ -1,6 +1,6 @@
 /* gltf_material.cpp: what a glTF file's materials read: the table of extensions gonio knows
- * (each one's support, and a material extension's own rules), images (PNG and JPEG, each
- * distinct one decoded once), samplers, textures with their texCoord and
+ * (each one's support, and a material extension's own rules), images (PNG and JPEG through
+ * stb, WebP and KTX2 through image_decode.h; each distinct one decoded once), samplers, textures with their texCoord and
  * KHR_texture_transform, KHR_materials_variants, and the materials, read and checked from the
  * JSON document row by row of the material table (glsl/lib/material.h), as cgltf reads each
  * extension into its struct: the types are checked while reading, so the check and the read
@@ -116,16 +116,17 @@ const Extension EXTENSIONS[] = {
     {"KHR_mesh_quantization", SCENE_SUPPORTED, "integer vertex attributes", false, nullptr},
     {"KHR_draco_mesh_compression", SCENE_SUPPORTED, "decoded by Draco", false, nullptr},
     {"EXT_meshopt_compression", SCENE_SUPPORTED, "decoded by meshoptimizer", false, nullptr},
-    {"KHR_texture_basisu", SCENE_UNSUPPORTED, "KTX2 images are not decoded: a texture's PNG or JPEG source is", false,
+    {"KHR_texture_basisu", SCENE_SUPPORTED,
+     "KTX2 images (ETC1S, UASTC, Zstandard) transcoded by Basis Universal; the core source is the fallback", false,
      nullptr},
-    {"EXT_texture_webp", SCENE_UNSUPPORTED, "WebP images are not decoded: a texture's PNG or JPEG source is", false,
-     nullptr},
-    {"EXT_mesh_gpu_instancing", SCENE_UNSUPPORTED, "the instances are not drawn, only the node's own mesh", false,
+    {"EXT_texture_webp", SCENE_SUPPORTED, "WebP images decoded by libwebp; the core source is the fallback", false,
      nullptr},
     {"EXT_lights_image_based", SCENE_PARTLY,
      "the scene's cube map (its sharpest level) lights it as the environment unless --env; the prefiltered levels "
      "and irradiance coefficients, made for rasterizers, are not needed by the path tracer",
      false, nullptr},
+    {"EXT_mesh_gpu_instancing", SCENE_SUPPORTED,
+     "TRANSLATION, ROTATION and SCALE: the node's mesh kept once and placed by each instance", false, nullptr},
     {"KHR_xmp_json_ld", SCENE_UNSUPPORTED, "metadata: nothing in it is rendered", false, nullptr},
     {"KHR_xmp", SCENE_UNSUPPORTED, "metadata (KHR_xmp_json_ld's draft): nothing in it is rendered", false, nullptr},
 };
@@ -138,9 +139,24 @@ const Extension *find_extension(const std::string &name)
     return nullptr;
 }
 
-bool supported(const Extension *e) { return e && e->support != SCENE_UNSUPPORTED; }
+/* What this build lacks to read extension e, or nullptr: KHR_texture_basisu needs Basis
+ * Universal, which the build fetches where it can (deps/basisu.sh) and goes on without where
+ * it cannot. The table says what a full build does; this, what this one cannot. */
+const char *missing(const Extension *e)
+{
+    static const std::string ktx2 =
+        std::string("this gonio was built without Basis Universal: ") + image_decode_ktx2_missing();
+    if (e && !strcmp(e->name, "KHR_texture_basisu") && !image_decode_has_ktx2())
+        return ktx2.c_str();
+    return nullptr;
+}
 
-std::string why_not(const Extension *e) { return e ? std::string(" (") + e->how + ")" : std::string(); }
+bool supported(const Extension *e) { return e && e->support != SCENE_UNSUPPORTED && !missing(e); }
+
+/* What an unsupported extension's messages add: why it is not read. */
+const char *why(const Extension *e) { return missing(e) ? missing(e) : e ? e->how : nullptr; }
+
+std::string why_not(const Extension *e) { return why(e) ? std::string(" (") + why(e) + ")" : std::string(); }
 
 bool check_extensions(Ctx &c)
 {
@@ -152,8 +168,8 @@ bool check_extensions(Ctx &c)
     std::vector<std::string> warned; /* one warning each, however often the file lists it */
     for (const auto &e : c.m.extensionsUsed)
         if (!supported(find_extension(e)) && std::find(warned.begin(), warned.end(), e) == warned.end()) {
-            const Extension *x = find_extension(e);
-            warn(c, "uses unsupported extension %s (ignored%s%s)", e.c_str(), x ? ": " : "", x ? x->how : "");
+            const char *x = why(find_extension(e));
+            warn(c, "uses unsupported extension %s (ignored%s%s)", e.c_str(), x ? ": " : "", x ? x : "");
             warned.push_back(e);
         }
     return !c.failed;
@@ -178,16 +194,28 @@ void list_extensions(Ctx &c, scene *out)
     }
 }
 
-/* Decodes PNG or JPEG, the formats glTF 2.0 allows. Anything else is refused before stb_image
- * sees it: its other decoders are not needed, and the 16-bit PNM path of the stb bundled with
- * tinygltf 2.7 overflows its buffer. On failure returns the reason. */
+/* The texel budget exceeded by image idx of w x h: the load fails with this message. */
+std::string too_large(Ctx &c, int idx, uint64_t w, uint64_t h)
+{
+    char msg[256];
+    snprintf(msg, sizeof msg, "images too large: %llu texels with image %d (%llux%llu), the limit is %llu",
+             (unsigned long long)(c.texels + w * h), idx, (unsigned long long)w, (unsigned long long)h,
+             (unsigned long long)SCENE_MAX_TEXELS);
+    if (c.limit_error.empty())
+        c.limit_error = msg;
+    return msg;
+}
+
+/* Decodes PNG or JPEG, the formats glTF 2.0 allows, through tinygltf's stb, and WebP and KTX2
+ * (EXT_texture_webp, KHR_texture_basisu) through image_decode.h. Anything else is refused
+ * before stb_image sees it: its other decoders are not needed, and the 16-bit PNM path of the
+ * stb bundled with tinygltf 2.7 overflows its buffer. On failure returns the reason. */
 std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned char *bytes, size_t size)
 {
-    static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-    bool is_png = size >= 8 && memcmp(bytes, png, 8) == 0;
-    bool is_jpeg = size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
-    if (!is_png && !is_jpeg)
-        return "not a PNG or JPEG image";
+    texture_format format = texture_format_of(bytes, size);
+    if (format == TEXTURE_FORMAT_UNKNOWN)
+        return "not a PNG, JPEG, WebP or KTX2 image" +
+               (img->mimeType.empty() ? std::string() : " (its mimeType says " + img->mimeType.substr(0, 40) + ")");
     if (size > size_t(INT32_MAX))
         return "image data too large";
     /* The same bytes are decoded once (a file listing one PNG 500 times decoded it 500 times). */
@@ -198,18 +226,33 @@ std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned c
         c.image_channels[idx] = c.image_channels[seen->second];
         return "";
     }
+    c.image_formats[idx] = format;
+    if (format == TEXTURE_FORMAT_WEBP || format == TEXTURE_FORMAT_KTX2) {
+        uint8_t *rgba = nullptr;
+        uint32_t w = 0, h = 0;
+        char why_bad[512];
+        image_decode_status st = image_decode(bytes, size, img->mimeType.c_str(), SCENE_MAX_TEXELS - c.texels, &rgba,
+                                              &w, &h, why_bad, sizeof why_bad);
+        if (st == IMAGE_TOO_LARGE)
+            return too_large(c, idx, w, h);
+        c.texels += uint64_t(w) * h; /* the declared size, decoded or not, as stb's images count */
+        if (st == IMAGE_BAD)
+            return why_bad;
+        c.decoded[key] = idx;
+        img->width = int(w);
+        img->height = int(h);
+        img->component = 4;
+        img->bits = 8;
+        img->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+        img->image.assign(rgba, rgba + size_t(w) * h * 4);
+        free(rgba);
+        return "";
+    }
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(bytes, int(size), &w, &h, &comp))
         return "cannot decode";
-    if (c.texels + uint64_t(w) * uint64_t(h) > SCENE_MAX_TEXELS) {
-        char msg[256];
-        snprintf(msg, sizeof msg, "images too large: %llu texels with image %d (%dx%d), the limit is %llu",
-                 (unsigned long long)(c.texels + uint64_t(w) * uint64_t(h)), idx, w, h,
-                 (unsigned long long)SCENE_MAX_TEXELS);
-        if (c.limit_error.empty())
-            c.limit_error = msg;
-        return msg;
-    }
+    if (c.texels + uint64_t(w) * uint64_t(h) > SCENE_MAX_TEXELS)
+        return too_large(c, idx, uint64_t(w), uint64_t(h));
     c.texels += uint64_t(w) * uint64_t(h);
     c.decoded[key] = idx;
     c.image_channels[idx] = comp;
@@ -386,6 +429,32 @@ uint32_t filter_mode(Ctx &c, size_t sampler, int mag, int min)
     return mag == TINYGLTF_TEXTURE_FILTER_NEAREST ? GN_TEX_NEAREST : 0u;
 }
 
+/* KHR_texture_basisu, EXT_texture_webp: the extension's source (a KTX2 or WebP image; the
+ * JSON checks made it an index into images) where its image decoded; else the core source,
+ * the optional fallback (a file that requires the extension may omit it); -1 when there is
+ * neither. */
+int texture_source(Ctx &c, size_t i)
+{
+    const auto &t = c.m.textures[i];
+    for (const char *name : {"KHR_texture_basisu", "EXT_texture_webp"}) {
+        auto e = t.extensions.find(name);
+        if (e == t.extensions.end() || !e->second.IsObject() || !e->second.Has("source"))
+            continue;
+        int s = e->second.Get("source").GetNumberAsInt();
+        if (s < 0 || size_t(s) >= c.m.images.size())
+            continue;
+        if (c.image_map[size_t(s)] != GN_INVALID)
+            return s;
+        if (t.source >= 0 && c.image_map[size_t(t.source)] != GN_INVALID) {
+            warn(c, "texture %zu: its %s image %d is unusable; its fallback, image %d, is used instead", i, name, s,
+                 t.source);
+            return t.source;
+        }
+        return s; /* unusable and no fallback: ignored, as the image's warning says */
+    }
+    return t.source;
+}
+
 void load_images_and_textures(Ctx &c, scene *out)
 {
     const auto &m = c.m;
@@ -404,6 +473,7 @@ void load_images_and_textures(Ctx &c, scene *out)
                  img.uri.empty() ? "" : " ", img.uri.substr(0, 200).c_str(), why.c_str());
             continue;
         }
+        out->images[out->num_images].format = uint32_t(c.image_formats[int(i)]);
         c.image_map[i] = out->num_images++;
         std::vector<unsigned char>().swap(c.m.images[i].image); /* keep one copy at a time */
     }
@@ -416,11 +486,12 @@ void load_images_and_textures(Ctx &c, scene *out)
     c.texture_map.assign(m.textures.size(), GN_INVALID);
     for (size_t i = 0; i < m.textures.size(); i++) {
         const auto &t = m.textures[i];
-        if (t.source < 0) {
+        int source = texture_source(c, i);
+        if (source < 0) {
             warn(c, "texture %zu has no image source (ignored)", i);
             continue;
         }
-        if (c.image_map[size_t(t.source)] == GN_INVALID)
+        if (c.image_map[size_t(source)] == GN_INVALID)
             continue;
         uint32_t flags = 0;
         if (t.sampler >= 0) {
@@ -428,7 +499,7 @@ void load_images_and_textures(Ctx &c, scene *out)
             flags = wrap_mode(c, size_t(t.sampler), s.wrapS) | wrap_mode(c, size_t(t.sampler), s.wrapT) << 2 |
                     filter_mode(c, size_t(t.sampler), s.magFilter, s.minFilter);
         }
-        out->textures[out->num_textures] = scene_texture{c.image_map[size_t(t.source)], flags, {1, 0, 0, 0, 1, 0}};
+        out->textures[out->num_textures] = scene_texture{c.image_map[size_t(source)], flags, {1, 0, 0, 0, 1, 0}};
         c.texture_map[i] = out->num_textures++;
     }
 }
@@ -759,6 +830,9 @@ void load_materials(Ctx &c, scene *out)
     bool need_default = false;
     for (uint32_t t = 0; t < out->num_triangles; t++)
         need_default |= out->tri_material[t] == n;
+    for (uint32_t m = 0; m < out->num_instanced_meshes; m++)
+        for (uint32_t t = 0; t < out->instanced_meshes[m].num_triangles; t++)
+            need_default |= out->instanced_meshes[m].tri_material[t] == n;
     out->num_materials = uint32_t(n + (need_default ? 1 : 0));
     out->materials = static_cast<GnMaterial *>(util_calloc(out->num_materials, sizeof(GnMaterial)));
     out->material_extras = static_cast<scene_material_extras *>(util_calloc(out->num_materials, sizeof(scene_material_extras)));
@@ -785,6 +859,10 @@ void load_materials(Ctx &c, scene *out)
 scene_support scene_extension_support(const char *name, const char **how)
 {
     const gltf::Extension *e = gltf::find_extension(name);
+    if (gltf::missing(e)) {
+        *how = gltf::missing(e);
+        return SCENE_UNSUPPORTED;
+    }
     *how = e ? e->how : "unknown to gonio";
     return e ? e->support : SCENE_UNSUPPORTED;
 }

@@ -1,5 +1,5 @@
-/* gltf_write.c: glTF 2.0 writer (Khronos glTF 2.0 specification; KHR_lights_punctual and
- * KHR_materials_{emissive_strength,specular,ior,transmission}); the buffer is embedded as
+/* gltf_write.c: glTF 2.0 writer (Khronos glTF 2.0 specification; KHR_lights_punctual,
+ * KHR_materials_{emissive_strength,specular,ior,transmission}, EXT_mesh_gpu_instancing); the buffer is embedded as
  * base64 (RFC 4648) in a data URI; .glb goes through tinygltf (gltf_glb.cpp). */
 #include "gltf_write.h"
 
@@ -159,13 +159,34 @@ static void write_material(FILE *f, const gltf_write_material *m)
     fputc('}', f);
 }
 
-static void write_node(FILE *f, const gltf_write_node *n, const gltf_write_desc *d)
+/* The instance attributes of node n, in the order written: translation, rotation, scale
+ * (NULL: not written; only a mesh node's are). */
+static const float *instance_attr(const gltf_write_node *n, int k)
+{
+    if (n->kind != GLTF_WRITE_NODE_MESH || !n->num_instances)
+        return NULL;
+    return k == 0 ? n->instance_translation : k == 1 ? n->instance_rotation : n->instance_scale;
+}
+
+/* *accessor: the next accessor of an instance attribute (write_accessors' order). */
+static void write_node(FILE *f, const gltf_write_node *n, const gltf_write_desc *d, uint32_t *accessor)
 {
     static const float identity[4] = {0, 0, 0, 1}, unit[3] = {1, 1, 1};
+    static const char *attrs[3] = {"TRANSLATION", "ROTATION", "SCALE"};
     switch (n->kind) {
     case GLTF_WRITE_NODE_MESH:
         assert(n->index < d->num_meshes);
         fprintf(f, "{\"mesh\":%u", n->index);
+        if (n->num_instances) {
+            const char *sep = "";
+            fputs(",\"extensions\":{\"EXT_mesh_gpu_instancing\":{\"attributes\":{", f);
+            for (int k = 0; k < 3; k++)
+                if (instance_attr(n, k)) {
+                    fprintf(f, "%s\"%s\":%u", sep, attrs[k], (*accessor)++);
+                    sep = ",";
+                }
+            fputs("}}}", f);
+        }
         break;
     case GLTF_WRITE_NODE_CAMERA:
         assert(n->index < d->num_cameras);
@@ -251,6 +272,13 @@ static void write_accessors(FILE *f, const gltf_write_desc *d)
                 item(a), a, GLTF_UNSIGNED_INT, m->num_indices);
         a++;
     }
+    for (uint32_t i = 0; i < d->num_nodes; i++) /* then the nodes' instance attributes */
+        for (int k = 0; k < 3; k++)
+            if (instance_attr(&d->nodes[i], k)) {
+                fprintf(f, "%s{\"bufferView\":%u,\"componentType\":%u,\"count\":%u,\"type\":\"%s\"}",
+                        item(a), a, GLTF_FLOAT, d->nodes[i].num_instances, k == 1 ? "VEC4" : "VEC3");
+                a++;
+            }
     fputs("\n  ],\n  \"bufferViews\": [", f);
     a = 0;
     for (uint32_t i = 0; i < d->num_meshes; i++) {
@@ -267,6 +295,13 @@ static void write_accessors(FILE *f, const gltf_write_desc *d)
             offset += sizes[k];
         }
     }
+    for (uint32_t i = 0; i < d->num_nodes; i++)
+        for (int k = 0; k < 3; k++)
+            if (instance_attr(&d->nodes[i], k)) {
+                size_t size = (k == 1 ? 16 : 12) * (size_t)d->nodes[i].num_instances;
+                fprintf(f, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", item(a++), offset, size);
+                offset += size;
+            }
     fputs("\n  ]", f);
 }
 
@@ -280,6 +315,9 @@ static uint8_t *make_buffer(const gltf_write_desc *d, size_t *size)
         n += (12 + (m->normals ? 12 : 0) + (m->uvs ? 8 : 0)) * (size_t)m->num_vertices +
              4 * (size_t)m->num_indices;
     }
+    for (uint32_t i = 0; i < d->num_nodes; i++)
+        for (int k = 0; k < 3; k++)
+            n += instance_attr(&d->nodes[i], k) ? (k == 1 ? 16 : 12) * (size_t)d->nodes[i].num_instances : 0;
     p = buf = util_malloc(n);
     for (uint32_t i = 0; i < d->num_meshes; i++) {
         const gltf_write_mesh *m = &d->meshes[i];
@@ -296,6 +334,10 @@ static uint8_t *make_buffer(const gltf_write_desc *d, size_t *size)
             p = put_u32(p, m->indices[k]);
         }
     }
+    for (uint32_t i = 0; i < d->num_nodes; i++)
+        for (int k = 0; k < 3; k++)
+            if (instance_attr(&d->nodes[i], k))
+                p = put_floats(p, instance_attr(&d->nodes[i], k), (k == 1 ? 4 : 3) * (size_t)d->nodes[i].num_instances);
     assert((size_t)(p - buf) == n);
     *size = n;
     return buf;
@@ -303,10 +345,14 @@ static uint8_t *make_buffer(const gltf_write_desc *d, size_t *size)
 
 static void write_json(FILE *f, const gltf_write_desc *d, const uint8_t *buf, size_t size)
 {
-    const char *used[7];
+    const char *used[8];
     int num_used = 0;
-    bool strength = false, specular = false, ior = false, transmission = false, unlit = false;
-    uint32_t a = 0;
+    bool strength = false, specular = false, ior = false, transmission = false, unlit = false, instancing = false;
+    uint32_t a = 0, inst_accessor = 0;
+    for (uint32_t i = 0; i < d->num_meshes; i++) /* (the instance attributes' accessors follow the meshes') */
+        inst_accessor += 2 + (d->meshes[i].normals != NULL) + (d->meshes[i].uvs != NULL);
+    for (uint32_t i = 0; i < d->num_nodes; i++)
+        instancing |= d->nodes[i].kind == GLTF_WRITE_NODE_MESH && d->nodes[i].num_instances > 0;
     for (uint32_t i = 0; i < d->num_materials; i++) {
         strength |= d->materials[i].emissive_strength != 0.0f;
         specular |= d->materials[i].has_specular;
@@ -326,6 +372,8 @@ static void write_json(FILE *f, const gltf_write_desc *d, const uint8_t *buf, si
         used[num_used++] = "KHR_materials_transmission";
     if (unlit)
         used[num_used++] = "KHR_materials_unlit";
+    if (instancing)
+        used[num_used++] = "EXT_mesh_gpu_instancing";
 
     fputs("{\n  \"asset\": {\"version\":\"2.0\",\"generator\":\"gonio\"}", f);
     if (num_used) {
@@ -341,7 +389,7 @@ static void write_json(FILE *f, const gltf_write_desc *d, const uint8_t *buf, si
         fputs("]}],\n  \"nodes\": [", f);
         for (uint32_t i = 0; i < d->num_nodes; i++) {
             fputs(item(i), f);
-            write_node(f, &d->nodes[i], d);
+            write_node(f, &d->nodes[i], d, &inst_accessor);
         }
         fputs("\n  ]", f);
     }

@@ -79,6 +79,11 @@ typedef struct gltf_write_node {
     float rotation[4];         /* unit quaternion x, y, z, w; all 0: identity */
     float scale[3];            /* all 0: 1 */
     const float *matrix;       /* 16 floats, column-major; non-NULL: written instead of TRS */
+    /* A mesh node's EXT_mesh_gpu_instancing: num_instances > 0 places its mesh once per
+     * instance (after the node's transform) with these translations (3 floats each), unit
+     * quaternions (4) and scales (3); each NULL: that attribute not written. */
+    uint32_t num_instances;
+    const float *instance_translation, *instance_rotation, *instance_scale;
 } gltf_write_node;
 
 typedef struct gltf_write_desc {

@@ -29,6 +29,7 @@ void scene_destroy(scene *s)
     free(s->textures);
     free(s->cameras);
     image_destroy(&s->environment);
+    scene_free_instances(s);
     memset(s, 0, sizeof *s);
 }
 
@@ -46,6 +47,7 @@ void scene_compute_bounds(scene *s)
             s->bounds_max[k] = fmaxf(s->bounds_max[k], c[k]);
         }
     }
+    scene_bound_instances(s);
 }
 
 void scene_triangle_cross(const scene *s, uint32_t t, double out[3])
@@ -67,24 +69,31 @@ static bool position_ok(const vec3 *p)
            fabsf(p->y) <= 1e15f && fabsf(p->z) <= 1e15f;
 }
 
-uint32_t scene_drop_invalid_triangles(scene *s)
+uint32_t scene_drop_invalid_triangles_of(GnVertex *vertices, uint32_t num_vertices, uint32_t *indices,
+                                         uint32_t *tri_material, uint32_t *num_triangles)
 {
     uint32_t kept = 0;
-    for (uint32_t t = 0; t < s->num_triangles; t++) {
-        const uint32_t *tri = &s->indices[3 * t];
-        if (!position_ok(&s->vertices[tri[0]].position) ||
-            !position_ok(&s->vertices[tri[1]].position) ||
-            !position_ok(&s->vertices[tri[2]].position))
+    for (uint32_t t = 0; t < *num_triangles; t++) {
+        const uint32_t *tri = &indices[3 * t];
+        if (!position_ok(&vertices[tri[0]].position) || !position_ok(&vertices[tri[1]].position) ||
+            !position_ok(&vertices[tri[2]].position))
             continue;
-        memmove(&s->indices[3 * kept], tri, 3 * sizeof *tri);
-        s->tri_material[kept++] = s->tri_material[t];
+        memmove(&indices[3 * kept], tri, 3 * sizeof *tri);
+        tri_material[kept++] = tri_material[t];
     }
-    for (uint32_t v = 0; v < s->num_vertices; v++)
-        if (!position_ok(&s->vertices[v].position))
-            memset(&s->vertices[v], 0, sizeof s->vertices[v]);
-    uint32_t dropped = s->num_triangles - kept;
-    s->num_triangles = kept;
+    for (uint32_t v = 0; v < num_vertices; v++)
+        if (!position_ok(&vertices[v].position))
+            memset(&vertices[v], 0, sizeof vertices[v]);
+    uint32_t dropped = *num_triangles - kept;
+    *num_triangles = kept;
     return dropped;
+}
+
+uint32_t scene_drop_invalid_triangles(scene *s)
+{
+    return scene_drop_invalid_triangles_of(s->vertices, s->num_vertices, s->indices, s->tri_material,
+                                           &s->num_triangles) +
+           scene_drop_invalid_instanced(s);
 }
 
 void scene_default_camera(const scene *s, float aspect, scene_camera *out)

@@ -28,6 +28,7 @@ typedef struct scene_camera {
 typedef struct scene_image {
     uint32_t width, height;
     uint8_t *rgba8; /* width * height * 4 bytes, rows top to bottom, as stored in the file */
+    uint32_t format; /* the file's encoding: texture_format (image_decode.h) */
 } scene_image;
 
 /* A material's use of an image (GnTexture): one per glTF texture, plus one per texture
@@ -37,6 +38,29 @@ typedef struct scene_texture {
     uint32_t flags; /* GnTexture flags: wrap S/T, GN_TEX_NEAREST, GN_TEX_UV1 */
     float transform[6]; /* the rows of KHR_texture_transform's matrix (GnTexture.row0, row1) */
 } scene_texture;
+
+/* A mesh drawn by instances (scene_instance): one the scene places several times (several
+ * nodes use it, or EXT_mesh_gpu_instancing), kept once in its own object space instead of
+ * once per placement in world space; the renderer builds its BVH once (src/render/
+ * render_geometry.c). Its vertices are as the loader makes a baked mesh's before the
+ * transform (normals normalised, tangents generated where a material needs them). */
+typedef struct scene_instanced_mesh {
+    uint32_t num_vertices;
+    GnVertex *vertices;         /* object space */
+    uint32_t num_triangles;
+    uint32_t *indices;          /* 3 per triangle, into vertices */
+    uint32_t *tri_material;     /* per triangle, into materials */
+    uint32_t gltf_mesh;         /* the glTF mesh */
+    float bounds_min[3], bounds_max[3]; /* of its triangles, object space */
+} scene_instanced_mesh;
+
+/* One placement of an instanced mesh: its object-to-world transform, 3x4 row-major (as
+ * GnInstance.to_world), invertible (the loader bakes a mesh a singular transform flattens). */
+typedef struct scene_instance {
+    float to_world[12];
+    uint32_t mesh;              /* into instanced_meshes */
+    uint32_t node;              /* the glTF node that places it */
+} scene_instance;
 
 /* Raw `extras: {"gonio": {...}}` of a material, kept for the integrators that read them. */
 typedef struct scene_material_extras {
@@ -72,6 +96,13 @@ typedef struct scene {
     uint32_t num_triangles;
     uint32_t *indices;          /* 3 per triangle, into vertices */
     uint32_t *tri_material;     /* per triangle, into materials */
+
+    /* Meshes placed by instances, besides the triangles above (which are the meshes used
+     * once, baked into world space); none in most scenes. */
+    uint32_t num_instanced_meshes;
+    scene_instanced_mesh *instanced_meshes;
+    uint32_t num_instances;
+    scene_instance *instances;
 
     uint32_t num_meshes;        /* glTF mesh primitives drawn (after instancing by nodes) */
     uint32_t num_gltf_meshes;   /* glTF meshes in the file */
@@ -121,7 +152,8 @@ typedef struct scene {
  * factor out of its range (clamped, or the default kept: its row of glsl/lib/material.h
  * says which), unsupported extensions in extensionsUsed (ignored, one warning each),
  * points/lines primitives (strips and fans become triangles), invalid cameras and lights,
- * texCoord > 1 and missing or undecodable images (PNG and JPEG only: the slot is
+ * texCoord > 1 and missing or undecodable images (PNG, JPEG, and WebP and KTX2 through
+ * EXT_texture_webp and KHR_texture_basisu, whose core source is the fallback: the slot is
  * GN_INVALID), non-unit normals (renormalised), skins, morph targets, bad COLOR_0,
  * triangles with non-finite or absurdly large (|x| > 1e15) vertices (dropped, one warning).
  * Primitives without NORMAL get flat normals (de-indexed); normal maps, clearcoat normal maps
@@ -130,15 +162,21 @@ typedef struct scene {
 bool scene_load(scene *out, const char *path);
 
 /* How gonio handles the glTF extension `name`: its support and a static sentence saying how
- * (also for a name it does not know: SCENE_UNSUPPORTED, "unknown to gonio"). */
+ * (also for a name it does not know: SCENE_UNSUPPORTED, "unknown to gonio"; for
+ * KHR_texture_basisu in a build without Basis Universal: SCENE_UNSUPPORTED, and why). */
 scene_support scene_extension_support(const char *name, const char **how);
 
 /* Limits of a decoded scene, checked before anything is allocated, with the numbers in the
- * error: triangles and vertices after instancing (about 300 bytes each through loading and
- * the BVH build: 5 GB at the limit), and texels of all images together (RGBA8; images with
+ * error: triangles and vertices stored (the meshes used once after baking them into world
+ * space, and each instanced mesh once; about 300 bytes each through loading and the BVH
+ * build: 5 GB at the limit), and texels of all images together (RGBA8; images with
  * the same bytes are decoded once and count once). */
 #define SCENE_MAX_TRIANGLES (1u << 24)
 #define SCENE_MAX_TEXELS (1ull << 28)
+/* Instances (each about 300 bytes through loading and the top tree's build: 300 MB at the
+ * limit). The triangles they place do not count against SCENE_MAX_TRIANGLES: a mesh placed
+ * by instances is kept once. */
+#define SCENE_MAX_INSTANCES (1u << 20)
 /* The same for the glTF scene of index scene_index (-1: the file's default scene, else its
  * first, else every node without a parent); an index the file lacks is an error. */
 bool scene_load_scene(scene *out, const char *path, int scene_index);
@@ -157,6 +195,13 @@ void scene_select_variant(const char *name);
  * lights move; morph-target weights are not animated (a warning). Negative (the default):
  * the nodes' own transforms. */
 void scene_animation_time(double seconds);
+
+/* Loads that follow keep a mesh that an animation moves (its node's or a parent's
+ * translation, rotation or scale) in its own space, placed by an instance, as they keep
+ * shared meshes: the frames of an animation then differ only in their instances'
+ * transforms (scene_same_geometry), and a renderer moves them by rebuilding only the top
+ * tree (renderer_update). False (the default): such a mesh is baked like any other. */
+void scene_instance_animated(bool on);
 
 /* Frees everything; accepts a zeroed struct. */
 void scene_destroy(scene *s);
@@ -178,14 +223,40 @@ void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *
  * its normal. */
 void scene_triangle_cross(const scene *s, uint32_t t, double out[3]);
 
-/* Recomputes bounds_min/bounds_max from the triangles. */
+/* Recomputes bounds_min/bounds_max from the triangles, and from the instances: the box of
+ * each one's mesh bounds transformed (so a turned instance may widen them a little). Also
+ * each instanced mesh's own bounds. */
 void scene_compute_bounds(scene *s);
+
+/* The triangles the scene places: the world's and, for each instance, its mesh's. */
+uint64_t scene_placed_triangles(const scene *s);
+/* Instance i's world box (its mesh's bounds transformed, as scene_compute_bounds takes them). */
+void scene_instance_box(const scene *s, uint32_t i, float lo[3], float hi[3]);
+/* Triangle t of instanced mesh m, transformed by instance i's transform: its corners' cross
+ * product, in double (twice its world area along its normal; for a mirroring instance the
+ * direction is that of the corners as stored, see GN_INSTANCE_MIRROR). */
+void scene_instance_triangle_cross(const scene *s, uint32_t i, uint32_t t, double out[3]);
+/* Are a and b the same geometry and materials, up to the instances' transforms (the same
+ * triangles, vertices, materials, instanced meshes and instances of the same meshes and
+ * nodes)? Then one's BVHs serve the other with only the top tree rebuilt (an animated frame;
+ * lights and cameras may differ). */
+bool scene_same_geometry(const scene *a, const scene *b);
 
 /* Removes every triangle with a corner whose position is not finite or has a coordinate
  * beyond 1e15 in magnitude (such values overflow ray-box tests in float), compacting indices
- * and tri_material, and zeroes those vertices (no triangle refers to them any more). Returns
- * the number of triangles removed; prints nothing (the caller warns once). */
+ * and tri_material, and zeroes those vertices (no triangle refers to them any more); the same
+ * in the instanced meshes, and removes instances whose world box goes beyond 1e15 and the
+ * meshes left without triangles or instances. Returns the number of triangles removed (an
+ * instance's, once); prints nothing (the caller warns once). */
 uint32_t scene_drop_invalid_triangles(scene *s);
+/* The same on one set of arrays. */
+uint32_t scene_drop_invalid_triangles_of(GnVertex *vertices, uint32_t num_vertices, uint32_t *indices,
+                                         uint32_t *tri_material, uint32_t *num_triangles);
+/* (src/scene/scene_instances.c: the instanced meshes' and instances' parts of
+ * scene_drop_invalid_triangles, scene_compute_bounds and scene_destroy) */
+uint32_t scene_drop_invalid_instanced(scene *s);
+void scene_bound_instances(scene *s);
+void scene_free_instances(scene *s);
 
 /* Default material, as glTF 2.0 specifies for primitives without one (white, metallic 1,
  * roughness 1), with the Phong parameters derived as scene_phong_from_pbr does. */

@@ -19,6 +19,7 @@ namespace gltf {
 
 bool allow_outside_files = false; /* scene_allow_outside_files */
 std::string variant;              /* scene_select_variant */
+bool instance_animated = false;   /* scene_instance_animated */
 double anim_time = -1;            /* scene_animation_time */
 
 void vreport(const Ctx &c, bool error, const char *fmt, va_list ap)
@@ -296,7 +297,7 @@ bool load(scene *out, const char *path, int scene_index)
     uint32_t dropped = scene_drop_invalid_triangles(out);
     if (dropped)
         warn(c, "dropped %u triangle(s) with non-finite or huge (|x| > 1e15) vertex positions", dropped);
-    if (out->num_triangles == 0)
+    if (out->num_triangles == 0 && out->num_instances == 0)
         return fail(c, "no triangles");
     scene_compute_bounds(out);
     return true;
@@ -316,6 +317,8 @@ void scene_animation_time(double seconds)
 void scene_allow_outside_files(bool allow) { allow_outside_files = allow; }
 
 void scene_select_variant(const char *name) { variant = name ? name : ""; }
+
+void scene_instance_animated(bool on) { instance_animated = on; }
 
 bool scene_load_scene(scene *out, const char *path, int scene_index)
 {

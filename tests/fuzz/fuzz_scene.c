@@ -1,7 +1,9 @@
-/* fuzz_scene.c: libFuzzer target over scene_load (glTF JSON and GLB, detected by content).
+/* fuzz_scene.c: libFuzzer target over scene_load (glTF JSON and GLB, detected by content)
+ * and the trees a loaded scene gets (render_geometry_build: with instances, two levels).
  * Any input must give a scene or false with an error, never a crash, a sanitizer report,
  * a leak or a hang. */
 #include "fuzz_common.h"
+#include "render_geometry.h"
 #include "scene.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -9,7 +11,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     scene sc;
     util_set_quiet(true);
     util_set_silent(true); /* the loader's warnings and errors: most of the time otherwise */
-    if (scene_load(&sc, fuzz_write_input("in.gltf", data, size)))
+    if (scene_load(&sc, fuzz_write_input("in.gltf", data, size))) {
+        render_geometry g;
+        if (render_geometry_build(&g, &sc))
+            render_geometry_destroy(&g);
         scene_destroy(&sc);
+    }
     return 0;
 }

@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # run.sh TARGET...: a bounded libFuzzer run of each target (make fuzz-run): FUZZ_TIME seconds
 # each (default 60), seeded in place from $GONIO_ASSETS (sample models, glTF-Validator's
-# invalid files) and from EXRs that $GONIO writes here, every compression, scanline and
-# tiled. New inputs and crash files go to a temporary folder, kept and named on a crash:
+# invalid files), from EXRs that $GONIO writes here, every compression, scanline and
+# tiled, and from WebP and KTX2 textures written here ($TESTTOOL ktx2, cwebp). New inputs and crash files go to a temporary folder, kept and named on a crash:
 # minimise one (TARGET -minimize_crash=1 FILE), fix the bug, and add the small file to
 # tests/fuzz/regress (tests/regress/fuzz.sh replays them in make test).
 set -u
 root=$(cd "$(dirname "$0")/../.." && pwd)
 cd "$root"
 GONIO=$(realpath "${GONIO:-build/release/gonio}")
+TESTTOOL=$(realpath "${TESTTOOL:-$(dirname "$GONIO")/testtool}")
 A=${GONIO_ASSETS:-$root/../shared/assets}
 T=${FUZZ_TIME:-60}
 tmp=$(mktemp -d)
@@ -27,6 +28,35 @@ if [ -d "$A" ]; then
 else
     echo "note: $A is absent: the scene fuzzer starts from scenes/ only"
 fi
+# instances: shared meshes, EXT_mesh_gpu_instancing (floats, normalized shorts, wrong ones)
+if python3 tests/tool/instances.py "$tmp/instances" >/dev/null 2>&1; then
+    for f in "$tmp"/instances/*.gltf; do link "$tmp/seed-scene" "$f"; done
+fi
+# Textures: a WebP by cwebp and a KTX2 of each Basis Universal mode by testtool ktx2, as GLBs
+# that use them (tests/tool/texture_glb.py) for the scene fuzzer, and bare for fuzz_image in
+# its layout: a format byte (1 KTX2, 0 WebP), then the file past its 12-byte signature.
+mkdir -p "$tmp/tex" "$tmp/seed-image"
+python3 -c 'import struct, sys, zlib
+rows = b"".join(b"\0" + b"".join(bytes((40 + 60 * (i // 2), 40 + 60 * (j // 2), 30 * i, 255 - 20 * j)) for i in range(8)) for j in range(8))
+c = lambda t, d: struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
+open(sys.argv[1], "wb").write(b"\x89PNG\r\n\x1a\n" + c(b"IHDR", struct.pack(">IIBBBBB", 8, 8, 8, 6, 0, 0, 0)) + c(b"IDAT", zlib.compress(rows)) + c(b"IEND", b""))' "$tmp/tex/tex.png"
+if command -v cwebp >/dev/null; then
+    cwebp -quiet -lossless "$tmp/tex/tex.png" -o "$tmp/tex/lossless.webp"
+    cwebp -quiet -q 80 "$tmp/tex/tex.png" -o "$tmp/tex/lossy.webp"
+else
+    echo "note: cwebp is absent: no WebP seeds"
+fi
+for m in etc1s uastc uastc-zstd; do
+    "$TESTTOOL" ktx2 $m "$tmp/tex/tex.png" "$tmp/tex/$m.ktx2" >/dev/null 2>&1 || { echo "note: no KTX2 seeds (testtool ktx2: no Basis Universal)"; break; }
+done
+for f in "$tmp"/tex/*.webp "$tmp"/tex/*.ktx2; do
+    [ -f "$f" ] || continue
+    b=$(basename "$f")
+    python3 tests/tool/texture_glb.py "$tmp/seed-scene/tex-$b.glb" "$f"
+    python3 tests/tool/texture_glb.py "$tmp/seed-scene/tex-$b-fallback.glb" "$f" "$tmp/tex/tex.png"
+    python3 -c 'import sys; d = open(sys.argv[1], "rb").read(); open(sys.argv[2], "wb").write(bytes([sys.argv[1].endswith(".ktx2")]) + d[12:])' \
+        "$f" "$tmp/seed-image/$b"
+done
 for c in none rle zips zip piz pxr24 b44 b44a; do
     "$GONIO" render scenes/cornell.gltf -o "$tmp/seed-exr/$c.exr" --size 19x13 --spp 1 --quiet --compression $c --aov normal,depth
     "$GONIO" render scenes/cornell.gltf -o "$tmp/seed-exr/$c-half.exr" --size 19x13 --spp 1 --quiet --compression $c --half
@@ -49,12 +79,13 @@ open(sys.argv[3], "wb").write(struct.pack("<I", len(a)) + a + b)' "$1" "$2" "$3"
 pair "$tmp/t-left.exr" "$tmp/t-right.exr" "$tmp/seed-merge/tiles"
 pair "$tmp/t-seed1.exr" "$tmp/t-seed2.exr" "$tmp/seed-merge/seeds"
 pair "$tmp/t-part.exr" "$tmp/t-seed1.exr" "$tmp/seed-merge/partial"
-echo "seeds: $(ls "$tmp/seed-scene" | wc -l) scenes, $(ls "$tmp/seed-exr" | wc -l) EXRs, $(ls "$tmp/seed-merge" | wc -l) merges"
+echo "seeds: $(ls "$tmp/seed-scene" | wc -l) scenes, $(ls "$tmp/seed-exr" | wc -l) EXRs, $(ls "$tmp/seed-merge" | wc -l) merges, $(ls "$tmp/seed-image" | wc -l) images"
 
 failed=0
 for f in "$@"; do
     t=$(basename "$f")
     case $t in *scene*) seeds=$tmp/seed-scene; len=65536 ;; *merge*) seeds=$tmp/seed-merge; len=32768 ;;
+        *image*) seeds=$tmp/seed-image; len=16384 ;;
         *) seeds=$tmp/seed-exr; len=16384 ;; esac
     mkdir -p "$tmp/corpus-$t"
     "$f" "$tmp/corpus-$t" "$seeds" -max_total_time="$T" -max_len=$len -timeout=10 -rss_limit_mb=2048 \

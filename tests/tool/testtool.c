@@ -9,6 +9,9 @@
  *   testtool stats IMAGE.exr           coverage, mean luminance, the box of red pixels
  *   testtool same WHOLE.exr PART.exr   every value of PART's channels (but sum.*) equals,
  *                                      bit for bit, WHOLE's at the same display-window pixel
+ *   testtool ktx2 MODE IN.png OUT.ktx2 [rg]   a KTX2 image by Basis Universal's encoder
+ *   testtool texels IMAGE REF.png CHANNELS MAX_ERR MAX_RMSE   a WebP or KTX2 image as gonio
+ *                                      decodes it, against the PNG it was made from
  */
 #include <math.h>
 #include <stdio.h>
@@ -17,7 +20,9 @@
 
 #include "gltf_write.h"
 #include "image.h"
+#include "image_decode.h"
 #include "meshgen.h"
+#include "util.h"
 
 /* The camera of both scenes: at `eye`, looking along -Z of a rotation about Y by `yaw`
  * then about X by `pitch`; yfov 50 degrees; square images. */
@@ -532,6 +537,49 @@ done:
     return rc;
 }
 
+/* Decodes ENCODED (WebP or KTX2) through image_decode, the loader's decoder, and compares
+ * its texels with REF.png's, read by libpng: the largest difference and the RMSE over the
+ * channels listed (e.g. RGBA, RG), in 8-bit steps. Exit 1 above either bound. */
+static int texels(const char *encoded, const char *ref, const char *channels, double max_err, double max_rmse)
+{
+    size_t n = 0;
+    uint8_t *bytes = util_read_file(encoded, &n), *dec = NULL, *px = NULL;
+    uint32_t w = 0, h = 0;
+    int rw = 0, rh = 0, rc = 1;
+    char why[512];
+    if (!bytes)
+        return 1;
+    if (image_decode(bytes, n, NULL, UINT64_MAX, &dec, &w, &h, why, sizeof why) != IMAGE_DECODED) {
+        fprintf(stderr, "%s: %s\n", encoded, why);
+        goto done;
+    }
+    if (!image_read_png(ref, &px, &rw, &rh) || (uint32_t)rw != w || (uint32_t)rh != h) {
+        fprintf(stderr, "%s: unreadable, or not %ux%u\n", ref, w, h);
+        goto done;
+    }
+    double sum = 0, worst = 0;
+    size_t count = 0;
+    for (size_t i = 0; i < (size_t)w * h; i++)
+        for (const char *c = channels; *c; c++) {
+            int k = (int)(strchr("RGBA", *c) ? strchr("RGBA", *c) - "RGBA" : 0);
+            double d = fabs((double)dec[4 * i + k] - px[4 * i + k]);
+            sum += d * d;
+            worst = d > worst ? d : worst;
+            count++;
+        }
+    double rmse = count ? sqrt(sum / count) : 0;
+    printf("%s: %ux%u, %s: max error %g, rmse %.3f (of 255)\n", encoded, w, h, channels, worst, rmse);
+    rc = worst > max_err || rmse > max_rmse;
+done:
+    free(bytes);
+    free(dec);
+    free(px);
+    return rc;
+}
+
+/* ktx2.cpp: IN.png encoded by Basis Universal's encoder into OUT.ktx2. */
+int tool_ktx2(const char *mode, const char *in, const char *out, bool rg);
+
 /* compress.cpp: IN.gltf encoded with Draco or meshoptimizer, losslessly, into OUT.gltf. */
 int tool_compress(const char *how, const char *in, const char *out);
 
@@ -570,6 +618,10 @@ int main(int argc, char **argv)
         return pick_channel(argv[2], argv[3], argv[4]);
     if (argc == 5 && !strcmp(argv[1], "compress") && (!strcmp(argv[2], "draco") || !strcmp(argv[2], "meshopt")))
         return tool_compress(argv[2], argv[3], argv[4]);
+    if ((argc == 5 || argc == 6) && !strcmp(argv[1], "ktx2"))
+        return tool_ktx2(argv[2], argv[3], argv[4], argc == 6 && !strcmp(argv[5], "rg"));
+    if (argc == 7 && !strcmp(argv[1], "texels"))
+        return texels(argv[2], argv[3], argv[4], atof(argv[5]), atof(argv[6]));
     if (argc == 4 && !strcmp(argv[1], "scene"))
         return write_scene(argv[2], argv[3]);
     if ((argc == 7 || argc == 8) && !strcmp(argv[1], "ref"))
@@ -581,6 +633,8 @@ int main(int argc, char **argv)
                     "       testtool moments IN.exr | testtool rename IN.exr OUT.exr OLD=NEW,OLD2=,...\n"
                     "       testtool poke IN.exr CHANNEL X Y VALUE OUT.exr | testtool errors TEST.exr REF.exr\n"
                     "       testtool png IN.exr OUT.png\n"
+                    "       testtool ktx2 etc1s|uastc|uastc-zstd IN.png OUT.ktx2 [rg]\n"
+                    "       testtool texels IMAGE.webp|.ktx2 REF.png CHANNELS MAX_ERR MAX_RMSE\n"
                     "       testtool sheen-table\n");
     return 2;
 }

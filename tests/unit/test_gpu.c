@@ -10,6 +10,7 @@
 
 #include "bvh.h"
 #include "gpu.h"
+#include "instances.h"
 #include "meshgen.h"
 #include "render.h"
 #include "scene_mesh.h"
@@ -24,11 +25,30 @@ typedef struct ray {
 typedef struct gpu_hit {
     float t, u, v;
     uint32_t tri;
-    float steps, unfinished, pad0, pad1;
+    float steps, unfinished;
+    uint32_t inst;
+    float pad1;
 } gpu_hit;
 
-/* A Walk of bvh.glsl in std430: Hit (6 words), node, sp, stack, regs. */
-#define WALK_BYTES (4 * (6 + 2 + GN_WALK_STACK + GN_WALK_REGS_MAX))
+/* A Walk of bvh.glsl in std430: Hit (7 words), node, inst, sp, stack, regs. */
+#define WALK_BYTES (4 * (7 + 3 + GN_WALK_STACK + GN_WALK_REGS_MAX))
+
+/* What gpu_trace walks: one tree (instances NULL) or two levels (the GPU arrays of a
+ * bvh_top and its instances). */
+typedef struct trace_scene {
+    const GnBvhNode *nodes;
+    uint32_t num_nodes;
+    const GnTriPair *pairs;
+    uint32_t num_pairs;
+    const GnInstance *instances;
+    uint32_t num_instances;
+    uint32_t depth; /* stack entries a walk may need (walk_regs may be used up to it) */
+} trace_scene;
+
+static trace_scene one_tree(const bvh *b)
+{
+    return (trace_scene){b->nodes, b->num_nodes, b->pairs, b->num_pairs, NULL, 0, b->depth};
+}
 
 /* The walk's stack for gpu_trace: 0, the array; K, K registers (trees of <= K levels). */
 static uint32_t walk_regs;
@@ -45,10 +65,10 @@ bool test_open_gpu(gpu *g)
 /* Traces rays on the GPU with a per-dispatch budget of `budget` node visits, resuming
  * unfinished walks until all are done (resume = false: one dispatch only). Returns the
  * number of dispatches. */
-static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any_hit,
-                     uint32_t budget, bool resume, gpu_hit *out)
+static int gpu_trace_scene(gpu *g, const trace_scene *b, const ray *rays, uint32_t n, bool any_hit,
+                           uint32_t budget, bool resume, gpu_hit *out)
 {
-    gpu_buffer frame, nodes, tris, rbuf, hbuf, wbuf, status;
+    gpu_buffer frame, nodes, tris, rbuf, hbuf, wbuf, status, inst;
     gpu_pipeline p;
     GnFrame f = {0};
     int dispatches = 0;
@@ -57,6 +77,10 @@ static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any
     gpu_buffer_upload(g, &frame, &f, sizeof f, 0);
     gpu_buffer_create_texels(g, &nodes, b->nodes, sizeof(GnBvhNode) * b->num_nodes);
     gpu_buffer_create_texels(g, &tris, b->pairs, sizeof(GnTriPair) * b->num_pairs);
+    if (b->instances)
+        gpu_buffer_create_texels(g, &inst, b->instances, sizeof(GnInstance) * b->num_instances);
+    else
+        gpu_buffer_create_texels(g, &inst, NULL, 16);
     gpu_buffer_create_storage(g, &rbuf, rays, sizeof(ray) * n);
     gpu_buffer_create(g, &hbuf, sizeof(gpu_hit) * n, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
     gpu_buffer_create_storage(g, &wbuf, NULL, (VkDeviceSize)WALK_BYTES * n);
@@ -70,9 +94,12 @@ static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any
             {GN_BIND_AOV, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &hbuf},
             {GN_BIND_VCOLOR, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &wbuf},
             {GN_BIND_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &status},
+            {GN_BIND_INSTANCES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &inst},
         };
-        const VkSpecializationMapEntry entry = {GN_SPEC_WALK_REGS, 0, sizeof(uint32_t)};
-        const VkSpecializationInfo spec = {1, &entry, sizeof walk_regs, &walk_regs};
+        const uint32_t values[2] = {walk_regs, b->instances != NULL};
+        const VkSpecializationMapEntry entries[2] = {{GN_SPEC_WALK_REGS, 0, sizeof(uint32_t)},
+                                                     {GN_SPEC_INSTANCES, sizeof(uint32_t), sizeof(uint32_t)}};
+        const VkSpecializationInfo spec = {2, entries, sizeof values, values};
         assert(walk_regs == 0 || b->depth <= walk_regs);
         gpu_pipeline_desc pd = {.name = "trace_test", .code = spv_trace_test, .specialization = &spec,
                                 .code_size = sizeof spv_trace_test, .local_size = {64, 1, 1},
@@ -100,7 +127,15 @@ static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any
     gpu_buffer_destroy(g, &hbuf);
     gpu_buffer_destroy(g, &wbuf);
     gpu_buffer_destroy(g, &status);
+    gpu_buffer_destroy(g, &inst);
     return dispatches;
+}
+
+static int gpu_trace(gpu *g, const bvh *b, const ray *rays, uint32_t n, bool any_hit,
+                     uint32_t budget, bool resume, gpu_hit *out)
+{
+    trace_scene t = one_tree(b);
+    return gpu_trace_scene(g, &t, rays, n, any_hit, budget, resume, out);
 }
 
 static uint64_t rng_state = 88172645463325252ull;
@@ -378,6 +413,147 @@ TEST(gpu, traversal_deep)
            h[0].tri, h[0].t, c0.t);
     bvh_destroy(&b);
     meshgen_destroy(&m);
+    gpu_destroy(&g);
+}
+
+/* ---- two levels: instances ------------------------------------------------------------- */
+
+/* The GPU arrays of a scene of instances, as the renderer uploads them. */
+static trace_scene two_levels(const bvh_top *t, GnBvhNode **nodes, GnTriPair **pairs)
+{
+    *nodes = malloc(t->num_nodes * sizeof **nodes);
+    *pairs = malloc(t->num_pairs * sizeof **pairs);
+    bvh_top_gpu_nodes(t, *nodes);
+    bvh_top_gpu_pairs(t, *pairs);
+    return (trace_scene){*nodes, t->num_nodes, *pairs, t->num_pairs, t->instances, t->num_instances,
+                         bvh_top_depth(t)};
+}
+
+/* The GPU's two-level walk against the C one (bvh_top_intersect, itself checked against brute
+ * force over the flattened triangles in test_bvh.c): the same instance and triangle, or a tie
+ * at the same t; the hit point on the triangle the GPU names; any hit agreeing. Walked with
+ * the stack in memory and (trees shallow enough) in registers, each whole and resumed every
+ * two node visits, so that walks stop inside meshes and go on there. */
+static void compare_instances(gpu *g, const char *what, const inst_scene *s, const ray *rays, uint32_t n)
+{
+    GnBvhNode *nodes;
+    GnTriPair *pairs;
+    trace_scene t = two_levels(&s->top, &nodes, &pairs);
+    gpu_hit *closest = calloc(n, sizeof *closest), *any = calloc(n, sizeof *any);
+    int bad = 0, hits = 0, ways = t.depth <= GN_WALK_REGS_MAX ? 4 : 2, resumed = 0;
+    float ext = 0;
+    for (int a = 0; a < 3; a++)
+        ext = fmaxf(ext, s->hi[a] - s->lo[a]);
+    for (int way = 0; way < ways; way++) {
+        uint32_t budget = way & 1 ? 2 : 1u << 30;
+        walk_regs = way >= 2 ? t.depth : 0;
+        resumed += gpu_trace_scene(g, &t, rays, n, false, budget, way & 1, closest) > 1;
+        gpu_trace_scene(g, &t, rays, n, true, budget, way & 1, any);
+        for (uint32_t i = 0; i < n && bad < 5; i++) {
+            bvh_hit c = bvh_top_intersect(&s->top, rays[i].o, rays[i].d, rays[i].tmin, rays[i].tmax, NULL);
+            const gpu_hit *h = &closest[i];
+            bool ok = (h->tri == GN_INVALID) == (c.tri == GN_INVALID) && h->unfinished == 0.0f &&
+                      (any[i].tri != GN_INVALID) == (c.tri != GN_INVALID);
+            if (ok && c.tri != GN_INVALID) {
+                hits++;
+                ok = same_t(h->t, c.t) && h->inst < s->num_instances &&
+                     ((h->inst == c.inst && h->tri == c.tri &&
+                       fabsf(h->u - c.u) <= 1e-4f && fabsf(h->v - c.v) <= 1e-4f) ||
+                      h->t == c.t);
+                /* whichever triangle: the GPU's at its barycentrics is the hit point */
+                float p[3];
+                const GnInstance *in = &s->top.instances[h->inst];
+                ok = ok && h->tri >= in->prim_base && h->tri - in->prim_base < s->tree[in->mesh].num_slots;
+                if (ok) {
+                    inst_hit_point(s, h->tri, h->inst, h->u, h->v, p);
+                    for (int a = 0; a < 3; a++)
+                        ok = ok && fabsf(p[a] - (rays[i].o[a] + h->t * rays[i].d[a])) <= 1e-4f * ext;
+                }
+            }
+            if (!ok) {
+                bad++;
+                fprintf(stderr, "  %s (%s%s) ray %u: gpu inst %u tri %u t %.9g uv %g %g unfinished %g any %u, "
+                        "C inst %u tri %u t %.9g uv %g %g\n", what, way >= 2 ? "registers" : "stack array",
+                        way & 1 ? ", resumed" : "", i, h->inst, h->tri, h->t, h->u, h->v, h->unfinished,
+                        any[i].tri, c.inst, c.tri, c.t, c.u, c.v);
+            }
+        }
+    }
+    walk_regs = 0;
+    CHECKF(bad == 0, "%s: %d rays disagree", what, bad);
+    CHECKF(hits > (int)n / 8, "%s: only %d hits: the test would prove little", what, hits);
+    CHECKF(resumed == ways / 2, "%s: the walks resumed every two visits needed no second dispatch", what);
+    free(closest);
+    free(any);
+    free(nodes);
+    free(pairs);
+}
+
+TEST(gpu, traversal_instances)
+{
+    gpu g;
+    inst_scene s;
+    if (!test_open_gpu(&g))
+        return;
+    ray *r = malloc(sizeof *r * 4096);
+    CHECK(inst_scene_make(&s, 60, 4.0, 3, false));
+    random_rays(r, 4096, s.lo, s.hi);
+    compare_instances(&g, "60 instances", &s, r, 4096);
+    inst_scene_destroy(&s);
+    /* small meshes: trees shallow enough for the stack in registers */
+    CHECK(inst_scene_make(&s, 3, 1.0, 4, true));
+    CHECKF(bvh_top_depth(&s.top) <= GN_WALK_REGS_MAX, "%u stack entries: too many for registers", bvh_top_depth(&s.top));
+    random_rays(r, 2048, s.lo, s.hi);
+    compare_instances(&g, "3 small instances", &s, r, 2048);
+    inst_scene_destroy(&s);
+    free(r);
+    CHECK(gpu_validation_message_count() == 0);
+    gpu_destroy(&g);
+}
+
+/* The comb (gpu.traversal_deep) placed three times: a ray down one copy's axis walks the
+ * whole of its mesh's tree, longer than one invocation may run, so the walk stops inside the
+ * instance, is saved and resumed there by later dispatches, and still gives the exact hit. */
+TEST(gpu, traversal_instances_deep)
+{
+    gpu g;
+    meshgen_mesh m = meshgen_comb(50000);
+    bvh b;
+    bvh_top t;
+    ray r[16];
+    gpu_hit h[16];
+    float xf[3][12] = {{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}, {0, 0, 1, 5, 0, 1, 0, 0, -1, 0, 0, 0},
+                       {0, 0, -1, -5, 0, 1, 0, 0, -1, 0, 0, 0}};
+    uint32_t mesh[3] = {0, 0, 0};
+    if (!test_open_gpu(&g))
+        return;
+    CHECK(bvh_build(&b, m.positions, 3, m.indices, m.num_triangles));
+    CHECK(bvh_top_build(&t, &b, 1, (const float(*)[12])xf, mesh, NULL, 3, "combs"));
+    GnBvhNode *nodes;
+    GnTriPair *pairs;
+    trace_scene ts = two_levels(&t, &nodes, &pairs);
+    for (int i = 0; i < 16; i++) {
+        /* down the axis of instance 1 (its comb turned to run along +x from x = 5; mirrored
+         * copy 2's along -x), then slightly off it */
+        float dy = i ? 1e-4f * (float)(i % 4) : 0, dz = i ? 1e-4f * (float)(i / 4) : 0;
+        r[i] = i < 8 ? (ray){{4.0f, dy, dz}, 0, {1, 0, 0}, 1e30f} : (ray){{-4.0f, dy, dz}, 0, {-1, 0, 0}, 1e30f};
+    }
+    int dispatches = gpu_trace_scene(&g, &ts, r, 16, false, 2000, true, h);
+    CHECKF(dispatches > 1, "the combs did not need resuming (%d dispatch): it tests nothing", dispatches);
+    for (int i = 0; i < 16; i++) {
+        bvh_hit c = bvh_top_intersect(&t, r[i].o, r[i].d, r[i].tmin, r[i].tmax, NULL);
+        CHECKF(h[i].tri != GN_INVALID && c.tri != GN_INVALID && same_t(h[i].t, c.t) && h[i].inst == c.inst &&
+                   h[i].inst == (i < 8 ? 1u : 2u) && h[i].unfinished == 0.0f,
+               "comb ray %d: gpu inst %u tri %u t %g, C inst %u tri %u t %g", i, h[i].inst, h[i].tri, h[i].t,
+               c.inst, c.tri, c.t);
+    }
+    printf("    combs: %u instances, GPU walks resumed over %d dispatches\n", t.num_instances, dispatches);
+    free(nodes);
+    free(pairs);
+    bvh_top_destroy(&t);
+    bvh_destroy(&b);
+    meshgen_destroy(&m);
+    CHECK(gpu_validation_message_count() == 0);
     gpu_destroy(&g);
 }
 

@@ -50,6 +50,24 @@ static bool near3(vec3 v, float x, float y, float z, float tol)
     return near(v.x, x, tol) && near(v.y, y, tol) && near(v.z, z, tol);
 }
 
+/* Vertices the scene places: its world-space ones and each instance's copy of its mesh's
+ * (a mesh several nodes use is kept once, with an instance per node: scene_instanced_mesh). */
+static uint64_t placed_vertices(const scene *s)
+{
+    uint64_t n = s->num_vertices;
+    for (uint32_t i = 0; i < s->num_instances; i++)
+        n += s->instanced_meshes[s->instances[i].mesh].num_vertices;
+    return n;
+}
+
+/* Instance i's placement of object-space point p (scene_instance.to_world: 3x4, row-major). */
+static vec3 placed(const scene *s, uint32_t i, vec3 p)
+{
+    const float *w = s->instances[i].to_world;
+    return (vec3){w[0] * p.x + w[1] * p.y + w[2] * p.z + w[3], w[4] * p.x + w[5] * p.y + w[6] * p.z + w[7],
+                  w[8] * p.x + w[9] * p.y + w[10] * p.z + w[11]};
+}
+
 static char *base64(const void *data, size_t n)
 {
     static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -376,11 +394,13 @@ TEST(scene, sample_models)
         CHECKF(ok, "%s did not load:\n%s", samples[i].path, load_log);
         if (!ok)
             continue;
-        CHECKF(s.num_triangles == samples[i].tris && s.num_vertices == samples[i].verts &&
+        /* (placed: a mesh several nodes use is kept once, with its instances) */
+        CHECKF(scene_placed_triangles(&s) == samples[i].tris && placed_vertices(&s) == samples[i].verts &&
                    s.num_meshes == samples[i].prims && s.num_gltf_meshes == samples[i].meshes &&
                    s.num_nodes == samples[i].nodes && s.num_materials == samples[i].mats,
-               "%s: %u triangles %u vertices %u prims %u meshes %u nodes %u materials", samples[i].path,
-               s.num_triangles, s.num_vertices, s.num_meshes, s.num_gltf_meshes, s.num_nodes, s.num_materials);
+               "%s: %llu triangles %llu vertices %u prims %u meshes %u nodes %u materials", samples[i].path,
+               (unsigned long long)scene_placed_triangles(&s), (unsigned long long)placed_vertices(&s), s.num_meshes,
+               s.num_gltf_meshes, s.num_nodes, s.num_materials);
         CHECKF(s.num_images == samples[i].images && s.num_textures == samples[i].textures &&
                    s.num_cameras == samples[i].cameras && s.num_lights == samples[i].lights,
                "%s: %u images %u textures %u cameras %u lights", samples[i].path, s.num_images, s.num_textures,
@@ -432,17 +452,24 @@ TEST(scene, simple_meshes)
     scene s;
     CHECKF(load(&s, asset(path, sizeof path, "gltf/SimpleMeshes/glTF/SimpleMeshes.gltf")), "%s", load_log);
     /* One triangle mesh (0,0,0) (1,0,0) (0,1,0), normals +Z, drawn by node 0 (identity) and
-     * node 1 (translation 1,0,0), in that order. */
-    CHECK(s.num_triangles == 2 && s.num_vertices == 6 && s.num_meshes == 2 && s.num_gltf_meshes == 1);
-    if (s.num_triangles == 2) {
-        for (int inst = 0; inst < 2; inst++) {
-            const uint32_t *t = &s.indices[3 * inst];
-            CHECK(near3(s.vertices[t[0]].position, (float)inst, 0, 0, 0));
-            CHECK(near3(s.vertices[t[1]].position, 1.0f + inst, 0, 0, 0));
-            CHECK(near3(s.vertices[t[2]].position, (float)inst, 1, 0, 0));
-            CHECK(near3(s.vertices[t[0]].normal, 0, 0, 1, 0));
+     * node 1 (translation 1,0,0), in that order: used twice, it is kept once in its own space
+     * and placed by two instances, nothing in world space. */
+    CHECK(s.num_triangles == 0 && s.num_meshes == 2 && s.num_gltf_meshes == 1 && s.num_instanced_meshes == 1 &&
+          s.num_instances == 2 && scene_placed_triangles(&s) == 2);
+    if (s.num_instanced_meshes == 1 && s.num_instances == 2 && s.instanced_meshes[0].num_triangles == 1 &&
+        s.instanced_meshes[0].num_vertices == 3) {
+        const scene_instanced_mesh *m = &s.instanced_meshes[0];
+        const uint32_t *t = m->indices;
+        for (uint32_t inst = 0; inst < 2; inst++) {
+            CHECK(s.instances[inst].node == inst && s.instances[inst].mesh == 0);
+            CHECK(near3(placed(&s, inst, m->vertices[t[0]].position), (float)inst, 0, 0, 0));
+            CHECK(near3(placed(&s, inst, m->vertices[t[1]].position), 1.0f + inst, 0, 0, 0));
+            CHECK(near3(placed(&s, inst, m->vertices[t[2]].position), (float)inst, 1, 0, 0));
         }
+        CHECK(near3(m->vertices[t[0]].normal, 0, 0, 1, 0));
         CHECK(s.bounds_min[0] == 0 && s.bounds_max[0] == 2);
+    } else {
+        CHECK(!"SimpleMeshes: one mesh of one triangle, placed twice");
     }
     scene_destroy(&s);
 }

@@ -1,0 +1,276 @@
+#!/usr/bin/env bash
+# image_formats.sh: WebP (EXT_texture_webp) and KTX2 (KHR_texture_basisu) textures. The images
+# are made here from one PNG by the formats' own encoders, not by gonio: cwebp (lossless) and
+# Basis Universal's encoder (testtool ktx2: ETC1S, UASTC, UASTC with Zstandard). The PNG is
+# 16x16 texels in 4x4 blocks of one colour each, R = 40 + 60 i, G = 40 + 60 j for block
+# column i and row j from the top, so a block-compressed codec codes each block as one flat
+# colour. Each codec's error, against the PNG read by libpng (testtool texels), is bounded by
+# what the codec can represent:
+#   - lossless WebP: exact;
+#   - UASTC: a solid block is UASTC's mode 8, which stores the colour's 8-bit RGBA exactly;
+#     one step allowed;
+#   - ETC1S: a block is one 5-bit-per-channel base colour (steps of 255/31 = 8.2) plus one
+#     intensity modifier shared by R, G and B, so a flat block's channels land within half a
+#     step plus what sharing the modifier costs: 6 steps, of which the encoder's codebook
+#     clustering may use 2 more; 8 allowed (an image of gradients, which ETC1S cannot
+#     code flat, is measured too, with the figures printed).
+# The glTF files render a quad that fills an orthographic view with --mode albedo --spp 1
+# (the pixel centre): every probed pixel well inside a block must show the PNG's colour,
+# sRGB-decoded, within the codec's bound. The fallback image, where there is one, is a flat
+# magenta, so a render of the fallback instead of the extension's image fails.
+. "$(dirname "$0")/../lib.sh"
+G=$GONIO
+command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
+command -v cwebp >/dev/null || skip_all "cwebp (Debian's webp) is needed to write WebP images"
+KTX2=1
+if ! "$G" --version | grep -q "Basis Universal [0-9]"; then
+    KTX2=0
+    echo "  note: this gonio has no Basis Universal ($("$G" --version | sed -n 's/.*no Basis Universal for KTX2 (\(.*\))$/\1/p')): KTX2 decoding and rendering are skipped"
+fi
+N=48
+EXR="python3 $(dirname "$0")/../tool/exrtool.py"
+
+python3 - "$tmp" <<'PY'
+import struct, sys, zlib
+d = sys.argv[1]
+def png(name, w, h, px):
+    rows = b"".join(b"\0" + b"".join(bytes(px(i, j)) for i in range(w)) for j in range(h))
+    def chunk(t, b): return struct.pack(">I", len(b)) + t + b + struct.pack(">I", zlib.crc32(t + b) & 0xffffffff)
+    open(d + "/" + name, "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 6, 0, 0, 0)) +
+                                     chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+png("blocks.png", 16, 16, lambda i, j: (40 + 60 * (i // 4), 40 + 60 * (j // 4), 0, 255))
+png("grad.png", 64, 64, lambda i, j: (4 * i, 4 * j, 2 * (i + j), 255 - 2 * i))
+png("fallback.png", 4, 4, lambda i, j: (200, 0, 200, 255))
+PY
+cwebp -quiet -lossless -exact "$tmp/blocks.png" -o "$tmp/blocks.webp"
+cwebp -quiet -lossless -exact "$tmp/grad.png" -o "$tmp/grad.webp"
+if [ $KTX2 = 1 ]; then
+    for m in etc1s uastc uastc-zstd; do
+        "$TESTTOOL" ktx2 $m "$tmp/blocks.png" "$tmp/blocks-$m.ktx2" >/dev/null
+        "$TESTTOOL" ktx2 $m "$tmp/grad.png" "$tmp/grad-$m.ktx2" >/dev/null
+    done
+    "$TESTTOOL" ktx2 etc1s "$tmp/blocks.png" "$tmp/rg-etc1s.ktx2" rg >/dev/null
+    "$TESTTOOL" ktx2 uastc "$tmp/blocks.png" "$tmp/rg-uastc.ktx2" rg >/dev/null
+fi
+
+# ---- decoded texels against the PNG (image_decode, the loader's decoder) -------------------
+T() { check "$1" "$TESTTOOL" texels "${@:2}"; cat "$tmp/out"; }
+T "lossless WebP: exact" "$tmp/blocks.webp" "$tmp/blocks.png" RGBA 0 0
+T "lossless WebP of gradients and alpha: exact" "$tmp/grad.webp" "$tmp/grad.png" RGBA 0 0
+if [ $KTX2 = 1 ]; then
+    T "UASTC: flat blocks within 1 step" "$tmp/blocks-uastc.ktx2" "$tmp/blocks.png" RGBA 1 1
+    T "UASTC + Zstandard: flat blocks within 1 step" "$tmp/blocks-uastc-zstd.ktx2" "$tmp/blocks.png" RGBA 1 1
+    T "ETC1S: flat blocks within 8 steps" "$tmp/blocks-etc1s.ktx2" "$tmp/blocks.png" RGBA 8 8
+    # Gradients: UASTC's blocks fit a line through each block's colours (4 steps a texel
+    # here, to within its 2-bit-plus weights); ETC1S's one colour plus one shared modifier
+    # per block cannot follow R and G rising at once: the bounds are the measured figures'
+    # order, to catch a decoder that breaks, not the codecs' guarantees.
+    T "UASTC: gradients (figures)" "$tmp/grad-uastc.ktx2" "$tmp/grad.png" RGBA 8 3
+    T "UASTC + Zstandard decodes to the same texels as UASTC" "$tmp/grad-uastc-zstd.ktx2" "$tmp/grad.png" RGBA 8 3
+    T "ETC1S: gradients (figures)" "$tmp/grad-etc1s.ktx2" "$tmp/grad.png" RGBA 24 6
+    T "ETC1S red-green (RRR + GGG slices): green read from the second slice" "$tmp/rg-etc1s.ktx2" "$tmp/blocks.png" RG 8 8
+    T "UASTC red-green (RRRG): green read from alpha" "$tmp/rg-uastc.ktx2" "$tmp/blocks.png" RG 1 1
+    # The same files with their DFD saying RGB + AAA and RGBA: the data is red-green (green
+    # where alpha would be), so read as such their green is their red and fails.
+    python3 - "$tmp" <<'PY'
+import struct, sys
+d = sys.argv[1]
+for name, ids in (("rg-etc1s", (0, 15)), ("rg-uastc", (3,))):
+    b = bytearray(open("%s/%s.ktx2" % (d, name), "rb").read())
+    dfd = struct.unpack_from("<I", b, 48)[0]
+    for k, c in enumerate(ids):
+        b[dfd + 28 + 16 * k + 3] = (b[dfd + 28 + 16 * k + 3] & 0xF0) | c
+    open("%s/%s-as-rgba.ktx2" % (d, name), "wb").write(bytes(b))
+PY
+    check_fails "ETC1S red-green data read as RGB + alpha: green is wrong" 1 \
+        "$TESTTOOL" texels "$tmp/rg-etc1s-as-rgba.ktx2" "$tmp/blocks.png" RG 8 8
+    check_fails "UASTC red-green data read as RGBA: green is wrong" 1 \
+        "$TESTTOOL" texels "$tmp/rg-uastc-as-rgba.ktx2" "$tmp/blocks.png" RG 1 1
+fi
+
+# ---- glTF files that use the extensions ------------------------------------------------------
+# gen.py OUT.gltf JSON: images (file names), texture (the texture object), used, required
+cat >"$tmp/gen.py" <<'PY'
+import base64, json, struct, sys
+out, opt = sys.argv[1], json.loads(sys.argv[2])
+pos = [-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0]
+uv = [0, 1, 1, 1, 1, 0, 0, 0]  # (0, 0) at the top left
+blob = struct.pack("<12f", *pos) + struct.pack("<12f", *[0, 0, 1] * 4) + struct.pack("<8f", *uv) + struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+views = [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 48},
+         {"buffer": 0, "byteOffset": 96, "byteLength": 32}, {"buffer": 0, "byteOffset": 128, "byteLength": 12}]
+accs = [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
+        {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
+        {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+        {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}]
+doc = {
+    "asset": {"version": "2.0", "generator": "image_formats.sh"},
+    "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+    "bufferViews": views, "accessors": accs,
+    "images": [{"uri": u} for u in opt["images"]],
+    "samplers": [{"magFilter": 9728, "minFilter": 9728}],
+    "textures": [dict(opt["texture"], sampler=0)],
+    "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": 0}]}],
+    "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 100}}],
+    "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}],
+    "scenes": [{"nodes": [0, 1]}], "scene": 0,
+}
+if opt.get("used"): doc["extensionsUsed"] = opt["used"]
+if opt.get("required"): doc["extensionsRequired"] = opt["required"]
+json.dump(doc, open(out, "w"))
+PY
+
+# probe.py IMAGE.exr TOL: every 3rd pixel well inside a block has the block's colour,
+# sRGB-decoded, within TOL 8-bit steps.
+cat >"$tmp/probe.py" <<'PY'
+import math, sys
+sys.path.insert(0, sys.argv[3])
+import exrtool
+_, ch = exrtool.read(sys.argv[1])
+tol, n = float(sys.argv[2]), int(sys.argv[4])
+def lin(c):
+    c = min(max(c, 0), 255) / 255
+    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+bad = checked = 0
+for py in range(1, n, 3):
+    for px in range(1, n, 3):
+        bx, by = (px + 0.5) / n * 4, (py + 0.5) / n * 4  # in blocks
+        if min(abs(bx - round(bx)), abs(by - round(by))) < 0.1:
+            continue
+        i, j = int(bx), int(by)
+        checked += 1
+        for k, c in (("R", 40 + 60 * i), ("G", 40 + 60 * j)):
+            got = ch[k][1][py * n + px]
+            if not lin(c - tol) - 1e-3 <= got <= lin(c + tol) + 1e-3:
+                bad += 1
+                if bad <= 5: print("pixel (%d, %d) %s: got %.4f, want block (%d, %d): %.4f" % (px, py, k, got, i, j, lin(c)))
+print("%d pixels checked, %d values wrong" % (checked, bad))
+sys.exit(1 if bad or checked < 100 else 0)
+PY
+
+scene() { python3 "$tmp/gen.py" "$tmp/$1.gltf" "$2"; }
+R() { "$G" render "$tmp/$1.gltf" --mode albedo --spp 1 --size ${N}x$N --quiet --compression none -o "$tmp/$1.exr"; }
+# case NAME TOL DESCRIPTION JSON: write, render (no warning), probe
+case_() {
+    scene "$1" "$4"
+    check "$3: renders" R "$1"
+    check "$3: no warning" test ! -s "$tmp/out"
+    check "$3: the image's texels" python3 "$tmp/probe.py" "$tmp/$1.exr" "$2" "$(dirname "$0")/../tool" $N
+}
+WEBP='["EXT_texture_webp"]'
+BASISU='["KHR_texture_basisu"]'
+case_ webp_fallback 0 "WebP with a PNG fallback, extension used" \
+    "{\"images\": [\"fallback.png\", \"blocks.webp\"], \"texture\": {\"source\": 0, \"extensions\": {\"EXT_texture_webp\": {\"source\": 1}}}, \"used\": $WEBP}"
+case_ webp_required 0 "WebP without a fallback, extension required" \
+    "{\"images\": [\"blocks.webp\"], \"texture\": {\"extensions\": {\"EXT_texture_webp\": {\"source\": 0}}}, \"used\": $WEBP, \"required\": $WEBP}"
+if [ $KTX2 = 1 ]; then
+    case_ etc1s_fallback 8 "KTX2 ETC1S with a PNG fallback, extension used" \
+        "{\"images\": [\"fallback.png\", \"blocks-etc1s.ktx2\"], \"texture\": {\"source\": 0, \"extensions\": {\"KHR_texture_basisu\": {\"source\": 1}}}, \"used\": $BASISU}"
+    case_ uastc_required 1 "KTX2 UASTC without a fallback, extension required" \
+        "{\"images\": [\"blocks-uastc.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU, \"required\": $BASISU}"
+    case_ zstd_required 1 "KTX2 UASTC + Zstandard without a fallback, extension required" \
+        "{\"images\": [\"blocks-uastc-zstd.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU, \"required\": $BASISU}"
+    check "gonio info: the images' formats" sh -c "'$G' info '$tmp/etc1s_fallback.gltf' | grep -q '^image formats  1 PNG, 1 KTX2$'"
+else
+    scene needs_basisu "{\"images\": [\"fallback.png\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU, \"required\": $BASISU}"
+    check_fails "without Basis Universal, a file requiring KHR_texture_basisu is refused" 1 R needs_basisu
+    check "... saying why" grep -q "needs_basisu.gltf: requires unsupported extension KHR_texture_basisu (this gonio was built without Basis Universal" "$tmp/last"
+fi
+
+# Images in a GLB's binary chunk, with their mimeType (decoded once the buffer views are
+# checked, where files named by a uri are decoded as tinygltf reads them).
+glb_case() { # glb_case NAME TOL DESCRIPTION IMAGE [FALLBACK]
+    python3 "$(dirname "$0")/../tool/texture_glb.py" "$tmp/$1.glb" "${@:4}"
+    check "$3: renders" "$G" render "$tmp/$1.glb" --mode albedo --spp 1 --size ${N}x$N --quiet --compression none -o "$tmp/$1.exr"
+    check "$3: no warning" test ! -s "$tmp/out"
+    check "$3: the image's texels" python3 "$tmp/probe.py" "$tmp/$1.exr" "$2" "$(dirname "$0")/../tool" $N
+}
+glb_case glb_webp 0 "GLB: WebP in the binary chunk, extension required" "$tmp/blocks.webp"
+if [ $KTX2 = 1 ]; then
+    glb_case glb_ktx2 1 "GLB: KTX2 UASTC + Zstandard in the binary chunk, a PNG fallback" "$tmp/blocks-uastc-zstd.ktx2" "$tmp/fallback.png"
+fi
+
+# ---- damaged images: a clear message naming the file, the image and the problem ------------
+# (gonio info loads a scene as render does, and says the same, without a device)
+head -c $(($(wc -c <"$tmp/grad.webp") / 2)) "$tmp/grad.webp" >"$tmp/trunc.webp"
+if [ $KTX2 = 1 ]; then
+    head -c 150 "$tmp/blocks-uastc-zstd.ktx2" >"$tmp/trunc.ktx2"
+else
+    python3 -c "import sys; sys.stdout.buffer.write(b'\xabKTX 20\xbb\r\n\x1a\n' + bytes(100))" >"$tmp/trunc.ktx2"
+fi
+scene trunc_fallback "{\"images\": [\"blocks.png\", \"trunc.ktx2\"], \"texture\": {\"source\": 0, \"extensions\": {\"KHR_texture_basisu\": {\"source\": 1}}}, \"used\": $BASISU}"
+"$G" render "$tmp/trunc_fallback.gltf" --mode albedo --spp 1 --size ${N}x$N --quiet --compression none -o "$tmp/trunc_fallback.exr" 2>"$tmp/trunc_fallback.txt"
+check "truncated KTX2 with a fallback: renders the fallback" python3 "$tmp/probe.py" "$tmp/trunc_fallback.exr" 0 "$(dirname "$0")/../tool" $N
+check "... saying which image of which file, and why" grep -q "trunc_fallback.gltf: image 1 trunc.ktx2: KTX2: " "$tmp/trunc_fallback.txt"
+check "... and that the fallback is used" grep -q "texture 0: its KHR_texture_basisu image 1 is unusable; its fallback, image 0, is used" "$tmp/trunc_fallback.txt"
+scene trunc_webp "{\"images\": [\"trunc.webp\"], \"texture\": {\"extensions\": {\"EXT_texture_webp\": {\"source\": 0}}}, \"used\": $WEBP, \"required\": $WEBP}"
+"$G" info "$tmp/trunc_webp.gltf" >/dev/null 2>"$tmp/trunc_webp.txt"
+check "truncated WebP: the file, the image and the problem" grep -q "trunc_webp.gltf: image 0 trunc.webp: WebP: libwebp cannot decode the 64x64 image (corrupt or truncated data); textures using it are ignored" "$tmp/trunc_webp.txt"
+printf 'RIFF\x20\0\0\0WEBPVP8 ' >"$tmp/junk.webp"
+scene junk_webp "{\"images\": [\"junk.webp\"], \"texture\": {\"extensions\": {\"EXT_texture_webp\": {\"source\": 0}}}, \"used\": $WEBP}"
+"$G" info "$tmp/junk_webp.gltf" >/dev/null 2>"$tmp/junk_webp.txt"
+check "a WebP header and no image: the problem named" grep -q "junk_webp.gltf: image 0 junk.webp: WebP: .*textures using it are ignored" "$tmp/junk_webp.txt"
+if [ $KTX2 = 1 ]; then
+    # Every kind of damage the KTX2 checks name, each in a copy of a good file.
+    python3 - "$tmp" <<'PY'
+import struct, sys
+d = sys.argv[1]
+good = open(d + "/blocks-etc1s.ktx2", "rb").read()
+def put(name, off, fmt, v):
+    b = bytearray(good); struct.pack_into(fmt, b, off, v); open(d + "/" + name, "wb").write(bytes(b))
+put("vkformat.ktx2", 12, "<I", 37)        # VK_FORMAT_R8G8B8A8_UNORM: not Basis Universal
+put("cube.ktx2", 36, "<I", 6)             # faceCount 6
+put("levels.ktx2", 40, "<I", 9)           # levelCount 9 for a 16x16 image
+put("scheme.ktx2", 44, "<I", 3)           # supercompression 3
+put("level0.ktx2", 80, "<Q", 1 << 62)     # level 0's offset far past the end
+put("sgd.ktx2", 72, "<Q", (1 << 64) - 1)  # global data that wraps around
+put("kvd.ktx2", 60, "<I", (1 << 32) - 14)  # key/value data that wraps around in 32 bits (the fuzzer's find)
+put("huge.ktx2", 20, "<Q", 65536 | 65536 << 32) # width and height 65536: 2^32 texels declared
+b = bytearray(good); b[len(b) // 2:] = bytes(len(b) - len(b) // 2); open(d + "/zeroed.ktx2", "wb").write(bytes(b))
+u = open(d + "/blocks-uastc.ktx2", "rb").read()  # UASTC's level moved one byte on (the fuzzer's find)
+off = struct.unpack_from("<Q", u, 80)[0]
+b = bytearray(u[:off] + b"\0" + u[off:]); struct.pack_into("<Q", b, 80, off + 1); open(d + "/misaligned.ktx2", "wb").write(bytes(b))
+PY
+    for f in vkformat:"vkFormat 37" cube:"cube map" levels:"levelCount 9" scheme:"supercompression scheme 3" \
+        level0:"level 0's" sgd:"BasisLZ global data" zeroed:"Basis Universal cannot" misaligned:"not a multiple of 16" \
+        kvd:"key/value data"; do
+        k=${f%%:*} want=${f#*:}
+        scene "bad_$k" "{\"images\": [\"$k.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU, \"required\": $BASISU}"
+        "$G" info "$tmp/bad_$k.gltf" >/dev/null 2>"$tmp/bad_$k.txt"
+        check "KTX2 $k: '$want' named, with the file and image" grep -q "bad_$k.gltf: image 0 $k.ktx2: KTX2: .*$want.*; textures using it are ignored" "$tmp/bad_$k.txt"
+    done
+    # A huge declared size is refused by the texel limit before anything is allocated (a
+    # 65536x65536 RGBA8 buffer would be 16 GiB).
+    scene huge "{\"images\": [\"huge.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU, \"required\": $BASISU}"
+    check_fails "KTX2 declaring 65536x65536: refused" 1 "$G" render "$tmp/huge.gltf" --mode albedo --spp 1 --size 8x8 --quiet -o "$tmp/huge.exr"
+    check "... by the texel limit, with the numbers" grep -q "huge.gltf: images too large: 4294967296 texels with image 0 (65536x65536), the limit is 268435456" "$tmp/last"
+    check "... and no output" test ! -e "$tmp/huge.exr"
+fi
+# WebP sizes stop at 16383: two declared at the most pass the limit together. The lossless
+# header's 14-bit width and height fields are set, the data left as it is.
+python3 - "$tmp" <<'PY'
+import struct, sys
+d = sys.argv[1]
+b = bytearray(open(d + "/blocks.webp", "rb").read())
+assert b[12:16] == b"VP8L" and b[20] == 0x2f, "cwebp wrote no simple lossless header"
+bits = struct.unpack_from("<I", b, 21)[0]
+bits = (bits & ~((1 << 28) - 1)) | 16382 | 16382 << 14
+struct.pack_into("<I", b, 21, bits)
+open(d + "/huge.webp", "wb").write(bytes(b))
+open(d + "/huge2.webp", "wb").write(bytes(b) + b"\0\0")  # other bytes: not one image decoded twice
+PY
+scene huge_webp "{\"images\": [\"huge.webp\", \"huge2.webp\"], \"texture\": {\"extensions\": {\"EXT_texture_webp\": {\"source\": 0}}}, \"used\": $WEBP}"
+check_fails "two WebPs declaring 16383x16383: refused" 1 "$G" info "$tmp/huge_webp.gltf"
+check "... by the texel limit, with the numbers" grep -q "images too large: 536805378 texels with image 1 (16383x16383)" "$tmp/last"
+
+# ---- the JSON checks of the extensions' source ----------------------------------------------
+J() { # J NAME TEXTURE-JSON MESSAGE
+    scene "$1" "{\"images\": [\"blocks.webp\"], \"texture\": $2, \"used\": $WEBP}"
+    check_fails "$1: refused" 1 "$G" info "$tmp/$1.gltf"
+    check "$1: the JSON path and the problem" grep -q "$1.gltf: $3" "$tmp/last"
+}
+J fractional '{"extensions": {"EXT_texture_webp": {"source": 0.5}}}' "textures\[0\].extensions.EXT_texture_webp.source: 0.5 is not an integer index"
+J missing '{"extensions": {"EXT_texture_webp": {}}}' "textures\[0\].extensions.EXT_texture_webp.source: missing (required)"
+J nosuch '{"extensions": {"KHR_texture_basisu": {"source": 3}}}' "textures\[0\].extensions.KHR_texture_basisu.source: 3 does not exist (images has 1 entry)"
+J negative '{"source": 0, "extensions": {"EXT_texture_webp": {"source": -1}}}' "textures\[0\].extensions.EXT_texture_webp.source: -1 is not a valid index (negative)"
+finish
