@@ -374,7 +374,7 @@ uint rng_pixel = 0u, rng_sample = 0u;
 // `alpha`.
 bool surface_passed(Hit h, vec3 d, bool alpha, bool cull, uint dim)
 {
-    if (GN_HAS(GN_FEAT_CULL) && cull && surface_culled(h.tri, d))
+    if (GN_HAS(GN_FEAT_CULL) && cull && surface_culled(h.tri, h.inst, d))
         return true;
     return GN_HAS(GN_FEAT_ALPHA) && alpha &&
            rng_uniform4(rng_pixel, rng_sample, dim, frame.seed).x >= surface_opacity(h.tri, h.u, h.v);

@@ -349,11 +349,19 @@ float surface_opacity(uint tri, float u, float v)
 // Whether a ray of direction d that hits triangle tri sees its back (the side its winding does
 // not call front, as surface_at decides) and its material is single-sided: a camera ray goes on
 // through it, as a rasterizer culls it (docs/path-tracing.md, "Single-sided materials").
-bool surface_culled(uint tri, vec3 d)
+// An instance's triangle (inst, INSTANCES) is tested in its object space, where its corners
+// are stored: d by the instance's world-to-object matrix. The authored winding is the front
+// there for a mirroring instance too (glTF: a negative determinant makes the world's
+// clockwise the front), as the loader's flattened copy swaps two corners to keep it.
+bool surface_culled(uint tri, uint inst, vec3 d)
 {
     GnPrim pr = prim_at(tri);
     if ((material_at(pr.material).flags & GN_MAT_DOUBLE_SIDED) != 0u)
         return false;
+    if (INSTANCES != 0u && inst != GN_INVALID) {
+        InstanceXf x = instance_xf(inst);
+        d = vec3(dot(x.o0, d), dot(x.o1, d), dot(x.o2, d));
+    }
     vec3 a = vertex_at(pr.i0).position, b = vertex_at(pr.i1).position, c = vertex_at(pr.i2).position;
     return !(dot(cross(b - a, c - a), d) < 0.0);
 }

@@ -79,6 +79,32 @@ for mode in path albedo phong; do
     got=$(colour toward $mode)
     [ "$got" = red ] && pass || fail "$mode: a single-sided quad turned toward the camera is not seen ($got at the centre)"
 done
+# instances (a mesh two nodes use is kept once and placed twice: docs/architecture.md): the
+# red quad's mesh used by a second node out of view, and the red quad's node as is (0),
+# mirrored in z (1: a negative determinant, whose front glTF defines as the authored side,
+# now toward +z) or turned 180 degrees about y (2): 1 and 2 turn the away quad toward the
+# camera and the toward quad away
+inst() { # inst IN OUT VARIANT
+    python3 -c 'import json, sys
+d = json.load(open(sys.argv[1]))
+d["nodes"].insert(2, {"mesh": 1, "translation": [10, 0, 0]})
+if sys.argv[3] == "1": d["nodes"][1]["scale"] = [1, 1, -1]
+if sys.argv[3] == "2": d["nodes"][1]["rotation"] = [0, 1, 0, 0]
+d["scenes"][0]["nodes"] = list(range(len(d["nodes"])))
+json.dump(d, open(sys.argv[2], "w"))' "$1" "$2" "$3"
+}
+for m in 0 1 2; do
+    inst "$tmp/away.gltf" "$tmp/away-inst$m.gltf" $m && inst "$tmp/toward.gltf" "$tmp/toward-inst$m.gltf" $m || fail "instanced scenes"
+    "$G" info "$tmp/away-inst$m.gltf" | grep -q "^instances *[1-9]" && pass || fail "the instanced scene has instances"
+    what=("an instance" "a mirrored instance" "a turned instance")
+    want_away=green want_toward=red
+    [ $m != 0 ] && want_away=red want_toward=green
+    got=$(colour away-inst$m path)
+    [ "$got" = $want_away ] && pass || fail "path: the away quad as ${what[$m]}: $got at the centre, not $want_away"
+    got=$(colour toward-inst$m path)
+    [ "$got" = $want_toward ] && pass || fail "path: the toward quad as ${what[$m]}: $got at the centre, not $want_toward"
+done
+
 # bounce rays see a back face: the roof behind the camera (its back to the scene) shades the
 # green quad from the environment above it
 lum() {
