@@ -293,28 +293,86 @@ void gpu_destroy(gpu *g)
     memset(g, 0, sizeof *g);
 }
 
+static bool has_device_extension(const VkExtensionProperties *e, uint32_t n, const char *name)
+{
+    for (uint32_t i = 0; i < n; i++)
+        if (strcmp(e[i].extensionName, name) == 0)
+            return true;
+    return false;
+}
+
+const char *gpu_ray_query_missing(VkPhysicalDevice dev)
+{
+    /* VK_KHR_acceleration_structure requires VK_KHR_deferred_host_operations. */
+    static const char *const exts[] = {VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                                       VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+                                       VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
+    static char missing[160];
+    VkPhysicalDeviceRayQueryFeaturesKHR rq = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR as = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, .pNext = &rq};
+    VkPhysicalDeviceFeatures2 f2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, .pNext = &as};
+    VkExtensionProperties *e;
+    uint32_t n = 0;
+
+    GPU_CHECK(vkEnumerateDeviceExtensionProperties(dev, NULL, &n, NULL));
+    e = util_calloc(n ? n : 1, sizeof *e);
+    GPU_CHECK(vkEnumerateDeviceExtensionProperties(dev, NULL, &n, e));
+    missing[0] = 0;
+    for (size_t i = 0; i < sizeof exts / sizeof *exts; i++)
+        if (!has_device_extension(e, n, exts[i]))
+            snprintf(missing + strlen(missing), sizeof missing - strlen(missing), "%s%s",
+                     missing[0] ? ", " : "", exts[i]);
+    free(e);
+    if (missing[0])
+        return missing;
+    /* The features' structures are chained only once the extensions are known to be there. */
+    vkGetPhysicalDeviceFeatures2(dev, &f2);
+    if (!as.accelerationStructure)
+        return "the accelerationStructure feature";
+    if (!rq.rayQuery)
+        return "the rayQuery feature";
+    return NULL;
+}
+
 bool gpu_print_devices(void)
 {
     gpu g = {0};
     gpu_desc desc = {.device_index = -1};
     VkPhysicalDevice *devs;
     uint32_t count = 0;
+    bool any_missing = false;
     if (!create_instance(&g, &desc))
         return false;
     devs = list_devices(g.instance, &count);
     pin_loaded_libraries(); /* the drivers just loaded, as gpu_create does */
-    printf("%-5s %-40s %-10s %-24s %s\n", "index", "name", "type", "driver", "api");
+    /* The driver, the longest and most variable field, comes last. */
+    printf("%-5s %-40s %-10s %-9s %-11s %s\n", "index", "name", "type", "api", "ray queries",
+           "driver");
     for (uint32_t i = 0; i < count; i++) {
         VkPhysicalDeviceDriverProperties drv = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
         VkPhysicalDeviceProperties2 p2 = {.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &drv};
-        char driver[2 * VK_MAX_DRIVER_NAME_SIZE + 2];
+        char api[32];
         uint32_t v;
+        bool ray_query;
         vkGetPhysicalDeviceProperties2(devs[i], &p2);
         v = p2.properties.apiVersion;
-        snprintf(driver, sizeof driver, "%s %s", drv.driverName, drv.driverInfo);
-        printf("%-5u %-40s %-10s %-24s %u.%u.%u\n", i, p2.properties.deviceName,
-               gpu_device_type_name(p2.properties.deviceType), driver, VK_API_VERSION_MAJOR(v),
-               VK_API_VERSION_MINOR(v), VK_API_VERSION_PATCH(v));
+        snprintf(api, sizeof api, "%u.%u.%u", VK_API_VERSION_MAJOR(v), VK_API_VERSION_MINOR(v),
+                 VK_API_VERSION_PATCH(v));
+        ray_query = gpu_ray_query_missing(devs[i]) == NULL;
+        any_missing |= !ray_query;
+        printf("%-5u %-40s %-10s %-9s %-11s %s %s\n", i, p2.properties.deviceName,
+               gpu_device_type_name(p2.properties.deviceType), api, ray_query ? "yes" : "no",
+               drv.driverName, drv.driverInfo);
+    }
+    /* What a device without ray queries lacks, under the table. */
+    if (any_missing)
+        printf("\n");
+    for (uint32_t i = 0; i < count; i++) {
+        const char *missing = gpu_ray_query_missing(devs[i]);
+        if (missing)
+            printf("device %u: no ray queries: it lacks %s\n", i, missing);
     }
     free(devs);
     gpu_destroy(&g);

@@ -60,8 +60,12 @@ uint32_t gpu_max_groups(const gpu *g, int axis);
 /* Validation messages (warnings and errors) seen since start: the tests require 0. */
 int gpu_validation_message_count(void);
 
-/* Prints the device list (index, name, type, driver, API version) to stdout. */
+/* Prints the device list (index, name, type, API version, ray queries, driver) to stdout. */
 bool gpu_print_devices(void);
+/* NULL when the device can trace rays from a compute kernel (VK_KHR_ray_query,
+ * VK_KHR_acceleration_structure and VK_KHR_deferred_host_operations, with the rayQuery and
+ * accelerationStructure features); otherwise what it lacks, in words (a static string). */
+const char *gpu_ray_query_missing(VkPhysicalDevice dev);
 /* Type name ("discrete", "integrated", "virtual", "cpu", "other"). */
 const char *gpu_device_type_name(VkPhysicalDeviceType t);
 

@@ -170,6 +170,18 @@ for f in triangles meshes materials lights 'bvh nodes' 'bvh depth' 'sah cost' 'b
     check "info prints $f" grep -q "$f" "$tmp/info.txt"
 done
 check "gonio devices lists lavapipe" sh -c "'$G' devices | grep -q llvmpipe"
+# Ray queries on lavapipe came with Mesa 24.1 (Debian 12: none in its own 22.3, yes in the
+# backports' 25.0): the column says so, and a device without them is told what it lacks.
+"$G" devices >"$tmp/devices.txt" 2>&1
+mesa=$(sed -n 's/.*llvmpipe Mesa \([0-9]*\)\.\([0-9]*\).*/\1.\2/p' "$tmp/devices.txt" | head -n 1)
+check "gonio devices names lavapipe's Mesa version ($mesa)" test -n "$mesa"
+if [ -n "$mesa" ] && [ $((${mesa%.*} * 100 + ${mesa#*.})) -ge 2401 ]; then
+    check "lavapipe of Mesa $mesa: ray queries yes" grep -Eq '^0 .* cpu .* yes +llvmpipe' "$tmp/devices.txt"
+    check_fails "... and no line of what it lacks" 1 grep -q 'no ray queries' "$tmp/devices.txt"
+else
+    check "lavapipe of Mesa $mesa: ray queries no" grep -Eq '^0 .* cpu .* no +llvmpipe' "$tmp/devices.txt"
+    check "... saying it lacks VK_KHR_ray_query" grep -q '^device 0: no ray queries: it lacks VK_KHR_ray_query' "$tmp/devices.txt"
+fi
 check "gonio --version" sh -c "'$G' --version | grep -q '^gonio '"
 for c in render info devices diff bench; do
     check "$c --help" sh -c "'$G' $c --help | grep -q usage"
