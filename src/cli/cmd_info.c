@@ -119,8 +119,9 @@ int cmd_info(int argc, char **argv)
     const cli_command cmd = {
         .name = "info", .synopsis = "SCENE.gltf|.glb [--allow-outside-files]",
         .intro = "Prints the scene's contents and its BVH statistics: the emissive triangles (the path\n"
-                 "tracer's area lights) and the materials that emit, and one line per camera (index, name,\n"
-                 "position, forward direction, vertical field of view or orthographic width x height;\n"
+                 "tracer's area lights) and the materials that emit, the skins (and their joints), and\n"
+                 "one line per camera (index, name, position, forward direction, vertical field of view or\n"
+                 "orthographic width x height;\n"
                  "the first is the one gonio render uses by default), the KHR_materials_variants\n"
                  "variants by index and name (for --variant), and one line per material that bounds a\n"
                  "medium (KHR_materials_volume) or disperses (KHR_materials_dispersion): attenuation\n"
@@ -150,6 +151,7 @@ int cmd_info(int argc, char **argv)
     printf("vertices       %u\n", sc.num_vertices);
     printf("meshes         %u (primitive instances; %u glTF meshes, %u nodes)\n", sc.num_meshes,
            sc.num_gltf_meshes, sc.num_nodes);
+    printf("skins          %u (%u joints)\n", sc.num_skins, sc.num_joints);
     printf("materials      %u\n", sc.num_materials);
     printf("variants       %u\n", sc.num_variants);
     for (uint32_t i = 0; i < sc.num_variants; i++)

@@ -314,6 +314,13 @@ void make_flat(Prim &p)
     if (!p.col.empty())
         f.col.resize(nt * 12);
     f.idx.resize(nt * 3);
+    f.influences = p.influences;
+    f.joints = std::move(p.joints);
+    f.weights = std::move(p.weights);
+    f.max_joint = p.max_joint;
+    f.max_joint_at = std::move(p.max_joint_at);
+    f.flat = true;
+    remap_skin_and_targets(f, p.idx.data(), nt * 3);
     for (size_t t = 0; t < nt; t++) {
         for (size_t k = 0; k < 3; k++) {
             size_t v = p.idx[t * 3 + k], o = t * 3 + k;
@@ -366,6 +373,7 @@ void generate_tangents(Prim &p, const std::vector<float> &uv)
     expand(p.uv, 2);
     expand(p.uv1, 2);
     expand(p.col, 4);
+    remap_skin_and_targets(p, remap, n);
     p.tan.assign(tan, tan + n * 4);
     free(remap);
     free(tan);
@@ -462,6 +470,8 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
     }
     if (col >= 0)
         read_colors(c, what, col, out);
+    if (!read_skin_and_targets(c, mi, pi, out))
+        return false;
     if (out.nrm.empty())
         make_flat(out);
     /* a normal map, a clearcoat normal map or anisotropy needs tangents (the mesh's, else
@@ -531,10 +541,6 @@ bool collect_instances(Ctx &c, std::vector<Instance> &inst, std::vector<Instance
             it.world = mat_mul(it.world, c.local[size_t(it.node)]);
             if (!mat_finite(it.world))
                 return fail(c, "%s: world transform is not finite", label("node", it.node, n.name).c_str());
-            if (n.skin >= 0 && !c.warned_skin) {
-                warn(c, "skins are not supported (skinned meshes drawn in their bind pose)");
-                c.warned_skin = true;
-            }
             if (n.mesh >= 0)
                 inst.push_back({it.node, n.mesh, it.world});
             if (n.camera >= 0 && c.camera_ok[size_t(n.camera)])
@@ -585,8 +591,10 @@ bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
     out->indices = static_cast<uint32_t *>(util_calloc(nt * 3, sizeof(uint32_t)));
     out->tri_material = static_cast<uint32_t *>(util_calloc(nt, sizeof(uint32_t)));
     uint32_t vbase = 0, tbase = 0, default_material = uint32_t(c.m.materials.size());
+    Mat id{};
+    id[0] = id[5] = id[10] = id[15] = 1;
     for (const auto &in : inst) {
-        const Mat &w = in.world;
+        const Mat &w = instance_skinned(c, in) ? id : in.world; /* a skin places its vertices in the world */
         /* Normals go through the cofactor matrix, det * inverse transpose: defined even for a
          * singular matrix; multiplied by sign(det) so mirroring keeps them pointing out. */
         double a[3][3];
@@ -601,7 +609,11 @@ bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
             }
         double det = a[0][0] * cof[0][0] + a[0][1] * cof[0][1] + a[0][2] * cof[0][2];
         double sgn = det < 0 ? -1 : 1;
-        for (const Prim &p : c.meshes[size_t(in.mesh)]) {
+        for (const Prim &base : c.meshes[size_t(in.mesh)]) {
+            Prim posed; /* skinned or morphed: this node's own copy */
+            const Prim &p = pose_primitive(c, in, base, posed) ? posed : base;
+            if (c.failed)
+                return false;
             size_t pv = p.pos.size() / 3;
             for (size_t v = 0; v < pv; v++) {
                 GnVertex &o = out->vertices[vbase + v];

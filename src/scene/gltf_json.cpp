@@ -65,6 +65,7 @@ void Doc::check_primitive(const Json &pr, const std::string &p)
     }
     index(pr, "indices", p, "accessors");
     index(pr, "material", p, "materials");
+
     enum_int(pr, "mode", p, {0, 1, 2, 3, 4, 5, 6});
     /* KHR_materials_variants: each mapping names existing variants (each at most once in the
      * primitive's mappings) and an existing material. */
@@ -250,7 +251,12 @@ void Doc::check()
     });
     materials_read(c, root);
     each(root, "materials", "", [&](const Json &m, const std::string &p, size_t i) { material_read(*this, m, p, i); });
-    each(root, "skins", "", [&](const Json &, const std::string &, size_t) {}); /* only node.skin is read */
+    each(root, "skins", "", [&](const Json &s, const std::string &p, size_t) {
+        index(s, "inverseBindMatrices", p, "accessors");
+        index(s, "skeleton", p, "nodes");
+        if (array(s, "joints", p, true))
+            indices(s, "joints", p, "nodes");
+    });
     each(root, "animations", "", [&](const Json &a, const std::string &p, size_t) {
         const Json *samplers = array(a, "samplers", p, true);
         size_t ns = samplers ? samplers->size() : 0;

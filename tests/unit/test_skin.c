@@ -1,0 +1,297 @@
+/* test_skin.c: skins through scene_load, against poses computed here from the glTF 2.0
+ * specification's formulas ("Skins": the joint matrix is the joint's world transform times
+ * its inverse bind matrix, a vertex moves by the weighted sum of its joints' matrices, the
+ * skinned node's own transform is ignored; "Animations": the rotation's slerp). The test's own
+ * arithmetic: rotations from Rodrigues' formula (axis and angle, not the loader's
+ * quaternion), translations added by hand, normals by a Gauss-Jordan inverse. The scene is
+ * written here: a two-bone strip with two JOINTS/WEIGHTS sets (unsigned byte joints and
+ * float weights, unsigned short joints and normalized weights). */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "scene.h"
+#include "test.h"
+#include "util.h"
+
+/* ---- a glTF file built in memory ---------------------------------------------------------- */
+
+typedef struct gltf_file {
+    unsigned char bin[8192];
+    size_t size;
+    char views[4096], accessors[8192];
+    int num_views, num_accessors;
+} gltf_file;
+
+static void app(char *dst, size_t cap, const char *fmt, ...)
+{
+    size_t n = strlen(dst);
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(dst + n, cap - n, fmt, ap);
+    va_end(ap);
+}
+
+/* Appends `bytes` as a buffer view (4-byte aligned) and returns its index. */
+static int view(gltf_file *f, const void *bytes, size_t n)
+{
+    f->size = (f->size + 3) & ~(size_t)3;
+    memcpy(f->bin + f->size, bytes, n);
+    app(f->views, sizeof f->views, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu}", f->num_views ? "," : "",
+        f->size, n);
+    f->size += n;
+    return f->num_views++;
+}
+
+/* An accessor of `count` elements of `type` over a new view of `bytes`; `extra` is more JSON
+ * ("" or ",\"normalized\":true" or ",\"min\":...,\"max\":..."). */
+static int accessor(gltf_file *f, const void *bytes, size_t n, int component, size_t count, const char *type,
+                    const char *extra)
+{
+    int v = view(f, bytes, n);
+    app(f->accessors, sizeof f->accessors, "%s{\"bufferView\":%d,\"componentType\":%d,\"count\":%zu,\"type\":\"%s\"%s}",
+        f->num_accessors ? "," : "", v, component, count, type, extra);
+    return f->num_accessors++;
+}
+
+static char *base64(const void *data, size_t n)
+{
+    static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const unsigned char *p = data;
+    char *out = util_malloc(4 * ((n + 2) / 3) + 1), *o = out;
+    for (size_t i = 0; i < n; i += 3) {
+        unsigned v = (unsigned)p[i] << 16 | (i + 1 < n ? (unsigned)p[i + 1] << 8 : 0) | (i + 2 < n ? p[i + 2] : 0);
+        *o++ = tab[v >> 18 & 63];
+        *o++ = tab[v >> 12 & 63];
+        *o++ = i + 1 < n ? tab[v >> 6 & 63] : '=';
+        *o++ = i + 2 < n ? tab[v & 63] : '=';
+    }
+    *o = 0;
+    return out;
+}
+
+static char load_log[8192];
+
+/* Writes the file (`rest`: meshes, nodes, skins, animations, scenes) and loads it at time t
+ * (< 0: the nodes' own transforms), its messages in load_log. */
+static bool write_and_load(scene *s, const gltf_file *f, const char *rest, double t)
+{
+    const char *path = "/tmp/gonio_skin_test.gltf";
+    char *b64 = base64(f->bin, f->size);
+    FILE *out = fopen(path, "wb");
+    fprintf(out, "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"uri\":\"data:application/octet-stream;base64,%s\","
+            "\"byteLength\":%zu}],\"bufferViews\":[%s],\"accessors\":[%s],%s}", b64, f->size, f->views, f->accessors, rest);
+    fclose(out);
+    free(b64);
+    FILE *tmp = tmpfile();
+    int saved = dup(2);
+    fflush(stderr);
+    dup2(fileno(tmp), 2);
+    scene_animation_time(t);
+    bool ok = scene_load(s, path);
+    scene_animation_time(-1);
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    rewind(tmp);
+    size_t n = fread(load_log, 1, sizeof load_log - 1, tmp);
+    load_log[n] = 0;
+    fclose(tmp);
+    return ok;
+}
+
+/* ---- the test's own arithmetic ------------------------------------------------------------ */
+
+/* 3x3 rotation (row-major) by `deg` degrees about the unit axis a (Rodrigues). */
+static void rotation(const double a[3], double deg, double r[3][3])
+{
+    double th = deg * M_PI / 180, c = cos(th), s = sin(th), C = 1 - c;
+    r[0][0] = c + a[0] * a[0] * C;
+    r[0][1] = a[0] * a[1] * C - a[2] * s;
+    r[0][2] = a[0] * a[2] * C + a[1] * s;
+    r[1][0] = a[1] * a[0] * C + a[2] * s;
+    r[1][1] = c + a[1] * a[1] * C;
+    r[1][2] = a[1] * a[2] * C - a[0] * s;
+    r[2][0] = a[2] * a[0] * C - a[1] * s;
+    r[2][1] = a[2] * a[1] * C + a[0] * s;
+    r[2][2] = c + a[2] * a[2] * C;
+}
+
+static void mul3(const double m[3][3], const double v[3], double out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2];
+}
+
+/* The inverse of m by Gauss-Jordan elimination with partial pivoting. */
+static void inverse3(const double m[3][3], double inv[3][3])
+{
+    double a[3][6];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 6; j++)
+            a[i][j] = j < 3 ? m[i][j] : (j - 3 == i);
+    for (int col = 0; col < 3; col++) {
+        int piv = col;
+        for (int i = col + 1; i < 3; i++)
+            if (fabs(a[i][col]) > fabs(a[piv][col]))
+                piv = i;
+        for (int j = 0; j < 6; j++) {
+            double t = a[col][j];
+            a[col][j] = a[piv][j];
+            a[piv][j] = t;
+        }
+        double d = a[col][col];
+        for (int j = 0; j < 6; j++)
+            a[col][j] /= d;
+        for (int i = 0; i < 3; i++)
+            if (i != col) {
+                double k = a[i][col];
+                for (int j = 0; j < 6; j++)
+                    a[i][j] -= k * a[col][j];
+            }
+    }
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            inv[i][j] = a[i][j + 3];
+}
+
+static void normalize(double v[3])
+{
+    double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3; k++)
+        v[k] /= l;
+}
+
+static bool close3(vec3 got, const double want[3], double tol)
+{
+    return fabs(got.x - want[0]) <= tol && fabs(got.y - want[1]) <= tol && fabs(got.z - want[2]) <= tol;
+}
+
+/* ---- skins -------------------------------------------------------------------------------- */
+
+/* The strip: 6 vertices (x in -0.5, 0.5; y in 0, 1, 2), normal +Z, tangent +X. Joint 0 (node 1)
+ * at (0.25, 0, 0); joint 1 (node 2) its child at (0, 0.5, 0), rotated by `deg` about the
+ * axis (1, 0, 1)/sqrt 2 (animated: 0 degrees at t 0, 90 at t 1, LINEAR). Row y 0 follows
+ * joint 0, row 2 joint 1, row 1 both: 0.6 (set 0, float) and 0.4 (set 1, unsigned short
+ * normalized). The skinned node (node 0) has a translation of (10, 0, 0) under a parent
+ * scaled by 3, which glTF says to ignore. With ibm, the inverse bind matrices are those of
+ * the joints at rest (deg 0); without, identity. */
+static const double AXIS[3] = {0.70710678118654752, 0, 0.70710678118654752};
+
+static bool load_strip(scene *s, double t, bool ibm, const char *joint1_rotation)
+{
+    gltf_file f = {0};
+    const float pos[18] = {-0.5f, 0, 0, 0.5f, 0, 0, -0.5f, 1, 0, 0.5f, 1, 0, -0.5f, 2, 0, 0.5f, 2, 0};
+    float nrm[18], tan[24];
+    for (int v = 0; v < 6; v++) {
+        memcpy(nrm + 3 * v, (float[3]){0, 0, 1}, 12);
+        memcpy(tan + 4 * v, (float[4]){1, 0, 0, 1}, 16);
+    }
+    const uint16_t idx[12] = {0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4};
+    const uint8_t j0[24] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    const float w0[24] = {1, 0, 0, 0, 1, 0, 0, 0, 0.6f, 0, 0, 0, 0.6f, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    const uint16_t j1[24] = {0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    const uint16_t w1[24] = {0, 0, 0, 0, 0, 0, 0, 0, 26214, 0, 0, 0, 26214, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    const float ibms[32] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -0.25f, 0, 0, 1,
+                            1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -0.25f, -0.5f, 0, 1};
+    const float times[2] = {0, 1};
+    const double h = sin(M_PI / 4); /* the quaternion of 90 degrees about AXIS: (sin 45 AXIS, cos 45) */
+    const float quats[8] = {0, 0, 0, 1, (float)(h * AXIS[0]), 0, (float)(h * AXIS[2]), (float)h};
+    accessor(&f, pos, sizeof pos, 5126, 6, "VEC3", ",\"min\":[-0.5,0,0],\"max\":[0.5,2,0]");
+    accessor(&f, nrm, sizeof nrm, 5126, 6, "VEC3", "");
+    accessor(&f, tan, sizeof tan, 5126, 6, "VEC4", "");
+    accessor(&f, idx, sizeof idx, 5123, 12, "SCALAR", "");
+    accessor(&f, j0, sizeof j0, 5121, 6, "VEC4", "");
+    accessor(&f, w0, sizeof w0, 5126, 6, "VEC4", "");
+    accessor(&f, j1, sizeof j1, 5123, 6, "VEC4", "");
+    accessor(&f, w1, sizeof w1, 5123, 6, "VEC4", ",\"normalized\":true");
+    accessor(&f, ibms, sizeof ibms, 5126, 2, "MAT4", "");
+    accessor(&f, times, sizeof times, 5126, 2, "SCALAR", ",\"min\":[0],\"max\":[1]");
+    accessor(&f, quats, sizeof quats, 5126, 2, "VEC4", "");
+    char rest[2048];
+    snprintf(rest, sizeof rest,
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TANGENT\":2,\"JOINTS_0\":4,"
+             "\"WEIGHTS_0\":5,\"JOINTS_1\":6,\"WEIGHTS_1\":7},\"indices\":3}]}],"
+             "\"nodes\":[{\"mesh\":0,\"skin\":0,\"translation\":[10,0,0]},{\"translation\":[0.25,0,0],\"children\":[2]},"
+             "{\"translation\":[0,0.5,0]%s},{\"scale\":[3,3,3],\"children\":[0]}],"
+             "\"skins\":[{\"joints\":[1,2]%s}],"
+             "\"animations\":[{\"samplers\":[{\"input\":9,\"output\":10}],"
+             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":2,\"path\":\"rotation\"}}]}],"
+             "\"scenes\":[{\"nodes\":[3,1]}]",
+             joint1_rotation, ibm ? ",\"inverseBindMatrices\":8" : "");
+    return write_and_load(s, &f, rest, t);
+}
+
+/* The strip's pose with joint 1 turned `deg` degrees, computed here: joint 0's matrix J0 is
+ * T(0.25) x IBM0 and joint 1's J1 = T(0.25) T(0, 0.5) R x IBM1; a vertex p goes to
+ * sum w J p, its normal by the inverse transpose of sum w J, its tangent by sum w J. */
+static void check_strip(const scene *s, double deg, bool ibm, const char *what)
+{
+    CHECKF(s->num_vertices == 6 && s->num_triangles == 4, "%s: %u vertices", what, s->num_vertices);
+    if (s->num_vertices != 6)
+        return;
+    double r[3][3];
+    rotation(AXIS, deg, r);
+    /* J0 and J1 as a 3x3 part and a translation */
+    const double t0[3] = {ibm ? 0 : 0.25, 0, 0};
+    double t1[3], ib1[3] = {ibm ? -0.25 : 0, ibm ? -0.5 : 0, 0}, rib[3];
+    mul3(r, ib1, rib);
+    for (int k = 0; k < 3; k++)
+        t1[k] = (k == 0 ? 0.25 : k == 1 ? 0.5 : 0) + rib[k];
+    const double id[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int v = 0; v < 6; v++) {
+        const double p[3] = {v % 2 ? 0.5 : -0.5, v / 2, 0};
+        const double wj1 = v / 2 == 0 ? 0 : v / 2 == 2 ? 1 : 26214 / 65535.0, wj0 = v / 2 == 1 ? 0.6 : 1 - wj1;
+        double m[3][3], tr[3], want[3], n[3], tg[3];
+        for (int i = 0; i < 3; i++) {
+            for (int j = 0; j < 3; j++)
+                m[i][j] = wj0 * id[i][j] + wj1 * r[i][j];
+            tr[i] = wj0 * t0[i] + wj1 * t1[i];
+        }
+        mul3(m, p, want);
+        for (int k = 0; k < 3; k++)
+            want[k] += tr[k];
+        double inv[3][3], invt[3][3];
+        inverse3(m, inv);
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                invt[i][j] = inv[j][i];
+        mul3(invt, (double[3]){0, 0, 1}, n);
+        normalize(n);
+        mul3(m, (double[3]){1, 0, 0}, tg);
+        normalize(tg);
+        const GnVertex *g = &s->vertices[v];
+        CHECKF(close3(g->position, want, 2e-5), "%s: vertex %d at (%g, %g, %g), expected (%g, %g, %g)", what, v,
+               g->position.x, g->position.y, g->position.z, want[0], want[1], want[2]);
+        CHECKF(close3(g->normal, n, 2e-5), "%s: vertex %d normal (%g, %g, %g), expected (%g, %g, %g)", what, v,
+               g->normal.x, g->normal.y, g->normal.z, n[0], n[1], n[2]);
+        CHECKF(close3((vec3){g->tangent.x, g->tangent.y, g->tangent.z}, tg, 2e-5) && g->tangent.w == 1,
+               "%s: vertex %d tangent (%g, %g, %g, %g), expected (%g, %g, %g, 1)", what, v, g->tangent.x, g->tangent.y,
+               g->tangent.z, g->tangent.w, tg[0], tg[1], tg[2]);
+    }
+}
+
+/* Joint 1's own rotation (30 degrees about AXIS) without --at; the animation's slerp at
+ * t 0.5 (45 degrees) and after its last key (90); identity inverse bind matrices. */
+TEST(skin, two_bone_strip)
+{
+    scene s;
+    char rot[128];
+    const double h = sin(M_PI / 12); /* 30 degrees: (sin 15 AXIS, cos 15) */
+    snprintf(rot, sizeof rot, ",\"rotation\":[%.17g,0,%.17g,%.17g]", h * AXIS[0], h * AXIS[2], cos(M_PI / 12));
+    struct { double t, deg; bool ibm; const char *what; } cases[] = {
+        {-1, 30, true, "own transforms"}, {0.5, 45, true, "t 0.5"}, {2, 90, true, "after the last key"},
+        {0.25, 22.5, false, "no inverseBindMatrices"}};
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        bool ok = load_strip(&s, cases[i].t, cases[i].ibm, rot);
+        CHECKF(ok, "%s: %s", cases[i].what, load_log);
+        if (ok)
+            check_strip(&s, cases[i].deg, cases[i].ibm, cases[i].what);
+        CHECKF(!strstr(load_log, "skin") && !strstr(load_log, "warning"), "%s: %s", cases[i].what, load_log);
+        scene_destroy(&s);
+    }
+}
