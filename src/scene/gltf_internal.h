@@ -3,7 +3,7 @@
  * checked (scene_gltf.cpp, gltf_json.cpp), tinygltf's parse with files read only through the
  * sandbox (gltf_files.cpp), the model it returns checked against the specification before
  * one byte is read (gltf_check.cpp), then read: animation (gltf_animation.cpp), geometry and
- * the node hierarchy (gltf_geometry.cpp), skins (gltf_skin.cpp), images,
+ * the node hierarchy (gltf_geometry.cpp), skins and morph targets (gltf_skin.cpp), images,
  * textures and materials (gltf_material.cpp).
  * No C++ exception escapes into C. */
 #ifndef GONIO_GLTF_INTERNAL_H
@@ -54,10 +54,14 @@ struct Prim {                  /* one triangle primitive of a glTF mesh, in the 
     std::vector<float> col;    /* 4 per vertex (RGBA), empty without COLOR_0 */
     std::vector<uint32_t> idx; /* 3 per triangle */
     uint32_t material;         /* glTF material, or GN_INVALID for the default one */
-    /* Skinning (gltf_skin.cpp), per vertex like the above: */
+    /* Skinning and morphing (gltf_skin.cpp), per vertex like the above: */
     size_t influences = 0;         /* joint-weight pairs per vertex, 4 per JOINTS_n/WEIGHTS_n set */
     std::vector<uint16_t> joints;  /* influences per vertex: indices into the node's skin's joints */
     std::vector<float> weights;    /* influences per vertex */
+    struct Target {                /* a morph target: displacements, 3 per vertex, empty if absent */
+        std::vector<float> pos, nrm, tan;
+    };
+    std::vector<Target> targets;
     int max_joint = -1;            /* the largest joint index with a weight > 0 ... */
     std::string max_joint_at;      /* ... and where: "meshes[0].primitives[1].attributes.JOINTS_0: vertex 5" */
     bool flat = false;             /* normals made flat (no NORMAL): recomputed once posed */
@@ -107,7 +111,7 @@ struct Ctx {
     std::map<int, int> image_alias;          /* image -> the earlier image with the same bytes */
     uint64_t texels = 0;                     /* of the images decoded so far */
     std::string limit_error;                 /* a SCENE_MAX_* limit exceeded while decoding */
-    bool warned_targets = false;
+    std::vector<std::vector<double>> anim_weights; /* per node: its animated morph weights, or empty */
     std::vector<Mat> world;                  /* per node, posed (gltf_skin.cpp: joint_matrices) */
     std::vector<std::vector<Mat>> joint_mats; /* per skin: each joint's world x inverse bind matrix */
     int scene_index = -1;                    /* the glTF scene to draw; -1: the default one */
@@ -176,22 +180,24 @@ bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out);
 void bake_cameras(Ctx &c, const std::vector<Instance> &cams, scene *out);
 void bake_lights(Ctx &c, const std::vector<Instance> &lights, scene *out);
 
-/* ---- gltf_skin.cpp: skins ------------------------------------------------------------------ */
-/* Skins, their joint sets and the nodes that use them as glTF 2.0 requires, with the loader's
- * limit on the data they add; errors name the JSON path. */
+/* ---- gltf_skin.cpp: skins and morph targets ------------------------------------------------ */
+/* Skins, morph targets, their weights and the nodes that use them as glTF 2.0 requires, with
+ * the loader's limit on the data they add; errors name the JSON path. */
 bool check_skins_and_targets(Ctx &c);
-/* JOINTS_n/WEIGHTS_n of primitive pi of mesh mi into out, per vertex. */
+/* JOINTS_n/WEIGHTS_n and the morph targets of primitive pi of mesh mi into out, per vertex. */
 bool read_skin_and_targets(Ctx &c, int mi, int pi, Prim &out);
-/* Per-vertex skin data in a new vertex order: vertex v takes old vertex src[v]. */
+/* Per-vertex skin and target data in a new vertex order: vertex v takes old vertex src[v]. */
 void remap_skin_and_targets(Prim &p, const uint32_t *src, size_t n);
+/* The morph weights node `node` draws its mesh with: animated, else the node's, else the mesh's. */
+std::vector<double> morph_weights(const Ctx &c, int node);
 /* Each skin's joint matrices at the pose of c.local (after the nodes' transforms are known). */
 bool joint_matrices(Ctx &c);
 /* Whether instance `in` is drawn skinned: its node's transform is then ignored (glTF 2.0,
  * "Skins"), the joints place the vertices in world space. */
 bool instance_skinned(const Ctx &c, const Instance &in);
-/* Primitive p as instance `in` draws it: the skin applied (positions, normals, tangents; flat
- * normals recomputed). False when nothing changes (p is drawn as it is) or on an error
- * (c.failed). */
+/* Primitive p as instance `in` draws it: the morph targets weighted, then the skin applied
+ * (positions, normals, tangents; flat normals recomputed). False when nothing changes (p is
+ * drawn as it is) or on an error (c.failed). */
 bool pose_primitive(Ctx &c, const Instance &in, const Prim &p, Prim &out);
 
 /* ---- gltf_material.cpp: the extensions, images, textures, materials ------------------------- */

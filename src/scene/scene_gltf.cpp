@@ -293,6 +293,11 @@ bool load(scene *out, const char *path, int scene_index)
     out->num_skins = uint32_t(c.m.skins.size());
     for (const auto &s : c.m.skins)
         out->num_joints += uint32_t(s.joints.size());
+    for (const auto &mesh : c.m.meshes)
+        if (!mesh.primitives.empty() && !mesh.primitives[0].targets.empty()) {
+            out->num_morph_targets += uint32_t(mesh.primitives[0].targets.size());
+            out->num_morphed_meshes++;
+        }
     std::vector<std::string> variants = variant_names(c.m);
     if (!variants.empty()) {
         out->num_variants = uint32_t(variants.size());

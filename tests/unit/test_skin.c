@@ -1,11 +1,14 @@
-/* test_skin.c: skins through scene_load, against poses computed here from the glTF 2.0
- * specification's formulas ("Skins": the joint matrix is the joint's world transform times
- * its inverse bind matrix, a vertex moves by the weighted sum of its joints' matrices, the
- * skinned node's own transform is ignored; "Animations": the rotation's slerp). The test's own
- * arithmetic: rotations from Rodrigues' formula (axis and angle, not the loader's
- * quaternion), translations added by hand, normals by a Gauss-Jordan inverse. The scene is
- * written here: a two-bone strip with two JOINTS/WEIGHTS sets (unsigned byte joints and
- * float weights, unsigned short joints and normalized weights). */
+/* test_skin.c: skins and morph targets through scene_load, against poses computed here from
+ * the glTF 2.0 specification's formulas ("Skins": the joint matrix is the joint's world
+ * transform times its inverse bind matrix, a vertex moves by the weighted sum of its joints'
+ * matrices, the skinned node's own transform is ignored; "Morph Targets": the base plus the
+ * weighted displacements, before skinning; "Animations": LINEAR, STEP and the CUBICSPLINE
+ * Hermite form). The test's own arithmetic: rotations from Rodrigues' formula (axis and
+ * angle, not the loader's quaternion), translations added by hand, weights interpolated
+ * here. The scenes are written here: a two-bone strip with two JOINTS/WEIGHTS sets (unsigned
+ * byte joints and float weights, unsigned short joints and normalized weights) and a quad
+ * with two morph targets (one sparse), its weights from the mesh, the node and three
+ * animations. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdarg.h>
@@ -55,6 +58,17 @@ static int accessor(gltf_file *f, const void *bytes, size_t n, int component, si
     int v = view(f, bytes, n);
     app(f->accessors, sizeof f->accessors, "%s{\"bufferView\":%d,\"componentType\":%d,\"count\":%zu,\"type\":\"%s\"%s}",
         f->num_accessors ? "," : "", v, component, count, type, extra);
+    return f->num_accessors++;
+}
+
+/* A sparse accessor without a buffer view: zeros but for `n` elements (indices u16). */
+static int sparse_vec3(gltf_file *f, size_t count, const uint16_t *idx, const float *values, int n)
+{
+    int vi = view(f, idx, sizeof *idx * (size_t)n), vv = view(f, values, 12 * (size_t)n);
+    app(f->accessors, sizeof f->accessors,
+        "%s{\"componentType\":5126,\"count\":%zu,\"type\":\"VEC3\",\"sparse\":{\"count\":%d,"
+        "\"indices\":{\"bufferView\":%d,\"componentType\":5123},\"values\":{\"bufferView\":%d}}}",
+        f->num_accessors ? "," : "", count, n, vi, vv);
     return f->num_accessors++;
 }
 
@@ -293,5 +307,172 @@ TEST(skin, two_bone_strip)
             check_strip(&s, cases[i].deg, cases[i].ibm, cases[i].what);
         CHECKF(!strstr(load_log, "skin") && !strstr(load_log, "warning"), "%s: %s", cases[i].what, load_log);
         scene_destroy(&s);
+    }
+}
+
+/* ---- morph targets ------------------------------------------------------------------------ */
+
+/* The quad (0,0,0) (1,0,0) (1,1,0) (0,1,0), normal +Z, with target 0 lifting every vertex by
+ * (0, 0, 1) and tilting its normal by (0.5, 0, 0), and target 1 a sparse POSITION moving
+ * vertex 2 by (0.5, 0.5, 0). Mesh weights (0.5, 0.25). Nodes: 0 the mesh's weights, at the
+ * origin; 1 its own weights (1, 1) at x 5; 2, 3, 4 animated LINEAR, STEP and CUBICSPLINE at
+ * x 10, 15, 20; 5 the same quad (mesh 1) skinned to joint node 6, scaled by 2 and moved by
+ * (0, 0, -3), with mesh 1's weights (1, 0.5) (morphing comes first, then the skin).
+ * Animation keys at t 0, 1, 2: LINEAR (0, 0) (1, 0.5) (0.5, 1); STEP the same; CUBICSPLINE
+ * keys at 0 and 2, values (0, 0) and (1, 0.5), in-tangents (9, 9) and (-1, 2), out-tangents
+ * (2, -1) and (9, 9). */
+static bool load_quad(scene *s, double t)
+{
+    gltf_file f = {0};
+    const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    const float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    const float lift[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    const float tilt[12] = {0.5f, 0, 0, 0.5f, 0, 0, 0.5f, 0, 0, 0.5f, 0, 0};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3}, sp_idx[1] = {2};
+    const float sp_val[3] = {0.5f, 0.5f, 0};
+    const uint8_t joints[16] = {0};
+    const float weights[16] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    const float t3[3] = {0, 1, 2}, t2[2] = {0, 2};
+    const float lin[6] = {0, 0, 1, 0.5f, 0.5f, 1};
+    const float cub[12] = {9, 9, 0, 0, 2, -1, -1, 2, 1, 0.5f, 9, 9};
+    accessor(&f, pos, sizeof pos, 5126, 4, "VEC3", ",\"min\":[0,0,0],\"max\":[1,1,0]"); /* 0 */
+    accessor(&f, nrm, sizeof nrm, 5126, 4, "VEC3", "");                                  /* 1 */
+    accessor(&f, idx, sizeof idx, 5123, 6, "SCALAR", "");                                /* 2 */
+    accessor(&f, lift, sizeof lift, 5126, 4, "VEC3", "");                                /* 3 */
+    accessor(&f, tilt, sizeof tilt, 5126, 4, "VEC3", "");                                /* 4 */
+    sparse_vec3(&f, 4, sp_idx, sp_val, 1);                                               /* 5 */
+    accessor(&f, joints, sizeof joints, 5121, 4, "VEC4", "");                            /* 6 */
+    accessor(&f, weights, sizeof weights, 5126, 4, "VEC4", "");                          /* 7 */
+    accessor(&f, t3, sizeof t3, 5126, 3, "SCALAR", "");                                  /* 8 */
+    accessor(&f, lin, sizeof lin, 5126, 6, "SCALAR", "");                                /* 9 */
+    accessor(&f, t2, sizeof t2, 5126, 2, "SCALAR", "");                                  /* 10 */
+    accessor(&f, cub, sizeof cub, 5126, 12, "SCALAR", "");                               /* 11 */
+    const char *targets = "\"targets\":[{\"POSITION\":3,\"NORMAL\":4},{\"POSITION\":5}]";
+    char rest[4096];
+    snprintf(rest, sizeof rest,
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2,%s}],"
+             "\"weights\":[0.5,0.25]},"
+             "{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"JOINTS_0\":6,\"WEIGHTS_0\":7},\"indices\":2,"
+             "%s}],\"weights\":[1,0.5]}],"
+             "\"nodes\":[{\"mesh\":0},{\"mesh\":0,\"weights\":[1,1],\"translation\":[5,0,0]},"
+             "{\"mesh\":0,\"translation\":[10,0,0]},{\"mesh\":0,\"translation\":[15,0,0]},"
+             "{\"mesh\":0,\"translation\":[20,0,0]},{\"mesh\":1,\"skin\":0,\"translation\":[7,7,7]},"
+             "{\"scale\":[2,2,2],\"translation\":[0,0,-3]}],"
+             "\"skins\":[{\"joints\":[6]}],"
+             "\"animations\":[{\"samplers\":[{\"input\":8,\"output\":9},{\"input\":8,\"output\":9,\"interpolation\":\"STEP\"},"
+             "{\"input\":10,\"output\":11,\"interpolation\":\"CUBICSPLINE\"}],"
+             "\"channels\":[{\"sampler\":0,\"target\":{\"node\":2,\"path\":\"weights\"}},"
+             "{\"sampler\":1,\"target\":{\"node\":3,\"path\":\"weights\"}},"
+             "{\"sampler\":2,\"target\":{\"node\":4,\"path\":\"weights\"}}]}],"
+             "\"scenes\":[{\"nodes\":[0,1,2,3,4,5,6]}]",
+             targets, targets);
+    return write_and_load(s, &f, rest, t);
+}
+
+/* Quad vertex v of instance i (offset x, lift and joint as given) with weights w0, w1. */
+static void check_quad_vertex(const scene *s, int inst, int v, double x, double w0, double w1, double scale,
+                              double dz, const char *what)
+{
+    const double base[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    double p[3], n[3] = {0.5 * w0, 0, 1};
+    for (int k = 0; k < 3; k++)
+        p[k] = base[v][k] + w0 * (k == 2 ? 1 : 0) + w1 * (v == 2 && k < 2 ? 0.5 : 0);
+    for (int k = 0; k < 3; k++)
+        p[k] = p[k] * scale + (k == 0 ? x : k == 2 ? dz : 0);
+    normalize(n);
+    const GnVertex *g = &s->vertices[4 * inst + v];
+    CHECKF(close3(g->position, p, 1e-5), "%s: instance %d vertex %d at (%g, %g, %g), expected (%g, %g, %g)", what, inst,
+           v, g->position.x, g->position.y, g->position.z, p[0], p[1], p[2]);
+    CHECKF(close3(g->normal, n, 1e-5), "%s: instance %d vertex %d normal (%g, %g, %g), expected (%g, %g, %g)", what,
+           inst, v, g->normal.x, g->normal.y, g->normal.z, n[0], n[1], n[2]);
+}
+
+/* The animated weights at time t, interpolated here. */
+static void anim_weights(double t, double lin[2], double step[2], double cub[2])
+{
+    const double k[3][2] = {{0, 0}, {1, 0.5}, {0.5, 1}};
+    int i = t >= 2 ? 2 : t >= 1 ? 1 : 0;
+    for (int j = 0; j < 2; j++) {
+        double u = i == 2 ? 0 : t - i;
+        lin[j] = i == 2 ? k[2][j] : (1 - u) * k[i][j] + u * k[i + 1][j];
+        step[j] = k[i][j];
+    }
+    /* CUBICSPLINE over keys 0 and 2 (td = 2): p(u) = h00 v0 + h10 td b0 + h01 v1 + h11 td a1 */
+    const double v0[2] = {0, 0}, b0[2] = {2, -1}, v1[2] = {1, 0.5}, a1[2] = {-1, 2};
+    double u = t >= 2 ? 1 : t / 2, td = 2;
+    double h00 = 2 * u * u * u - 3 * u * u + 1, h10 = u * u * u - 2 * u * u + u, h01 = -2 * u * u * u + 3 * u * u,
+           h11 = u * u * u - u * u;
+    for (int j = 0; j < 2; j++)
+        cub[j] = t >= 2 ? v1[j] : h00 * v0[j] + h10 * td * b0[j] + h01 * v1[j] + h11 * td * a1[j];
+}
+
+TEST(skin, morph_targets)
+{
+    const double times[] = {-1, 0.25, 1.5, 0.999, 3};
+    for (size_t i = 0; i < sizeof times / sizeof *times; i++) {
+        scene s;
+        char what[64];
+        snprintf(what, sizeof what, "t %g", times[i]);
+        bool ok = load_quad(&s, times[i]);
+        CHECKF(ok, "%s: %s", what, load_log);
+        if (!ok)
+            continue;
+        CHECKF(s.num_vertices == 24, "%s: %u vertices", what, s.num_vertices);
+        CHECKF(!strstr(load_log, "warning"), "%s: %s", what, load_log);
+        if (s.num_vertices == 24) {
+            double lin[2] = {0.5, 0.25}, step[2] = {0.5, 0.25}, cub[2] = {0.5, 0.25};
+            if (times[i] >= 0)
+                anim_weights(times[i], lin, step, cub);
+            for (int v = 0; v < 4; v++) {
+                check_quad_vertex(&s, 0, v, 0, 0.5, 0.25, 1, 0, what);
+                check_quad_vertex(&s, 1, v, 5, 1, 1, 1, 0, what);
+                check_quad_vertex(&s, 2, v, 10, lin[0], lin[1], 1, 0, what);
+                check_quad_vertex(&s, 3, v, 15, step[0], step[1], 1, 0, what);
+                check_quad_vertex(&s, 4, v, 20, cub[0], cub[1], 1, 0, what);
+                check_quad_vertex(&s, 5, v, 0, 1, 0.5, 2, -3, what);
+            }
+        }
+        scene_destroy(&s);
+    }
+}
+
+/* The sample models' skins, joints and morph targets, as their JSON lists them (read with a
+ * Python script when the test was written), loaded without a warning. */
+TEST(skin, sample_models)
+{
+    static const struct {
+        const char *path;
+        uint32_t skins, joints, targets, morphed;
+    } models[] = {
+        {"gltf/RiggedSimple/glTF/RiggedSimple.gltf", 1, 2, 0, 0},
+        {"gltf/SimpleSkin/glTF/SimpleSkin.gltf", 1, 2, 0, 0},
+        {"gltf/CesiumMan/glTF/CesiumMan.gltf", 1, 19, 0, 0},
+        {"gltf/AnimatedMorphCube/glTF/AnimatedMorphCube.gltf", 0, 0, 2, 1},
+        {"gltf/SimpleMorph/glTF/SimpleMorph.gltf", 0, 0, 2, 1},
+        {"gltf/MorphPrimitivesTest/glTF/MorphPrimitivesTest.gltf", 0, 0, 1, 1},
+    };
+    if (!test_assets_dir()) {
+        test_skip("no test assets");
+        return;
+    }
+    for (size_t i = 0; i < sizeof models / sizeof *models; i++) {
+        char path[4096];
+        scene s;
+        snprintf(path, sizeof path, "%s/%s", test_assets_dir(), models[i].path);
+        for (int at = 0; at < 2; at++) {
+            int w0 = util_warning_count();
+            scene_animation_time(at ? 0.7 : -1);
+            bool ok = scene_load(&s, path);
+            scene_animation_time(-1);
+            CHECKF(ok && util_warning_count() == w0, "%s at %s: loaded %d, %d warnings", models[i].path,
+                   at ? "0.7 s" : "its own transforms", ok, util_warning_count() - w0);
+            if (!ok)
+                continue;
+            CHECKF(s.num_skins == models[i].skins && s.num_joints == models[i].joints &&
+                       s.num_morph_targets == models[i].targets && s.num_morphed_meshes == models[i].morphed,
+                   "%s: %u skins, %u joints, %u morph targets in %u meshes", models[i].path, s.num_skins,
+                   s.num_joints, s.num_morph_targets, s.num_morphed_meshes);
+            scene_destroy(&s);
+        }
     }
 }
