@@ -6,9 +6,9 @@
  * Hermite form). The test's own arithmetic: rotations from Rodrigues' formula (axis and
  * angle, not the loader's quaternion), translations added by hand, weights interpolated
  * here. The scenes are written here: a two-bone strip with two JOINTS/WEIGHTS sets (unsigned
- * byte joints and float weights, unsigned short joints and normalized weights) and a quad
+ * byte joints and float weights, unsigned short joints and normalized weights), a quad
  * with two morph targets (one sparse), its weights from the mesh, the node and three
- * animations. */
+ * animations, and quads whose targets tilt flat normals and tangents. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdarg.h>
@@ -475,4 +475,71 @@ TEST(skin, sample_models)
             scene_destroy(&s);
         }
     }
+}
+
+/* A morphed quad without NORMAL gets the flat normals of its posed triangles (its corners
+ * lifted by 0, 0.4, 1 and 0.2), and a TANGENT target moves tangents as a NORMAL target moves
+ * normals (weight 0.5: normal (0, 0, 1) + 0.5 (0.5, 0, 0), tangent (1, 0, 0) + 0.5 (0, 0, -0.5)). */
+TEST(skin, morph_flat_normals_and_tangents)
+{
+    gltf_file f = {0};
+    const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    const float nrm[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+    const float tan[16] = {1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1};
+    const float lift[12] = {0, 0, 0, 0, 0, 0.4f, 0, 0, 1, 0, 0, 0.2f};
+    const float dn[12] = {0.5f, 0, 0, 0.5f, 0, 0, 0.5f, 0, 0, 0.5f, 0, 0};
+    const float dt[12] = {0, 0, -0.5f, 0, 0, -0.5f, 0, 0, -0.5f, 0, 0, -0.5f};
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    accessor(&f, pos, sizeof pos, 5126, 4, "VEC3", ",\"min\":[0,0,0],\"max\":[1,1,0]"); /* 0 */
+    accessor(&f, nrm, sizeof nrm, 5126, 4, "VEC3", "");                                  /* 1 */
+    accessor(&f, tan, sizeof tan, 5126, 4, "VEC4", "");                                  /* 2 */
+    accessor(&f, idx, sizeof idx, 5123, 6, "SCALAR", "");                                /* 3 */
+    accessor(&f, lift, sizeof lift, 5126, 4, "VEC3", "");                                /* 4 */
+    accessor(&f, dn, sizeof dn, 5126, 4, "VEC3", "");                                    /* 5 */
+    accessor(&f, dt, sizeof dt, 5126, 4, "VEC3", "");                                    /* 6 */
+    const char *rest =
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":3,\"targets\":[{\"POSITION\":4}]}],"
+        "\"weights\":[1]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TANGENT\":2},\"indices\":3,"
+        "\"targets\":[{\"NORMAL\":5,\"TANGENT\":6}]}],\"weights\":[0.5]}],"
+        "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[5,0,0]}],\"scenes\":[{\"nodes\":[0,1]}]";
+    scene s;
+    bool ok = write_and_load(&s, &f, rest, -1);
+    CHECKF(ok, "%s", load_log);
+    if (!ok)
+        return;
+    CHECKF(s.num_vertices == 10, "%u vertices", s.num_vertices);
+    const int tris[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (int t = 0; t < 2 && s.num_vertices == 10; t++) {
+        double p[3][3], e1[3], e2[3], n[3];
+        for (int k = 0; k < 3; k++)
+            for (int j = 0; j < 3; j++)
+                p[k][j] = pos[3 * tris[t][k] + j] + lift[3 * tris[t][k] + j];
+        for (int j = 0; j < 3; j++) {
+            e1[j] = p[1][j] - p[0][j];
+            e2[j] = p[2][j] - p[0][j];
+        }
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        normalize(n);
+        for (int k = 0; k < 3; k++) {
+            const GnVertex *g = &s.vertices[3 * t + k];
+            CHECKF(close3(g->position, p[k], 1e-6) && close3(g->normal, n, 1e-5),
+                   "flat triangle %d corner %d: (%g, %g, %g) normal (%g, %g, %g), expected (%g, %g, %g) normal "
+                   "(%g, %g, %g)", t, k, g->position.x, g->position.y, g->position.z, g->normal.x, g->normal.y,
+                   g->normal.z, p[k][0], p[k][1], p[k][2], n[0], n[1], n[2]);
+        }
+    }
+    double n[3] = {0.25, 0, 1}, t[3] = {1, 0, -0.25};
+    normalize(n);
+    normalize(t);
+    for (int v = 6; v < 10 && s.num_vertices == 10; v++) {
+        const GnVertex *g = &s.vertices[v];
+        CHECKF(close3(g->normal, n, 1e-6) && close3((vec3){g->tangent.x, g->tangent.y, g->tangent.z}, t, 1e-6) &&
+                   g->tangent.w == 1,
+               "vertex %d: normal (%g, %g, %g) tangent (%g, %g, %g, %g)", v, g->normal.x, g->normal.y, g->normal.z,
+               g->tangent.x, g->tangent.y, g->tangent.z, g->tangent.w);
+    }
+    scene_destroy(&s);
 }
