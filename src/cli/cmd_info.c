@@ -150,7 +150,9 @@ int cmd_info(int argc, char **argv)
     const cli_command cmd = {
         .name = "info", .synopsis = "SCENE.gltf|.glb [--allow-outside-files]",
         .intro = "Prints the scene's contents and its BVH statistics: the emissive triangles (the path\n"
-                 "tracer's area lights) and the materials that emit, and one line per camera (index, name,\n"
+                 "tracer's area lights) and the materials that emit, the skins (and their joints) and the\n"
+                 "morph targets (and the meshes that have them), the load's time (and the part posing\n"
+                 "skinned and morphed meshes took), and one line per camera (index, name,\n"
                  "position, forward direction, vertical field of view or orthographic width x height;\n"
                  "the first is the one gonio render uses by default), the KHR_materials_variants\n"
                  "variants by index and name (for --variant), and one line per material that bounds a\n"
@@ -174,8 +176,10 @@ int cmd_info(int argc, char **argv)
         return rc;
     const char *path = args.arg[0];
     scene_allow_outside_files(outside);
+    double t0 = util_now();
     if (!scene_load(&sc, path))
         return 1;
+    double load_seconds = util_now() - t0;
     if (!render_geometry_build(&geo, &sc)) {
         scene_destroy(&sc);
         return 1;
@@ -198,6 +202,10 @@ int cmd_info(int argc, char **argv)
     }
     printf("meshes         %u (primitive instances; %u glTF meshes, %u nodes)\n", sc.num_meshes,
            sc.num_gltf_meshes, sc.num_nodes);
+    printf("skins          %u (%u joints), morph targets %u (in %u mesh(es))\n", sc.num_skins, sc.num_joints,
+           sc.num_morph_targets, sc.num_morphed_meshes);
+    printf("load           %.2f ms (posing skinned and morphed meshes %.2f ms)\n", load_seconds * 1e3,
+           sc.pose_seconds * 1e3);
     printf("materials      %u\n", sc.num_materials);
     printf("variants       %u\n", sc.num_variants);
     for (uint32_t i = 0; i < sc.num_variants; i++)

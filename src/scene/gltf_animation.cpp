@@ -119,10 +119,11 @@ bool check_animations(Ctx &c)
     return true;
 }
 
-/* Every animation's channels sampled at anim_time (all animations play together), per node. */
+/* Every animation's channels sampled at anim_time (all animations play together), per node:
+ * translation, rotation and scale into pose, morph target weights into c.anim_weights. */
 bool animate(Ctx &c, std::vector<Pose> &pose)
 {
-    bool warned_weights = false;
+    c.anim_weights.assign(pose.size(), {});
     for (const auto &a : c.m.animations)
         for (const auto &ch : a.channels) {
             const int path = ch.target_path == "translation" ? 0 : ch.target_path == "rotation" ? 1
@@ -130,11 +131,14 @@ bool animate(Ctx &c, std::vector<Pose> &pose)
             if (!in_range(ch.target_node, pose.size()) || !in_range(ch.sampler, a.samplers.size()))
                 return fail(c, "animation '%s': a channel targets node %d, sampler %d, which do not exist",
                             a.name.c_str(), ch.target_node, ch.sampler);
-            if (path < 0) {
-                if (!warned_weights)
-                    warn(c, "animation '%s': '%s' channels are not animated (morph targets are not supported)",
-                         a.name.c_str(), ch.target_path.c_str());
-                warned_weights = true;
+            if (path < 0) { /* weights: one per morph target of the node's mesh (check_skins_and_targets) */
+                const int mesh = c.m.nodes[size_t(ch.target_node)].mesh;
+                const size_t n = in_range(mesh, c.m.meshes.size()) && !c.m.meshes[size_t(mesh)].primitives.empty()
+                                     ? c.m.meshes[size_t(mesh)].primitives[0].targets.size() : 0;
+                std::vector<double> &w = c.anim_weights[size_t(ch.target_node)];
+                w.assign(n, 0.0);
+                if (n && !sample_channel(c, a, ch.sampler, anim_time, n, false, w.data()))
+                    return false;
                 continue;
             }
             Pose &p = pose[size_t(ch.target_node)];

@@ -325,6 +325,14 @@ void make_flat(Prim &p)
     if (!p.col.empty())
         f.col.resize(nt * 12);
     f.idx.resize(nt * 3);
+    f.influences = p.influences;
+    f.joints = std::move(p.joints);
+    f.weights = std::move(p.weights);
+    f.targets = std::move(p.targets);
+    f.max_joint = p.max_joint;
+    f.max_joint_at = std::move(p.max_joint_at);
+    f.flat = true;
+    remap_skin_and_targets(f, p.idx.data(), nt * 3);
     for (size_t t = 0; t < nt; t++) {
         for (size_t k = 0; k < 3; k++) {
             size_t v = p.idx[t * 3 + k], o = t * 3 + k;
@@ -377,6 +385,7 @@ void generate_tangents(Prim &p, const std::vector<float> &uv)
     expand(p.uv, 2);
     expand(p.uv1, 2);
     expand(p.col, 4);
+    remap_skin_and_targets(p, remap, n);
     p.tan.assign(tan, tan + n * 4);
     free(remap);
     free(tan);
@@ -406,10 +415,6 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
     if (pos < 0) {
         warn(c, "%s has no POSITION (skipped)", what.c_str());
         return false;
-    }
-    if (!p.targets.empty() && !c.warned_targets) {
-        warn(c, "morph targets are not supported (meshes drawn with their base shapes)");
-        c.warned_targets = true;
     }
     size_t nv = c.m.accessors[size_t(pos)].count;
     std::vector<uint32_t> seq;
@@ -473,6 +478,8 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
     }
     if (col >= 0)
         read_colors(c, what, col, out);
+    if (!read_skin_and_targets(c, mi, pi, out))
+        return false;
     if (out.nrm.empty())
         make_flat(out);
     /* a normal map, a clearcoat normal map or anisotropy needs tangents (the mesh's, else
@@ -593,10 +600,6 @@ bool collect_instances(Ctx &c, std::vector<Instance> &inst, std::vector<Instance
             it.moving = it.moving || (size_t(it.node) < c.animated.size() && c.animated[size_t(it.node)]);
             if (!mat_finite(it.world))
                 return fail(c, "%s: world transform is not finite", label("node", it.node, n.name).c_str());
-            if (n.skin >= 0 && !c.warned_skin) {
-                warn(c, "skins are not supported (skinned meshes drawn in their bind pose)");
-                c.warned_skin = true;
-            }
             if (n.mesh >= 0 && n.extensions.count("EXT_mesh_gpu_instancing")) {
                 size_t first = inst.size();
                 if (!gpu_instances(c, it.node, it.world, inst))
@@ -640,10 +643,11 @@ bool normalize3(double v[3])
     return true;
 }
 
-/* Mesh `mesh`'s primitives transformed by w into vertices, indices and tri_material, from
- * vertex vbase (the indices' base too) and triangle tbase. */
-void bake_mesh(Ctx &c, int mesh, const Mat &w, GnVertex *vertices, uint32_t *indices, uint32_t *tri_material,
-               uint32_t vbase, uint32_t tbase, bool &colors)
+/* Instance in's mesh, posed for its node (skins, morph targets: pose_primitive) and
+ * transformed by w, into vertices, indices and tri_material, from vertex vbase (the indices'
+ * base too) and triangle tbase; false on a bad pose. */
+bool bake_mesh(Ctx &c, const Instance &in, const Mat &w, GnVertex *vertices, uint32_t *indices, uint32_t *tri_material,
+               uint32_t vbase, uint32_t tbase, scene *out)
 {
     /* Normals go through the cofactor matrix, det * inverse transpose: defined even for a
      * singular matrix; multiplied by sign(det) so mirroring keeps them pointing out. */
@@ -660,7 +664,15 @@ void bake_mesh(Ctx &c, int mesh, const Mat &w, GnVertex *vertices, uint32_t *ind
     double det = a[0][0] * cof[0][0] + a[0][1] * cof[0][1] + a[0][2] * cof[0][2];
     double sgn = det < 0 ? -1 : 1;
     uint32_t default_material = uint32_t(c.m.materials.size());
-    for (const Prim &p : c.meshes[size_t(mesh)]) {
+    for (const Prim &base : c.meshes[size_t(in.mesh)]) {
+        Prim posed; /* skinned or morphed: this node's own copy */
+        const double t0 = util_now();
+        const Prim &p = pose_primitive(c, in, base, posed) ? posed : base;
+        out->pose_seconds += util_now() - t0;
+        if (c.failed)
+            return false;
+        if (p.pos.size() != base.pos.size() || p.idx.size() != base.idx.size())
+            return fail(c, "%s: posing changed its vertex count", label("mesh", in.mesh, c.m.meshes[size_t(in.mesh)].name).c_str());
         size_t pv = p.pos.size() / 3;
         for (size_t v = 0; v < pv; v++) {
             GnVertex &o = vertices[vbase + v];
@@ -688,7 +700,7 @@ void bake_mesh(Ctx &c, int mesh, const Mat &w, GnVertex *vertices, uint32_t *ind
             }
             if (!p.col.empty()) {
                 o.color = vec4{p.col[v * 4], p.col[v * 4 + 1], p.col[v * 4 + 2], p.col[v * 4 + 3]};
-                colors = true;
+                out->vertex_colors = true;
             } else {
                 o.color = vec4{1, 1, 1, 1};
             }
@@ -711,6 +723,7 @@ void bake_mesh(Ctx &c, int mesh, const Mat &w, GnVertex *vertices, uint32_t *ind
         vbase += uint32_t(pv);
         tbase += uint32_t(pt);
     }
+    return true;
 }
 
 /* w as an instance's transform (scene_instance: 3x4, row-major, float); false when that is
@@ -740,6 +753,17 @@ bool instance_transform(const Mat &w, float out[12])
     return true;
 }
 
+/* Whether instance in's geometry is its node's own: skinned, or a mesh with morph targets. */
+static bool posed_mesh(const Ctx &c, const Instance &in)
+{
+    if (instance_skinned(c, in))
+        return true;
+    for (const Prim &p : c.meshes[size_t(in.mesh)])
+        if (!p.targets.empty())
+            return true;
+    return false;
+}
+
 /* The instances' geometry: a mesh that several nodes use, or that EXT_mesh_gpu_instancing
  * places, or (scene_instance_animated) that an animation moves, is kept once in its own
  * space (scene_instanced_mesh) and placed by instances; the others, and placements whose
@@ -764,7 +788,8 @@ bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
             mt += p.idx.size() / 3;
         }
         np += c.meshes[m].size();
-        placed[i] = (uses[m] > 1 || gpu[m] || (instance_animated && inst[i].moving)) && mt > 0 &&
+        /* a skinned or morphed mesh is posed per node, in world space: never placed */
+        placed[i] = !posed_mesh(c, inst[i]) && (uses[m] > 1 || gpu[m] || (instance_animated && inst[i].moving)) && mt > 0 &&
                     instance_transform(inst[i].world, &xf[12 * i]);
         if (!placed[i]) {
             nv += mv;
@@ -806,7 +831,10 @@ bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
     for (size_t i = 0; i < inst.size(); i++) {
         const Instance &in = inst[i];
         if (!placed[i]) {
-            bake_mesh(c, in.mesh, in.world, out->vertices, out->indices, out->tri_material, vbase, tbase, out->vertex_colors);
+            /* a skin places its vertices in the world: its node's transform is not applied */
+            if (!bake_mesh(c, in, instance_skinned(c, in) ? id : in.world, out->vertices, out->indices,
+                           out->tri_material, vbase, tbase, out))
+                return false;
             for (const Prim &p : c.meshes[size_t(in.mesh)]) {
                 vbase += uint32_t(p.pos.size() / 3);
                 tbase += uint32_t(p.idx.size() / 3);
@@ -824,7 +852,8 @@ bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out)
             im.vertices = static_cast<GnVertex *>(util_calloc(im.num_vertices, sizeof(GnVertex)));
             im.indices = static_cast<uint32_t *>(util_calloc(3 * size_t(im.num_triangles), sizeof(uint32_t)));
             im.tri_material = static_cast<uint32_t *>(util_calloc(im.num_triangles, sizeof(uint32_t)));
-            bake_mesh(c, in.mesh, id, im.vertices, im.indices, im.tri_material, 0, 0, out->vertex_colors);
+            if (!bake_mesh(c, in, id, im.vertices, im.indices, im.tri_material, 0, 0, out))
+                return false;
         }
         scene_instance &o = out->instances[k++];
         memcpy(o.to_world, &xf[12 * i], sizeof o.to_world);

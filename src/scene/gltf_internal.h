@@ -3,7 +3,8 @@
  * checked (scene_gltf.cpp, gltf_json.cpp), tinygltf's parse with files read only through the
  * sandbox (gltf_files.cpp), the model it returns checked against the specification before
  * one byte is read (gltf_check.cpp), then read: animation (gltf_animation.cpp), geometry and
- * the node hierarchy (gltf_geometry.cpp), images, textures and materials (gltf_material.cpp).
+ * the node hierarchy (gltf_geometry.cpp), skins and morph targets (gltf_skin.cpp), images,
+ * textures and materials (gltf_material.cpp).
  * No C++ exception escapes into C. */
 #ifndef GONIO_GLTF_INTERNAL_H
 #define GONIO_GLTF_INTERNAL_H
@@ -55,6 +56,17 @@ struct Prim {                  /* one triangle primitive of a glTF mesh, in the 
     std::vector<float> col;    /* 4 per vertex (RGBA), empty without COLOR_0 */
     std::vector<uint32_t> idx; /* 3 per triangle */
     uint32_t material;         /* glTF material, or GN_INVALID for the default one */
+    /* Skinning and morphing (gltf_skin.cpp), per vertex like the above: */
+    size_t influences = 0;         /* joint-weight pairs per vertex, 4 per JOINTS_n/WEIGHTS_n set */
+    std::vector<uint16_t> joints;  /* influences per vertex: indices into the node's skin's joints */
+    std::vector<float> weights;    /* influences per vertex */
+    struct Target {                /* a morph target: displacements, 3 per vertex, empty if absent */
+        std::vector<float> pos, nrm, tan;
+    };
+    std::vector<Target> targets;
+    int max_joint = -1;            /* the largest joint index with a weight > 0 ... */
+    std::string max_joint_at;      /* ... and where: "meshes[0].primitives[1].attributes.JOINTS_0: vertex 5" */
+    bool flat = false;             /* normals made flat (no NORMAL): recomputed once posed */
 };
 
 struct Instance {
@@ -113,7 +125,9 @@ struct Ctx {
     std::map<int, texture_format> image_formats; /* image -> the format of its bytes, once read */
     uint64_t texels = 0;                     /* of the images decoded so far */
     std::string limit_error;                 /* a SCENE_MAX_* limit exceeded while decoding */
-    bool warned_skin = false, warned_targets = false;
+    std::vector<std::vector<double>> anim_weights; /* per node: its animated morph weights, or empty */
+    std::vector<Mat> world;                  /* per node, posed (gltf_skin.cpp: joint_matrices) */
+    std::vector<std::vector<Mat>> joint_mats; /* per skin: each joint's world x inverse bind matrix */
     int scene_index = -1;                    /* the glTF scene to draw; -1: the default one */
     std::string folder;                      /* realpath of the scene's folder */
     std::string base_dir;                    /* the folder as tinygltf joins URIs to it */
@@ -174,6 +188,8 @@ unsigned format_bit(const tinygltf::Accessor &a);
 const uint8_t *view_data(const Ctx &c, int view, size_t offset);
 double read_comp(const uint8_t *p, int ct, bool norm);
 std::vector<double> read_accessor(const Ctx &c, int i);
+Mat mat_mul(const Mat &a, const Mat &b);
+bool mat_finite(const Mat &m);
 bool node_local(Ctx &c, int i, Mat &out, const Pose *pose = nullptr);
 int node_light(const tinygltf::Node &n);
 bool load_meshes(Ctx &c);
@@ -181,6 +197,26 @@ bool collect_instances(Ctx &c, std::vector<Instance> &inst, std::vector<Instance
 bool bake_geometry(Ctx &c, const std::vector<Instance> &inst, scene *out);
 void bake_cameras(Ctx &c, const std::vector<Instance> &cams, scene *out);
 void bake_lights(Ctx &c, const std::vector<Instance> &lights, scene *out);
+
+/* ---- gltf_skin.cpp: skins and morph targets ------------------------------------------------ */
+/* Skins, morph targets, their weights and the nodes that use them as glTF 2.0 requires, with
+ * the loader's limit on the data they add; errors name the JSON path. */
+bool check_skins_and_targets(Ctx &c);
+/* JOINTS_n/WEIGHTS_n and the morph targets of primitive pi of mesh mi into out, per vertex. */
+bool read_skin_and_targets(Ctx &c, int mi, int pi, Prim &out);
+/* Per-vertex skin and target data in a new vertex order: vertex v takes old vertex src[v]. */
+void remap_skin_and_targets(Prim &p, const uint32_t *src, size_t n);
+/* The morph weights node `node` draws its mesh with: animated, else the node's, else the mesh's. */
+std::vector<double> morph_weights(const Ctx &c, int node);
+/* Each skin's joint matrices at the pose of c.local (after the nodes' transforms are known). */
+bool joint_matrices(Ctx &c);
+/* Whether instance `in` is drawn skinned: its node's transform is then ignored (glTF 2.0,
+ * "Skins"), the joints place the vertices in world space. */
+bool instance_skinned(const Ctx &c, const Instance &in);
+/* Primitive p as instance `in` draws it: the morph targets weighted, then the skin applied
+ * (positions, normals, tangents; flat normals recomputed). False when nothing changes (p is
+ * drawn as it is) or on an error (c.failed). */
+bool pose_primitive(Ctx &c, const Instance &in, const Prim &p, Prim &out);
 
 /* ---- gltf_material.cpp: the extensions, images, textures, materials ------------------------- */
 /* The file's extensionsRequired and extensionsUsed against the table of extensions: an

@@ -65,6 +65,11 @@ void Doc::check_primitive(const Json &pr, const std::string &p)
     }
     index(pr, "indices", p, "accessors");
     index(pr, "material", p, "materials");
+    /* morph targets: objects of attribute -> accessor, as the attributes */
+    each(pr, "targets", p, [&](const Json &t, const std::string &tp, size_t) {
+        for (auto it = t.begin(); it != t.end(); ++it)
+            index(it.value(), at(tp, key_of(it.key()).c_str()), "accessors", count_of("accessors"));
+    });
     enum_int(pr, "mode", p, {0, 1, 2, 3, 4, 5, 6});
     /* KHR_materials_variants: each mapping names existing variants (each at most once in the
      * primitive's mappings) and an existing material. */
@@ -99,6 +104,7 @@ void Doc::check_node(const Json &n, const std::string &p)
     index(n, "mesh", p, "meshes");
     index(n, "skin", p, "skins");
     indices(n, "children", p, "nodes");
+    numbers(n, "weights", p, 0);
     if (numbers(n, "matrix", p, 16)) {
         /* glTF node matrices are affine: the last row (elements 3, 7, 11, 15 in column-major
          * order) is 0 0 0 1. A projective one cannot be a rigid placement; up to rounding. */
@@ -267,6 +273,7 @@ void Doc::check()
     unbounded.assign(count_of("accessors"), false);
     each(root, "accessors", "", [&](const Json &a, const std::string &p, size_t) { check_accessor(a, p); });
     each(root, "meshes", "", [&](const Json &m, const std::string &p, size_t) {
+        numbers(m, "weights", p, 0);
         if (!array(m, "primitives", p, true))
             return;
         each(m, "primitives", p, [&](const Json &pr, const std::string &pp, size_t) { check_primitive(pr, pp); });
@@ -312,7 +319,12 @@ void Doc::check()
     });
     materials_read(c, root);
     each(root, "materials", "", [&](const Json &m, const std::string &p, size_t i) { material_read(*this, m, p, i); });
-    each(root, "skins", "", [&](const Json &, const std::string &, size_t) {}); /* only node.skin is read */
+    each(root, "skins", "", [&](const Json &s, const std::string &p, size_t) {
+        index(s, "inverseBindMatrices", p, "accessors");
+        index(s, "skeleton", p, "nodes");
+        if (array(s, "joints", p, true))
+            indices(s, "joints", p, "nodes");
+    });
     each(root, "animations", "", [&](const Json &a, const std::string &p, size_t) {
         const Json *samplers = array(a, "samplers", p, true);
         size_t ns = samplers ? samplers->size() : 0;

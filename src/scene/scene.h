@@ -2,7 +2,8 @@
  *
  * The loader (scene_gltf.cpp and the gltf_*.cpp files: gltf_internal.h names them) hides
  * tinygltf behind scene_load. It walks the node hierarchy (matrix and TRS, animated at the
- * time scene_animation_time gives), bakes every mesh primitive instance into world space and
+ * time scene_animation_time gives), poses skinned and morphed meshes at that time, bakes every
+ * mesh primitive instance into world space and
  * merges them into one triangle list; per-vertex data stays indexed. Materials and lights
  * are stored directly in their GPU form (glsl/lib/shared.h; a material's fields and where
  * the file sets them: glsl/lib/material.h). */
@@ -107,6 +108,11 @@ typedef struct scene {
     uint32_t num_meshes;        /* glTF mesh primitives drawn (after instancing by nodes) */
     uint32_t num_gltf_meshes;   /* glTF meshes in the file */
     uint32_t num_nodes;         /* glTF nodes in the file */
+    uint32_t num_skins;         /* glTF skins in the file ... */
+    uint32_t num_joints;        /* ... and their joints, all together */
+    uint32_t num_morph_targets; /* morph targets of the file's meshes, all together ... */
+    uint32_t num_morphed_meshes; /* ... and the meshes that have them */
+    double pose_seconds;        /* the time posing skinned and morphed meshes took */
 
     uint32_t num_materials;     /* >= 1: a default material is appended when needed */
     GnMaterial *materials;
@@ -144,7 +150,10 @@ typedef struct scene {
  * unknown enum: the message names the JSON path, materials[2].extensions.KHR_materials_sheen.
  * sheenRoughnessFactor, and is the same for every extension); anything that could make a read
  * go out of bounds (buffers, views, accessors and their sparse parts, attribute formats,
- * indices), node loops, non-finite transforms, bad animation samplers, compressed data its
+ * indices), node loops, non-finite transforms, bad animation samplers, skins and morph targets
+ * glTF does not allow (a joint index beyond the skin's joints, a target whose count is not the
+ * primitive's, weights that do not match the targets, a skin on a mesh without JOINTS_0, ...:
+ * the message names the JSON path), compressed data its
  * decoder rejects; an extension in extensionsRequired that gonio does not support
  * (scene_extension_support); files outside the scene's folder (scene_allow_outside_files);
  * a scene too large (SCENE_MAX_*) or without any triangle ("no triangles").
@@ -154,7 +163,8 @@ typedef struct scene {
  * points/lines primitives (strips and fans become triangles), invalid cameras and lights,
  * texCoord > 1 and missing or undecodable images (PNG, JPEG, and WebP and KTX2 through
  * EXT_texture_webp and KHR_texture_basisu, whose core source is the fallback: the slot is
- * GN_INVALID), non-unit normals (renormalised), skins, morph targets, bad COLOR_0,
+ * GN_INVALID), non-unit normals (renormalised), joint weights that do not sum to one
+ * (renormalised), morph target attributes other than POSITION, NORMAL, TANGENT, bad COLOR_0,
  * triangles with non-finite or absurdly large (|x| > 1e15) vertices (dropped, one warning).
  * Primitives without NORMAL get flat normals (de-indexed); normal maps, clearcoat normal maps
  * and anisotropy get MikkTSpace tangents where a mesh has no TANGENT. out->extensions lists
@@ -192,8 +202,9 @@ void scene_select_variant(const char *name);
 /* Loads that follow see the file's animations at this time in seconds: every animation's
  * translation, rotation and scale channels (STEP, LINEAR with slerp for rotations,
  * CUBICSPLINE as glTF 2.0 defines them) replace the nodes' own, so meshes, cameras and
- * lights move; morph-target weights are not animated (a warning). Negative (the default):
- * the nodes' own transforms. */
+ * lights move, skinned meshes follow their joints, and `weights` channels set the nodes' morph
+ * target weights. Negative (the default): the nodes' own transforms and weights. Skins and
+ * morph targets are posed either way (gltf_skin.cpp). */
 void scene_animation_time(double seconds);
 
 /* Loads that follow keep a mesh that an animation moves (its node's or a parent's

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # run.sh TARGET...: a bounded libFuzzer run of each target (make fuzz-run): FUZZ_TIME seconds
-# each (default 60), seeded in place from $GONIO_ASSETS (sample models, glTF-Validator's
-# invalid files), from EXRs that $GONIO writes here, every compression, scanline and
-# tiled, and from WebP and KTX2 textures written here ($TESTTOOL ktx2, cwebp). New inputs and crash files go to a temporary folder, kept and named on a crash:
+# each (default 60), seeded in place from scenes/, tests/fuzz/seeds (what the sample models
+# lack: a skinned and morphed scene, sparse targets, animated weights), $GONIO_ASSETS (sample
+# models, glTF-Validator's invalid files), from EXRs that $GONIO writes here, every
+# compression, scanline and tiled, and from WebP and KTX2 textures written here ($TESTTOOL
+# ktx2, cwebp). New inputs and crash files go to a temporary folder, kept and named on a crash:
 # minimise one (TARGET -minimize_crash=1 FILE), fix the bug, and add the small file to
 # tests/fuzz/regress (tests/regress/fuzz.sh replays them in make test).
 set -u
@@ -21,7 +23,7 @@ export VK_ICD_FILENAMES=${VK_ICD_FILENAMES:-$(ls /usr/share/vulkan/icd.d/lvp_icd
 mkdir -p "$tmp/seed-scene" "$tmp/seed-exr" "$tmp/seed-merge"
 n=0
 link() { ln -s "$(realpath "$2")" "$1/$n-$(basename "$2")"; n=$((n + 1)); }
-for f in scenes/*.gltf; do link "$tmp/seed-scene" "$f"; done
+for f in scenes/*.gltf tests/fuzz/seeds/*; do link "$tmp/seed-scene" "$f"; done
 if [ -d "$A" ]; then
     while IFS= read -r f; do link "$tmp/seed-scene" "$f"; done < <(
         find "$A/gltf" "$A/invalid-gltf" "$A/asset-generator" \( -name '*.gltf' -size -64k \) -o \( -name '*.glb' -size -256k \) 2>/dev/null)

@@ -344,6 +344,7 @@ static const struct {
     uint32_t tris, verts, prims, meshes, nodes, mats, images, textures, cameras, lights;
     int warnings;
 } samples[] = {
+    {"gltf/AnimatedMorphCube/glTF/AnimatedMorphCube.gltf", 12, 24, 1, 1, 1, 1, 0, 0, 0, 0, 0},
     {"gltf/Avocado/glTF/Avocado.gltf", 682, 406, 1, 1, 1, 1, 3, 3, 0, 0, 0},
     {"gltf/Box/glTF-Binary/Box.glb", 12, 24, 1, 1, 2, 1, 0, 0, 0, 0, 0},
     {"gltf/Box/glTF-Embedded/Box.gltf", 12, 24, 1, 1, 2, 1, 0, 0, 0, 0, 0},
@@ -353,6 +354,7 @@ static const struct {
     {"gltf/BoxTextured/glTF/BoxTextured.gltf", 12, 24, 1, 1, 2, 1, 1, 1, 0, 0, 0},
     {"gltf/Cameras/glTF-Embedded/Cameras.gltf", 2, 6, 1, 1, 3, 1, 0, 0, 2, 0, 0},
     {"gltf/Cameras/glTF/Cameras.gltf", 2, 6, 1, 1, 3, 1, 0, 0, 2, 0, 0},
+    {"gltf/CesiumMan/glTF/CesiumMan.gltf", 4672, 3273, 1, 1, 22, 1, 1, 1, 0, 0, 0},
     {"gltf/DamagedHelmet/glTF/DamagedHelmet.gltf", 15452, 14566, 1, 1, 1, 1, 5, 5, 0, 0, 0},
     {"gltf/Duck/glTF-Binary/Duck.glb", 4212, 2399, 1, 1, 3, 1, 1, 1, 1, 0, 0},
     {"gltf/Duck/glTF/Duck.gltf", 4212, 2399, 1, 1, 3, 1, 1, 1, 1, 0, 0},
@@ -362,11 +364,16 @@ static const struct {
     {"gltf/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf", 6000, 4555, 3, 3, 8, 3, 7, 7, 0, 5, 0},
     {"gltf/MetalRoughSpheresNoTextures/glTF-Binary/MetalRoughSpheresNoTextures.glb", 1040409, 528291, 123, 102, 119, 99, 0, 0, 0, 0, 0},
     {"gltf/MetalRoughSpheresNoTextures/glTF/MetalRoughSpheresNoTextures.gltf", 1040409, 528291, 123, 102, 119, 99, 0, 0, 0, 0, 0},
+    {"gltf/MorphPrimitivesTest/glTF/MorphPrimitivesTest.gltf", 32, 30, 2, 1, 2, 2, 1, 1, 0, 0, 0},
     {"gltf/NormalTangentTest/glTF/NormalTangentTest.gltf", 7774, 3983, 1, 1, 2, 1, 3, 3, 0, 0, 0},
     {"gltf/OrientationTest/glTF-Binary/OrientationTest.glb", 524, 1048, 13, 13, 13, 7, 0, 0, 0, 0, 0},
     {"gltf/OrientationTest/glTF/OrientationTest.gltf", 524, 1048, 13, 13, 13, 7, 0, 0, 0, 0, 0},
+    {"gltf/RiggedSimple/glTF/RiggedSimple.gltf", 188, 160, 1, 1, 5, 1, 0, 0, 0, 0, 0},
     {"gltf/SimpleMeshes/glTF-Embedded/SimpleMeshes.gltf", 2, 6, 2, 1, 2, 1, 0, 0, 0, 0, 0},
     {"gltf/SimpleMeshes/glTF/SimpleMeshes.gltf", 2, 6, 2, 1, 2, 1, 0, 0, 0, 0, 0},
+    {"gltf/SimpleMorph/glTF/SimpleMorph.gltf", 1, 3, 1, 1, 1, 1, 0, 0, 0, 0, 0},
+    {"gltf/SimpleSkin/glTF/SimpleSkin.gltf", 8, 24, 1, 1, 3, 1, 0, 0, 0, 0, 0},
+    {"gltf/SimpleSparseAccessor/glTF/SimpleSparseAccessor.gltf", 12, 36, 1, 1, 1, 1, 0, 0, 0, 0, 0},
     {"gltf/Suzanne/glTF/Suzanne.gltf", 3936, 11808, 1, 1, 1, 1, 2, 2, 0, 0, 0},
     {"gltf/TextureCoordinateTest/glTF-Binary/TextureCoordinateTest.glb", 10, 20, 5, 5, 5, 5, 1, 1, 0, 0, 0},
     {"gltf/TextureCoordinateTest/glTF/TextureCoordinateTest.gltf", 10, 20, 5, 5, 5, 5, 1, 1, 0, 0, 0},
