@@ -3,7 +3,15 @@
 // queries (one per invocation) so the unit tests and `gonio brdf` measure the shader code
 // itself: eval and pdf at given directions, sample with given random numbers, and the
 // Fresnel functions (BrdfQuery/BrdfResult in brdf_models.h).
+// Specialised, as the renderer's kernels are, on the GN_FEAT_* that a batch's queries need
+// (src/render/brdf.c: brdf_query_features): llvmpipe runs both sides of a branch, so the code
+// of every model a query does not use would cost it as much time as its own (20 times a
+// Lambert's). FEATURES = GN_FEAT_ALL (GONIO_ALL_FEATURES) is the unspecialised kernel.
 #extension GL_GOOGLE_include_directive : require
+
+#define GN_HAS(f) ((FEATURES & (f)) != 0u)
+#include "shared.h"
+layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
 
 #include "brdf.glsl"
 
@@ -36,12 +44,16 @@ void main()
         results[i] = r;
         return;
     }
-    Bsdf b = q.model == BRDF_GLTF
-        ? bsdf_gltf(q.color, q.params.x, q.params.y, q.params.z, q.extra.xyz, q.params.w, q.extra.w)
-        : bsdf_from_model(q.model, q.color, q.params);
-    if (q.model == BRDF_GLTF) {
-        b = bsdf_gltf_film(b, q.color, q.params.x, q.params.z, q.extra.xyz, q.params.w, q.extra.w, q.irid.xyz, q.dt);
-        b = bsdf_layers(b, q.layer.x, q.layer.y, vec3(sin(q.layer.w), 0.0, cos(q.layer.w)), q.sheen.rgb, q.layer.z);
+    // (the models' and glTF's parts gated as path.comp's material_bsdf gates them)
+    Bsdf b;
+    if (GN_HAS(GN_FEAT_MODELS) && (!GN_HAS(GN_FEAT_GLTF) || q.model != BRDF_GLTF)) {
+        b = bsdf_from_model(q.model, q.color, q.params);
+    } else {
+        b = bsdf_gltf(q.color, q.params.x, q.params.y, q.params.z, q.extra.xyz, q.params.w, q.extra.w);
+        if (GN_HAS(GN_FEAT_LAYERS)) {
+            b = bsdf_gltf_film(b, q.color, q.params.x, q.params.z, q.extra.xyz, q.params.w, q.extra.w, q.irid.xyz, q.dt);
+            b = bsdf_layers(b, q.layer.x, q.layer.y, vec3(sin(q.layer.w), 0.0, cos(q.layer.w)), q.sheen.rgb, q.layer.z);
+        }
         // the tangent is +x: the anisotropy's direction is the rotation's
         b = bsdf_anisotropy(b, q.aniso.x, vec2(cos(q.aniso.y), sin(q.aniso.y)));
     }

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "brdf.h"
 #include "test.h"
@@ -166,33 +167,49 @@ static brdf_runner runner;
 #define CHUNK 65536 /* queries per batch: small buffers keep page faults (and ASan) cheap */
 static BrdfQuery *qbuf; /* CHUNK queries and results, reused by every batch */
 static BrdfResult *rbuf;
+static int messages_before; /* validation messages when the running test began */
 
 static void grid_init(void);
 
-static bool open_runner(void)
-{
-    gpu_desc d = {.device_index = -1};
-    const char *env = getenv("GONIO_VALIDATE");
-    d.validate = env && !strcmp(env, "1");
-    if (!gpu_create(&test_gpu, &d)) {
-        CHECKF(false, "no Vulkan device");
-        return false;
-    }
-    brdf_runner_create(&runner, &test_gpu, CHUNK);
-    grid_init();
-    return true;
-}
-
-static void close_runner(void)
+/* At exit: the runner and device the tests shared, destroyed; a validation message in
+ * that makes the run fail. */
+static void destroy_runner(void)
 {
     brdf_runner_destroy(&runner);
-    CHECK(gpu_validation_message_count() == 0);
     gpu_destroy(&test_gpu);
     free(qbuf);
     free(rbuf);
-    qbuf = NULL;
-    rbuf = NULL;
+    if (gpu_validation_message_count() > messages_before) {
+        fprintf(stderr, "test_brdf.c: validation messages while destroying the runner\n");
+        _exit(1);
+    }
 }
+
+/* The runner, its device and its kernels are made once a process and shared by the tests
+ * (each specialised kernel is compiled once: brdf_runner keeps them). */
+static bool open_runner(void)
+{
+    static bool opened, failed;
+    if (!opened && !failed) {
+        gpu_desc d = {.device_index = -1};
+        const char *env = getenv("GONIO_VALIDATE");
+        d.validate = env && !strcmp(env, "1");
+        if (!gpu_create(&test_gpu, &d)) {
+            failed = true;
+        } else {
+            brdf_runner_create(&runner, &test_gpu, CHUNK);
+            grid_init();
+            atexit(destroy_runner);
+            opened = true;
+        }
+    }
+    CHECKF(opened, "no Vulkan device");
+    messages_before = gpu_validation_message_count();
+    return opened;
+}
+
+/* The end of a test: no validation message while it ran. */
+static void close_runner(void) { CHECK(gpu_validation_message_count() == messages_before); }
 
 /* ---- statistics --------------------------------------------------------------------- */
 
@@ -552,6 +569,57 @@ TEST(brdf, finite_and_positive)
         }
         CHECKF(bad == 0, "%s: %d queries with NaN/Inf or negative values", describe(&cases[ci]), bad);
         CHECKF(below == 0, "%s: %d queries reflect light below an opaque surface", describe(&cases[ci]), below);
+    }
+    close_runner();
+}
+
+/* The kernel specialised on a query's features (brdf_query_features, as the renderer's
+ * kernels are on a scene's) computes what the unspecialised one does, bit for bit, for
+ * every setting: over the same random, grazing and degenerate directions as above, eval,
+ * sample and the NDF queries. A feature missing from brdf_query_features would compile code out from under
+ * the tests that follow (they run the specialised kernel); this finds it. */
+TEST(brdf, specialised_same)
+{
+    enum { N = 4096 };
+    static BrdfResult unspec[N];
+    if (!open_runner())
+        return;
+    BrdfQuery *q = qbuf;
+    BrdfResult *r = rbuf;
+    rng_state = 10;
+    for (int ci = 0; ci < num_cases(); ci++) {
+        brdf_setting s;
+        int differ = 0;
+        make_setting(&cases[ci], &s);
+        for (int i = 0; i < N; i++) {
+            vec3 wo = polar(acos(1 - 2 * rnd()), 2 * PI * rnd()), wi = polar(acos(1 - 2 * rnd()), 2 * PI * rnd());
+            if (i % 4 == 1)
+                wo = polar(acos(pow(10.0, -2.0 - 6.0 * rnd())), 2 * PI * rnd()); /* grazing */
+            if (i % 4 == 2)
+                wi = wo;
+            q[i] = query(&s, i % 8 == 7 ? BRDF_OP_NDF : BRDF_OP_EVAL | BRDF_OP_SAMPLE, wo, wi, rnd_u());
+        }
+        runner.all_features = true;
+        brdf_runner_run(&runner, q, unspec, N);
+        runner.all_features = false;
+        brdf_runner_run(&runner, q, r, N);
+        for (int i = 0; i < N; i++) {
+            const float *a = &r[i].f.x, *b = &unspec[i].f.x;
+            bool same = !memcmp(&r[i].pdf, &unspec[i].pdf, sizeof(float)) &&
+                        !memcmp(&r[i].s_pdf, &unspec[i].s_pdf, sizeof(float)) &&
+                        !memcmp(&r[i].s_pdf_eval, &unspec[i].s_pdf_eval, sizeof(float)) &&
+                        r[i].s_flags == unspec[i].s_flags;
+            for (int c = 0; c < 3; c++)
+                same = same && !memcmp(&a[c], &b[c], sizeof(float)) &&
+                       !memcmp(&(&r[i].s_wi.x)[c], &(&unspec[i].s_wi.x)[c], sizeof(float)) &&
+                       !memcmp(&(&r[i].s_weight.x)[c], &(&unspec[i].s_weight.x)[c], sizeof(float)) &&
+                       !memcmp(&(&r[i].s_f.x)[c], &(&unspec[i].s_f.x)[c], sizeof(float));
+            if (!same && differ++ < 2)
+                fprintf(stderr, "  %s (features 0x%08x): query %d: f %g pdf %g w %g flags %u, unspecialised f %g pdf %g "
+                        "w %g flags %u\n", describe(&cases[ci]), brdf_query_features(&q[i]), i, a[0], r[i].pdf,
+                        r[i].s_weight.x, r[i].s_flags, b[0], unspec[i].pdf, unspec[i].s_weight.x, unspec[i].s_flags);
+        }
+        CHECKF(differ == 0, "%s: %d of %d queries differ from the unspecialised kernel's", describe(&cases[ci]), differ, N);
     }
     close_runner();
 }
