@@ -17,14 +17,23 @@ check_fails "an unknown BRDF model is a usage error" 2 "$G" render $C -o "$tmp/x
 check "the message names the models" grep -q 'torrance-sparrow' "$tmp/last"
 check_fails "a missing environment map fails" 1 "$G" render $C -o "$tmp/x.exr" --env "$tmp/none.exr" --quiet
 
+# base SCENE FLAGS...: the path of SCENE's render as it is (3 spp, 24x24, FLAGS), made once
+# in this script (with GONIO_WALK_ARRAY as set now): the checks below compare several
+# variants of a render against it.
+base() {
+    local f=$tmp/base-$(printf '%s\n' "${GONIO_WALK_ARRAY:-}" "$@" | md5sum | cut -c1-16).exr
+    [ -e "$f" ] || "$G" render "$1" -o "$f" --spp 3 --size 24x24 --quiet "${@:2}" || return 1
+    echo "$f"
+}
+
 # same_pixels WHAT ENV NAME SCENE FLAGS...: a render as it is and one with the environment
 # assignment ENV must give identical pixels; the check is named "WHAT: NAME".
 same_pixels() {
-    local what=$1 env=$2 name=$3 scene=$4; shift 4
-    if "$G" render "$scene" -o "$tmp/one.exr" --spp 3 --size 24x24 --quiet "$@" 2>"$tmp/spec.err" &&
+    local what=$1 env=$2 name=$3 scene=$4 one; shift 4
+    if one=$(base "$scene" "$@" 2>"$tmp/spec.err") &&
         env "$env" "$G" render "$scene" -o "$tmp/two.exr" --spp 3 --size 24x24 --quiet "$@" \
             2>>"$tmp/spec.err"; then
-        check_fails "$what: $name" 0 "$G" diff "$tmp/one.exr" "$tmp/two.exr" --max-error 0
+        check_fails "$what: $name" 0 "$G" diff "$one" "$tmp/two.exr" --max-error 0
     else
         fail "$what: $name (render failed)"; sed 's/^/    /' "$tmp/spec.err"
     fi
@@ -75,11 +84,11 @@ same_as_stack_array "Cornell box, --mode gouraud" $C --mode gouraud
 # every pixel and AOV must be what the render at the normal cap gives, and resuming must
 # really have happened (GONIO_DEBUG_RESUMES).
 same_interrupted() {
-    local name=$1 scene=$2; shift 2
-    if "$G" render "$scene" -o "$tmp/one.exr" --spp 3 --size 24x24 --quiet "$@" 2>"$tmp/cap.err" &&
+    local name=$1 scene=$2 one; shift 2
+    if one=$(base "$scene" "$@" 2>"$tmp/cap.err") &&
         env GONIO_LOOP_CAP=3000 GONIO_DEBUG_RESUMES=1 "$G" render "$scene" -o "$tmp/two.exr" \
             --spp 3 --size 24x24 --quiet "$@" 2>>"$tmp/cap.err"; then
-        check "interrupted paths = whole paths: $name" "$TESTTOOL" same "$tmp/one.exr" "$tmp/two.exr"
+        check "interrupted paths = whole paths: $name" "$TESTTOOL" same "$one" "$tmp/two.exr"
         n=$(sed -n 's/^gonio: debug: \([0-9]*\) dispatch.*/\1/p' "$tmp/cap.err")
         check "... and some were interrupted ($name: ${n:-no} resuming dispatches)" test "${n:-0}" -gt 0
         check "... none cut short ($name)" sh -c "! grep -q 'internal error\|cut short' '$tmp/cap.err'"
