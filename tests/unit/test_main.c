@@ -74,12 +74,15 @@ static int by_place(const void *pa, const void *pb)
     return c ? c : a->line - b->line;
 }
 
-static double now(void)
+static double seconds(clockid_t clock)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(clock, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
+static double now(void) { return seconds(CLOCK_MONOTONIC); }
+/* CPU time of the process, lavapipe's threads included */
+static double cpu_now(void) { return seconds(CLOCK_PROCESS_CPUTIME_ID); }
 
 static bool matches(const char *name, const char *pattern)
 {
@@ -120,7 +123,7 @@ int main(int argc, char **argv)
     qsort(tests, (size_t)num_tests, sizeof *tests, by_place);
     for (int i = 0; i < num_tests; i++) {
         int before, k;
-        double t0, dt;
+        double t0, dt, c0;
         if (!(tests[i].slow ? want_slow : want_fast))
             continue;
         for (k = 0; k < npat && !matches(tests[i].name, patterns[k]); k++)
@@ -136,11 +139,12 @@ int main(int argc, char **argv)
         printf("  %s\n", tests[i].name);
         fflush(stdout);
         t0 = now();
+        c0 = cpu_now();
         tests[i].fn();
         dt = now() - t0;
         if (dt > TEST_BUDGET_S)
-            printf("    note: %s took %.1f s, over the %.0f s budget of a test (tests/README.md)%s\n", tests[i].name,
-                   dt, TEST_BUDGET_S, tests[i].slow ? "; it is in the slow tier" : "");
+            printf("    note: %s took %.1f s (CPU %.1f s), over the %.0f s budget of a test (tests/README.md)%s\n",
+                   tests[i].name, dt, cpu_now() - c0, TEST_BUDGET_S, tests[i].slow ? "; it is in the slow tier" : "");
         if (test_failures != before) {
             failed++;
             printf("    FAILED\n");
