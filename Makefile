@@ -1,6 +1,7 @@
 # gonio: build, run, test, bench.
 #   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
-#   make run | test | test-farm | bench | bench-peer | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
+#   make run | test | test-slow | test-full | mutants | test-farm | bench | bench-peer | docs-images | clean
+#   make install [PREFIX=/usr/local] [DESTDIR=]
 #   make fuzz (libFuzzer targets, clang, in build/fuzz) | fuzz-run [FUZZ_TIME=60]
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
 # is printed and make stops.
@@ -96,8 +97,8 @@ FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
 	echo 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n) { return 0; }' | \
 	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
 
-.PHONY: all deps test-deps run test unit regress bench clean install shaders docs-images \
-	fuzz fuzz-deps fuzz-targets fuzz-run test-farm bench-peer
+.PHONY: all deps test-deps run test test-build test-slow test-full mutants unit regress bench clean \
+	install shaders docs-images fuzz fuzz-deps fuzz-targets fuzz-run test-farm bench-peer
 all: $(GONIO) build/gonio
 
 deps:
@@ -154,8 +155,20 @@ run: all
 	@mkdir -p out
 	$(GONIO) render scenes/cornell.gltf -o out/cornell.exr --png out/cornell.png
 
-test: all $(UNIT) $(TESTTOOL) test-deps
-	@GONIO=$(GONIO) UNIT=$(UNIT) TESTTOOL=$(TESTTOOL) CONFIG=$(config) tests/run.sh
+# The tests in two tiers (tests/README.md): make test is the fast one (at most 5 minutes on
+# 2 cores), test-slow the rest, test-full both. TESTS=NAME... runs only the jobs whose names
+# contain a NAME (unit/brdf, regress/path.sh, ...); TEST_JOBS=N runs N at once (default: the CPUs).
+TEST_ENV = GONIO=$(GONIO) UNIT=$(UNIT) TESTTOOL=$(TESTTOOL) CONFIG=$(config)
+test-build: all $(UNIT) $(TESTTOOL) test-deps
+test: test-build
+	@$(TEST_ENV) tests/run.sh --tier fast $(TESTS)
+test-slow: test-build
+	@$(TEST_ENV) tests/run.sh --tier slow $(TESTS)
+test-full: test-build
+	@$(TEST_ENV) tests/run.sh --tier full $(TESTS)
+# Deliberate bugs, each built in a scratch copy, that the fast tier must catch (tests/mutants.sh).
+mutants: test-build
+	@config=$(config) tests/mutants.sh $(TESTS)
 
 # A one-node Slurm cluster on localhost runs farm/slurm-tiles.sh (tests/farm/slurm.sh);
 # it skips, saying why, where slurm-wlm and munge cannot be installed or started.
