@@ -1,7 +1,7 @@
 # gonio: build, run, test, bench.
 #   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
-#   make run | test | test-slow | test-full | mutants | test-farm | bench | bench-peer | docs-images | clean
-#   make install [PREFIX=/usr/local] [DESTDIR=]
+#   make run | test | test-slow | test-full | mutants | check-layers | test-farm | bench | bench-peer
+#   make bench-denoise | denoiser | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
 #   make fuzz (libFuzzer targets, clang, in build/fuzz) | fuzz-run [FUZZ_TIME=60]
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
 # is printed and make stops.
@@ -23,12 +23,25 @@ PKGS := vulkan glfw3 OpenEXR tinygltf nlohmann_json libpng zlib stb draco
 # meshoptimizer ships no pkg-config file (Debian 12): linked by name.
 LIBS_EXTRA := -lmeshoptimizer
 WARN := -Wall -Wextra -Wshadow -Werror
-# The folders of the architecture (docs/architecture.md): core (errors, images, Vulkan, plots),
-# scene (glTF, meshes, camera, environment), accel (the BVH), render (the renderer, BRDFs,
-# outputs), cli (the commands); glsl/lib holds what kernels include, glsl/kernels the
-# program's kernels, tests/kernels the unit tests' own.
-SRC_DIRS := src/core src/scene src/accel src/render src/cli
-CPPFLAGS += $(SRC_DIRS:%=-I%) -Iglsl/lib -I$(BUILD)/spv -MMD -MP
+# The folders of the architecture (docs/architecture.md) are layers, lowest first: core
+# (errors, images, Vulkan, plots), scene (glTF, meshes, camera, environment) and accel (the
+# BVH) on it, render (the renderer, BRDFs, outputs), cli (the commands); glsl/lib (what the
+# host and the kernels share) is below them all, glsl/kernels the program's kernels (their
+# SPIR-V headers are the render and cli layers'), tests/kernels the unit tests' own.
+# LAYER_x: the folders x may include from besides its own. Each source is compiled with the
+# include paths of its layer only, so an upward #include does not compile, and make test
+# checks the include graph (tests/tool/layers.sh: also includes that name a path).
+LAYERS := core scene accel render cli
+LAYER_core :=
+LAYER_scene := core
+LAYER_accel := core
+LAYER_render := core scene accel
+LAYER_cli := core scene accel render
+SRC_DIRS := $(LAYERS:%=src/%)
+layer_includes = $(patsubst %,-Isrc/%,$(1) $(LAYER_$(1))) -Iglsl/lib $(if $(filter render cli,$(1)),-I$(BUILD)/spv)
+$(foreach l,$(LAYERS),$(eval $(BUILD)/src/$(l)/%.o: INCLUDES = $(call layer_includes,$(l))))
+INCLUDES = $(SRC_DIRS:%=-I%) -Iglsl/lib -I$(BUILD)/spv # tests, tools and fuzz targets: every layer
+CPPFLAGS += -MMD -MP
 CFLAGS += -std=c11 -D_DEFAULT_SOURCE -pthread $(WARN)
 CXXFLAGS += -std=c++14 -pthread -Wall -Wextra -Werror
 LDFLAGS += -pthread
@@ -74,7 +87,7 @@ UNIT := $(BUILD)/unit_tests
 TESTTOOL := $(BUILD)/testtool
 
 # ---- Debian packages -------------------------------------------------------------------
-# nlohmann-json3-dev: the JSON library tinygltf parses with, which scene_gltf.cpp uses to check
+# nlohmann-json3-dev: the JSON library tinygltf parses with, which gltf_json.cpp uses to check
 # the document itself (tinygltf's package does not depend on it).
 DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
 	libopenexr-dev libtinygltf-dev nlohmann-json3-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers help2man \
@@ -97,8 +110,9 @@ FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
 	echo 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n) { return 0; }' | \
 	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
 
-.PHONY: all deps test-deps run test test-build test-slow test-full mutants unit regress bench clean \
-	install shaders docs-images fuzz fuzz-deps fuzz-targets fuzz-run test-farm bench-peer
+.PHONY: all deps test-deps run test test-build test-slow test-full mutants check-layers unit regress \
+	bench clean install shaders docs-images fuzz fuzz-deps fuzz-targets fuzz-run fuzz-partials test-farm \
+	bench-peer denoiser denoiser-if-possible bench-denoise
 all: $(GONIO) build/gonio
 
 deps:
@@ -136,11 +150,11 @@ $(TESTTOOL): $(TOOL_OBJ) $(LIB_OBJ) | deps
 
 $(BUILD)/%.o: %.c | deps $(SPV_HDR)
 	@mkdir -p $(dir $@)
-	$(CC) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
+	$(CC) $(INCLUDES) $(CPPFLAGS) $(PKG_CFLAGS) $(CFLAGS) -c -o $@ $<
 
 $(BUILD)/%.o: %.cpp | deps
 	@mkdir -p $(dir $@)
-	$(CXX) $(CPPFLAGS) $(PKG_CFLAGS) $(CXXFLAGS) -c -o $@ $<
+	$(CXX) $(INCLUDES) $(CPPFLAGS) $(PKG_CFLAGS) $(CXXFLAGS) -c -o $@ $<
 
 # Shaders: GLSL -> SPIR-V (checked by spirv-val) -> C array in a generated header.
 $(BUILD)/spv/%.h: %.comp | deps
@@ -149,6 +163,8 @@ $(BUILD)/spv/%.h: %.comp | deps
 	spirv-val --target-env vulkan1.1 $(BUILD)/spv/$*.spv
 	glslangValidator -V --target-env vulkan1.1 -Iglsl/lib --vn spv_$(subst -,_,$*) -o $@ $< >/dev/null
 	@sed -i 's|\.spv:|.h:|' $(BUILD)/spv/$*.d
+	@# (and, as -MP does for C, an empty rule per included file: a file renamed or removed is no error)
+	@sed -n 's|^[^:]*: [^ ]*||p' $(BUILD)/spv/$*.d | tr ' ' '\n' | sed -n 's|^\(..*\)$$|\1:|p' >>$(BUILD)/spv/$*.d
 shaders: $(SPV_HDR)
 
 run: all
@@ -159,7 +175,7 @@ run: all
 # 2 cores), test-slow the rest, test-full both. TESTS=NAME... runs only the jobs whose names
 # contain a NAME (unit/brdf, regress/path.sh, ...); TEST_JOBS=N runs N at once (default: the CPUs).
 TEST_ENV = GONIO=$(GONIO) UNIT=$(UNIT) TESTTOOL=$(TESTTOOL) CONFIG=$(config)
-test-build: all $(UNIT) $(TESTTOOL) test-deps
+test-build: check-layers all $(UNIT) $(TESTTOOL) test-deps denoiser-if-possible
 test: test-build
 	@$(TEST_ENV) tests/run.sh --tier fast $(TESTS)
 test-slow: test-build
@@ -170,6 +186,41 @@ test-full: test-build
 mutants: test-build
 	@config=$(config) tests/mutants.sh $(TESTS)
 
+# Intel Open Image Denoise 2 for `render --denoise` and `gonio denoise` (src/core/denoise.h,
+# docs/denoise.md). Debian 12 packages no OIDN 2: its CPU libraries (the RT filter's
+# weights in _core, the CPU device, TBB) come from PyPI's pyoidn wheel, fetched with pip
+# into build/oidn and unpacked there without the GPU devices' libraries (CUDA, HIP, SYCL),
+# which the CPU device does not load. gonio loads it at run time; a plain `make` fetches
+# nothing. `make test` fetches it where it can (its denoise tests skip, saying so, where
+# not); `make denoiser` fails where it cannot. Version pinned: the one measured in
+# docs/performance.md.
+OIDN_VERSION := 2.5.1
+OIDN_LIB := build/oidn/lib/libOpenImageDenoise.so.2
+OIDN_FILES := libOpenImageDenoise.so.2 libOpenImageDenoise_core.so.$(OIDN_VERSION) \
+	libOpenImageDenoise_device_cpu.so.$(OIDN_VERSION) libtbb.so.12
+DEB_OIDN := python3-pip
+denoiser: $(OIDN_LIB)
+$(OIDN_LIB):
+	@if ! python3 -m pip --version >/dev/null 2>&1; then $(call apt_install,$(DEB_OIDN)); fi
+	@rm -rf build/oidn/wheel build/oidn/lib && mkdir -p build/oidn/wheel build/oidn/lib
+	@echo "gonio: fetching Open Image Denoise $(OIDN_VERSION) (pip: pyoidn==$(OIDN_VERSION).0) into build/oidn"
+	@python3 -m pip download -q --retries 1 --timeout 30 --no-deps --only-binary=:all: --platform manylinux2014_x86_64 \
+		-d build/oidn/wheel pyoidn==$(OIDN_VERSION).0 \
+		|| { rm -rf build/oidn; echo "gonio: pip could not fetch pyoidn==$(OIDN_VERSION).0"; exit 1; }
+	@python3 -c 'import sys, zipfile, glob, os; \
+		z = zipfile.ZipFile(glob.glob("build/oidn/wheel/*.whl")[0]); \
+		[open(os.path.join("build/oidn/lib", f), "wb").write(z.read("pyoidn/oidn/lib/" + f)) for f in sys.argv[1:]]' \
+		$(OIDN_FILES) || { rm -rf build/oidn; echo "gonio: the pyoidn wheel lacks the expected libraries"; exit 1; }
+	@rm -rf build/oidn/wheel
+	@echo "gonio: $(OIDN_LIB) and its CPU device are in place"
+# The denoiser's figures of docs/performance.md: quality against high-spp references and
+# the time to an RMSE with and without it (tests/denoise/quality.sh; about half an hour).
+bench-denoise: all $(TESTTOOL) denoiser
+	@tests/denoise/quality.sh $(GONIO) $(TESTTOOL) build/denoise
+denoiser-if-possible:
+	@[ -e $(OIDN_LIB) ] || $(MAKE) --no-print-directory denoiser || \
+		echo "gonio: note: no Open Image Denoise; the denoise tests will skip (make denoiser says why)"
+
 # A one-node Slurm cluster on localhost runs farm/slurm-tiles.sh (tests/farm/slurm.sh);
 # it skips, saying why, where slurm-wlm and munge cannot be installed or started.
 DEB_FARM := slurm-wlm munge
@@ -177,6 +228,10 @@ FARM_DEPS_CHECK = { command -v slurmctld && command -v slurmd && command -v mung
 test-farm: all $(TESTTOOL)
 	@if ! $(FARM_DEPS_CHECK); then ( $(call apt_install,$(DEB_FARM)) ) || true; fi
 	@GONIO=$(GONIO) TESTTOOL=$(TESTTOOL) tests/farm/slurm.sh; rc=$$?; [ $$rc = 0 ] || [ $$rc = 77 ]
+
+# The include graph against LAYERS (also run by make test).
+check-layers:
+	@tests/tool/layers.sh $(foreach l,$(LAYERS),"$(l):$(LAYER_$(l))")
 
 unit: $(UNIT)
 	$(UNIT) $(T)
@@ -195,7 +250,7 @@ bench-peer: all
 
 # libFuzzer targets over scene_load and image_read_exr (tests/fuzz); fuzz-run runs each for
 # FUZZ_TIME seconds from seeds of $GONIO_ASSETS and EXRs gonio writes (tests/fuzz/run.sh).
-FUZZ_TARGETS := build/fuzz/fuzz_scene build/fuzz/fuzz_exr
+FUZZ_TARGETS := build/fuzz/fuzz_scene build/fuzz/fuzz_exr build/fuzz/fuzz_merge
 FUZZ_TIME ?= 60
 fuzz: fuzz-deps
 	@$(MAKE) --no-print-directory config=fuzz CC=clang CXX=clang++ fuzz-targets
@@ -205,6 +260,13 @@ build/fuzz/fuzz_%: $(BUILD)/tests/fuzz/fuzz_%.o $(LIB_OBJ) | deps
 	$(CXX) $(LDFLAGS) -fsanitize=fuzzer -o $@ $^ $(PKG_LIBS) $(LIBS_EXTRA) -lm
 fuzz-run: fuzz all test-deps
 	@GONIO=$(GONIO) FUZZ_TIME=$(FUZZ_TIME) tests/fuzz/run.sh $(FUZZ_TARGETS)
+
+# PARTIALS damaged resumable partials and tiles through the sanitizer build's gonio
+# (tests/fuzz/partials.sh): no crash, hang, sanitizer report, or NaN written with exit 0.
+PARTIALS ?= 2000
+fuzz-partials:
+	@$(MAKE) --no-print-directory config=sanitize all
+	@GONIO=build/sanitize/gonio tests/fuzz/partials.sh $(PARTIALS)
 
 # The figures of docs/ (docs/make-images.sh lists them).
 docs-images: all $(TESTTOOL)

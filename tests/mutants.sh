@@ -15,14 +15,14 @@ config=${config:-release}
 # name|file|the exact text|its replacement: each text must occur exactly once in its file.
 mutants=(
     # BSDF: GGX's distribution without its alpha^2 numerator (not normalised for alpha != 1).
-    "brdf-ggx-norm|glsl/lib/brdf.glsl|    return a * a / (BRDF_PI * d * d);|    return a / (BRDF_PI * d * d);"
+    "brdf-ggx-norm|glsl/lib/brdf_scatter.glsl|    return a * a / (BRDF_PI * d * d);|    return a / (BRDF_PI * d * d);"
     # BSDF sampling: Blinn's pdf with the Jacobian of the half vector at the normal's cosine
     # instead of wo.h: f is right, the sampled directions' density is not what pdf says.
-    "brdf-blinn-pdf|glsl/lib/brdf.glsl|        pdf = (n + 1.0) / (2.0 * BRDF_PI) * v / (4.0 * oh);|        pdf = (n + 1.0) / (2.0 * BRDF_PI) * v / (4.0 * h.z);"
+    "brdf-blinn-pdf|glsl/lib/brdf_bsdf.glsl|        pdf = (n + 1.0) / (2.0 * BRDF_PI) * v / (4.0 * oh);|        pdf = (n + 1.0) / (2.0 * BRDF_PI) * v / (4.0 * h.z);"
     # merge: every file weighted by the first one's sample count, not its own.
     "merge-weights|src/cli/cmd_merge.c|                        double w = (double)spp[i], xv;|                        double w = (double)spp[0], xv;"
     # loader: the check that an accessor fits in its buffer view, removed.
-    "loader-accessor-bounds|src/scene/scene_gltf.cpp|        if (!fits(a.byteOffset, stride, a.count, es, v.byteLength))|        if (false)"
+    "loader-accessor-bounds|src/scene/gltf_check.cpp|        if (!fits(a.byteOffset, stride, a.count, es, v.byteLength))|        if (false)"
     # path tracer: light sampling's area-to-solid-angle Jacobian without the emitter's cosine.
     "path-light-pdf|glsl/kernels/path.comp|            s.pdf = e.pdf / e.area * d2 / c;|            s.pdf = e.pdf / e.area * d2;"
 )

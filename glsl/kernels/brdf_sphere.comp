@@ -2,10 +2,12 @@
 // brdf_sphere.comp: the material ball of `gonio brdf --sphere`: a unit sphere lit by a
 // directional light (evaluated directly: Lo += f E cos, the point-light integral)
 // and a constant environment (reached by BSDF sampling, bounces through glass included),
-// one path per pixel per dispatch, accumulated. Uses the renderer's brdf.glsl.
+// one path per pixel per dispatch, accumulated. Uses the renderer's brdf_material.glsl.
 #extension GL_GOOGLE_include_directive : require
 
-#include "brdf.glsl"
+// The ball's material has no textures (every slot GN_INVALID): no lookup is ever made.
+#define MATERIAL_TEXTURE(index, uv, srgb) vec4(1.0)
+#include "brdf_material.glsl"
 
 layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
 
@@ -34,16 +36,15 @@ void main()
     if (px.x >= scene.width || px.y >= scene.height)
         return;
     uint pixel = px.y * scene.width + px.x;
-    Bsdf b = scene.model == BRDF_GLTF
-        ? bsdf_gltf(scene.color, scene.params.x, scene.params.y, scene.params.z, scene.extra.xyz,
-                    scene.params.w, scene.extra.w)
-        : bsdf_from_model(scene.model, scene.color, scene.params);
-    if (scene.model == BRDF_GLTF)
-        b = bsdf_gltf_film(b, scene.color, scene.params.x, scene.params.z, scene.extra.xyz, scene.params.w,
-                           scene.extra.w, scene.irid.xyz, scene.dt);
-    if (scene.model == BRDF_GLTF)
-        b = bsdf_layers(b, scene.layer.x, scene.layer.y, vec3(0.0, 0.0, 1.0), scene.sheen.rgb, scene.layer.z);
-    Bsdf b0 = b; // before the anisotropy, whose direction each hit sets
+    // The ball's tangent runs along its parallels (about the vertical axis), as on a
+    // lathe-brushed part: each hit gives it, in its shading frame, to material_eval, which
+    // turns it by the anisotropy's rotation toward the bitangent n x t.
+    MaterialHit mh;
+    mh.uv = vec4(0.0);
+    mh.color = vec4(1.0);
+    mh.n = vec3(0.0, 0.0, 1.0);
+    mh.tangent = vec4(1.0, 0.0, 0.0, 1.0);
+    Bsdf b0 = bsdf_material(material_eval(scene.material, mh)), b = b0;
     vec4 jitter = rng_uniform4(pixel, push.sample_index, 0u, push.seed);
     float aspect = float(scene.width) / float(scene.height);
     vec2 ndc = vec2(2.0 * (float(px.x) + jitter.x) / float(scene.width) - 1.0,
@@ -60,13 +61,12 @@ void main()
         vec3 p = o + t * d, n = normalize(p), tx, ty;
         sampling_basis(n, tx, ty);
         vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
-        if (scene.model == BRDF_GLTF && scene.aniso.x > 0.0) {
-            // The ball's tangent runs along its parallels (about the vertical axis), as on a
-            // lathe-brushed part; the rotation turns it toward the bitangent n x t.
+        if (scene.material.anisotropy_strength > 0.0) {
             vec3 t = cross(vec3(0.0, 1.0, 0.0), n);
             t = dot(t, t) > 1e-12 ? normalize(t) : tx;
-            vec2 tl = vec2(dot(t, tx), dot(t, ty)), bl = vec2(-tl.y, tl.x);
-            b = bsdf_anisotropy(b0, scene.aniso.x, cos(scene.aniso.y) * tl + sin(scene.aniso.y) * bl);
+            mh.tangent = vec4(dot(t, tx), dot(t, ty), 0.0, 1.0);
+            Shading sh = material_eval(scene.material, mh);
+            b = bsdf_orient(b0, sh, vec3(0.0, 0.0, 1.0), sh.aniso_t.xy);
         }
         // The light reaches only the outside (the sphere is convex: no shadow ray needed).
         vec3 wl = vec3(dot(scene.light_dir, tx), dot(scene.light_dir, ty), dot(scene.light_dir, n));

@@ -1,19 +1,22 @@
 #version 450
-// brdf_test.comp: runs brdf.glsl, the same file the renderer includes, on a buffer of
+// brdf_test.comp: runs brdf_material.glsl, the same files the renderer includes, on a buffer of
 // queries (one per invocation) so the unit tests and `gonio brdf` measure the shader code
 // itself: eval and pdf at given directions, sample with given random numbers, and the
 // Fresnel functions (BrdfQuery/BrdfResult in brdf_models.h).
 // Specialised, as the renderer's kernels are, on the GN_FEAT_* that a batch's queries need
 // (src/render/brdf.c: brdf_query_features): llvmpipe runs both sides of a branch, so the code
 // of every model a query does not use would cost it as much time as its own (20 times a
-// Lambert's). FEATURES = GN_FEAT_ALL (GONIO_ALL_FEATURES) is the unspecialised kernel.
+// Lambert's). Every bit set (GONIO_ALL_FEATURES) is the unspecialised kernel.
 #extension GL_GOOGLE_include_directive : require
 
-#define GN_HAS(f) ((FEATURES & (f)) != 0u)
+#define GN_HAS(f) (((FEATURES & (f).x) | (FEATURES_HI & (f).y)) != 0u)
 #include "shared.h"
-layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
+layout(constant_id = GN_SPEC_FEATURES) const uint FEATURES = 0xffffffffu;    // GN_FEAT_* bits 0-31
+layout(constant_id = GN_SPEC_FEATURES_HI) const uint FEATURES_HI = 0xffffffffu; // ... 32-63
 
-#include "brdf.glsl"
+// The queries' materials have no textures (every slot GN_INVALID): no lookup is ever made.
+#define MATERIAL_TEXTURE(index, uv, srgb) vec4(1.0)
+#include "brdf_material.glsl"
 
 layout(local_size_x = 64) in;
 
@@ -37,26 +40,21 @@ void main()
     r.s_f = vec3(0.0);
     r.s_pdf_eval = 0.0;
     if ((q.op & BRDF_OP_FRESNEL) != 0u) {
-        r.f = vec3(brdf_fresnel_dielectric(q.wo.z, q.params.x),
-                   brdf_fresnel_schlick(q.wo.z, vec3(q.params.y), q.params.z).x,
-                   brdf_sheen_table(q.wo.z, q.params.w));
-        r.s_f = brdf_fresnel_conductor(q.wo.z, q.color, q.extra.xyz);
+        r.f = vec3(brdf_fresnel_dielectric(q.wo.z, q.args.x), brdf_fresnel_schlick(q.wo.z, vec3(q.args.y), q.args.z).x,
+                   brdf_sheen_table(q.wo.z, q.args.w));
+        r.s_f = brdf_fresnel_conductor(q.wo.z, q.material.base_color.rgb, q.material.brdf_params.xyz);
         results[i] = r;
         return;
     }
-    // (the models' and glTF's parts gated as path.comp's material_bsdf gates them)
-    Bsdf b;
-    if (GN_HAS(GN_FEAT_MODELS) && (!GN_HAS(GN_FEAT_GLTF) || q.model != BRDF_GLTF)) {
-        b = bsdf_from_model(q.model, q.color, q.params);
-    } else {
-        b = bsdf_gltf(q.color, q.params.x, q.params.y, q.params.z, q.extra.xyz, q.params.w, q.extra.w);
-        if (GN_HAS(GN_FEAT_LAYERS)) {
-            b = bsdf_gltf_film(b, q.color, q.params.x, q.params.z, q.extra.xyz, q.params.w, q.extra.w, q.irid.xyz, q.dt);
-            b = bsdf_layers(b, q.layer.x, q.layer.y, vec3(sin(q.layer.w), 0.0, cos(q.layer.w)), q.sheen.rgb, q.layer.z);
-        }
-        // the tangent is +x: the anisotropy's direction is the rotation's
-        b = bsdf_anisotropy(b, q.aniso.x, vec2(cos(q.aniso.y), sin(q.aniso.y)));
-    }
+    // The material on the shading frame itself: normal +z, tangent +x (the anisotropy's
+    // direction is its rotation), and the coat's normal tilted toward +x by coat_tilt.
+    MaterialHit h;
+    h.uv = vec4(0.0);
+    h.color = vec4(1.0);
+    h.n = vec3(0.0, 0.0, 1.0);
+    h.tangent = vec4(1.0, 0.0, 0.0, 1.0);
+    Shading sh = material_eval(q.material, h);
+    Bsdf b = bsdf_orient(bsdf_material(sh), sh, vec3(sin(q.coat_tilt), 0.0, cos(q.coat_tilt)), sh.aniso_t.xy);
     if ((q.op & BRDF_OP_NDF) != 0u) {
         r.f = vec3(brdf_base_d(b, q.wi), brdf_base_g1(b, q.wo), 0.0);
         results[i] = r;

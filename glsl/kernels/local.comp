@@ -7,9 +7,10 @@
 #extension GL_GOOGLE_include_directive : require
 
 // Specialised on GN_FEAT_ALPHA only (src/render/render.c: kernel_features): the rest is always on.
-#define GN_HAS(f) ((FEATURES & (f)) != 0u)
+#define GN_HAS(f) (((FEATURES & (f).x) | (FEATURES_HI & (f).y)) != 0u)
 #include "shared.h"
-layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
+layout(constant_id = GN_SPEC_FEATURES) const uint FEATURES = 0xffffffffu;    // GN_FEAT_* bits 0-31
+layout(constant_id = GN_SPEC_FEATURES_HI) const uint FEATURES_HI = 0xffffffffu; // ... 32-63
 
 #include "phong.glsl"
 
@@ -71,13 +72,13 @@ void main()
     float depth = 0.0;
     if (h.tri != GN_INVALID) {
         Surface s = surface_at(h.tri, h.t, h.u, h.v, o, d);
-        normal = s.n;
-        albedo = s.base;
+        normal = s.sh.n;
+        albedo = s.sh.m.base_color.rgb;
         depth = h.t * dot(d, frame.camera.forward);
         if (MODE == GN_MODE_NORMAL) color = normal;
         else if (MODE == GN_MODE_ALBEDO) color = albedo;
         else if (MODE == GN_MODE_DEPTH) color = vec3(depth);
-        else if (MODE == GN_MODE_PHONG) color = phong_shade(s.p, s.n, s.ng, s.uv, s.vcolor, s.material, -d);
+        else if (MODE == GN_MODE_PHONG) color = phong_shade(s.p, s.sh.n, s.ng, s.uv, s.vcolor, s.material, -d);
         else if (MODE == GN_MODE_GOURAUD) color = gouraud_color(h, d);
         else if (MODE == GN_MODE_FLAT) color = flat_color(h, d);
     } else {

@@ -3,7 +3,7 @@
 // L_o = L_e + integral f L_i cos, several path samples a pixel per dispatch. At every vertex:
 // next-event estimation (one light from the power-proportional table, area sampling on
 // triangles, the lat-long environment map by its luminance) and a BSDF sample from
-// brdf.glsl, combined by multiple importance sampling with the power heuristic (Veach &
+// brdf_bsdf.glsl, combined by multiple importance sampling with the power heuristic (Veach &
 // Guibas 1995, "Optimally combining sampling techniques"); Dirac lobes and punctual lights
 // take their one strategy exactly; Russian roulette after ROULETTE_DEPTH bounces.
 // docs/path-tracing.md derives the estimator and names the tests that check it.
@@ -12,14 +12,15 @@
 
 // Specialised on the scene's features (GN_FEAT_* in shared.h): code no lane can need is
 // compiled away, which llvmpipe (running both sides of every branch) needs most.
-#define GN_HAS(f) ((FEATURES & (f)) != 0u)
+#define GN_HAS(f) (((FEATURES & (f).x) | (FEATURES_HI & (f).y)) != 0u)
 #include "shared.h"
-layout(constant_id = 1) const uint FEATURES = GN_FEAT_ALL;
+layout(constant_id = GN_SPEC_FEATURES) const uint FEATURES = 0xffffffffu;    // GN_FEAT_* bits 0-31
+layout(constant_id = GN_SPEC_FEATURES_HI) const uint FEATURES_HI = 0xffffffffu; // ... 32-63
 
 #include "bvh.glsl"
 // The sheen's albedo table heads the texel buffer in scenes with layers (src/render/render.c).
 #define BRDF_SHEEN_FETCH(i) uintBitsToFloat(texelFetch(texels, (i)).x)
-#include "brdf.glsl"
+#include "brdf_material.glsl"
 
 layout(local_size_x = GN_TILE_X, local_size_y = GN_TILE_Y) in;
 
@@ -27,7 +28,7 @@ layout(std430, binding = GN_BIND_ACCUM) buffer AccumBlock { vec4 accum[]; };
 layout(std430, binding = GN_BIND_AOV) buffer AovBlock { vec4 aov[]; };
 // GnEmitter[] as one RGBA32UI texel each (a storage buffer read with per-lane indices costs
 // llvmpipe a scalar load per lane and component: scene.glsl).
-layout(binding = GN_BIND_EMITTERS) uniform usamplerBuffer emitter_texels;
+layout(binding = GN_BIND_EMITTERS) uniform utextureBuffer emitter_texels;
 GnEmitter emitter_at(uint i)
 {
     uvec4 t = texelFetch(emitter_texels, int(i));
@@ -38,7 +39,7 @@ layout(std430, binding = GN_BIND_SQUARES) buffer SquaresBlock { vec4 squares[]; 
 // Lat-long map: 2 words (RGB as half floats) per texel, rows top (+Y) to bottom, then the
 // marginal CDF of the rows (env_height floats), then each row's conditional CDF.
 // (An R32UI texel buffer: a storage buffer's per-lane reads cost llvmpipe a branch per lane.)
-layout(binding = GN_BIND_ENV) uniform usamplerBuffer env_texels;
+layout(binding = GN_BIND_ENV) uniform utextureBuffer env_texels;
 uint envdata(uint i) { return texelFetch(env_texels, int(i)).x; }
 layout(push_constant) uniform PushBlock { GnPush push; };
 
@@ -289,26 +290,14 @@ LightSample light_sample(vec3 p, vec3 u)
 }
 
 // ---- materials ------------------------------------------------------------------------------
-Bsdf material_bsdf(Surface s, GnMaterial m)
-{
-    if (GN_HAS(GN_FEAT_MODELS) && (!GN_HAS(GN_FEAT_GLTF) || m.brdf != BRDF_GLTF)) // the colour of a conductor is its index, never a texture's
-        return bsdf_from_model(m.brdf, m.brdf == BRDF_CONDUCTOR ? m.base_color.rgb : s.base, m.brdf_params);
-    Bsdf b = bsdf_gltf(s.base, s.metallic, s.roughness, m.specular, m.specular_color, m.ior, m.transmission);
-    if (GN_HAS(GN_FEAT_LAYERS)) // the coat's normal in the local frame: main() sets it
-        b = bsdf_layers(b, s.coat, s.coat_roughness, vec3(0.0, 0.0, 1.0), s.sheen, s.sheen_roughness);
-    if (GN_HAS(GN_FEAT_LAYERS)) // iridescence, diffuse transmission
-        b = bsdf_gltf_film(b, s.base, s.metallic, m.specular, m.specular_color, m.ior, m.transmission, s.irid, s.dt);
-    return b;
-}
-
 // Does b have a part that light sampling can reach (anything but Dirac lobes)?
 bool bsdf_has_smooth(Bsdf b)
 {
     return any(greaterThan(b.diffuse, vec3(0.0))) || (GN_HAS(GN_FEAT_LAYERS) && brdf_has_dt(b)) ||
            (b.lobe != BRDF_LOBE_NONE && b.lobe != BRDF_LOBE_MIRROR) ||
-           (b.dielectric > 0.0 && b.shape >= BRDF_ALPHA_MIN) ||
+           (b.dielectric > 0.0 && !lobes_smooth(b.shape)) ||
            (GN_HAS(GN_FEAT_LAYERS) && (any(greaterThan(b.sheen, vec3(0.0))) ||
-                                       (b.coat > 0.0 && b.coat_alpha >= BRDF_ALPHA_MIN)));
+                                       (b.coat > 0.0 && !lobes_smooth(b.coat_alpha))));
 }
 
 // ---- media: KHR_materials_volume and _dispersion (GN_FEAT_VOLUME) --------------------------
@@ -317,7 +306,7 @@ bool bsdf_has_smooth(Bsdf b)
 // back face, so nested and touching media (a glass of water: water inside glass) have the
 // right one on top, and the index at an interface is the ratio of the two sides' media.
 // Paths start in vacuum (index 1, no absorption); a fifth nested medium is not entered.
-#define MEDIA_MAX 4u
+#define MEDIA_MAX GN_MEDIA_MAX
 uint media[MEDIA_MAX];
 uint media_n;
 vec3 seg_from; // where the path's current segment starts: the vertex, not the offset origin
@@ -403,7 +392,7 @@ uint medium_interface(Surface s, GnMaterial m, inout Bsdf b, float u, inout vec3
     }
     float eta = inner / outer;
     // The rough BTDF collapses to a Dirac at 1 (bsdf_gltf): kept as far off it as there.
-    if (b.shape >= BRDF_ALPHA_MIN)
+    if (!lobes_smooth(b.shape))
         eta = eta >= 1.0 ? max(eta, 1.01) : min(eta, 1.0 / 1.01);
     b.ior = eta;
     return far;
@@ -531,37 +520,31 @@ void path_miss(Hit h, bool light_only, bool bsdf_only)
 
 // ---- a path's saved state (GN_BIND_PSTATE: frame.state_stride words a pixel) -----------------
 // Word 0: the pixel's samples still to take, the saved one included (0: none pending); then
-// the path and its walk. Read and written only by LOOP_CAP kernels.
-uint ps_base;
-void ps_f(uint k, float x) { pstate[ps_base + k] = floatBitsToUint(x); }
-void ps_v(uint k, vec3 x) { ps_f(k, x.x); ps_f(k + 1u, x.y); ps_f(k + 2u, x.z); }
-float pl_f(uint k) { return uintBitsToFloat(pstate[ps_base + k]); }
-vec3 pl_v(uint k) { return vec3(pl_f(k), pl_f(k + 1u), pl_f(k + 2u)); }
+// the fields of GN_PATH_STATE (glsl/lib/shared.h), each saved and loaded by the expansions
+// below at word ps_k, and the walk's stack. Read and written only by LOOP_CAP kernels.
+uint ps_base, ps_k;
+#define PS_AT(i) pstate[ps_base + ps_k + (i)]
+#define PS_SAVE_U(v) PS_AT(0u) = v;
+#define PS_SAVE_I(v) PS_AT(0u) = uint(v);
+#define PS_SAVE_F(v) PS_AT(0u) = floatBitsToUint(v);
+#define PS_SAVE_B(v) PS_AT(0u) = v ? 1u : 0u;
+#define PS_SAVE_V(v) PS_AT(0u) = floatBitsToUint(v.x); PS_AT(1u) = floatBitsToUint(v.y); \
+                     PS_AT(2u) = floatBitsToUint(v.z);
+#define PS_SAVE_M(v) for (uint m = 0u; m < GN_MEDIA_MAX; m++) PS_AT(m) = v[m];
+#define PS_LOAD_U(v) v = PS_AT(0u);
+#define PS_LOAD_I(v) v = int(PS_AT(0u));
+#define PS_LOAD_F(v) v = uintBitsToFloat(PS_AT(0u));
+#define PS_LOAD_B(v) v = PS_AT(0u) != 0u;
+#define PS_LOAD_V(v) v = vec3(uintBitsToFloat(PS_AT(0u)), uintBitsToFloat(PS_AT(1u)), uintBitsToFloat(PS_AT(2u)));
+#define PS_LOAD_M(v) for (uint m = 0u; m < GN_MEDIA_MAX; m++) v[m] = PS_AT(m);
+#define PS_SAVE(kind, var, when) if (when) { PS_SAVE_##kind(var) } ps_k += GN_PS_WORDS_##kind;
+#define PS_LOAD(kind, var, when) if (when) { PS_LOAD_##kind(var) } ps_k += GN_PS_WORDS_##kind;
 
 void path_save(uint behind)
 {
     pstate[ps_base] = behind;
-    pstate[ps_base + 1u] = phase | (prev_delta ? 2u : 0u) | (covered ? 4u : 0u) | (alive ? 8u : 0u);
-    pstate[ps_base + 2u] = depth;
-    pstate[ps_base + 3u] = GN_HAS(GN_FEAT_ALPHA) ? tr_k : 0u;
-    ps_v(4u, o); ps_v(7u, d); ps_f(10u, tmin); ps_v(11u, radiance); ps_v(14u, beta);
-    ps_f(17u, prev_pdf); ps_v(18u, normal); ps_v(21u, albedo); ps_f(24u, depth_aov);
-    ps_v(25u, so); ps_v(28u, sd); ps_f(31u, smax); ps_v(32u, c);
-    if (GN_HAS(GN_FEAT_ALPHA)) {
-        ps_f(35u, tr_lo);
-        ps_f(36u, tr_max);
-    }
-    if (GN_HAS(GN_FEAT_VOLUME)) { // the media the path is in (path.comp: media)
-        for (uint k = 0u; k < MEDIA_MAX; k++)
-            pstate[ps_base + 44u + k] = media[k];
-        pstate[ps_base + 48u] = media_n | channel << 8u;
-        ps_v(49u, seg_from);
-    }
-    ps_f(37u, walk.hit.t); ps_f(38u, walk.hit.u); ps_f(39u, walk.hit.v);
-    pstate[ps_base + 40u] = walk.hit.tri;
-    pstate[ps_base + 41u] = walk.hit.steps;
-    pstate[ps_base + 42u] = walk.node;
-    pstate[ps_base + 43u] = uint(walk.sp);
+    ps_k = 1u;
+    GN_PATH_STATE(PS_SAVE)
     if (WALK_REGS > 0u) {
         for (uint k = 0u; k < WALK_REGS; k++)
             pstate[ps_base + GN_PATH_STATE_WORDS + k] = walk.regs[k];
@@ -573,26 +556,9 @@ void path_save(uint behind)
 
 void path_load()
 {
-    uint f = pstate[ps_base + 1u];
-    phase = f & 1u; prev_delta = (f & 2u) != 0u; covered = (f & 4u) != 0u; alive = (f & 8u) != 0u;
-    depth = pstate[ps_base + 2u];
-    tr_k = pstate[ps_base + 3u];
-    o = pl_v(4u); d = pl_v(7u); tmin = pl_f(10u); radiance = pl_v(11u); beta = pl_v(14u);
-    prev_pdf = pl_f(17u); normal = pl_v(18u); albedo = pl_v(21u); depth_aov = pl_f(24u);
-    so = pl_v(25u); sd = pl_v(28u); smax = pl_f(31u); c = pl_v(32u); tr_lo = pl_f(35u); tr_max = pl_f(36u);
-    if (GN_HAS(GN_FEAT_VOLUME)) {
-        for (uint k = 0u; k < MEDIA_MAX; k++)
-            media[k] = pstate[ps_base + 44u + k];
-        media_n = pstate[ps_base + 48u] & 0xffu;
-        channel = pstate[ps_base + 48u] >> 8u;
-        seg_from = pl_v(49u);
-    }
-    walk.hit.t = pl_f(37u); walk.hit.u = pl_f(38u); walk.hit.v = pl_f(39u);
-    walk.hit.tri = pstate[ps_base + 40u];
-    walk.hit.steps = pstate[ps_base + 41u];
+    ps_k = 1u;
+    GN_PATH_STATE(PS_LOAD)
     walk.hit.truncated = false;
-    walk.node = pstate[ps_base + 42u];
-    walk.sp = int(pstate[ps_base + 43u]);
     if (WALK_REGS > 0u) {
         for (uint k = 0u; k < WALK_REGS; k++)
             walk.regs[k] = pstate[ps_base + GN_PATH_STATE_WORDS + k];
@@ -686,12 +652,12 @@ void main()
             GnMaterial m = material_at(s.material);
             covered = covered || depth == 0u;
             if (GN_HAS(GN_FEAT_AOV) && depth == 0u) {
-                normal = s.n;
-                albedo = s.base;
+                normal = s.sh.n;
+                albedo = s.sh.m.base_color.rgb;
                 depth_aov = h.t * dot(d, frame.camera.forward);
             }
             if (GN_HAS(GN_FEAT_UNLIT) && (m.flags & GN_MAT_UNLIT) != 0u) { // KHR_materials_unlit: the colour is the radiance
-                radiance += beta * s.base;
+                radiance += beta * s.sh.m.base_color.rgb;
                 break;
             }
             if (GN_HAS(GN_FEAT_EMISSIVE) && (s.front || (m.flags & GN_MAT_DOUBLE_SIDED) != 0u) &&
@@ -702,23 +668,20 @@ void main()
                                abs(dot(s.ng, d));
                     w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, pl);
                 }
-                radiance += beta * s.emission * w;
+                radiance += beta * s.sh.m.emissive * w;
             }
             if (frame.max_depth != 0u && depth >= frame.max_depth)
                 break;
 
-            Bsdf b = material_bsdf(s, m);
-            // A transmitting surface needs the side: brdf.glsl's normal points outside.
+            Bsdf b = bsdf_material(s.sh);
+            // A transmitting surface needs the side: a Bsdf's normal points outside.
             bool flip = b.dielectric > 0.0 && !s.front;
-            vec3 n = flip ? -s.n : s.n, ng = flip ? -s.ng : s.ng, tx, ty;
+            vec3 n = flip ? -s.sh.n : s.sh.n, ng = flip ? -s.ng : s.ng, tx, ty;
             sampling_basis(n, tx, ty);
             vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
-            if (GN_HAS(GN_FEAT_LAYERS)) {
-                vec3 cn = flip ? -s.coat_n : s.coat_n;
-                b.coat_n = normalize(vec3(dot(cn, tx), dot(cn, ty), dot(cn, n)));
-            }
-            if (GN_HAS(GN_FEAT_ANISO) && s.aniso > 0.0 && m.brdf == BRDF_GLTF) // the direction on the shading plane
-                b = bsdf_anisotropy(b, s.aniso, vec2(dot(s.aniso_t, tx), dot(s.aniso_t, ty)));
+            vec3 cn = flip ? -s.sh.coat_n : s.sh.coat_n; // (the anisotropy's direction on the shading plane)
+            b = bsdf_orient(b, s.sh, normalize(vec3(dot(cn, tx), dot(cn, ty), dot(cn, n))),
+                            vec2(dot(s.sh.aniso_t, tx), dot(s.sh.aniso_t, ty)));
             vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
             uint far = GN_INVALID; // the medium beyond a transmitting surface
             if (GN_HAS(GN_FEAT_VOLUME))

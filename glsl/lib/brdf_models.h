@@ -1,9 +1,9 @@
 /* brdf_models.h: the table of BRDF models, their parameter slots and the records of the BRDF
- * test kernel, shared by C (src/render/brdf.c, src/render/render.c, the tests) and GLSL (brdf.glsl,
- * brdf_test.comp). docs/brdf.md has the models' equations.
+ * test kernel, shared by C (src/render/brdf.c, src/render/render_material.c, the tests) and
+ * GLSL (brdf_material.glsl, brdf_test.comp). docs/brdf.md has the models' equations.
  *
  * A model is a colour plus four scalars: GnMaterial.brdf (the id) with base_color.rgb as the
- * colour and brdf_params as the scalars; bsdf_from_model() in brdf.glsl reads them. The
+ * colour and brdf_params as the scalars; bsdf_from_model() in brdf_material.glsl reads them. The
  * glTF model (id 0) has more parameters and is built by bsdf_gltf() from GnMaterial. */
 #ifndef GONIO_BRDF_MODELS_H
 #define GONIO_BRDF_MODELS_H
@@ -11,7 +11,7 @@
 #include "shared.h"
 
 /* ---- the models: one table, expanded by C (src/render/brdf.c: names, parameters, --list;
- * src/render/render.c: material_features) and GLSL (brdf.glsl: bsdf_from_model). A row is
+ * src/render/render_material.c: material_features) and GLSL (brdf_material.glsl: bsdf_from_model). A row is
  *   X(id, name, summary, lobe, fresnel, layout, lobe_feats, feats, params)
  * - id: GnMaterial.brdf; unique (tests/unit/test_brdf.c checks), never reused. BRDF_GLTF is
  *   built by bsdf_gltf from GnMaterial's own fields, the rest by bsdf_from_model from a
@@ -20,13 +20,13 @@
  *   the `gonio brdf` / `--brdf` name, its --list line, and its parameters as
  *   COLOR/SCALAR(name, slot, default(s), min, max) of src/render/brdf.c, slots of src/render/brdf.h;
  * - lobe, fresnel: the Bsdf's specular lobe and its Fresnel factor (BRDF_LOBE_*,
- *   BRDF_FRESNEL_* of brdf.glsl); a microfacet lobe (Beckmann, GGX) whose alpha is below
+ *   BRDF_FRESNEL_* of brdf_bsdf.glsl); a microfacet lobe (Beckmann, GGX) whose alpha is below
  *   BRDF_ALPHA_MIN becomes the mirror;
  * - lobe_feats: the GN_FEAT_* of the lobes the model can build (GN_FEAT_LOBES is their
  *   union); feats: its other GN_FEAT_* (Fresnel, glass). The path kernel is specialised on
- *   their union for a scene whose materials use the model (src/render/render.c: material_features;
+ *   their union for a scene whose materials use the model (src/render/render_material.c: material_features;
  *   glTF's bits depend on the material's values and are worked out there).
- * Adding a model: a row here, its lobe in brdf.glsl if it has a new one, its section in
+ * Adding a model: a row here, its lobe in brdf_bsdf.glsl if it has a new one, its section in
  * docs/brdf.md (docs/architecture.md: Adding a BRDF model). */
 #define BRDF_GLTF 0u /* the ids that code names; a new model needs none */
 #define BRDF_LAMBERT 1u
@@ -86,28 +86,38 @@
        SCALAR("alpha", P(BRDF_P_DIELECTRIC_ALPHA), 0, 0, 1))) \
     X(BRDF_GLTF, "gltf", \
       "glTF metallic-roughness + KHR_materials_specular/transmission/ior/clearcoat/sheen/anisotropy/iridescence/diffuse_transmission", \
-      BRDF_LOBE_GGX, BRDF_FRESNEL_SCHLICK, BRDF_LAYOUT_GLTF, BRDF_GLTF_FEATS, GN_FEAT_GLTF, \
-      (COLOR("base-color", BRDF_SLOT_COLOR, 0.8f, 0.8f, 0.8f, 0, 1), \
-       SCALAR("metallic", P(0), 0, 0, 1), SCALAR("roughness", P(1), 0.5f, 0, 1), \
-       SCALAR("specular", P(2), 1, 0, 1), SCALAR("ior", P(3), 1.5f, 1, 4), \
-       COLOR("specular-color", BRDF_SLOT_EXTRA, 1, 1, 1, 0, 100), \
-       SCALAR("transmission", BRDF_SLOT_EXTRA + 3, 0, 0, 1), \
-       SCALAR("clearcoat", BRDF_SLOT_LAYER, 0, 0, 1), SCALAR("clearcoat-roughness", BRDF_SLOT_LAYER + 1, 0, 0, 1), \
-       COLOR("sheen-color", BRDF_SLOT_SHEEN, 0, 0, 0, 0, 1), SCALAR("sheen-roughness", BRDF_SLOT_LAYER + 2, 0, 0, 1), \
-       SCALAR("anisotropy", BRDF_SLOT_ANISO, 0, 0, 1), SCALAR("anisotropy-rotation", BRDF_SLOT_ANISO + 1, 0, -6.2832f, 6.2832f), \
-       SCALAR("iridescence", BRDF_SLOT_IRID, 0, 0, 1), SCALAR("iridescence-ior", BRDF_SLOT_IRID + 1, 1.3f, 1, 4), \
-       SCALAR("iridescence-thickness", BRDF_SLOT_IRID + 2, 400, 0, 2000), \
-       SCALAR("diffuse-transmission", BRDF_SLOT_DT + 3, 0, 0, 1), \
-       COLOR("diffuse-transmission-color", BRDF_SLOT_DT, 1, 1, 1, 0, 1)))
+      BRDF_LOBE_GGX, BRDF_FRESNEL_SCHLICK, BRDF_LAYOUT_GLTF, BRDF_GLTF_FEATS, GN_FEAT_GLTF, (BRDF_GLTF_PARAMS))
+
+/* The glTF model's parameters: the material table's (glsl/lib/material.h), each row with a
+ * BRDF(name, default, lo, hi) column, in the table's order, at its field's word. C only:
+ * glslang expands a macro's arguments even where they are not used. */
+#ifdef VULKAN
+#define BRDF_GLTF_PARAMS
+#else
+#define BRDF_GLTF_PARAMS GN_MATERIAL(BRDF_GLTF_PARAM, GN_MAT_NO_TEX, GN_MAT_NO_FIELD)
+#define BRDF_GLTF_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) \
+    BRDF_GLTF_PARAM_##type(GN_MAT_WORD(name), brdf)
+/* (the BRDF(...) column arrives expanded, as its arguments: has, name, default, lo, hi) */
+#define BRDF_GLTF_PARAM_float(slot, has, name, def, lo, hi) BRDF_GLTF_SCALAR_##has(slot, name, def, lo, hi)
+#define BRDF_GLTF_PARAM_vec3(slot, has, name, def, lo, hi) BRDF_GLTF_COLOR_##has(slot, name, def, lo, hi)
+/* (RGB: the alpha is no parameter) */
+#define BRDF_GLTF_PARAM_vec4(slot, has, name, def, lo, hi) BRDF_GLTF_COLOR_##has(slot, name, def, lo, hi)
+#define BRDF_GLTF_SCALAR_BRDF_YES(slot, name, def, lo, hi) SCALAR(name, slot, def, lo, hi),
+#define BRDF_GLTF_COLOR_BRDF_YES(slot, name, def, lo, hi) COLOR(name, slot, def, def, def, lo, hi),
+#define BRDF_GLTF_SCALAR_BRDF_NO(slot, name, def, lo, hi)
+#define BRDF_GLTF_COLOR_BRDF_NO(slot, name, def, lo, hi)
+#define BRDF(name, def, lo, hi) BRDF_YES, name, def, lo, hi
+#define NO_BRDF BRDF_NO, 0, 0, 0, 0
+#endif
 
 /* Below this GGX/Beckmann alpha a lobe is treated as smooth (a Dirac lobe): a narrower lobe
- * is under a tenth of a degree wide, which float directions cannot resolve (brdf.glsl's
- * constructors; src/render/render.c: material_features, which must agree). */
+ * is under a tenth of a degree wide, which float directions cannot resolve (brdf_material.glsl's
+ * constructors; src/render/render_material.c: material_features, which must agree). */
 #define BRDF_ALPHA_MIN 1e-3f
 
 /* The union of every model's lobe features: may a kernel meet any specular lobe at all. */
 #define BRDF_X_LOBE_FEATS(id, name, summary, lobe, fresnel, layout, lobe_feats, feats, params) | (lobe_feats)
-#define GN_FEAT_LOBES (0u BRDF_MODELS(BRDF_X_LOBE_FEATS))
+#define GN_FEAT_LOBES (GN_FEAT_NONE BRDF_MODELS(BRDF_X_LOBE_FEATS))
 
 /* ---- slots of the four scalars (indices into brdf_params) ------------------------------ */
 /* BRDF_LAYOUT_LAYERED: a Lambert layer (the colour) plus one specular lobe;
@@ -122,7 +132,7 @@
 #define BRDF_P_DIELECTRIC_IOR 0
 #define BRDF_P_DIELECTRIC_ALPHA 1 /* GGX alpha; 0 = smooth glass (delta) */
 
-/* The sheen's albedo table (brdf.glsl) in the BRDF kernels (brdf_test.comp, brdf_sphere.comp):
+/* The sheen's albedo table (brdf_scatter.glsl) in the BRDF kernels (brdf_test.comp, brdf_sphere.comp):
  * an R32UI texel buffer of SHEEN_N x SHEEN_N float bits. */
 #define BRDF_BIND_SHEEN 2
 
@@ -137,27 +147,21 @@
 #define BRDF_OP_FRESNEL 4u /* Fresnel functions at cos = wo.z (see BrdfResult) */
 #define BRDF_OP_NDF 8u     /* the base's GGX: D at the half vector wi, G1(wo) (see BrdfResult) */
 
-/* A material and the directions to query it with. model BRDF_GLTF: color = base colour,
- * params = (metallic, roughness, specular, ior), extra = (specular colour, transmission),
- * layer = (clearcoat, clearcoat roughness, sheen roughness, the coat normal's tilt from +z
- * toward +x in radians: a test-only stand-in for a clearcoat normal map), sheen.rgb = sheen
- * colour (bsdf_layers); aniso, irid and dt as their comments say.
- * Otherwise color and params are those of bsdf_from_model and extra is unused.
- * BRDF_OP_FRESNEL: params.x = eta (dielectric), color = eta and extra.xyz = k (conductor),
- * params.y = F0 and params.z = F90 (Schlick), params.w = sheen roughness (the sheen's table). */
+/* A material and the directions to query it with: the material as the renderer has it, less
+ * its textures (every slot GN_INVALID), its model in .brdf (bsdf_material builds its Bsdf as
+ * the path kernel does: glTF from its own fields, a model from base_color.rgb and
+ * brdf_params), on the shading frame with the tangent +x and the coat's normal tilted by
+ * coat_tilt radians from +z toward +x (a test-only stand-in for a clearcoat normal map).
+ * BRDF_OP_FRESNEL: args.x = eta (dielectric), the material's base_color.rgb = eta and its
+ * brdf_params.xyz = k (conductor), args.y = F0 and args.z = F90 (Schlick), args.w = the sheen's
+ * roughness (its table). */
 GN_STRUCT(BrdfQuery) {
-    vec3 color; uint model;
-    vec4 params;
-    vec4 extra;
-    vec3 wo; uint op;   /* wo: toward the viewer, local frame (normal = +z) */
-    vec3 wi; float pad0; /* wi: toward the light */
-    vec3 u; float pad1;  /* the sample's random numbers in [0, 1) */
-    vec4 layer;
-    vec4 sheen;
-    vec4 aniso; /* KHR_materials_anisotropy: strength, rotation (radians), 0, 0 */
-    vec4 irid;  /* KHR_materials_iridescence: factor, film ior, film thickness (nm), 0 */
-    vec4 dt;    /* KHR_materials_diffuse_transmission: colour.rgb, factor */
-} GN_END(BrdfQuery); /* 176 bytes */
+    GnMaterial material;
+    vec3 wo; uint op;       /* wo: toward the viewer, local frame (normal = +z) */
+    vec3 wi; float coat_tilt; /* wi: toward the light */
+    vec3 u; float pad0;     /* the sample's random numbers in [0, 1) */
+    vec4 args;
+} GN_END(BrdfQuery); /* 400 bytes */
 
 /* BRDF_OP_EVAL: f, pdf. BRDF_OP_SAMPLE: s_* (s_f, s_pdf_eval: eval and pdf at s_wi).
  * BRDF_OP_FRESNEL: f = (dielectric, Schlick, the sheen's albedo E from its table), s_f =
@@ -171,25 +175,18 @@ GN_STRUCT(BrdfResult) {
 
 /* brdf_sphere.comp: a unit sphere at the origin, seen from +z by a pinhole camera, lit by a
  * directional light and a constant environment (the material-ball view of `gonio brdf`).
- * Material fields as in BrdfQuery. */
+ * The material as BrdfQuery's, its tangent along the ball's parallels. */
 GN_STRUCT(BrdfSphere) {
-    vec3 color; uint model;
-    vec4 params;
-    vec4 extra;
+    GnMaterial material;
     vec3 light_dir; uint width;        /* unit, toward the light */
     vec3 light_irradiance; uint height; /* W/m^2 on a surface facing the light */
     vec3 env; uint max_depth;          /* environment radiance; path length limit */
-    vec4 layer;
-    vec4 sheen;
-    vec4 aniso; /* as BrdfQuery's */
-    vec4 irid;
-    vec4 dt;
-} GN_END(BrdfSphere); /* 176 bytes */
+} GN_END(BrdfSphere); /* 384 bytes */
 
 #ifndef VULKAN
-GN_STATIC_ASSERT(sizeof(BrdfSphere) == 176, "BrdfSphere layout");
-GN_STATIC_ASSERT(sizeof(BrdfQuery) == 176, "BrdfQuery layout");
-GN_STATIC_ASSERT(offsetof(BrdfQuery, wo) == 48, "BrdfQuery layout");
+GN_STATIC_ASSERT(sizeof(BrdfSphere) == 384, "BrdfSphere layout");
+GN_STATIC_ASSERT(sizeof(BrdfQuery) == 400, "BrdfQuery layout");
+GN_STATIC_ASSERT(offsetof(BrdfQuery, wo) == 336, "BrdfQuery layout");
 GN_STATIC_ASSERT(sizeof(BrdfResult) == 64, "BrdfResult layout");
 #endif
 

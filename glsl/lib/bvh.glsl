@@ -15,14 +15,15 @@
 #include "scene.glsl"
 
 // The walk's stack: 0, an array (GN_WALK_STACK entries, in memory); K > 0, its entries in K
-// registers, for trees of at most K levels (the host sets it from the tree: src/render/render.c).
+// registers, for trees of at most K levels (the host sets it from the tree:
+// src/render/render_limits.c: walk_regs).
 // llvmpipe keeps a private array that is indexed per lane in memory and reads and writes it
 // one lane at a time with a branch on each lane's mask; a shift register of K values costs
 // it 2K vector selects a node visit instead (the gain: docs/performance.md).
 layout(constant_id = GN_SPEC_WALK_REGS) const uint WALK_REGS = 0u;
 
-// LOOP_CAP > 0: the loop passes a SIMD group may run (src/render/render.c sets it below llvmpipe's
-// cap), shared out as LOOP_CAP / gl_SubgroupSize to each lane (a subgroup is llvmpipe's SIMD
+// LOOP_CAP > 0: the loop passes a SIMD group may run (src/render/render_limits.c sets it below
+// llvmpipe's cap), shared out as LOOP_CAP / gl_SubgroupSize to each lane (a subgroup is llvmpipe's SIMD
 // group): loop_left is what this lane has left. A loop costs the group its longest lane's
 // passes plus the test that ends it, which is at most the sum over the lanes in it of their
 // passes plus one; so while every lane stays within its share, the group stays within the

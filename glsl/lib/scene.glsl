@@ -13,26 +13,29 @@
 // dispatch larger than a small render (docs/performance.md).
 layout(std430, binding = GN_BIND_FRAME) readonly buffer FrameBlock { GnFrame frame; };
 // The BVH nodes (GnBvhNode = 4 texels), triangle pairs (GnTriPair = 3), shading triangles
-// (GnPrim = 1), vertices (GnVertex = 5), materials (GnMaterial = 21), textures (GnTexture =
+// (GnPrim = 1), vertices (GnVertex = 5), materials (GnMaterial = GN_MATERIAL_TEXELS), textures (GnTexture =
 // 1; their RGBA8 images: R32UI) and path.comp's lights (GnEmitter = 1) are read from texel
 // buffers, not storage buffers: llvmpipe fetches a storage buffer with per-lane offsets one
 // lane and one component at a time, branching on each lane's mask, a texel buffer with
 // one load per lane and no branches, which makes the walk several times faster there;
 // GPUs read both at full speed.
+// They are textureBuffers, images without a sampler (texelFetch needs none): SPIR-V deprecates
+// a sampler combined with a buffer image, and Mesa 25 warns at every such binding.
+#extension GL_EXT_samplerless_texture_functions : require
 // An integer format passes every bit through (a float format may flush the denormals that
 // small integers stored as floats are); floats come back with uintBitsToFloat.
-layout(binding = GN_BIND_NODES) uniform usamplerBuffer node_texels;
-layout(binding = GN_BIND_TRIS) uniform usamplerBuffer tri_texels;
-layout(binding = GN_BIND_PRIMS) uniform usamplerBuffer prim_texels;
-layout(binding = GN_BIND_VERTICES) uniform usamplerBuffer vertex_texels;
-layout(binding = GN_BIND_MATERIALS) uniform usamplerBuffer material_texels;
+layout(binding = GN_BIND_NODES) uniform utextureBuffer node_texels;
+layout(binding = GN_BIND_TRIS) uniform utextureBuffer tri_texels;
+layout(binding = GN_BIND_PRIMS) uniform utextureBuffer prim_texels;
+layout(binding = GN_BIND_VERTICES) uniform utextureBuffer vertex_texels;
+layout(binding = GN_BIND_MATERIALS) uniform utextureBuffer material_texels;
 layout(std430, binding = GN_BIND_LIGHTS) readonly buffer LightBlock { GnLight lights[]; };
-layout(binding = GN_BIND_TEXELS) uniform usamplerBuffer texels; // R32UI: one RGBA8 texel each
-layout(binding = GN_BIND_TEXTURES) uniform usamplerBuffer texture_texels; // GnTexture[]
+layout(binding = GN_BIND_TEXELS) uniform utextureBuffer texels; // R32UI: one RGBA8 texel each
+layout(binding = GN_BIND_TEXTURES) uniform utextureBuffer texture_texels; // GnTexture[]
 
 #define PI GN_PI // (the name path.comp and bench.comp use)
 
-vec4 texel_f(usamplerBuffer b, uint i) { return uintBitsToFloat(texelFetch(b, int(i))); }
+vec4 texel_f(utextureBuffer b, uint i) { return uintBitsToFloat(texelFetch(b, int(i))); }
 
 GnPrim prim_at(uint i)
 {
@@ -61,34 +64,14 @@ void tri_corners(uint i, out vec3 a, out vec3 b, out vec3 c)
 // Does the scene have vertex colours (glTF COLOR_0)? Without, GnVertex.color is not read.
 bool vertex_colors() { return GN_HAS(GN_FEAT_VERTEX_COLOR) && (frame.flags & GN_FRAME_VERTEX_COLOR) != 0u; }
 
-// Fields a kernel does not read are never fetched: the compiler drops unused texel loads.
+// Material i, each field from its word (glsl/lib/material.h); fields a kernel does not read are
+// never fetched: the compiler drops unused texel loads.
 GnMaterial material_at(uint i)
 {
-    uint k = 21u * i;
-    vec4 t0 = texel_f(material_texels, k), t1 = texel_f(material_texels, k + 1u);
-    vec4 t2 = texel_f(material_texels, k + 2u), t3 = texel_f(material_texels, k + 3u);
-    uvec4 t4 = texelFetch(material_texels, int(k + 4u)), t5 = texelFetch(material_texels, int(k + 5u));
-    uvec4 t6 = texelFetch(material_texels, int(k + 6u));
-    vec4 t7 = texel_f(material_texels, k + 7u), t8 = texel_f(material_texels, k + 8u);
-    vec4 t9 = texel_f(material_texels, k + 9u), t10 = texel_f(material_texels, k + 10u);
-    vec4 t11 = texel_f(material_texels, k + 11u), t12 = texel_f(material_texels, k + 12u);
-    uvec4 t13 = texelFetch(material_texels, int(k + 13u));
-    uvec4 t14 = texelFetch(material_texels, int(k + 14u)), t15 = texelFetch(material_texels, int(k + 15u));
-    vec4 t16 = texel_f(material_texels, k + 16u);
-    uvec4 t17 = texelFetch(material_texels, int(k + 17u)), t18 = texelFetch(material_texels, int(k + 18u));
-    uvec4 t19 = texelFetch(material_texels, int(k + 19u)), t20 = texelFetch(material_texels, int(k + 20u));
-    return GnMaterial(t0, t1.xyz, t1.w, t2.xyz, t2.w, t3.x, t3.y, t3.z, t3.w,
-                      uintBitsToFloat(t4.x), uintBitsToFloat(t4.y), t4.z, t4.w,
-                      t5.x, t5.y, t5.z, t5.w, t6.x, t6.y, t6.z, t6.w,
-                      t7, t8.xyz, t8.w, t9.xyz, t9.w, t10.xyz, t10.w, t11.xyz, t11.w,
-                      t12.xyz, t12.w, uintBitsToFloat(t13.x), uintBitsToFloat(t13.y), t13.z,
-                      uintBitsToFloat(t13.w),
-                      uintBitsToFloat(t14.x), uintBitsToFloat(t14.y), t14.z, t14.w,
-                      t15.x, uintBitsToFloat(t15.y), t15.z, t15.w, t16.xyz, t16.w,
-                      uintBitsToFloat(t17.x), uintBitsToFloat(t17.y), t17.z, uintBitsToFloat(t17.w),
-                      uintBitsToFloat(t18.x), uintBitsToFloat(t18.y), uintBitsToFloat(t18.z),
-                      uintBitsToFloat(t18.w), t19.x, t19.y, uintBitsToFloat(t19.z), t19.w,
-                      uintBitsToFloat(t20.xyz), t20.w);
+    uint k = GN_MATERIAL_TEXELS * i;
+    GnMaterial m;
+    GN_MATERIAL(GN_MAT_READ_PARAM, GN_MAT_READ_TEX, GN_MAT_READ_FIELD)
+    return m;
 }
 
 // ---- random numbers that depend only on (pixel, sample, dimension, seed) ---------------
@@ -214,53 +197,21 @@ vec3 shading_normal_valid(vec3 n, vec3 ng, vec3 wo)
     return normalize(sa * x + ca * ng);
 }
 
+// The material at a hit (glsl/lib/material.glsl), its textures read by texture_sample.
+#define MATERIAL_TEXTURE(index, uv, srgb) texture_sample(index, uv, srgb)
+#include "material.glsl"
+
 struct Surface {
     vec3 p;           // world position
     vec3 ng;          // geometric normal, facing the incoming ray
-    vec3 n;           // shading normal (interpolated, normal-mapped, bent by
-                      // shading_normal_valid), same side as ng
     vec4 uv;          // TEXCOORD_0 (xy) and TEXCOORD_1 (zw)
-    vec3 base;        // linear base colour (factor * texture * vertex colour)
     vec3 vcolor;      // the interpolated vertex colour (1 without COLOR_0)
-    float metallic;
-    float roughness;
-    vec3 emission;
     uint material;
     bool front;       // the ray hit the side the triangle's winding calls front
-    // KHR_materials_clearcoat and _sheen (GN_FEAT_LAYERS; else 0): the coat's weight,
-    // roughness and normal (the mesh's, or its own normal map's: never normalTexture's),
-    // the sheen's colour and roughness
-    float coat;
-    float coat_roughness;
-    vec3 coat_n;
-    vec3 sheen;
-    float sheen_roughness;
-    // KHR_materials_anisotropy (GN_FEAT_ANISO; else 0): the strength and the direction in
-    // world space (the tangent frame's, rotated; 0 where the mesh has no tangents)
-    float aniso;
-    vec3 aniso_t;
-    // KHR_materials_iridescence (factor, film ior, thickness in nm) and _diffuse_transmission
-    // (colour, factor), textures applied (GN_FEAT_LAYERS; else factors 0)
-    vec3 irid;
-    vec4 dt;
+    Shading sh;       // the material there (material_eval); its normals sh.n (the shading
+                      // normal: interpolated, normal-mapped) and sh.coat_n (GN_FEAT_LAYERS)
+                      // turned to ng's side and bent by shading_normal_valid
 };
-
-// KHR_materials_iridescence: factor x texture R, thickness mix(min, max, texture G) (max
-// without one); KHR_materials_diffuse_transmission: factor x texture A, colour x texture RGB.
-void surface_film(inout Surface s, GnMaterial m)
-{
-    s.irid = vec3(m.iridescence, m.iridescence_ior, m.iridescence_thickness_max);
-    if (GN_HAS(GN_FEAT_TEXTURES) && s.irid.x > 0.0 && m.tex_iridescence != GN_INVALID)
-        s.irid.x *= texture_sample(m.tex_iridescence, s.uv, false).r;
-    if (GN_HAS(GN_FEAT_TEXTURES) && s.irid.x > 0.0 && m.tex_iridescence_thickness != GN_INVALID)
-        s.irid.z = mix(m.iridescence_thickness_min, m.iridescence_thickness_max,
-                       texture_sample(m.tex_iridescence_thickness, s.uv, false).g);
-    s.dt = vec4(m.diffuse_transmission_color, m.diffuse_transmission);
-    if (GN_HAS(GN_FEAT_TEXTURES) && s.dt.w > 0.0 && m.tex_diffuse_transmission != GN_INVALID)
-        s.dt.w *= texture_sample(m.tex_diffuse_transmission, s.uv, false).a;
-    if (GN_HAS(GN_FEAT_TEXTURES) && s.dt.w > 0.0 && m.tex_diffuse_transmission_color != GN_INVALID)
-        s.dt.rgb *= texture_sample(m.tex_diffuse_transmission_color, s.uv, true).rgb;
-}
 
 // tri: BVH-order triangle index; (u, v): barycentrics of v1 and v2; d: ray direction.
 Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
@@ -283,102 +234,21 @@ Surface surface_at(uint tri, float t, float u, float v, vec3 o, vec3 d)
     bool flip = dot(n, ng) < 0.0;
     s.ng = ng;
     s.uv = w * vertex_uv(a) + u * vertex_uv(b) + v * vertex_uv(c);
-
-    GnMaterial m = material_at(pr.material);
     s.material = pr.material;
-    vec4 base = m.base_color;
-    if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_base != GN_INVALID)
-        base *= texture_sample(m.tex_base, s.uv, true);
     vec4 vc = vec4(1.0);
     if (vertex_colors())
         vc = w * a.color + u * b.color + v * c.color;
-    base *= vc;
     s.vcolor = vc.rgb;
-    s.base = base.rgb;
-    s.metallic = m.metallic;
-    s.roughness = m.roughness;
-    if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_mr != GN_INVALID) {
-        vec4 mr = texture_sample(m.tex_mr, s.uv, false);
-        s.roughness *= mr.g;
-        s.metallic *= mr.b;
-    }
-    s.emission = m.emissive;
-    if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_emissive != GN_INVALID)
-        s.emission *= texture_sample(m.tex_emissive, s.uv, true).rgb;
+    MaterialHit h;
+    h.uv = s.uv;
+    h.color = vc;
+    h.n = n;
+    h.tangent = w * a.tangent + u * b.tangent + v * c.tangent;
+    s.sh = material_eval(material_at(pr.material), h);
     // (occlusion maps: the local modes' ambient term only, glsl/lib/phong.glsl)
-    s.coat = 0.0;
-    s.coat_roughness = 0.0;
-    s.coat_n = n;
-    s.sheen = vec3(0.0);
-    s.sheen_roughness = 0.0;
-    s.irid = vec3(0.0);
-    s.dt = vec4(0.0);
-    vec4 tg = w * a.tangent + u * b.tangent + v * c.tangent;
-    if (GN_HAS(GN_FEAT_LAYERS)) {
-        s.coat = m.clearcoat;
-        s.coat_roughness = m.clearcoat_roughness;
-        if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_clearcoat != GN_INVALID)
-            s.coat *= texture_sample(m.tex_clearcoat, s.uv, false).r;
-        if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_clearcoat_roughness != GN_INVALID)
-            s.coat_roughness *= texture_sample(m.tex_clearcoat_roughness, s.uv, false).g;
-        s.sheen = m.sheen_color;
-        s.sheen_roughness = m.sheen_roughness;
-        if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_sheen_color != GN_INVALID)
-            s.sheen *= texture_sample(m.tex_sheen_color, s.uv, true).rgb;
-        if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_sheen_roughness != GN_INVALID)
-            s.sheen_roughness *= texture_sample(m.tex_sheen_roughness, s.uv, false).a;
-        if (GN_HAS(GN_FEAT_TEXTURES) && s.coat > 0.0 && m.tex_clearcoat_normal != GN_INVALID) {
-            vec3 tangent = tg.xyz - n * dot(n, tg.xyz);
-            if (dot(tangent, tangent) > 1e-20) {
-                tangent = normalize(tangent);
-                vec3 bitangent = (tg.w < 0.0 ? -1.0 : 1.0) * cross(n, tangent);
-                vec3 tn = texture_sample(m.tex_clearcoat_normal, s.uv, false).xyz * 2.0 - 1.0;
-                tn.xy *= m.clearcoat_normal_scale;
-                vec3 nm = tn.x * tangent + tn.y * bitangent + tn.z * n;
-                if (dot(nm, nm) > 1e-20)
-                    s.coat_n = normalize(nm);
-            }
-        }
-        s.coat_n = shading_normal_valid(flip ? -s.coat_n : s.coat_n, ng, -d);
-        surface_film(s, m);
-    }
-    s.aniso = 0.0;
-    s.aniso_t = vec3(0.0);
-    if (GN_HAS(GN_FEAT_ANISO) && m.anisotropy_strength > 0.0) {
-        // The extension's direction: (1, 0) or the texture's RG in [-1, 1], rotated by the
-        // rotation from the tangent toward the bitangent; its B scales the strength.
-        vec2 dir = vec2(1.0, 0.0);
-        s.aniso = m.anisotropy_strength;
-        if (GN_HAS(GN_FEAT_TEXTURES) && m.tex_anisotropy != GN_INVALID) {
-            vec3 ta = texture_sample(m.tex_anisotropy, s.uv, false).rgb;
-            dir = ta.rg * 2.0 - 1.0;
-            s.aniso *= ta.b;
-        }
-        float cr = cos(m.anisotropy_rotation), sr = sin(m.anisotropy_rotation);
-        dir = vec2(cr * dir.x - sr * dir.y, sr * dir.x + cr * dir.y);
-        vec3 tangent = tg.xyz - n * dot(n, tg.xyz);
-        if (dot(tangent, tangent) > 1e-20) {
-            tangent = normalize(tangent);
-            vec3 bitangent = (tg.w < 0.0 ? -1.0 : 1.0) * cross(n, tangent);
-            s.aniso_t = dir.x * tangent + dir.y * bitangent;
-        }
-    }
-    if (GN_HAS(GN_FEAT_NORMAL_MAP) && m.tex_normal != GN_INVALID) {
-        // The vertex tangents: the mesh's TANGENT or the loader's MikkTSpace ones, which
-        // glTF asks for (src/scene/tangent.c); bitangent = cross(normal, tangent) w, toward -v.
-        vec3 tangent = tg.xyz - n * dot(n, tg.xyz);
-        if (dot(tangent, tangent) > 1e-20) {
-            tangent = normalize(tangent);
-            vec3 bitangent = (tg.w < 0.0 ? -1.0 : 1.0) * cross(n, tangent);
-            vec3 tn = texture_sample(m.tex_normal, s.uv, false).xyz * 2.0 - 1.0;
-            tn.xy *= m.normal_scale; // glTF: the scale applies to X and Y of the sampled normal
-            vec3 nm = tn.x * tangent + tn.y * bitangent + tn.z * n;
-            if (dot(nm, nm) > 1e-20)
-                n = normalize(nm);
-        }
-    }
-    if (flip) n = -n;
-    s.n = shading_normal_valid(n, ng, -d);
+    if (GN_HAS(GN_FEAT_LAYERS))
+        s.sh.coat_n = shading_normal_valid(flip ? -s.sh.coat_n : s.sh.coat_n, ng, -d);
+    s.sh.n = shading_normal_valid(flip ? -s.sh.n : s.sh.n, ng, -d);
     return s;
 }
 

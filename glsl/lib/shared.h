@@ -37,7 +37,7 @@ typedef uint32_t uint;
  * prefers a leaf; GnBvhNode's count field has room for 8). */
 #define GN_BVH_MAX_LEAF 8
 /* Loop passes one node visit of a walk can cost: the visit, and the two leaves it may open,
- * each one pass plus one a pair (src/render/render.c: traversal_budget). */
+ * each one pass plus one a pair (src/render/render_limits.c: traversal_budget). */
 #define GN_WALK_VISIT_PASSES (1u + 2u * (1u + GN_BVH_MAX_LEAF))
 
 /* ---- descriptor bindings (set 0) of the render kernels -------------------------------- */
@@ -66,7 +66,7 @@ typedef uint32_t uint;
 /* Work-group size of the 2D image kernels: 8x8 matches lavapipe's 8-wide SIMD rows and is a
  * good default for GPUs (64 threads = 2 warps / 1 wavefront). */
 /* The most samples per pixel one dispatch of the path kernel takes (glsl/kernels/path.comp;
- * src/render/render.c: path_samples picks the number for a scene). */
+ * src/render/render_limits.c: path_samples picks the number for a scene). */
 #define GN_PATH_SAMPLES 32u
 /* Entries of a BVH walk's stack (glsl/lib/bvh.glsl: Walk), a sentinel and a spare included:
  * room for the 63 nodes a tree of the builder's 64 levels (src/accel/bvh.c) can put off. */
@@ -79,16 +79,41 @@ typedef uint32_t uint;
 /* The path kernel's loop passes per SIMD group before its walks stop (specialization constant
  * 3; 0: none; glsl/lib/bvh.glsl: LOOP_CAP), set below llvmpipe's loop cap. */
 #define GN_SPEC_LOOP_CAP 3u
-/* Words of a path's saved state (glsl/kernels/path.comp: path_save) before its walk's stack: 44 of the
- * path and its walk, 8 of its media (GN_FEAT_VOLUME). */
-#define GN_PATH_STATE_WORDS 52u
+/* A path's saved state (glsl/kernels/path.comp: path_save, path_load; GN_BIND_PSTATE,
+ * GnFrame.state_stride words a pixel): word 0, the pixel's samples still to take, then the
+ * fields of GN_PATH_STATE in order, then the walk's stack. A row X(kind, variable, when) is a
+ * variable of the kernel, saved and loaded where the kernel's condition `when` holds (the
+ * host only counts the words). Kinds: U a uint, I an int, F a float, B a bool (a word each),
+ * V a vec3 (three), M the media stack (GN_MEDIA_MAX). A field of the path is one row here. */
+#define GN_MEDIA_MAX 4u /* media a path can be inside at once (path.comp: media) */
+#define GN_PATH_STATE(X)                                                                     \
+    X(U, phase, true) X(B, prev_delta, true) X(B, covered, true) X(B, alive, true)           \
+    X(U, depth, true) X(V, o, true) X(V, d, true) X(F, tmin, true) X(V, radiance, true)      \
+    X(V, beta, true) X(F, prev_pdf, true) X(V, normal, true) X(V, albedo, true)              \
+    X(F, depth_aov, true) X(V, so, true) X(V, sd, true) X(F, smax, true) X(V, c, true)       \
+    X(F, walk.hit.t, true) X(F, walk.hit.u, true) X(F, walk.hit.v, true)                     \
+    X(U, walk.hit.tri, true) X(U, walk.hit.steps, true) X(U, walk.node, true)                \
+    X(I, walk.sp, true)                                                                      \
+    X(U, tr_k, GN_HAS(GN_FEAT_ALPHA)) X(F, tr_lo, GN_HAS(GN_FEAT_ALPHA))                     \
+    X(F, tr_max, GN_HAS(GN_FEAT_ALPHA))                                                      \
+    X(M, media, GN_HAS(GN_FEAT_VOLUME)) X(U, media_n, GN_HAS(GN_FEAT_VOLUME))                \
+    X(U, channel, GN_HAS(GN_FEAT_VOLUME)) X(V, seg_from, GN_HAS(GN_FEAT_VOLUME))
+#define GN_PS_WORDS_U 1u
+#define GN_PS_WORDS_I 1u
+#define GN_PS_WORDS_F 1u
+#define GN_PS_WORDS_B 1u
+#define GN_PS_WORDS_V 3u
+#define GN_PS_WORDS_M GN_MEDIA_MAX
+#define GN_PS_COUNT(kind, var, when) + GN_PS_WORDS_##kind
+/* Words of a path's saved state before its walk's stack. */
+#define GN_PATH_STATE_WORDS (1u GN_PATH_STATE(GN_PS_COUNT))
 #define GN_TILE_X 8u
 #define GN_TILE_Y 8u
 
 /* ---- render modes: the one list -------------------------------------------------------
  * X(ID, value, kernel, flags, name, help): mode GN_MODE_<ID> = value (0, 1, ... in list
  * order: --mode's list, the help and the preview's number keys follow it), the kernel that
- * renders it, its GN_MODEF_* and, for the host only (src/render/render.c's registry; glslang drops
+ * renders it, its GN_MODEF_* and, for the host only (src/render/render_modes.c; glslang drops
  * the unexpanded strings), its --mode name and its line of help. A mode of the local kernel
  * is one branch of glsl/kernels/local.comp's local_color: a new mode is an entry here and that branch
  * (docs/architecture.md, "Adding a render mode"). */
@@ -121,7 +146,7 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
 #define GN_LIGHT_SPOT 1u
 #define GN_LIGHT_DIRECTIONAL 2u
 /* A small Lambertian emitter seen as a point: I(theta) = color * max(cos theta, 0) around
- * direction. Stands in for emissive geometry in the local modes (src/render/render.c). */
+ * direction. Stands in for emissive geometry in the local modes (src/render/render_lights.c). */
 #define GN_LIGHT_COSINE 3u
 
 #define GN_INVALID 0xffffffffu
@@ -146,47 +171,61 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
  * or the environment (GN_INVALID). */
 #define GN_EMITTER_LIGHT 0x80000000u
 
-/* Features of the path kernel (its specialization constant 1): what a scene and a render
- * can need. llvmpipe never jumps over an `if` (both sides run, lanes masked), so code for a
- * BRDF lobe, a light type or texturing costs every path vertex whether or not any lane
- * uses it; the host sets only the bits its materials, lights and settings need, and the
- * driver compiles the rest away. Each bit only removes code that cannot change the result
- * for a scene without the feature (src/render/render.c: path_features). */
-#define GN_FEAT_GLTF (1u << 0)          /* glTF materials (bsdf_gltf) */
-#define GN_FEAT_MODELS (1u << 1)        /* BRDF-model overrides (bsdf_from_model) */
-#define GN_FEAT_MIRROR (1u << 2)        /* a Dirac mirror lobe */
-#define GN_FEAT_PHONG (1u << 3)         /* lobes: normalised Phong, */
-#define GN_FEAT_BLINN (1u << 4)         /* Blinn-Phong, */
-#define GN_FEAT_TS (1u << 5)            /* Torrance-Sparrow, */
-#define GN_FEAT_BECKMANN (1u << 6)      /* Beckmann, */
-#define GN_FEAT_GGX (1u << 7)           /* GGX */
-#define GN_FEAT_FRESNEL_DIELECTRIC (1u << 8)
-#define GN_FEAT_FRESNEL_CONDUCTOR (1u << 9)
-#define GN_FEAT_FRESNEL_SCHLICK (1u << 10)
-#define GN_FEAT_COUPLED (1u << 11)      /* a diffuse layer under a Schlick layer */
-#define GN_FEAT_SMOOTH_GLASS (1u << 12)
-#define GN_FEAT_ROUGH_GLASS (1u << 13)
-#define GN_FEAT_TEXTURES (1u << 14)     /* base colour, metal-rough, emissive, occlusion maps */
-#define GN_FEAT_NORMAL_MAP (1u << 15)
-#define GN_FEAT_UNLIT (1u << 16)
-#define GN_FEAT_EMISSIVE (1u << 17)     /* emissive triangles */
-#define GN_FEAT_PUNCTUAL (1u << 18)     /* KHR_lights_punctual lights */
-#define GN_FEAT_ENV (1u << 19)          /* an environment (constant or map) */
-#define GN_FEAT_ENV_MAP (1u << 20)
-#define GN_FEAT_LIGHT_SEARCH (1u << 21) /* more than one light to choose from */
-#define GN_FEAT_STRATEGY (1u << 22)     /* light-only or BSDF-only estimators */
-#define GN_FEAT_AOV (1u << 23)
-#define GN_FEAT_VERTEX_COLOR (1u << 24) /* glTF COLOR_0 */
-#define GN_FEAT_ALPHA (1u << 25)        /* alphaMode MASK or BLEND (glsl/lib/bvh.glsl: trace_visible) */
-#define GN_FEAT_VARIANCE (1u << 26)     /* sums of squares (--aov variance) */
-#define GN_FEAT_TEX_TRANSFORM (1u << 27) /* KHR_texture_transform (GnTexture.transform) */
-#define GN_FEAT_UV1 (1u << 28)          /* textures reading TEXCOORD_1 (GN_TEX_UV1) */
-#define GN_FEAT_LAYERS (1u << 29)       /* KHR_materials_clearcoat, _sheen, _iridescence, _diffuse_transmission (brdf.glsl: bsdf_layers) */
-#define GN_FEAT_VOLUME (1u << 30)       /* KHR_materials_volume media, _dispersion */
-#define GN_FEAT_ANISO (1u << 31)        /* KHR_materials_anisotropy */
+/* Features of the path kernel: what a scene and a render can need. llvmpipe never jumps over
+ * an `if` (both sides run, lanes masked), so code for a BRDF lobe, a light type or texturing
+ * costs every path vertex whether or not any lane uses it; the host sets only the bits its
+ * materials, lights and settings need, and the driver compiles the rest away. Each bit only
+ * removes code that cannot change the result for a scene without the feature
+ * (src/render/render_material.c: material_features; src/render/render.c: path_features).
+ * 64 of them, half used: the host's GnFeatures (uint64_t) is two 32-bit specialization
+ * constants (GN_SPEC_FEATURES: bits 0-31, GN_SPEC_FEATURES_HI: 32-63), a kernel's feature a
+ * uvec2 (its bit in x or y) that GN_HAS tests; | combines features in both. */
+#define GN_SPEC_FEATURES 1u
+#define GN_SPEC_FEATURES_HI 4u
+#ifdef VULKAN
+#define GN_FEAT(n) uvec2((n) < 32 ? 1u << ((n) & 31) : 0u, (n) >= 32 ? 1u << ((n) & 31) : 0u)
+#define GN_FEAT_NONE uvec2(0u)
+#define GN_FEAT_ALL uvec2(0xffffffffu)
+#else
+typedef uint64_t GnFeatures;
+#define GN_FEAT(n) ((GnFeatures)1 << (n))
+#define GN_FEAT_NONE ((GnFeatures)0)
+#define GN_FEAT_ALL (~(GnFeatures)0)
+#endif
+#define GN_FEAT_GLTF GN_FEAT(0)       /* glTF materials (bsdf_gltf) */
+#define GN_FEAT_MODELS GN_FEAT(1)     /* BRDF-model overrides (bsdf_from_model) */
+#define GN_FEAT_MIRROR GN_FEAT(2)     /* a Dirac mirror lobe */
+#define GN_FEAT_PHONG GN_FEAT(3)      /* lobes: normalised Phong, */
+#define GN_FEAT_BLINN GN_FEAT(4)      /* Blinn-Phong, */
+#define GN_FEAT_TS GN_FEAT(5)         /* Torrance-Sparrow, */
+#define GN_FEAT_BECKMANN GN_FEAT(6)   /* Beckmann, */
+#define GN_FEAT_GGX GN_FEAT(7)        /* GGX */
+#define GN_FEAT_FRESNEL_DIELECTRIC GN_FEAT(8)
+#define GN_FEAT_FRESNEL_CONDUCTOR GN_FEAT(9)
+#define GN_FEAT_FRESNEL_SCHLICK GN_FEAT(10)
+#define GN_FEAT_COUPLED GN_FEAT(11)   /* a diffuse layer under a Schlick layer */
+#define GN_FEAT_SMOOTH_GLASS GN_FEAT(12)
+#define GN_FEAT_ROUGH_GLASS GN_FEAT(13)
+#define GN_FEAT_TEXTURES GN_FEAT(14)  /* texture maps (glsl/lib/material.h: the TEX rows) */
+#define GN_FEAT_NORMAL_MAP GN_FEAT(15)
+#define GN_FEAT_UNLIT GN_FEAT(16)
+#define GN_FEAT_EMISSIVE GN_FEAT(17)  /* emissive triangles */
+#define GN_FEAT_PUNCTUAL GN_FEAT(18)  /* KHR_lights_punctual lights */
+#define GN_FEAT_ENV GN_FEAT(19)       /* an environment (constant or map) */
+#define GN_FEAT_ENV_MAP GN_FEAT(20)
+#define GN_FEAT_LIGHT_SEARCH GN_FEAT(21) /* more than one light to choose from */
+#define GN_FEAT_STRATEGY GN_FEAT(22)  /* light-only or BSDF-only estimators */
+#define GN_FEAT_AOV GN_FEAT(23)
+#define GN_FEAT_VERTEX_COLOR GN_FEAT(24) /* glTF COLOR_0 */
+#define GN_FEAT_ALPHA GN_FEAT(25)     /* alphaMode MASK or BLEND (glsl/lib/bvh.glsl: trace_visible) */
+#define GN_FEAT_VARIANCE GN_FEAT(26)  /* sums of squares (--aov variance) */
+#define GN_FEAT_TEX_TRANSFORM GN_FEAT(27) /* KHR_texture_transform (GnTexture.transform) */
+#define GN_FEAT_UV1 GN_FEAT(28)       /* textures reading TEXCOORD_1 (GN_TEX_UV1) */
+#define GN_FEAT_LAYERS GN_FEAT(29)    /* KHR_materials_clearcoat, _sheen, _iridescence, _diffuse_transmission (brdf_material.glsl: bsdf_layers) */
+#define GN_FEAT_VOLUME GN_FEAT(30)    /* KHR_materials_volume media, _dispersion */
+#define GN_FEAT_ANISO GN_FEAT(31)     /* KHR_materials_anisotropy */
 /* (GN_FEAT_LOBES, every lobe a BRDF model can build: brdf_models.h, from its table) */
 #define GN_FEAT_GLASS (GN_FEAT_SMOOTH_GLASS | GN_FEAT_ROUGH_GLASS)
-#define GN_FEAT_ALL 0xffffffffu
 
 /* ---- BVH: both children's boxes in one 64-byte node (Aila & Laine 2009, "Understanding
  * the efficiency of ray traversal on GPUs"): one fetch tests two boxes and the walk only
@@ -201,7 +240,7 @@ enum { GN_MODES(GN_MODE_ID) GN_MODE_COUNT };
  *                                     box is inverted (min FLT_MAX, max -FLT_MAX), so the
  *                                     walk's slab test never enters it and needs no check
  * Leaves hold at most GN_BVH_MAX_LEAF pairs and scenes at most 2^26 triangles
- * (src/scene/scene_gltf.cpp), so first fits in 27 bits. */
+ * (src/scene/scene.h: SCENE_MAX_TRIANGLES), so first fits in 27 bits. */
 #define GN_BVH_LEAF 0x80000000u
 #define GN_BVH_COUNT_SHIFT 27
 #define GN_BVH_FIRST 0x07ffffffu
@@ -253,43 +292,13 @@ GN_STRUCT(GnVertex) {
                      kernels with GN_FEAT_UV1 */
 } GN_END(GnVertex); /* 80 bytes */
 
-/* glTF metallic-roughness material plus the classic (OpenGL 1.x) Phong parameters used by
- * the local shading modes, and an optional BRDF-model override for the path tracer.
- * Texture fields index GnTexture[], GN_INVALID when absent. */
+/* A material: glTF metallic-roughness with its extensions, the classic (OpenGL 1.x) Phong
+ * parameters of the local shading modes, and an optional BRDF-model override for the path
+ * tracer. Declared field by field in glsl/lib/material.h (GN_MATERIAL), which everything that
+ * reads or writes one expands. Texture fields index GnTexture[], GN_INVALID when absent. */
+#include "material.h"
 GN_STRUCT(GnMaterial) {
-    vec4 base_color;                       /* linear RGBA factor */
-    vec3 emissive; float metallic;         /* emissive factor * KHR_materials_emissive_strength */
-    vec3 specular_color; float roughness;  /* KHR_materials_specular colour factor */
-    float specular; float ior; float transmission; float normal_scale;
-    float occlusion_strength; float alpha_cutoff; uint flags; uint brdf; /* brdf: 0 = glTF model */
-    uint tex_base; uint tex_mr; uint tex_normal; uint tex_emissive;
-    uint tex_occlusion; uint pad0; uint pad1; uint pad2;
-    vec4 brdf_params;                      /* parameters of the override model */
-    vec3 phong_ambient; float phong_shininess;
-    vec3 phong_diffuse; float phong_pad0;
-    vec3 phong_specular; float phong_pad1;
-    vec3 phong_emission; float phong_pad2;
-    /* KHR_materials_volume (read by kernels with GN_FEAT_VOLUME; docs/path-tracing.md):
-     * volume 1 when the material bounds a medium (the extension with thicknessFactor > 0),
-     * whose absorption is sigma_a = -ln(attenuation_color) / attenuation_distance (+inf: no
-     * absorption). thickness is the rasterizers' stand-in for the real geometry: kept for
-     * `gonio info`, unused in shading. dispersion: KHR_materials_dispersion, 20 / Abbe number. */
-    vec3 attenuation_color; float attenuation_distance;
-    float thickness; float dispersion; uint volume; float volume_pad0;
-    /* KHR_materials_clearcoat: factor, roughness factor and their textures (R, G); the coat's
-     * normal map and its scale (GN_INVALID: the mesh's normal, not normalTexture's) */
-    float clearcoat; float clearcoat_roughness; uint tex_clearcoat; uint tex_clearcoat_roughness;
-    uint tex_clearcoat_normal; float clearcoat_normal_scale; uint tex_sheen_color; uint tex_sheen_roughness;
-    vec3 sheen_color; float sheen_roughness; /* KHR_materials_sheen factors (textures: RGB, A) */
-    /* KHR_materials_anisotropy: strength, rotation (radians, from the tangent toward the
-     * bitangent) and the direction/strength texture (RG: direction, B: strength) */
-    float anisotropy_strength; float anisotropy_rotation; uint tex_anisotropy; float anisotropy_pad0;
-    /* KHR_materials_iridescence: factor, the film's ior, its thickness range in nm and the
-     * factor (R) and thickness (G) textures */
-    float iridescence; float iridescence_ior; float iridescence_thickness_min; float iridescence_thickness_max;
-    uint tex_iridescence; uint tex_iridescence_thickness; float diffuse_transmission; uint tex_diffuse_transmission;
-    /* KHR_materials_diffuse_transmission: factor (above, texture A) and colour (texture RGB) */
-    vec3 diffuse_transmission_color; uint tex_diffuse_transmission_color;
+    GN_MATERIAL(GN_MAT_DECL_PARAM, GN_MAT_DECL_TEX, GN_MAT_DECL_FIELD)
 } GN_END(GnMaterial); /* 336 bytes */
 
 /* glTF KHR_lights_punctual light in world space. color = colour * intensity (W/sr for point
@@ -402,12 +411,19 @@ GN_STATIC_ASSERT(sizeof(GnTriPair) == 48, "GnTriPair layout");
 GN_STATIC_ASSERT(sizeof(GnPrim) == 16, "GnPrim layout");
 GN_STATIC_ASSERT(sizeof(GnVertex) == 80, "GnVertex layout");
 GN_STATIC_ASSERT(offsetof(GnVertex, u1) == 64, "GnVertex layout");
-GN_STATIC_ASSERT(sizeof(GnMaterial) == 336, "GnMaterial layout");
-GN_STATIC_ASSERT(offsetof(GnMaterial, attenuation_color) == 192, "GnMaterial layout");
-GN_STATIC_ASSERT(offsetof(GnMaterial, clearcoat) == 224, "GnMaterial layout");
-GN_STATIC_ASSERT(offsetof(GnMaterial, sheen_color) == 256, "GnMaterial layout");
-GN_STATIC_ASSERT(offsetof(GnMaterial, brdf_params) == 112, "GnMaterial layout");
-GN_STATIC_ASSERT(offsetof(GnMaterial, phong_ambient) == 128, "GnMaterial layout");
+GN_STATIC_ASSERT(sizeof(GnMaterial) == 4 * GN_MATERIAL_WORDS && GN_MATERIAL_WORDS == 4 * GN_MATERIAL_TEXELS,
+                 "GnMaterial layout");
+/* every row of GN_MATERIAL at its word, a vec3 or vec4 at the start of a texel */
+#define GN_MAT_ALIGNED_float(word) 1
+#define GN_MAT_ALIGNED_uint(word) 1
+#define GN_MAT_ALIGNED_vec3(word) ((word) % 4 == 0)
+#define GN_MAT_ALIGNED_vec4(word) ((word) % 4 == 0)
+#define GN_MAT_ASSERT_FIELD(name, type, word) \
+    GN_STATIC_ASSERT(offsetof(GnMaterial, name) == 4 * (word) && GN_MAT_ALIGNED_##type(word), \
+                     "GnMaterial." #name " is not at word " #word " (glsl/lib/material.h)");
+#define GN_MAT_ASSERT_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) GN_MAT_ASSERT_FIELD(name, type, word)
+#define GN_MAT_ASSERT_TEX(name, word, ext, json, space, gate, uses) GN_MAT_ASSERT_FIELD(name, uint, word)
+GN_MATERIAL(GN_MAT_ASSERT_PARAM, GN_MAT_ASSERT_TEX, GN_MAT_ASSERT_FIELD)
 GN_STATIC_ASSERT(sizeof(GnLight) == 64, "GnLight layout");
 GN_STATIC_ASSERT(sizeof(GnEmitter) == 16, "GnEmitter layout");
 GN_STATIC_ASSERT(sizeof(GnTexture) == 48, "GnTexture layout");

@@ -1,5 +1,7 @@
 /* cli.c: option helpers shared by the subcommands. */
 #include <assert.h>
+#include <float.h>
+#include <limits.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -48,11 +50,48 @@ static int bad_value(const cli_command *c, const char *opt, const char *val, con
     return cli_usage_error(c->name, "%s '%s': expected %s", opt, val, expect);
 }
 
+/* What a bad value of o should have been: its expect, else for a number its range, for a
+ * list of words "one of" them; NULL when the parser says it itself. */
+static const char *expectation(const cli_option *o, char *buf, size_t cap)
+{
+    if (o->expect)
+        return o->expect;
+    switch (o->kind) {
+    case CLI_INT:
+    case CLI_U32:
+        snprintf(buf, cap, "an integer in [%.10g, %.10g]", o->min, o->max);
+        return buf;
+    case CLI_FLOAT:
+    case CLI_DOUBLE:
+        snprintf(buf, cap, "a number in %s%.10g, %.10g]", o->min == FLT_MIN ? "(" : "[",
+                 o->min == FLT_MIN ? 0.0 : o->min, o->max);
+        return buf;
+    case CLI_CALL:
+        if (!o->complete || strchr(o->complete, '*') || strchr(o->complete, '/'))
+            return NULL;
+        snprintf(buf, cap, "one of %s", o->complete);
+        return buf;
+    default:
+        return NULL;
+    }
+}
+
+/* A number outside an option's range: the message gives the range ("(0, 1e+06]": more
+ * than 0; "[0, 1e+09]": 0 to 1e9, both included). */
+static int out_of_range(const cli_command *c, const cli_option *o, const char *opt, const char *val)
+{
+    const bool open_low = o->kind == CLI_FLOAT || o->kind == CLI_DOUBLE ? o->min == FLT_MIN : false;
+    return cli_usage_error(c->name, "%s '%s': out of range: must be in %s%.10g, %.10g]", opt, val,
+                           open_low ? "(" : "[", open_low ? 0.0 : o->min, o->max);
+}
+
 /* Stores val in option o's destination; -1 ok, else 2 after a usage error. */
 static int take_value(const cli_command *c, const cli_option *o, const char *opt, const char *val)
 {
     long v;
     float f;
+    char buf[256];
+    const char *expect = expectation(o, buf, sizeof buf);
     switch (o->kind) {
     case CLI_STRING:
         *(const char **)o->dest = val;
@@ -60,7 +99,8 @@ static int take_value(const cli_command *c, const cli_option *o, const char *opt
     case CLI_INT:
     case CLI_U32:
         if (!util_parse_int(val, (long)o->min, (long)o->max, &v))
-            return bad_value(c, opt, val, o->expect);
+            return util_parse_int(val, LONG_MIN, LONG_MAX, &v) ? out_of_range(c, o, opt, val)
+                                                                : bad_value(c, opt, val, expect);
         if (o->kind == CLI_INT)
             *(int *)o->dest = (int)v;
         else
@@ -68,8 +108,10 @@ static int take_value(const cli_command *c, const cli_option *o, const char *opt
         return -1;
     case CLI_FLOAT:
     case CLI_DOUBLE:
-        if (!util_parse_float(val, &f) || !(f >= o->min && f <= o->max))
-            return bad_value(c, opt, val, o->expect);
+        if (!util_parse_float(val, &f))
+            return bad_value(c, opt, val, expect);
+        if (!(f >= o->min && f <= o->max))
+            return out_of_range(c, o, opt, val);
         if (o->kind == CLI_FLOAT)
             *(float *)o->dest = f;
         else
@@ -78,11 +120,68 @@ static int take_value(const cli_command *c, const cli_option *o, const char *opt
     case CLI_CALL:
         if (o->call(c->name, opt, val, o->dest))
             return -1;
-        return o->expect ? bad_value(c, opt, val, o->expect) : 2;
+        return expect ? bad_value(c, opt, val, expect) : 2;
     default:
         return -1;
     }
 }
+
+/* ---- completion ------------------------------------------------------------------------- */
+
+static const char *complete_word; /* the word being completed; NULL: parse */
+
+void cli_complete(const char *word) { complete_word = word; }
+
+void cli_complete_print(const char *list)
+{
+    while (list && *list) {
+        size_t n = strcspn(list, ", ");
+        if (n)
+            printf("%.*s\n", (int)n, list);
+        list += n;
+        list += strspn(list, ", ");
+    }
+}
+
+/* cli_parse under cli_complete: argv holds the words before complete_word. */
+static int complete(const cli_command *c, int argc, char **argv)
+{
+    const cli_option *value_of = NULL; /* the option whose value complete_word is */
+    bool options = true;
+    int positional = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        value_of = NULL;
+        if (!options || a[0] != '-' || !a[1]) {
+            positional++;
+        } else if (!strcmp(a, "--")) {
+            options = false;
+        } else if (!strchr(a, '=')) {
+            int k = find_option(c, a, strlen(a));
+            if (k >= 0 && c->options[k].kind != CLI_FLAG) {
+                if (i + 1 < argc)
+                    i++; /* its value */
+                else
+                    value_of = &c->options[k];
+            }
+        }
+    }
+    if (value_of)
+        cli_complete_print(value_of->complete);
+    else if (options && complete_word[0] == '-') {
+        for (int k = 0; k < c->num_options; k++)
+            if (c->options[k].kind != CLI_TEXT)
+                cli_complete_print(c->options[k].names);
+        cli_complete_print("--help");
+    } else if (c->max_args < 0 || positional < c->max_args || positional == 0) {
+        /* (positional 0: also the first argument a command reads before its options, such
+         * as brdf's model, which its max_args does not count until it is there) */
+        cli_complete_print(c->complete_args);
+    }
+    return 0;
+}
+
+/* ---- parsing ---------------------------------------------------------------------------- */
 
 int cli_parse(const cli_command *c, int argc, char **argv, cli_args *out)
 {
@@ -90,6 +189,8 @@ int cli_parse(const cli_command *c, int argc, char **argv, cli_args *out)
     assert(c->num_options <= CLI_MAX_OPTIONS);
     memset(out, 0, sizeof *out);
     out->arg = argv + 1;
+    if (complete_word)
+        return complete(c, argc, argv);
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *eq = a[0] == '-' && a[1] == '-' ? strchr(a, '=') : NULL;
         size_t len = eq ? (size_t)(eq - a) : strlen(a);
@@ -139,43 +240,6 @@ bool cli_given(const cli_command *c, const cli_args *a, const char *name)
     int k = find_option(c, name, strlen(name));
     assert(k >= 0); /* a name the table does not have is a bug */
     return k >= 0 && a->given[k];
-}
-
-bool cli_take_size(const char *cmd, const char *opt, const char *value, void *dest)
-{
-    (void)cmd, (void)opt;
-    int *wh = dest;
-    return util_parse_size(value, &wh[0], &wh[1]);
-}
-
-bool cli_take_mode(const char *cmd, const char *opt, const char *value, void *dest)
-{
-    int m = render_mode_from_name(value);
-    if (m < 0) {
-        cli_usage_error(cmd, "%s '%s': expected one of %s", opt, value, render_mode_list());
-        return false;
-    }
-    *(uint32_t *)dest = (uint32_t)m;
-    return true;
-}
-
-bool cli_take_tonemap(const char *cmd, const char *opt, const char *value, void *dest)
-{
-    (void)cmd, (void)opt;
-    return image_tonemap_from_name(value, dest);
-}
-
-bool cli_take_variant(const char *cmd, const char *opt, const char *value, void *dest)
-{
-    (void)cmd, (void)opt, (void)dest;
-    scene_select_variant(value);
-    return true;
-}
-
-bool cli_take_exr_compression(const char *cmd, const char *opt, const char *value, void *dest)
-{
-    (void)cmd, (void)opt;
-    return image_exr_compression_from_name(value, dest);
 }
 
 /* The help column: option names and value, padded to it, then the text. */

@@ -8,9 +8,9 @@
 
 #include "gpu.h"
 
+struct image;
+struct render_settings;
 struct scene;
-
-#define GONIO_VERSION "0.1.0"
 
 int cmd_render(int argc, char **argv);
 int cmd_info(int argc, char **argv);
@@ -23,6 +23,7 @@ int cmd_teapot(int argc, char **argv);
 int cmd_merge(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_preview(int argc, char **argv);
+int cmd_denoise(int argc, char **argv);
 
 /* One of `gonio scene`'s scenes ("cornell", "teapot") loaded as from its glTF (written to a
  * temporary directory and removed), so a default scene needs no file in the working
@@ -31,9 +32,10 @@ bool cli_load_builtin_scene(struct scene *out, const char *name);
 
 /* ---- options ----------------------------------------------------------------------------
  * Every command declares its options once, as a table of cli_option; cli_parse reads argv
- * against it (--opt value and --opt=value, -h/--help, "--" ending the options) and cli_help
- * prints the --help text from it, so what --help lists is exactly what the command accepts
- * (completion/gonio and the man page read that text). */
+ * against it (--opt value and --opt=value, -h/--help, "--" ending the options), cli_help
+ * prints the --help text from it (which the man page reads), and bash completion asks the
+ * program for the names and values in it (cli_complete, completion/gonio), so what --help
+ * lists and completion offers is exactly what the command accepts. */
 typedef enum cli_kind {
     CLI_FLAG,   /* bool *dest = true; takes no value */
     CLI_STRING, /* const char **dest = the value */
@@ -53,8 +55,12 @@ typedef struct cli_option {
     cli_kind kind;
     void *dest;
     double min, max;    /* CLI_INT, CLI_U32, CLI_FLOAT, CLI_DOUBLE */
-    const char *expect; /* what a bad value should have been: "an integer 1..16777216" */
+    const char *expect; /* what a bad value should have been: "WxH, e.g. 640x480"; NULL for a
+                         * number: its range ("an integer in [1, 16777216]") */
     bool (*call)(const char *cmd, const char *opt, const char *value, void *dest);
+    /* What completion offers for the value, separated by spaces or ", ": words, *.EXT (the
+     * files with that extension, and folders), / (folders); NULL: nothing to guess. */
+    const char *complete;
 } cli_option;
 
 #define CLI_MAX_OPTIONS 64
@@ -69,6 +75,8 @@ typedef struct cli_command {
     int min_args, max_args; /* positional arguments; max_args -1: any number */
     const char *missing;    /* the usage error when fewer than min_args: "no scene given" */
     const char *unknown_hint; /* appended to "unknown option": where the options are listed */
+    const char *complete_args; /* what completion offers for a positional argument (as
+                                * cli_option.complete) */
 } cli_command;
 /* A destination of the type its kind writes, or a compile error (the table's void * would
  * take any pointer): CLI_AS(float, &x). The typed kinds' tables and the shared option
@@ -85,40 +93,150 @@ typedef struct cli_args {
 } cli_args;
 
 /* Parses argv[1..argc) (argv[0] the command's name). Returns -1 to go on, or the exit code
- * the command should return: 0 after --help, 2 after a usage error (printed). */
+ * the command should return: 0 after --help, 2 after a usage error (printed). After
+ * cli_complete, it prints the completions instead and returns 0. */
 int cli_parse(const cli_command *c, int argc, char **argv, cli_args *out);
 /* Whether option `name` (any of its aliases) was on the command line. */
 bool cli_given(const cli_command *c, const cli_args *a, const char *name);
 void cli_help(const cli_command *c, FILE *f);
 
-/* Options every command that uses a device has, defined once. */
-#define CLI_OPT_DEVICE(dest)                                                                  \
-    {"--device", "N", "Vulkan device index (see gonio devices)", CLI_INT, CLI_AS(int, dest), 0, 64, \
-     "an index (see gonio devices)", NULL}
-#define CLI_OPT_VALIDATE(dest)                                                                \
-    {"--validate", NULL, "enable the Vulkan validation layer; any message is an error",     \
-     CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL}
-#define CLI_OPT_QUIET(dest, what)                                                             \
-    {"-q, --quiet", NULL, what, CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL}
-#define CLI_OPT_ALLOW_OUTSIDE_FILES(dest)                                                     \
-    {"--allow-outside-files", NULL,                                                           \
-     "let the scene read files outside its folder (default: only\nregular files under it)",  \
-     CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL}
+/* Completion (gonio __complete WORD..., which completion/gonio runs): from now on cli_parse
+ * takes argv as the words before `word`, the one being completed, and prints what may stand
+ * there, one a line: the option names when word starts with '-', the values of the option
+ * before it, else the command's complete_args (see cli_option.complete). */
+void cli_complete(const char *word);
+/* Prints the items of a cli_option.complete list, one a line. */
+void cli_complete_print(const char *list);
 
-/* CLI_CALL parsers of values several commands take. */
+/* ---- the options several commands take, each defined once (options.c) -------------------
+ * A command's table lists them with these macros: the names, the value, its range and parser
+ * and what completion offers are fixed here; `help` (where a macro takes it) is the
+ * command's own wording of what the option does there and its default. */
+
+/* Samples per pixel: the sums count them exactly in float (sum.N, merge) up to 2^24. */
+#define CLI_SPP_MAX (1 << 24)
+#define CLI_OPT_SPP(dest, help)                                                                   \
+    {"--spp", "N", help, CLI_INT, CLI_AS(int, dest), 1, CLI_SPP_MAX, NULL, NULL, NULL}
+/* The image size, WxH, each 1..UTIL_SIZE_MAX (dest: int[2]). */
+#define CLI_OPT_SIZE(dest, help)                                                                  \
+    {"--size", "WxH", help, CLI_CALL, CLI_AS(int, dest), 0, 0,                                    \
+     "WxH, e.g. 640x480 (each 1.." UTIL_STRING(UTIL_SIZE_MAX) ")", cli_take_size, NULL}
+#define CLI_OPT_SEED(dest, help)                                                                  \
+    {"--seed", "S", help, CLI_U32, CLI_AS(uint32_t, dest), 0, 4294967295.0, NULL, NULL, NULL}
+/* The glTF scene of the file (its scenes[] index). */
+#define CLI_OPT_SCENE(dest, help)                                                                 \
+    {"--scene", "N", help, CLI_INT, CLI_AS(int, dest), 0, 1 << 20, NULL, NULL, NULL}
+/* Path length: up to 2^16 bounces each has random dimensions of its own (the alpha tests'
+ * DIM_ALPHA + DIM_ALPHA_RAY * 2 depth in glsl/lib/bvh.glsl stays within 32 bits), and a path
+ * that long has been ended by Russian roulette long before (0: unbounded). */
+#define CLI_MAX_DEPTH_MAX (1 << 16)
+#define CLI_OPT_MAX_DEPTH(dest, help)                                                             \
+    {"--max-depth", "N", help, CLI_INT, CLI_AS(int, dest), 0, CLI_MAX_DEPTH_MAX, NULL, NULL, NULL}
+#define CLI_OPT_MODE(dest)                                                                        \
+    {"--mode", "M", render_mode_help(), CLI_CALL, CLI_AS(uint32_t, dest), 0, 0, NULL, cli_take_mode, \
+     render_mode_list()}
+#define CLI_OPT_VARIANT(help)                                                                     \
+    {"--variant", "NAME", help, CLI_CALL, NULL, 0, 0, NULL, cli_take_variant, NULL}
+#define CLI_OPT_NO_SHADOWS(dest)                                                                  \
+    {"--no-shadows", NULL, "local modes: no shadow rays", CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL, NULL}
+#define CLI_OPT_EXPOSURE(dest, help)                                                              \
+    {"--exposure", "E", help, CLI_FLOAT, CLI_AS(float, dest), -1e6, 1e6, NULL, NULL, NULL}
+#define CLI_OPT_TONEMAP(dest, help)                                                               \
+    {"--tonemap", "T", help, CLI_CALL, CLI_AS(image_tonemap, dest), 0, 0, NULL, cli_take_tonemap, \
+     image_tonemap_list()}
+/* Intel Open Image Denoise on the result (src/core/denoise.h). */
+#define CLI_OPT_DENOISE(dest, help)                                                       \
+    {"--denoise", NULL, help, CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL, NULL}
+#define CLI_OPT_PNG(dest, help)                                                                   \
+    {"--png", "FILE", help, CLI_STRING, CLI_AS(const char *, dest), 0, 0, NULL, NULL, "*.png"}
+#define CLI_OPT_DEVICE(dest)                                                                      \
+    {"--device", "N", "Vulkan device index (see gonio devices)", CLI_INT, CLI_AS(int, dest), 0, 64, \
+     "an index (see gonio devices)", NULL, NULL}
+#define CLI_OPT_VALIDATE(dest)                                                                    \
+    {"--validate", NULL, "enable the Vulkan validation layer; any message is an error",           \
+     CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL, NULL}
+#define CLI_OPT_QUIET(dest, what)                                                                 \
+    {"-q, --quiet", NULL, what, CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL, NULL}
+#define CLI_OPT_ALLOW_OUTSIDE_FILES(dest)                                                         \
+    {"--allow-outside-files", NULL,                                                               \
+     "let the scene read files outside its folder (default: only\nregular files under it)",       \
+     CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL, NULL}
+/* EXR output (render, merge). */
+#define CLI_OPT_EXR_HALF(dest)                                                                    \
+    {"--half", NULL, "EXR: 16-bit half channels (default 32-bit float)", CLI_FLAG, CLI_AS(bool, dest), \
+     0, 0, NULL, NULL, NULL}
+#define CLI_OPT_EXR_COMPRESSION(dest)                                                             \
+    {"--compression", "C", "EXR: none, rle, zips, zip (default), piz, pxr24, b44, b44a",          \
+     CLI_CALL, CLI_AS(int, dest), 0, 0, NULL, cli_take_exr_compression, image_exr_compression_list()}
+
+/* The CLI_CALL parsers of the options above; a bad value gets a usage error naming what the
+ * value may be. */
 bool cli_take_size(const char *cmd, const char *opt, const char *value, void *dest); /* WxH: int[2] */
 bool cli_take_mode(const char *cmd, const char *opt, const char *value, void *dest); /* uint32_t GN_MODE_* */
 bool cli_take_tonemap(const char *cmd, const char *opt, const char *value, void *dest); /* image_tonemap */
 bool cli_take_variant(const char *cmd, const char *opt, const char *value, void *dest); /* no dest: scene_select_variant */
+bool cli_take_exr_compression(const char *cmd, const char *opt, const char *value, void *dest); /* int */
+/* The BRDF models' names (gonio brdf --list), ", "-separated. */
+const char *cli_brdf_models(void);
 
-/* EXR output options (render, merge). */
-bool cli_take_exr_compression(const char *cmd, const char *opt, const char *value, void *dest);
-#define CLI_OPT_EXR_HALF(dest)                                                                \
-    {"--half", NULL, "EXR: 16-bit half channels (default 32-bit float)", CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL}
-#define CLI_OPT_EXR_COMPRESSION(dest)                                                         \
-    {"--compression", "C", "EXR: none, rle, zips, zip (default), piz, pxr24, b44, b44a",      \
-     CLI_CALL, CLI_AS(int, dest), 0, 0, "none, rle, zips, zip, piz, pxr24, b44 or b44a",       \
-     cli_take_exr_compression}
+/* ---- the view: camera and environment (options.c) --------------------------------------- */
+
+/* The camera options of render, preview and compare: a camera_option (camera.h). */
+#define CAMERA_OPTIONS(cam)                                                                       \
+    {"--camera", "C",                                                                             \
+     "N: the scene's N-th camera (0 = the first in the default scene's\n"                         \
+     "node order, the default); frame: frame the bounds from a raised\n"                          \
+     "three-quarter view (the default without a camera); FILE.exr: the\n"                         \
+     "view recorded by gonio render or preview",                                                  \
+     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, cli_take_camera, "frame *.exr"},           \
+    {"--look-at", "E,T[,U]",                                                                      \
+     "place a camera: eye EX,EY,EZ, target TX,TY,TZ, up UX,UY,UZ\n"                               \
+     "(default 0,1,0), world coordinates",                                                        \
+     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, cli_take_camera, NULL},                    \
+    {"--fov", "DEGREES", "vertical field of view (default: the camera's own, else 45)",           \
+     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, cli_take_camera, NULL}
+/* The camera options' parser (dest: the camera_option). */
+bool cli_take_camera(const char *cmd, const char *opt, const char *val, void *dest);
+
+typedef struct env_option {
+    bool given;              /* --env was on the command line */
+    const char *path;        /* a map (.exr or .hdr), else NULL: the constant `color` */
+    bool studio;             /* --env studio: gonio's studio, whatever lights the scene has */
+    float color[3];
+    float rotation;          /* degrees about +Y, right-handed (--env-rotate) */
+    float intensity;         /* scale of the radiance (--env-intensity); 0 means 1 */
+} env_option;
+
+/* The environment options of render and preview: an env_option. CLI_OPT_ENV alone: --env
+ * (bench: help its own wording). */
+#define CLI_OPT_ENV(env, help)                                                                    \
+    {"--env", "R,G,B | V", help, CLI_CALL, CLI_AS(env_option, env), 0, 0, NULL, cli_take_env,     \
+     "studio *.exr *.hdr"}
+#define ENV_OPTIONS(env)                                                                          \
+    CLI_OPT_ENV(env, "constant environment radiance; 0: black (default: the scene's own\n"        \
+                     "lights, or gonio's studio environment when it has none)"),                  \
+    {NULL, NULL,                                                                                  \
+     "  --env FILE          a lat-long HDR environment map, OpenEXR (.exr) or Radiance (.hdr),\n" \
+     "                      +Y up; importance sampled by the path tracer, its mean radiance is\n" \
+     "                      the local modes' ambient light\n"                                     \
+     "  --env studio        gonio's studio environment besides the scene's own lights (as model\n" \
+     "                      viewers light a scene that has only punctual lights)\n",              \
+     CLI_TEXT, NULL, 0, 0, NULL, NULL, NULL},                                                     \
+    {"--env-rotate", "DEG", "turn the environment about +Y (right-handed, default 0)",            \
+     CLI_CALL, CLI_AS(env_option, env), 0, 0, NULL, cli_take_env, NULL},                          \
+    {"--env-intensity", "X", "scale the environment's radiance (default 1)",                      \
+     CLI_CALL, CLI_AS(env_option, env), 0, 0, NULL, cli_take_env, NULL}
+/* The environment options' parser (dest: the env_option). */
+bool cli_take_env(const char *cmd, const char *opt, const char *val, void *dest);
+
+/* Sets s's environment (env, env_map, env_rotation) from e for scene sc, reading a map into
+ * *map (which the caller destroys), or the studio when e is not given and the scene has no
+ * light, announced on stderr unless quiet; *studio tells which. For a local mode (s->mode)
+ * the environment's mean radiance becomes the ambient light (unless s->ambient_set) and the
+ * studio's key light is added to sc's lights. False with an error naming the file on a bad
+ * map. */
+bool env_setup(const env_option *e, struct scene *sc, bool quiet, struct image *map, struct render_settings *s,
+               bool *studio);
 
 /* "gonio CMD: MESSAGE" and the hint to use --help; returns 2. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);

@@ -11,6 +11,7 @@
 
 #include "bench.h" /* spv_bench: glsl/kernels/bench.comp compiled by the build */
 #include "cli.h"
+#include "denoise.h"
 #include "meshgen.h"
 #include "render.h"
 #include "scene.h"
@@ -90,17 +91,79 @@ static double path_pass(renderer *r, uint32_t first, uint32_t count)
     return util_now() - t0;
 }
 
+static const double bench_thresholds[] = {0.05, 0.02};
+
+/* A progressive render of s (seed 0) against ref: the render time and spp at which its RMSE,
+ * less the reference's own noise, first falls below each of bench_thresholds (spp 0: not
+ * within ref_spp). With denoise, the image at each pass is denoised (src/core/denoise.h)
+ * first, each time as `render --denoise` would, its filters made anew, and the time of
+ * that denoise is added; the render then takes the albedo and normal it needs. False when
+ * renderer_begin or the denoiser fails. */
+static bool paths_to_rmse(renderer *r, render_settings *s, const image *ref, double ref_noise, int ref_spp,
+                          bool denoise, double times[2], int spps[2], double rmses[2], double denoise_seconds[2])
+{
+    GnFrame frame;
+    double t_run = 0, rmse;
+    int k = 0;
+    const uint32_t aov = denoise ? RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL : 0;
+    s->seed = 0;
+    s->aov = RENDER_AOV_VARIANCE | aov;
+    /* The kernel with the guides is another specialization: compiled before the timing,
+     * as the warm-up pass compiled the first. */
+    if (!renderer_begin(r, s, &frame))
+        return false;
+    if (denoise) {
+        path_pass(r, 0, 1);
+        if (!renderer_begin(r, s, &frame))
+            return false;
+    }
+    spps[0] = spps[1] = 0;
+    /* Passes of 1, 1, 2, 4, ... samples up to the renderer's own per dispatch: the first
+     * thresholds may be met at a few spp, the denoised ones especially. */
+    for (int spp = 0, n = 1; spp < ref_spp && k < 2; n = spp < (int)r->path_samples ? spp : (int)r->path_samples) {
+        image img = {0};
+        image_metrics m;
+        denoise_info dn = {0};
+        if (n > ref_spp - spp)
+            n = ref_spp - spp;
+        t_run += path_pass(r, (uint32_t)spp, (uint32_t)n);
+        spp += n;
+        renderer_resolve(r, spp, aov, &img);
+        if (denoise) {
+            denoise_channels ch = {{0, 1, 2}, {7, 8, 9}, {4, 5, 6}}; /* R G B A normal.XYZ albedo.RGB */
+            denoise_shutdown();
+            if (!denoise_image(&img, &ch, true, &dn, "bench")) {
+                image_destroy(&img);
+                return false;
+            }
+        }
+        image_compare(&img, ref, &m);
+        image_destroy(&img);
+        rmse = sqrt(fmax(0.0, m.rmse * m.rmse - ref_noise));
+        for (; k < 2 && rmse < bench_thresholds[k]; k++) {
+            times[k] = t_run + dn.seconds + dn.setup_seconds;
+            denoise_seconds[k] = dn.seconds + dn.setup_seconds;
+            spps[k] = spp;
+            rmses[k] = rmse;
+        }
+    }
+    for (; k < 2; k++)
+        times[k] = t_run;
+    return true;
+}
+
 /* --paths: prints the path tracer's first pixel, paths/s at s's size and the time to reach
  * each RMSE against a reference of ref_w x ref_h at ref_spp (seed 1; the timed render uses
- * seed 0). False when renderer_begin fails. */
+ * seed 0); with denoise, the same for the denoised image and the speed-up at equal RMSE.
+ * False when renderer_begin fails. */
 static bool bench_paths(renderer *r, render_settings *s, double t_start, float seconds,
-                        int ref_w, int ref_h, int ref_spp)
+                        int ref_w, int ref_h, int ref_spp, bool denoise)
 {
-    static const double thresholds[] = {0.05, 0.02};
     GnFrame frame;
     image ref = {0};
-    double t_first, t_paths = 0, t_ref, t_run = 0, ref_noise = 0, rmse;
-    int samples = 0, k = 0;
+    double t_first, t_paths = 0, t_ref, ref_noise = 0;
+    double times[2][2], rmses[2][2] = {{0}}, dn_seconds[2][2] = {{0}};
+    int samples = 0, spps[2][2];
 
     if (!renderer_begin(r, s, &frame))
         return false;
@@ -138,27 +201,34 @@ static bool bench_paths(renderer *r, render_settings *s, double t_start, float s
 
     /* The progressive render stops at the reference's spp: beyond it the error left is
      * below the reference's own, and only the noise estimate subtracted stands for it. */
-    s->seed = 0;
-    if (!renderer_begin(r, s, &frame)) {
-        image_destroy(&ref);
-        return false;
+    for (int d = 0; d < 1 + denoise; d++) {
+        if (!paths_to_rmse(r, s, &ref, ref_noise, ref_spp, d, times[d], spps[d], rmses[d], dn_seconds[d])) {
+            image_destroy(&ref);
+            return false;
+        }
+        for (int k = 0; k < 2; k++) {
+            if (!spps[d][k])
+                printf("%s < %.2f%snot reached in %d spp (%.2f s)\n", d ? "denoised rmse" : "rmse",
+                       bench_thresholds[k], d ? " " : "        ", ref_spp, times[d][k]);
+            else if (!d)
+                printf("rmse < %.2f        %.2f s (%d spp, rmse %.4f, %dx%d)\n", bench_thresholds[k], times[d][k],
+                       spps[d][k], rmses[d][k], ref_w, ref_h);
+            else
+                printf("denoised rmse < %.2f %.2f s (%d spp + denoise %.2f s, rmse %.4f, %dx%d)\n",
+                       bench_thresholds[k], times[d][k], spps[d][k], dn_seconds[d][k], rmses[d][k], ref_w, ref_h);
+        }
     }
-    for (int spp = 0; spp < ref_spp && k < 2;) {
-        image img = {0};
-        image_metrics m;
-        int n = ref_spp - spp < (int)r->path_samples ? ref_spp - spp : (int)r->path_samples;
-        t_run += path_pass(r, (uint32_t)spp, (uint32_t)n);
-        spp += n;
-        renderer_resolve(r, spp, false, &img);
-        image_compare(&img, &ref, &m);
-        image_destroy(&img);
-        rmse = sqrt(fmax(0.0, m.rmse * m.rmse - ref_noise));
-        for (; k < 2 && rmse < thresholds[k]; k++)
-            printf("rmse < %.2f        %.2f s (%d spp, rmse %.4f, %dx%d)\n", thresholds[k], t_run,
-                   spp, rmse, ref_w, ref_h);
+    if (denoise) {
+        for (int k = 0; k < 2; k++)
+            if (spps[0][k] && spps[1][k])
+                printf("denoise speed-up   %.1fx at rmse %.2f (%d spp in %.2f s, denoised %d spp in %.2f s)\n",
+                       times[0][k] / times[1][k], bench_thresholds[k], spps[0][k], times[0][k], spps[1][k],
+                       times[1][k]);
+            else
+                printf("denoise speed-up   at rmse %.2f: not measured (a run did not reach it)\n",
+                       bench_thresholds[k]);
+        denoise_shutdown();
     }
-    for (; k < 2; k++)
-        printf("rmse < %.2f        not reached in %d spp (%.2f s)\n", thresholds[k], ref_spp, t_run);
     image_destroy(&ref);
     return true;
 }
@@ -189,23 +259,24 @@ int cmd_bench(int argc, char **argv)
     const double t_start = util_now();
     const char *path = NULL; /* the built-in Cornell box */
     int generate = 0;
-    float seconds = 3, env = 0;
+    float seconds = 3;
+    env_option env = {0};
     int device = -1, size[2] = {0, 0}, ref_w = 128, ref_h = 128, ref_spp = 512;
-    bool validate = false, paths = false;
+    bool validate = false, paths = false, denoise = false;
     reference_option ref = {&ref_w, &ref_h, &ref_spp};
     const cli_option options[] = {
         /* meshgen_bench_mesh's 16 spheres and ground need about 1000 triangles. */
         {"--generate", "N", "a procedural mesh of about N triangles (1000..50000000) instead of a scene",
-         CLI_INT, CLI_AS(int, &generate), 1000, 50000000, "a triangle count 1000..50000000", NULL},
-        {"--size", "WxH", "rays per pass (default 512x512; --paths: 256x256)", CLI_CALL, size, 0, 0,
-         "WxH", cli_take_size},
+         CLI_INT, CLI_AS(int, &generate), 1000, 50000000, "a triangle count 1000..50000000", NULL, NULL},
+        CLI_OPT_SIZE(size, "rays per pass (default 512x512; --paths: 256x256)"),
         {"--seconds", "S", "measure each rate for about S seconds (default 3)", CLI_FLOAT, CLI_AS(float, &seconds),
-         FLT_MIN, 1e6, "a number > 0", NULL},
-        {"--paths", NULL, "measure the path tracer", CLI_FLAG, CLI_AS(bool, &paths), 0, 0, NULL, NULL},
-        {"--env", "V", "--paths: constant environment radiance (default 0)", CLI_FLOAT, CLI_AS(float, &env), 0, 3e38,
-         "a radiance >= 0", NULL},
+         FLT_MIN, 1e6, "a number > 0", NULL, NULL},
+        {"--paths", NULL, "measure the path tracer", CLI_FLAG, CLI_AS(bool, &paths), 0, 0, NULL, NULL, NULL},
+        CLI_OPT_ENV(&env, "--paths: the environment, as gonio render's (default 0: black)"),
         {"--reference", "WxH:SPP", "--paths: the RMSE reference (default 128x128:512)", CLI_CALL, &ref,
-         0, 0, "WxH:SPP", take_reference},
+         0, 0, "WxH:SPP", take_reference, NULL},
+        CLI_OPT_DENOISE(&denoise, "--paths: also the time to each RMSE of the denoised image (render\n"
+                                  "--denoise: OIDN guided by albedo and normal) and the speed-up"),
         CLI_OPT_DEVICE(&device),
         CLI_OPT_VALIDATE(&validate),
     };
@@ -222,7 +293,7 @@ int cmd_bench(int argc, char **argv)
             "progressive render's RMSE (linear RGB) against a high-spp reference (with the\n"
             "reference's own estimated noise removed) first falls below 0.05 and 0.02 (times count\n"
             "the passes, not the RMSE checks).\n",
-        CLI_OPTIONS(options), .max_args = 1};
+        CLI_OPTIONS(options), .max_args = 1, .complete_args = "*.gltf *.glb"};
     cli_args args;
     int rc;
     scene sc = {0};
@@ -240,6 +311,10 @@ int cmd_bench(int argc, char **argv)
         return rc;
     if (args.num_args)
         path = args.arg[0];
+    if (denoise && !paths)
+        return cli_usage_error("bench", "--denoise is for --paths");
+    if (denoise && !denoise_load())
+        return 1;
     int w = size[0], h = size[1];
 
     if (!build_scene(&sc, path, generate))
@@ -264,11 +339,18 @@ int cmd_bench(int argc, char **argv)
     s.camera = sc.num_cameras ? 0 : -1;
     s.no_shadows = true;
     if (paths) {
-        bool ok;
+        bool ok, studio;
+        image env_map = {0};
         s.mode = GN_MODE_PATH;
         s.aov = RENDER_AOV_VARIANCE; /* the reference's own noise needs its squares */
-        s.env[0] = s.env[1] = s.env[2] = env;
-        ok = bench_paths(&r, &s, t_start, seconds, ref_w, ref_h, ref_spp);
+        if (env.given && !env_setup(&env, &sc, true, &env_map, &s, &studio)) {
+            renderer_destroy(&r);
+            scene_destroy(&sc);
+            gpu_destroy(&g);
+            return 1;
+        }
+        ok = bench_paths(&r, &s, t_start, seconds, ref_w, ref_h, ref_spp, denoise);
+        image_destroy(&env_map);
         print_build(&sc);
         renderer_destroy(&r);
         scene_destroy(&sc);

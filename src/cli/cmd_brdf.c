@@ -2,7 +2,7 @@
  * model list, polar plots of a lobe in the plane of incidence (Lambertian, specular,
  * combined), the directional albedo against incident angle (the energy-conservation
  * integral), and a material ball under a directional light
- * and a constant environment. Every number comes from glsl/lib/brdf.glsl run on the GPU. */
+ * and a constant environment. Every number comes from glsl/lib/brdf_*.glsl run on the GPU. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +14,7 @@
 #include "draw.h"
 #include "image.h"
 #include "util.h"
+#include "vec.h"
 
 
 static int bad_usage(const char *fmt, const char *arg)
@@ -30,7 +31,6 @@ static bool take_param(const char *cmd, const char *opt, const char *val, void *
     return brdf_setting_set(dest, opt + 2, val);
 }
 
-static double luminance(vec3 c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 
 /* ---- lobe plot ------------------------------------------------------------------------ */
 
@@ -64,7 +64,7 @@ static void plot_eval(brdf_runner *r, const brdf_setting *s, double theta, doubl
     }
     brdf_runner_run(r, q, res, PLOT_N);
     for (int k = 0; k < PLOT_N; k++)
-        out[k] = luminance(res[k].f);
+        out[k] = vec_luminance(&res[k].f.x);
     free(q);
     free(res);
 }
@@ -92,7 +92,7 @@ static int plot_dirac_lobes(brdf_runner *r, const brdf_setting *s, double theta,
             continue;
         seen |= kind;
         out[n].psi = atan2(res[k].s_wi.x, res[k].s_wi.z) * 180 / M_PI;
-        out[n++].reflectance = luminance(res[k].s_weight) * res[k].s_pdf;
+        out[n++].reflectance = vec_luminance(&res[k].s_weight.x) * res[k].s_pdf;
     }
     return n;
 }
@@ -310,15 +310,7 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
     memset(&q, 0, sizeof q);
     memset(&scene, 0, sizeof scene);
     brdf_setting_to_query(s, &q);
-    scene.color = q.color;
-    scene.model = q.model;
-    scene.params = q.params;
-    scene.extra = q.extra;
-    scene.layer = q.layer;
-    scene.sheen = q.sheen;
-    scene.aniso = q.aniso;
-    scene.irid = q.irid;
-    scene.dt = q.dt;
+    scene.material = q.material;
     scene.light_dir = (vec3){-0.5f / 0.9718f, 0.6f / 0.9718f, 0.55f / 0.9718f}; /* upper left, front */
     scene.light_irradiance = (vec3){2.5f, 2.5f, 2.5f};
     scene.env = (vec3){0.3f, 0.3f, 0.3f};
@@ -395,27 +387,25 @@ int cmd_brdf(int argc, char **argv)
     }
     cli_option options[BRDF_FIXED_OPTIONS + BRDF_MAX_PARAMS] = {
         {"--list", NULL, "the models, one a line: name, then each parameter=default", CLI_FLAG, CLI_AS(bool, &list), 0, 0,
-         NULL, NULL},
+         NULL, NULL, NULL},
         {NULL, NULL, "  --PARAM VALUE       a model parameter (see --list); colours as R,G,B or one value\n",
-         CLI_TEXT, NULL, 0, 0, NULL, NULL},
+         CLI_TEXT, NULL, 0, 0, NULL, NULL, NULL},
         {"--theta", "DEG", "lobe plot: incident (light) direction, degrees from the normal\n"
                            "(default 30); the curve is f(wi, wo) for wo in the plane of incidence",
-         CLI_FLOAT, CLI_AS(float, &theta), 0, 90, "degrees in [0, 90]", NULL},
+         CLI_FLOAT, CLI_AS(float, &theta), 0, 90, "degrees in [0, 90]", NULL, NULL},
         {"--albedo", NULL, "print 'theta_deg albedo_r albedo_g albedo_b' for theta = 0, 5, ...,\n"
                            "85, 89: the directional albedo (reflected + transmitted fraction)\n"
                            "of light from theta",
-         CLI_FLAG, CLI_AS(bool, &albedo), 0, 0, NULL, NULL},
+         CLI_FLAG, CLI_AS(bool, &albedo), 0, 0, NULL, NULL, NULL},
         {"--sphere", NULL, "render a unit sphere of the material: directional light + constant sky",
-         CLI_FLAG, CLI_AS(bool, &sphere), 0, 0, NULL, NULL},
+         CLI_FLAG, CLI_AS(bool, &sphere), 0, 0, NULL, NULL, NULL},
         {"-o, --output", "FILE", "the lobe plot: a .png; the sphere: a .exr (linear float OpenEXR)\n"
                                  "or a .png (sRGB, clamped); any other name is a usage error",
-         CLI_STRING, CLI_AS(const char *, &out), 0, 0, NULL, NULL},
-        {"--png", "FILE", "sphere: also a PNG (sRGB, clamped)", CLI_STRING, CLI_AS(const char *, &png), 0, 0, NULL, NULL},
-        {"--size", "WxH", "image size (lobe default 560x360, 560x560 with transmission;\n"
-                          "sphere 256x256)",
-         CLI_CALL, size, 0, 0, "WxH (1..16384 each)", cli_take_size},
-        {"--spp", "N", "sphere: samples per pixel (default 64)", CLI_INT, CLI_AS(int, &spp), 1, 1 << 20,
-         "a count in [1, 1048576]", NULL},
+         CLI_STRING, CLI_AS(const char *, &out), 0, 0, NULL, NULL, "*.exr *.png"},
+        CLI_OPT_PNG(&png, "sphere: also a PNG (sRGB, clamped)"),
+        CLI_OPT_SIZE(size, "image size (lobe default 560x360, 560x560 with transmission;\n"
+                           "sphere 256x256)"),
+        CLI_OPT_SPP(&spp, "sphere: samples per pixel (default 64)"),
         CLI_OPT_DEVICE(&device),
         CLI_OPT_VALIDATE(&validate),
     };
@@ -430,7 +420,7 @@ int cmd_brdf(int argc, char **argv)
         else
             snprintf(help[i], sizeof help[i], "%s: in [%g, %g] (default %g)", m->name, p->min, p->max, p->def[0]);
         options[n++] = (cli_option){names[i], p->count == 3 ? "R,G,B" : "V", help[i], CLI_CALL, &s, 0, 0, NULL,
-                                    take_param};
+                                    take_param, NULL};
     }
     const cli_command command = {
         .name = "brdf",
@@ -440,6 +430,7 @@ int cmd_brdf(int argc, char **argv)
                     "       gonio brdf MODEL [--PARAM VALUE ...] --sphere -o BALL.exr|BALL.png [--png BALL.png]\n"
                     "                  [--size WxH] [--spp N]",
         .options = options, .num_options = n, .max_args = m ? 1 : 0,
+        .complete_args = m ? NULL : cli_brdf_models(),
         .unknown_hint = " (gonio brdf --list: the models' parameters)"};
     cli_args args;
     if ((rc = cli_parse(&command, argc, argv, &args)) >= 0)

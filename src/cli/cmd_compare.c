@@ -16,6 +16,7 @@
 #include "draw.h"
 #include "environment.h"
 #include "image.h"
+#include "progress.h"
 #include "render.h"
 #include "scene.h"
 #include "util.h"
@@ -34,6 +35,7 @@ typedef struct compare_opts {
     uint32_t modes[COMPARE_MAX_MODES];
     int num_modes;
     int spp, width, height, device;
+    int size[2]; /* --size */
     bool size_given, validate, quiet;
     camera_option camera;   /* the rule of every command (src/scene/camera.h) */
     scene_camera view;      /* ... resolved for the scene being compared */
@@ -61,9 +63,11 @@ static bool choose_view(const scene *sc, compare_opts *o)
 static bool render_one(renderer *r, const compare_opts *o, uint32_t mode, image *out)
 {
     render_stats st;
+    cli_progress progress;
     render_settings s = {.mode = mode, .width = o->width, .height = o->height,
                          .spp = mode == GN_MODE_PATH || o->spp < COMPARE_LOCAL_SPP ? o->spp : COMPARE_LOCAL_SPP,
-                         .view = &o->view, .progress = !o->quiet};
+                         .view = &o->view, .progress = o->quiet ? NULL : cli_progress_report,
+                         .progress_user = &progress};
     return renderer_render(r, &s, out, &st);
 }
 
@@ -181,11 +185,12 @@ typedef struct compare_row {
 
 static bool write_metrics(const char *path, const compare_row *rows, int n, bool print)
 {
-    char tmp[4200];
+    util_out out;
     FILE *f;
-    bool ok;
-    if (!(f = util_tmp_open(tmp, sizeof tmp, path, "w")))
+    if (!util_out_open(&out, path))
         return false;
+    if (!(f = util_out_file(&out)))
+        return util_out_commit(&out, false);
     fprintf(f, "mode,reference,rmse,rel_bias,max_err\n");
     if (print)
         printf("%-8s %-9s %10s %10s %10s\n", "mode", "reference", "rmse", "rel_bias", "max_err");
@@ -196,8 +201,7 @@ static bool write_metrics(const char *path, const compare_row *rows, int n, bool
         if (print)
             printf("%-8s %-9s %10.5f %+10.4f %10.4f\n", a, b, m->rmse, m->rel_bias, m->max_err);
     }
-    ok = fclose(f) == 0;
-    return util_commit_file(tmp, path, ok);
+    return util_out_commit(&out, true);
 }
 
 static bool run_compare(renderer *r, const compare_opts *o)
@@ -368,11 +372,12 @@ static bool write_sweep_plot(const char *path, const sweep_row *rows, int n)
 
 static bool write_sweep_csv(const char *path, const sweep_row *rows, int n, bool print)
 {
-    char tmp[4200];
+    util_out out;
     FILE *f;
-    bool ok;
-    if (!(f = util_tmp_open(tmp, sizeof tmp, path, "w")))
+    if (!util_out_open(&out, path))
         return false;
+    if (!(f = util_out_file(&out)))
+        return util_out_commit(&out, false);
     fprintf(f, "level,triangles,gouraud_rmse,gouraud_rel_bias,gouraud_max_err,"
                "flat_rmse,flat_rel_bias,flat_max_err\n");
     if (print)
@@ -387,8 +392,7 @@ static bool write_sweep_csv(const char *path, const sweep_row *rows, int n, bool
             printf("%5d %9u %12.6f %12.6f %12.4f\n", s->level, s->triangles, s->gouraud.rmse,
                    s->flat.rmse, s->gouraud.max_err);
     }
-    ok = fclose(f) == 0;
-    return util_commit_file(tmp, path, ok);
+    return util_out_commit(&out, true);
 }
 
 /* The teapot at each level through `gonio teapot` (into DIR, removed once loaded). */
@@ -524,14 +528,6 @@ static bool take_modes(const char *cmd, const char *opt, const char *val, void *
     return parse_modes(val, dest);
 }
 
-static bool take_size(const char *cmd, const char *opt, const char *val, void *dest)
-{
-    (void)cmd, (void)opt;
-    compare_opts *o = dest;
-    o->size_given = true;
-    return util_parse_size(val, &o->width, &o->height);
-}
-
 int cmd_compare(int argc, char **argv)
 {
     compare_opts o = {.modes = {GN_MODE_FLAT, GN_MODE_GOURAUD, GN_MODE_PHONG, GN_MODE_PATH},
@@ -542,19 +538,19 @@ int cmd_compare(int argc, char **argv)
     bool outside = false;
     gpu g = {0};
     const cli_option options[] = {
-        {"-o, --output", "DIR", "output directory (created if missing)", CLI_STRING, CLI_AS(const char *, &o.dir), 0, 0, NULL, NULL},
+        {"-o, --output", "DIR", "output directory (created if missing)", CLI_STRING, CLI_AS(const char *, &o.dir), 0, 0, NULL, NULL,
+         "/"},
         {"--sweep", "LEVELS", "the teapot at these tessellation levels (see above)", CLI_CALL, &sweep_levels,
-         0, 0, "up to 16 increasing levels 1..256, e.g. 1,2,4,8", take_levels},
+         0, 0, "up to 16 increasing levels 1..256, e.g. 1,2,4,8", take_levels, NULL},
         {"--modes", "LIST", "any of flat,gouraud,phong,path (default all four; phong and path\n"
                             "are the references)",
-         CLI_CALL, &o, 0, 0, "a list of flat, gouraud, phong, path (each once)", take_modes},
-        {"--spp", "N", "path tracer samples per pixel (default 64); the local modes take\n"
-                       "min(N, 16), which only anti-aliases them",
-         CLI_INT, CLI_AS(int, &o.spp), 1, 1 << 24, "an integer 1..16777216", NULL},
-        {"--size", "WxH", "image size (default 320 wide, the camera's aspect)", CLI_CALL, &o, 0, 0,
-         "WxH, e.g. 320x240", take_size},
+         CLI_CALL, &o, 0, 0, "a list of flat, gouraud, phong, path (each once)", take_modes,
+         "flat gouraud phong path"},
+        CLI_OPT_SPP(&o.spp, "path tracer samples per pixel (default 64); the local modes take\n"
+                            "min(N, 16), which only anti-aliases them"),
+        CLI_OPT_SIZE(o.size, "image size (default 320 wide, the camera's aspect)"),
         CAMERA_OPTIONS(&o.camera),
-        {"--scene", "N", "compare the file's glTF scene N (default: its default scene)", CLI_INT, CLI_AS(int, &scene_index), 0, 1 << 20, "an index >= 0", NULL},
+        CLI_OPT_SCENE(&scene_index, "compare the file's glTF scene N (default: its default scene)"),
         CLI_OPT_ALLOW_OUTSIDE_FILES(&outside),
         CLI_OPT_DEVICE(&o.device),
         CLI_OPT_VALIDATE(&o.validate),
@@ -563,11 +559,15 @@ int cmd_compare(int argc, char **argv)
     const cli_command command = {
         .name = "compare", .synopsis = "SCENE.gltf -o DIR [options]\n"
                                        "       gonio compare --sweep LEVELS teapot -o DIR [options]",
-        .intro = COMPARE_INTRO, CLI_OPTIONS(options), .max_args = 1};
+        .intro = COMPARE_INTRO, CLI_OPTIONS(options), .max_args = 1, .complete_args = "*.gltf *.glb teapot"};
     cli_args args;
     if ((rc = cli_parse(&command, argc, argv, &args)) >= 0)
         return rc;
     rc = 1;
+    if ((o.size_given = cli_given(&command, &args, "--size"))) {
+        o.width = o.size[0];
+        o.height = o.size[1];
+    }
     input = args.num_args ? args.arg[0] : NULL;
     sweep = cli_given(&command, &args, "--sweep") ? "" : NULL;
     if (sweep && (cli_given(&command, &args, "--scene") || outside))

@@ -113,12 +113,12 @@ int cmd_diff(int argc, char **argv)
     bool quiet = false;
     const cli_option options[] = {
         {"--max-rmse", "X", "exit 1 when the RMSE is above X", CLI_FLOAT, CLI_AS(float, &limits[0]), 0, 3e38,
-         "a number >= 0", NULL},
+         "a number >= 0", NULL, NULL},
         {"--max-rel-bias", "X", "exit 1 when |rel_bias| is above X", CLI_FLOAT, CLI_AS(float, &limits[1]), 0, 3e38,
-         "a number >= 0", NULL},
-        {"--max-error", "X", "exit 1 when the largest absolute difference is above X", CLI_FLOAT, CLI_AS(float, &limits[2]), 0, 3e38, "a number >= 0", NULL},
+         "a number >= 0", NULL, NULL},
+        {"--max-error", "X", "exit 1 when the largest absolute difference is above X", CLI_FLOAT, CLI_AS(float, &limits[2]), 0, 3e38, "a number >= 0", NULL, NULL},
         {"--channels", "R,G,B", "compare these channels (default: R, G and B where both have\nthem, else the first channel of each)",
-         CLI_CALL, &channels, 0, 0, "a comma-separated list of channel names", take_channels},
+         CLI_CALL, &channels, 0, 0, "a comma-separated list of channel names", take_channels, NULL},
         CLI_OPT_QUIET(&quiet, "print no metrics (limits and errors still go to stderr)"),
     };
     const cli_command cmd = {
@@ -126,7 +126,8 @@ int cmd_diff(int argc, char **argv)
         .intro = "Compares two EXR images and prints rmse, psnr, mae, rel_bias and max_err. B is the\n"
                  "reference: rel_bias = (mean A - mean B) / |mean B|. Exit 1 above a limit or on\n"
                  "NaN/Inf values.\n",
-        CLI_OPTIONS(options), .min_args = 2, .max_args = 2, .missing = "expected two images"};
+        CLI_OPTIONS(options), .min_args = 2, .max_args = 2, .missing = "expected two images",
+        .complete_args = "*.exr"};
     cli_args args;
     image img[2] = {{0}, {0}};
     int status = cli_parse(&cmd, argc, argv, &args);

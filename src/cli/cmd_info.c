@@ -8,8 +8,19 @@
 #include "scene.h"
 #include "util.h"
 
-/* The area lights as the path tracer sees them (render.c: build_emitters): triangles of
- * non-zero area whose material emits and is not unlit; prints the materials by name. */
+/* A name from the file, as printed: control characters escaped, "(unnamed)" when empty. Four
+ * buffers in turn, for the printf calls that print up to four names. */
+static const char *shown(const char *name)
+{
+    static char buf[4][512];
+    static int next;
+    char *b = buf[next++ & 3];
+    return name[0] ? util_escape(name, b, sizeof buf[0]) : "(unnamed)";
+}
+
+/* The area lights as the path tracer sees them (src/render/render_lights.c: build_emitters):
+ * triangles of non-zero area whose material emits and is not unlit; prints the materials by
+ * name. */
 static void print_emitters(const scene *sc)
 {
     uint32_t tris = 0, mats = 0;
@@ -28,7 +39,7 @@ static void print_emitters(const scene *sc)
     printf("emissive       %u triangles in %u material(s)", tris, mats);
     for (uint32_t m = 0, n = 0; m < sc->num_materials; m++)
         if (count[m])
-            printf("%s%s (%u)", n++ ? ", " : ": ", sc->material_names[m][0] ? sc->material_names[m] : "(unnamed)",
+            printf("%s%s (%u)", n++ ? ", " : ": ", shown(sc->material_names[m]),
                    count[m]);
     printf("\n");
     free(count);
@@ -47,7 +58,7 @@ static void print_media(const scene *sc)
         for (int k = 0; k < 3; k++)
             sigma[k] = c[k] >= 1 ? 0 : -log(c[k] > 1e-30f ? c[k] : 1e-30f) / m->attenuation_distance;
         printf("medium %-7u \"%s\" %s attenuation (%g, %g, %g) distance %g (sigma_a %g, %g, %g), "
-               "thickness %g, ior %g, dispersion %g\n", i, sc->material_names[i][0] ? sc->material_names[i] : "(unnamed)",
+               "thickness %g, ior %g, dispersion %g\n", i, shown(sc->material_names[i]),
                m->volume ? "volume" : "thin-walled", c[0], c[1], c[2], m->attenuation_distance, sigma[0], sigma[1],
                sigma[2], m->thickness, m->ior, m->dispersion);
     }
@@ -61,7 +72,7 @@ static void print_anisotropy(const scene *sc)
         if (!(m->anisotropy_strength > 0) && m->tex_anisotropy == GN_INVALID)
             continue;
         printf("anisotropy %-3u \"%s\" strength %g, rotation %g deg%s\n", i,
-               sc->material_names[i][0] ? sc->material_names[i] : "(unnamed)", m->anisotropy_strength,
+               shown(sc->material_names[i]), m->anisotropy_strength,
                m->anisotropy_rotation * 180 / M_PI, m->tex_anisotropy != GN_INVALID ? ", textured" : "");
     }
 }
@@ -71,7 +82,7 @@ static void print_films(const scene *sc)
 {
     for (uint32_t i = 0; i < sc->num_materials; i++) {
         const GnMaterial *m = &sc->materials[i];
-        const char *name = sc->material_names[i][0] ? sc->material_names[i] : "(unnamed)";
+        const char *name = shown(sc->material_names[i]);
         if (m->iridescence > 0 && m->tex_iridescence_thickness != GN_INVALID)
             printf("iridescence %-3u \"%s\" factor %g%s, film ior %g, thickness %g - %g nm (texture G)\n", i, name,
                    m->iridescence, m->tex_iridescence != GN_INVALID ? " x texture" : "", m->iridescence_ior,
@@ -85,6 +96,19 @@ static void print_films(const scene *sc)
                    m->diffuse_transmission, m->tex_diffuse_transmission != GN_INVALID ? " x texture" : "",
                    m->diffuse_transmission_color.x, m->diffuse_transmission_color.y, m->diffuse_transmission_color.z,
                    m->tex_diffuse_transmission_color != GN_INVALID ? " x texture" : "");
+    }
+}
+
+/* The extensions the file lists, one line each: how gonio handles it (scene.h: scene_extension). */
+static void print_extensions(const scene *sc)
+{
+    static const char *const support[] = {[SCENE_UNSUPPORTED] = "unsupported (ignored)", [SCENE_PARTLY] = "partly",
+                                          [SCENE_SUPPORTED] = "supported"};
+    printf("extensions     %u\n", sc->num_extensions);
+    for (uint32_t i = 0; i < sc->num_extensions; i++) {
+        const scene_extension *e = &sc->extensions[i];
+        printf("extension      %s%s: %s: %s\n", shown(e->name), e->required ? " (required)" : "", support[e->support],
+               e->how);
     }
 }
 
@@ -105,8 +129,10 @@ int cmd_info(int argc, char **argv)
                  "(KHR_materials_anisotropy): strength, rotation and whether a texture sets them;\n"
                  "and one line per material with an iridescent film (KHR_materials_iridescence:\n"
                  "factor, film IOR, thickness) or a diffuse transmission\n"
-                 "(KHR_materials_diffuse_transmission: factor, colour).\n",
-        CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given"};
+                 "(KHR_materials_diffuse_transmission: factor, colour); and one line per extension the\n"
+                 "file lists: whether gonio supports it, partly (and what it leaves out) or not (and why).\n",
+        CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given",
+        .complete_args = "*.gltf *.glb"};
     cli_args args;
     scene sc = {0};
     bvh b = {0};
@@ -119,7 +145,7 @@ int cmd_info(int argc, char **argv)
         return 1;
     bvh_build(&b, &sc.vertices[0].position.x, sizeof(GnVertex) / sizeof(float), sc.indices,
               sc.num_triangles);
-    printf("scene          %s\n", path);
+    printf("scene          %s\n", shown(path));
     printf("triangles      %u\n", sc.num_triangles);
     printf("vertices       %u\n", sc.num_vertices);
     printf("meshes         %u (primitive instances; %u glTF meshes, %u nodes)\n", sc.num_meshes,
@@ -127,7 +153,8 @@ int cmd_info(int argc, char **argv)
     printf("materials      %u\n", sc.num_materials);
     printf("variants       %u\n", sc.num_variants);
     for (uint32_t i = 0; i < sc.num_variants; i++)
-        printf("variant %-6u \"%s\"\n", i, sc.variant_names[i]);
+        printf("variant %-6u \"%s\"\n", i, shown(sc.variant_names[i]));
+    print_extensions(&sc);
     printf("textures       %u (%u images)\n", sc.num_textures, sc.num_images);
     printf("lights         %u\n", sc.num_lights);
     print_emitters(&sc);
@@ -137,7 +164,7 @@ int cmd_info(int argc, char **argv)
     printf("cameras        %u\n", sc.num_cameras);
     for (uint32_t i = 0; i < sc.num_cameras; i++) {
         const scene_camera *c = &sc.cameras[i];
-        printf("camera %-7u \"%s\" position (%g, %g, %g) forward (%g, %g, %g) ", i, c->name, c->position[0],
+        printf("camera %-7u \"%s\" position (%g, %g, %g) forward (%g, %g, %g) ", i, shown(c->name), c->position[0],
                c->position[1], c->position[2], c->forward[0], c->forward[1], c->forward[2]);
         if (c->ortho_half_height > 0)
             printf("orthographic %g x %g\n", 2 * c->ortho_half_height * c->aspect, 2 * c->ortho_half_height);

@@ -51,6 +51,28 @@ static bool overlap(const image *a, const image *b)
            b->y0 < a->y0 + a->height;
 }
 
+/* Every value of the channels that are merged is finite: a NaN or Inf would spread into the
+ * result unseen. False, with an error naming the file, channel, pixel and count, if not. */
+static bool finite_pixels(const char *path, const image *img)
+{
+    for (int c = 0; c < img->num_channels; c++) {
+        const size_t n = (size_t)img->width * (size_t)img->height;
+        size_t bad = 0, first = 0;
+        if (is_sum(img->names[c]))
+            continue;
+        for (size_t p = 0; p < n; p++)
+            if (!isfinite(img->planes[c][p]) && bad++ == 0)
+                first = p;
+        if (bad) {
+            util_error("%s: channel '%s' has %zu NaN or infinite value(s), the first at pixel (%d, %d); "
+                       "a render writes none", path, img->names[c], bad, img->x0 + (int)(first % (size_t)img->width),
+                       img->y0 + (int)(first / (size_t)img->width));
+            return false;
+        }
+    }
+    return true;
+}
+
 /* The file's sample count: a finite positive integer no larger than INT32_MAX. */
 static bool read_spp(const char *path, int64_t *out)
 {
@@ -150,7 +172,8 @@ static bool same_render(const char *a, const char *b)
     "Inputs rendered with --crop are placed by their EXR data windows: tiles assemble into\n" \
     "the frame (or the region they cover), and at every pixel the inputs covering it are\n" \
     "combined; every pixel must get the same number of samples (no holes, no uneven\n" \
-    "overlaps). The sum.* channels of --resumable renders are left out.\n" \
+    "overlaps). The sum.* channels of --resumable renders are left out. Denoised renders\n" \
+    "(render --denoise, gonio denoise) are refused: their pixels are no mean of samples.\n" \
     "\n" \
     "The inputs must be one render: the same frame size and channels, and the same gonio:scene\n" \
     "(a hash of the scene's content), gonio:size, gonio:mode, gonio:camera and options of the\n" \
@@ -169,14 +192,14 @@ int cmd_merge(int argc, char **argv)
     image_exr_options exr = IMAGE_EXR_DEFAULTS;
     const cli_option options[] = {
         {"-o, --output", "FILE", "the merged OpenEXR (a .exr name; written atomically)", CLI_STRING, CLI_AS(const char *, &out_path),
-         0, 0, NULL, NULL},
-        {"--force", NULL, "merge inputs that share a seed", CLI_FLAG, CLI_AS(bool, &force), 0, 0, NULL, NULL},
+         0, 0, NULL, NULL, "*.exr"},
+        {"--force", NULL, "merge inputs that share a seed", CLI_FLAG, CLI_AS(bool, &force), 0, 0, NULL, NULL, NULL},
         CLI_OPT_EXR_HALF(&exr.half),
         CLI_OPT_EXR_COMPRESSION(&exr.compression),
     };
     const cli_command cmd = {
         .name = "merge", .synopsis = "A.exr B.exr ... -o OUT.exr [--force] [--half] [--compression C]",
-        .intro = MERGE_INTRO, CLI_OPTIONS(options), .max_args = -1};
+        .intro = MERGE_INTRO, CLI_OPTIONS(options), .max_args = -1, .complete_args = "*.exr"};
     cli_args args;
     if ((rc = cli_parse(&cmd, argc, argv, &args)) >= 0)
         return rc;
@@ -209,6 +232,23 @@ int cmd_merge(int argc, char **argv)
         double s;
         if (!image_read_exr(&imgs[i], inputs[i]) || !read_spp(inputs[i], &spp[i]))
             goto done;
+        {
+            /* A denoised file's R, G, B are no mean of samples (render --denoise, gonio denoise). */
+            char dn[256];
+            if (image_exr_attr_string(inputs[i], "gonio:denoiser", dn, sizeof dn)) {
+                util_error("%s: is denoised (gonio:denoiser '%s'): its R, G, B are not a mean of samples; merge "
+                           "renders made without --denoise, then denoise the merge (gonio denoise)", inputs[i], dn);
+                goto done;
+            }
+        }
+        if (!image_inside_frame(&imgs[i])) {
+            util_error("%s: its data window (%d,%d)+%dx%d lies outside its %dx%d display window: not a tile "
+                       "of a render", inputs[i], imgs[i].x0, imgs[i].y0, imgs[i].width, imgs[i].height,
+                       imgs[i].full_width, imgs[i].full_height);
+            goto done;
+        }
+        if (!finite_pixels(inputs[i], &imgs[i]))
+            goto done;
         if (frame_width(&imgs[i]) != frame_width(&imgs[0]) || frame_height(&imgs[i]) != frame_height(&imgs[0]) ||
             pixel_channels(&imgs[i]) != pixel_channels(&imgs[0])) {
             util_error("%s: a %dx%d frame with %d channels, but %s is %dx%d with %d", inputs[i],
@@ -234,18 +274,29 @@ int cmd_merge(int argc, char **argv)
             goto done;
         }
     }
-    /* A seed may repeat in tiles that do not overlap; in overlapping ones its samples repeat. */
-    for (int a = 0; a < seeds.count; a++)
-        for (int b = 0; b < a; b++)
-            if (seeds.seed[a] == seeds.seed[b] && overlap(&imgs[seeds.file[a]], &imgs[seeds.file[b]])) {
-                if (!force) {
-                    util_error("%s and %s: both have seed %u: its samples repeat and add no information "
-                               "(--force merges anyway)", inputs[seeds.file[b]], inputs[seeds.file[a]], seeds.seed[a]);
-                    goto done;
+    /* A seed may repeat in tiles that do not overlap; in overlapping ones its samples repeat.
+     * With --force, one warning for all the repeats, not one per pair. */
+    {
+        long repeats = 0;
+        int fa = 0, fb = 0;
+        uint32_t first_seed = 0;
+        for (int a = 0; a < seeds.count; a++)
+            for (int b = 0; b < a; b++)
+                if (seeds.seed[a] == seeds.seed[b] && overlap(&imgs[seeds.file[a]], &imgs[seeds.file[b]]) &&
+                    repeats++ == 0) {
+                    fa = seeds.file[b];
+                    fb = seeds.file[a];
+                    first_seed = seeds.seed[a];
                 }
-                util_warn("%s and %s: both have seed %u (merged: --force)", inputs[seeds.file[b]],
-                          inputs[seeds.file[a]], seeds.seed[a]);
-            }
+        if (repeats && !force) {
+            util_error("%s and %s: both have seed %u: its samples repeat and add no information "
+                       "(--force merges anyway)", inputs[fa], inputs[fb], first_seed);
+            goto done;
+        }
+        if (repeats)
+            util_warn("%ld pair(s) of overlapping inputs share a seed, the first %s and %s (seed %u): merged "
+                      "(--force)", repeats, inputs[fa], inputs[fb], first_seed);
+    }
 
     {
         const char *names[IMAGE_MAX_CHANNELS];

@@ -1,4 +1,5 @@
 /* cmd_render.c: `gonio render`. */
+#include <assert.h>
 #include <errno.h>
 #include <float.h>
 #include <math.h>
@@ -12,9 +13,12 @@
 #include "brdf.h"
 #include "camera.h"
 #include "cli.h"
+#include "denoise.h"
 #include "environment.h"
 #include "image.h"
+#include "progress.h"
 #include "render.h"
+#include "render_material.h"
 #include "render_output.h"
 #include "scene.h"
 #include "util.h"
@@ -37,16 +41,47 @@ static void on_signal(int sig)
         return;
 }
 
-/* A file-name pattern with exactly one %d, %Nd or %0Nd and no other '%'. */
-static bool frame_pattern(const char *p)
+/* --frames' file-name patterns: exactly one %d, %Nd or %0Nd, N at most FRAME_WIDTH_MAX, and
+ * no other '%'. */
+#define FRAME_WIDTH_MAX 16
+
+static bool frame_pattern(const char *p, const char *opt)
 {
-    const char *c = strchr(p, '%');
+    const char *c = strchr(p, '%'), *digits;
     if (!c)
-        return false;
-    c++;
-    while (*c >= '0' && *c <= '9')
+        return cli_usage_error("render", "%s '%s': with --frames, a pattern with one %%d (e.g. frame_%%04d.exr)",
+                               opt, p), false;
+    digits = ++c;
+    if (*c == '0')
         c++;
-    return *c == 'd' && !strchr(c, '%');
+    while (*c >= '0' && *c <= '9' && c - digits <= 3)
+        c++;
+    if (*c >= '0' && *c <= '9')
+        return cli_usage_error("render", "%s '%s': the width of the frame number is too large (at most %d)", opt,
+                               p, FRAME_WIDTH_MAX), false;
+    if (*c != 'd' || strchr(c, '%'))
+        return cli_usage_error("render", "%s '%s': with --frames, a pattern with one %%d, %%Nd or %%0Nd and no "
+                               "other %% (e.g. frame_%%04d.exr)", opt, p), false;
+    if (c > digits && atoi(digits) > FRAME_WIDTH_MAX)
+        return cli_usage_error("render", "%s '%s': the width of the frame number is too large (at most %d)", opt,
+                               p, FRAME_WIDTH_MAX), false;
+    return true;
+}
+
+/* The name of frame f of a checked pattern, into out (PATH_MAX bytes); false when it does
+ * not fit or no longer names the pattern's format. */
+static bool frame_name(const char *pattern, long f, const char *opt, char *out, size_t cap)
+{
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+    int n = snprintf(out, cap, pattern, (int)f); /* checked: frame_pattern */
+#pragma GCC diagnostic pop
+    if (n < 0 || (size_t)n >= cap)
+        return cli_usage_error("render", "%s '%s': frame %ld's name is too long", opt, pattern, f), false;
+    if (image_format_of(out) != image_format_of(pattern))
+        return cli_usage_error("render", "%s '%s': frame %ld's name '%s' does not end in the pattern's extension",
+                               opt, pattern, f, out), false;
+    return true;
 }
 
 /* --crop X0,Y0,X1,Y1: pixels, or fractions when any value has a '.'. */
@@ -99,6 +134,62 @@ static bool apply_crop(const crop_option *c, render_settings *s, const char *val
     return true;
 }
 
+/* The sums of a --resumable file are trusted only as far as they are what a render writes:
+ * each sum.* and sum2.* channel stored as 32-bit float, every value finite, sum.N (each
+ * pixel's sample count) the header's spp everywhere, each pixel's coverage sum.A a whole
+ * number from 0 to spp, the sums of depth, albedo and squares (and of radiance, in path
+ * mode) not negative, of normals within +-spp. False with an error naming the first
+ * problem: the channel, the pixel and the value. */
+static bool check_sums(const char *path, const image *prev, int spp, uint32_t mode)
+{
+    const size_t n = (size_t)prev->width * (size_t)prev->height;
+    const int cn = image_channel(prev, "sum.N");
+    if (image_channel(prev, "sum.R") < 0)
+        return true; /* not a --resumable file: the render names the first channel it lacks */
+    if (cn < 0) {
+        util_error("%s: cannot resume: no sum.N channel (each pixel's sample count; written by "
+                   "--resumable since this version: render it again)", path);
+        return false;
+    }
+    for (int c = 0; c < prev->num_channels; c++) {
+        const char *name = prev->names[c];
+        const float *v = prev->planes[c];
+        const bool nonneg = !strcmp(name, "sum.A") || !strcmp(name, "sum.depth.Z") ||
+                            !strncmp(name, "sum.albedo.", 11) || !strncmp(name, "sum2.", 5) ||
+                            (mode == GN_MODE_PATH && (!strcmp(name, "sum.R") || !strcmp(name, "sum.G") ||
+                                                      !strcmp(name, "sum.B")));
+        const bool unit = !strncmp(name, "sum.normal.", 11), coverage = !strcmp(name, "sum.A");
+        if (strncmp(name, "sum.", 4) && strncmp(name, "sum2.", 5))
+            continue;
+        if (prev->stored[c] != IMAGE_STORED_FLOAT) {
+            util_error("%s: cannot resume: channel '%s' is stored as %s; the sums are 32-bit float", path, name,
+                       prev->stored[c] == IMAGE_STORED_HALF ? "16-bit half" : "unsigned int");
+            return false;
+        }
+        for (size_t p = 0; p < n; p++) {
+            const char *why = !isfinite(v[p])                ? "not finite"
+                              : c == cn && v[p] != (float)spp ? "the header's gonio:spp is %d"
+                              : nonneg && v[p] < 0            ? "negative"
+                              : coverage && (v[p] > spp || v[p] != floorf(v[p]))
+                                  ? "not a whole number of samples from 0 to gonio:spp (%d)"
+                              : unit && fabsf(v[p]) > spp ? "beyond gonio:spp (%d) samples of a unit vector"
+                                                          : NULL;
+            if (why) {
+                char text[128];
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+                snprintf(text, sizeof text, why, spp); /* one of the literals above */
+#pragma GCC diagnostic pop
+                util_error("%s: cannot resume: channel '%s' at pixel (%d, %d) is %g: %s", path, name,
+                           prev->x0 + (int)(p % (size_t)prev->width), prev->y0 + (int)(p / (size_t)prev->width),
+                           (double)v[p], text);
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
 /* --resume FILE: the file must be an earlier render of exactly this one (identity, seed,
  * region) with fewer samples and the sums; loads it into *prev and sets s->resume. */
 static bool check_resume(const char *path, const renderer *r, render_settings *s, const char *brdf, image *prev)
@@ -108,7 +199,7 @@ static bool check_resume(const char *path, const renderer *r, render_settings *s
     int region[4];
     double spp;
     uint32_t seed;
-    render_header_build(&h, r, s, &st, brdf);
+    render_header_build(&h, r, s, &st, brdf, cli_command_line());
     if (!image_read_exr(prev, path))
         return false;
     if (!image_exr_attr_double(path, "gonio:spp", &spp) || !(spp >= 1 && spp <= INT32_MAX && spp == floor(spp))) {
@@ -146,6 +237,12 @@ static bool check_resume(const char *path, const renderer *r, render_settings *s
             return false;
         }
     }
+    if (!image_inside_frame(prev)) {
+        util_error("%s: cannot resume: its data window lies outside its display window", path);
+        return false;
+    }
+    if (!check_sums(path, prev, (int)spp, s->mode))
+        return false;
     if (s->time_limit <= 0 && spp >= s->spp) {
         util_error("%s: cannot resume: it has %d spp already, and --spp %d is the total wanted", path,
                    (int)spp, s->spp);
@@ -209,7 +306,8 @@ typedef struct render_job {
     camera_option cam;
     env_option env;
     crop_option crop;
-    bool size_given, quiet, validate, resumable, outside;
+    int size[2];  /* --size */
+    bool size_given, quiet, validate, resumable, outside, denoise;
     int frame;   /* --frame, -1 none */
     float fps;
     float at;    /* --at, -1 none */
@@ -220,14 +318,6 @@ typedef struct render_job {
 } render_job;
 
 /* CLI_CALL parsers of render's own values. */
-static bool take_size(const char *cmd, const char *opt, const char *val, void *dest)
-{
-    (void)cmd, (void)opt;
-    render_job *j = dest;
-    j->size_given = true;
-    return util_parse_size(val, &j->s.width, &j->s.height);
-}
-
 static bool take_crop(const char *cmd, const char *opt, const char *val, void *dest)
 {
     (void)cmd, (void)opt;
@@ -269,15 +359,25 @@ static bool take_brdf(const char *cmd, const char *opt, const char *val, void *d
     return brdf_spec_check(val);
 }
 
+/* --estimator: the names and their GnFrame strategy flags. */
+static const char *const estimator_names[] = {"mis", "light", "bsdf"};
+static const uint32_t estimator_flags[] = {0, GN_FRAME_LIGHT_ONLY, GN_FRAME_BSDF_ONLY};
+
 static bool take_estimator(const char *cmd, const char *opt, const char *val, void *dest)
 {
     (void)cmd, (void)opt;
-    uint32_t *strategy = dest;
-    if (!strcmp(val, "mis")) *strategy = 0;
-    else if (!strcmp(val, "light")) *strategy = GN_FRAME_LIGHT_ONLY;
-    else if (!strcmp(val, "bsdf")) *strategy = GN_FRAME_BSDF_ONLY;
-    else return false;
-    return true;
+    for (int i = 0; i < 3; i++)
+        if (!strcmp(val, estimator_names[i])) {
+            *(uint32_t *)dest = estimator_flags[i];
+            return true;
+        }
+    return false;
+}
+
+static const char *estimator_list(void)
+{
+    static char list[32];
+    return list[0] ? list : util_join(list, sizeof list, estimator_names, 3);
 }
 
 static int render_run(const render_job *job);
@@ -295,24 +395,26 @@ static int render_frames(const render_job *job)
     if (!dash || !util_parse_int(range, 0, 1 << 24, &a) || !util_parse_int(dash + 1, 0, 1 << 24, &b) || b < a)
         return cli_usage_error("render", "--frames '%s': expected A-B, frames 0 <= A <= B", job->frames);
     const char *outs[2] = {job->out_path, job->png_path}, *opts[2] = {"-o", "--png"};
-    for (int k = 0; k < 2; k++)
-        if (outs[k] && !frame_pattern(outs[k]))
-            return cli_usage_error("render", "%s '%s': with --frames, a pattern with one %%d (e.g. frame_%%04d.exr)",
-                                   opts[k], outs[k]);
+    /* Every name is checked before any work: the pattern's form, and the first and last
+     * frames' names (the longest is the last's). */
+    for (int k = 0; k < 2; k++) {
+        if (!outs[k])
+            continue;
+        if (!frame_pattern(outs[k], opts[k]) || !frame_name(outs[k], a, opts[k], names[k], sizeof names[k]) ||
+            !frame_name(outs[k], b, opts[k], names[1 - k], sizeof names[k]))
+            return 2;
+        if (!util_check_output(names[k]) || !util_check_output(names[1 - k]))
+            return 1;
+    }
     if (job->frame >= 0 || job->at >= 0)
         return cli_usage_error("render", "--frames and %s exclude each other", job->frame >= 0 ? "--frame" : "--at");
     for (long f = a; f <= b && rc == 0 && !stop_requested; f++) {
         render_job one = *job;
         one.frames = NULL;
         one.frame = (int)f;
-        for (int k = 0; k < 2; k++) {
-            if (!outs[k])
-                continue;
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wformat-nonliteral"
-            snprintf(names[k], sizeof names[k], outs[k], (int)f); /* checked: frame_pattern */
-#pragma GCC diagnostic pop
-        }
+        for (int k = 0; k < 2; k++)
+            if (outs[k] && !frame_name(outs[k], f, opts[k], names[k], sizeof names[k]))
+                return 2;
         one.out_path = outs[0] ? names[0] : NULL;
         one.png_path = outs[1] ? names[1] : NULL;
         rc = render_run(&one);
@@ -330,8 +432,7 @@ static int render_frames(const render_job *job)
 
 int cmd_render(int argc, char **argv)
 {
-    render_job j = {.s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .progress = true,
-                          .stop = &stop_requested},
+    render_job j = {.s = {.mode = GN_MODE_PATH, .spp = 16, .camera = -1, .stop = &stop_requested},
                     .frame = -1, .fps = 24, .at = -1, .device = -1, .scene_index = -1,
                     .tm = IMAGE_TONEMAP_CLAMP, .exr = IMAGE_EXR_DEFAULTS};
     bool no_shadows = false;
@@ -339,82 +440,83 @@ int cmd_render(int argc, char **argv)
         {"-o, --output", "FILE", "the image, in the format its name says: .exr linear float RGBA\n"
                                  "OpenEXR with the gonio:* header; .png the PNG --png writes\n"
                                  "(any other name is a usage error); written atomically",
-         CLI_STRING, CLI_AS(const char *, &j.out_path), 0, 0, NULL, NULL},
-        {"--png", "FILE", "also write a PNG: tonemapped sRGB; in modes depth, normal and\n"
-                          "cost a picture of the data: depth grey from white (nearest) to 20%\n"
-                          "grey (farthest visible), normals 0.5 n + 0.5, cost a viridis heat\n"
-                          "map up to the image's maximum (misses too: they walk the tree);\n"
-                          "the background of depth and normals black",
-         CLI_STRING, CLI_AS(const char *, &j.png_path), 0, 0, NULL, NULL},
-        {"--mode", "M", render_mode_help(), CLI_CALL, &j.s.mode, 0, 0, NULL, cli_take_mode},
-        {"--spp", "N", "samples per pixel (default 16)", CLI_INT, CLI_AS(int, &j.s.spp), 1, 1 << 24,
-         "an integer 1..16777216", NULL},
+         CLI_STRING, CLI_AS(const char *, &j.out_path), 0, 0, NULL, NULL, "*.exr *.png"},
+        CLI_OPT_PNG(&j.png_path, "also write a PNG: tonemapped sRGB; in modes depth, normal and\n"
+                                 "cost a picture of the data: depth grey from white (nearest) to 20%\n"
+                                 "grey (farthest visible), normals 0.5 n + 0.5, cost a viridis heat\n"
+                                 "map up to the image's maximum (misses too: they walk the tree);\n"
+                                 "the background of depth and normals black"),
+        CLI_OPT_MODE(&j.s.mode),
+        CLI_OPT_SPP(&j.s.spp, "samples per pixel (default 16)"),
         {"--time", "SECONDS", "render for this long instead of --spp", CLI_DOUBLE, CLI_AS(double, &j.s.time_limit), FLT_MIN,
-         3e38, "seconds > 0", NULL},
-        {"--size", "WxH", "image size (default 512 on the longer side, the camera's aspect)", CLI_CALL, &j,
-         0, 0, "WxH, e.g. 640x480 (1..16384)", take_size},
+         3e38, "seconds > 0", NULL, NULL},
+        CLI_OPT_SIZE(j.size, "image size (default 512 on the longer side, the camera's aspect)"),
         CAMERA_OPTIONS(&j.cam),
-        {"--scene", "N", "render the file's glTF scene N (default: its default scene)", CLI_INT, CLI_AS(int, &j.scene_index), 0, 1 << 20, "an index >= 0", NULL},
-        {"--variant", "NAME", "the materials of the file's KHR_materials_variants variant NAME\n"
-                              "(gonio info lists them; default: the file's own materials)",
-         CLI_CALL, NULL, 0, 0, NULL, cli_take_variant},
+        CLI_OPT_SCENE(&j.scene_index, "render the file's glTF scene N (default: its default scene)"),
+        CLI_OPT_VARIANT("the materials of the file's KHR_materials_variants variant NAME\n"
+                        "(gonio info lists them; default: the file's own materials)"),
         CLI_OPT_ALLOW_OUTSIDE_FILES(&j.outside),
-        {"--seed", "S", "random seed (default 0); renders with different seeds merge", CLI_U32, CLI_AS(uint32_t, &j.s.seed), 0,
-         4294967295.0, "an integer 0..4294967295", NULL},
+        CLI_OPT_SEED(&j.s.seed, "random seed (default 0); renders with different seeds merge"),
         {"--frame", "N", "the scene's glTF animations at frame N / --fps (all play at once:\n"
                          "node translation, rotation, scale; meshes, cameras, lights)",
-         CLI_INT, CLI_AS(int, &j.frame), 0, 1 << 24, "a frame number >= 0", NULL},
+         CLI_INT, CLI_AS(int, &j.frame), 0, 1 << 24, "a frame number >= 0", NULL, NULL},
         {"--fps", "F", "frames per second for --frame and --frames (default 24)", CLI_FLOAT, CLI_AS(float, &j.fps), FLT_MIN,
-         1e6, "frames per second > 0", NULL},
-        {"--at", "SECONDS", "the animations at this time", CLI_FLOAT, CLI_AS(float, &j.at), 0, 1e9, "seconds >= 0", NULL},
+         1e6, "frames per second > 0", NULL, NULL},
+        {"--at", "SECONDS", "the animations at this time", CLI_FLOAT, CLI_AS(float, &j.at), 0, 1e9, "seconds >= 0", NULL, NULL},
         {"--frames", "A-B", "render frames A to B, one file each: -o and --png are patterns\n"
                             "with one %d (e.g. out/frame_%04d.exr); stops at the first failure",
-         CLI_STRING, CLI_AS(const char *, &j.frames), 0, 0, NULL, NULL},
+         CLI_STRING, CLI_AS(const char *, &j.frames), 0, 0, NULL, NULL, NULL},
         {"--crop", "X0,Y0,X1,Y1", "render only pixels [X0, X1) x [Y0, Y1) of the image, each as the\n"
                                   "whole render has it, bit for bit: an EXR whose data window is the\n"
                                   "region of the full display window (gonio merge assembles tiles);\n"
                                   "values with a '.' are fractions of the size (0,0,0.5,0.5: the\n"
                                   "top-left quarter; pixel = ceil(fraction x size), as pbrt's)",
-         CLI_CALL, &j, 0, 0, "X0,Y0,X1,Y1 in pixels (integers) or fractions 0..1", take_crop},
+         CLI_CALL, &j, 0, 0, "X0,Y0,X1,Y1 in pixels (integers) or fractions 0..1", take_crop, NULL},
         {"--resumable", NULL, "EXR: also write the exact sums (sum.* channels, 32-bit float)\n"
                               "that --resume goes on from; SIGTERM always writes them",
-         CLI_FLAG, CLI_AS(bool, &j.resumable), 0, 0, NULL, NULL},
+         CLI_FLAG, CLI_AS(bool, &j.resumable), 0, 0, NULL, NULL, NULL},
         {"--resume", "FILE.exr", "go on from a --resumable render of the same scene, camera, crop,\n"
                                  "seed and options (checked): --spp is the total; the result is the\n"
                                  "render of --spp in one run, bit for bit",
-         CLI_STRING, CLI_AS(const char *, &j.resume_path), 0, 0, NULL, NULL},
+         CLI_STRING, CLI_AS(const char *, &j.resume_path), 0, 0, NULL, NULL, "*.exr"},
+        CLI_OPT_DENOISE(&j.denoise, "path: denoise with Intel Open Image Denoise (RT filter), guided by\n"
+                                    "the albedo and normal (rendered for it, written only as --aov\n"
+                                    "says): the PNG and the EXR's R,G,B denoised, its noisy.R/G/B the\n"
+                                    "render itself (make denoiser fetches the library; docs/denoise.md)"),
         {"--aov", "LIST", "extra EXR channels, exactly those listed: any of normal (normal.XYZ),\n"
                           "albedo (albedo.RGB), depth (depth.Z, 0 on a miss), variance\n"
                           "(variance.RGB: of each pixel's mean), comma-separated",
-         CLI_CALL, &j.s.aov, 0, 0, NULL, take_aov},
+         CLI_CALL, &j.s.aov, 0, 0, NULL, take_aov, render_aov_list()},
         CLI_OPT_EXR_HALF(&j.exr.half),
         CLI_OPT_EXR_COMPRESSION(&j.exr.compression),
         ENV_OPTIONS(&j.env),
-        {"--max-depth", "N", "path: at most N bounces (default 0: unbounded, roulette ends paths)", CLI_INT, CLI_AS(int, &j.s.max_depth), 0, 1 << 20, "an integer >= 0", NULL},
+        CLI_OPT_MAX_DEPTH(&j.s.max_depth, "path: at most N bounces (default 0: unbounded, roulette ends paths)"),
         {"--brdf", "MODEL[:P=V]", "path: render every material with a BRDF model (see gonio brdf\n"
                                   "--list), e.g. --brdf torrance-sparrow:exponent=128:specular=0.5",
-         CLI_CALL, &j.brdf, 0, 0, "a model of gonio brdf --list", take_brdf},
+         CLI_CALL, &j.brdf, 0, 0, "a model of gonio brdf --list", take_brdf, cli_brdf_models()},
         {"--estimator", "E", "path: mis (default), light or bsdf: one strategy only (tests)", CLI_CALL,
-         &j.s.strategy, 0, 0, "mis, light or bsdf", take_estimator},
-        {"--no-shadows", NULL, "local modes: no shadow rays", CLI_FLAG, CLI_AS(bool, &no_shadows), 0, 0, NULL, NULL},
+         &j.s.strategy, 0, 0, NULL, take_estimator, estimator_list()},
+        CLI_OPT_NO_SHADOWS(&no_shadows),
         {"--ambient", "R,G,B | V", "local modes: the Phong model's global ambient light (default 0)", CLI_CALL,
-         &j.s, 0, 0, "R,G,B or one value >= 0", take_ambient},
-        {"--exposure", "E", "PNG only: scale by 2^E before tonemapping (default 0)", CLI_FLOAT, CLI_AS(float, &j.exposure),
-         -1e6, 1e6, "a number", NULL},
-        {"--tonemap", "T", "PNG only: clamp (default), reinhard, aces", CLI_CALL, &j.tm, 0, 0,
-         "clamp, reinhard or aces", cli_take_tonemap},
+         &j.s, 0, 0, "R,G,B or one value >= 0", take_ambient, NULL},
+        CLI_OPT_EXPOSURE(&j.exposure, "PNG only: scale by 2^E before tonemapping (default 0)"),
+        CLI_OPT_TONEMAP(&j.tm, "PNG only: clamp (default), reinhard, aces"),
         CLI_OPT_DEVICE(&j.device),
         CLI_OPT_VALIDATE(&j.validate),
         CLI_OPT_QUIET(&j.quiet, "no progress and no summary line"),
     };
     const cli_command command = {.name = "render", .synopsis = "SCENE.gltf|.glb -o OUT.exr|OUT.png [options]",
                                  CLI_OPTIONS(options), .epilog = RENDER_EPILOG, .min_args = 1, .max_args = 1,
-                                 .missing = "no scene given"};
+                                 .missing = "no scene given", .complete_args = "*.gltf *.glb"};
     cli_args args;
     int rc = cli_parse(&command, argc, argv, &args);
     if (rc >= 0)
         return rc;
     j.scene_path = args.arg[0];
+    if ((j.size_given = cli_given(&command, &args, "--size"))) {
+        j.s.width = j.size[0];
+        j.s.height = j.size[1];
+    }
     j.s.no_shadows = no_shadows;
     const char *out_path = j.out_path, *png_path = j.png_path, *exr_path = NULL;
     warn_inapplicable(&command, &args, &j.s, png_path, out_path);
@@ -438,7 +540,32 @@ int cmd_render(int argc, char **argv)
         return cli_usage_error("render", "--resume '%s': expected a .exr render", j.resume_path);
     if (j.frame >= 0 && j.at >= 0 && !j.frames)
         return cli_usage_error("render", "--frame and --at exclude each other");
+    if (j.denoise && j.s.mode != GN_MODE_PATH)
+        return cli_usage_error("render", "--denoise is for --mode path (the other modes have no noise to remove)");
     return j.frames ? render_frames(&j) : render_run(&j);
+}
+
+/* ---- --denoise ---------------------------------------------------------------------------
+ * The render's albedo and normal guide OIDN (src/core/denoise.h); they stay in the EXR only
+ * when --aov asked for them. The header says what the denoiser did and how long it took. */
+static bool denoise_render(image *img, uint32_t user_aov, const char *name, denoise_info *info)
+{
+    denoise_channels ch;
+    static const char *const names[9] = {"R", "G", "B", "albedo.R", "albedo.G", "albedo.B",
+                                         "normal.X", "normal.Y", "normal.Z"};
+    for (int k = 0; k < 3; k++) {
+        ch.beauty[k] = image_channel(img, names[k]);
+        ch.albedo[k] = image_channel(img, names[3 + k]);
+        ch.normal[k] = image_channel(img, names[6 + k]);
+    }
+    if (!denoise_image(img, &ch, true, info, name))
+        return false;
+    for (int k = 0; k < 6; k++) {
+        int c = image_channel(img, names[3 + k]);
+        if (!(user_aov & (k < 3 ? RENDER_AOV_ALBEDO : RENDER_AOV_NORMAL)) && c >= 0)
+            image_remove_channel(img, c);
+    }
+    return true;
 }
 
 /* One render of the job: load, render, write. */
@@ -473,10 +600,17 @@ static int render_run(const render_job *job)
         png_o = out_path;
     exr.exact_prefix = "sum"; /* sum.* and sum2.*: the state --resume needs exactly */
     util_set_quiet(quiet);
-    s.progress = !quiet;
+    cli_progress progress;
+    s.progress = quiet ? NULL : cli_progress_report;
+    s.progress_user = &progress;
     scene_allow_outside_files(job->outside);
     if ((out_path && !util_check_output(out_path)) || (png_path && !util_check_output(png_path)))
         return 1;
+    if (job->denoise) { /* the library is there, before any work; the guides are rendered */
+        if (!denoise_load())
+            return 1;
+        s.aov |= RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL;
+    }
 
     if (frame >= 0)
         at = frame / (double)job->fps;
@@ -519,7 +653,8 @@ static int render_run(const render_job *job)
         render_header h;
         bool ok = true;
         int region[4];
-        render_header_build(&h, &r, &s, &st, brdf);
+        denoise_info dn = {0};
+        render_header_build(&h, &r, &s, &st, brdf, cli_command_line());
         if (at >= 0 && h.count + 2 <= RENDER_HEADER_MAX) { /* the animation's time, and frame */
             h.attrs[h.count++] = (image_attr){"gonio:time", IMAGE_ATTR_DOUBLE, NULL, 0, at, NULL};
             if (frame >= 0)
@@ -528,8 +663,17 @@ static int render_run(const render_job *job)
         if (stop_requested && !quiet)
             util_warn("interrupted: writing the %d spp rendered so far%s", st.spp,
                       stop_requested == SIGTERM && exr_path ? " (resumable: --resume)" : "");
-        if (resumable || stop_requested == SIGTERM)
-            renderer_sums(&r, s.aov, &img);
+        if (job->denoise) {
+            ok = denoise_render(&img, job->s.aov, out_path ? out_path : png_path, &dn);
+            if (ok) {
+                assert(h.count + 2 <= RENDER_HEADER_MAX); /* a path render's header has 22 at most */
+                h.attrs[h.count++] = (image_attr){"gonio:denoiser", IMAGE_ATTR_STRING, dn.description, 0, 0, NULL};
+                h.attrs[h.count++] = (image_attr){"gonio:denoise-seconds", IMAGE_ATTR_DOUBLE, NULL, 0, dn.seconds, NULL};
+            }
+        }
+        /* With --denoise the sums include the guides', so that --resume --denoise goes on. */
+        if (ok && (resumable || stop_requested == SIGTERM))
+            renderer_sums(&r, st.spp, s.aov, &img);
         render_region(&s, region);
         if (s.crop_x1 > 0) { /* the region in the whole frame: OpenEXR's data window */
             img.x0 = region[0];
@@ -537,7 +681,7 @@ static int render_run(const render_job *job)
             img.full_width = s.width;
             img.full_height = s.height;
         }
-        if (exr_path)
+        if (ok && exr_path)
             ok = image_write_exr_with(&img, exr_path, h.attrs, h.count, &exr);
         if (ok && png_o)
             ok = render_write_png(&img, s.mode, png_o, job->exposure, job->tm);
@@ -550,11 +694,16 @@ static int render_run(const render_job *job)
                     out_path ? out_path : png_path, s.width, s.height, camera_text, render_mode_name(s.mode),
                     st.spp, seconds, st.seconds > 0 ? (double)st.rays / st.seconds * 1e-6 : 0.0,
                     s.mode == GN_MODE_PATH ? "M paths/s" : "Mrays/s primary", st.setup_seconds);
+        if (ok && !quiet && job->denoise)
+            fprintf(stderr, "gonio: denoised in %.2f s (%s; library and device setup %.2f s)\n", dn.seconds,
+                    dn.description, dn.setup_seconds);
         rc = !ok ? 1 : stop_requested ? 128 + stop_requested : 0;
     }
     image_destroy(&img);
     image_destroy(&prev);
     image_destroy(&env_map);
+    if (job->denoise)
+        denoise_shutdown();
     renderer_destroy(&r);
     if (!cli_gpu_finish(&g))
         rc = 1;

@@ -16,6 +16,7 @@
 #include "scene.h"
 #include "teapot.h"
 #include "util.h"
+#include "vec.h"
 
 #define SCENE_TEAPOT_LEVEL 8
 #define SCENE_TEAPOT_MAX_LEVEL 256 /* 4.2 M triangles: far past any use */
@@ -90,19 +91,6 @@ static void cornell_to_gltf(const float p[3], float out[3])
     out[2] = 0.0f - p[2] * 0.001f; /* 0 - x: no "-0" in the file */
 }
 
-static void sub3(const float a[3], const float b[3], float out[3])
-{
-    for (int k = 0; k < 3; k++)
-        out[k] = a[k] - b[k];
-}
-
-static void cross3(const float a[3], const float b[3], float out[3])
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 /* Flat-shaded quads, two triangles each, wound counter-clockwise about the side they face:
  * into the box (towards its centre) or out of a block (away from the block's centre). */
 static void cornell_build(const cornell_part *part, cornell_mesh *m)
@@ -124,10 +112,10 @@ static void cornell_build(const cornell_part *part, cornell_mesh *m)
         for (int c = 0; c < 4; c++)
             cornell_to_gltf(part->quads[q][c], p[c]);
         cornell_to_gltf(ref, ref_g);
-        sub3(p[2], p[0], d0);
-        sub3(p[3], p[1], d1);
-        cross3(d0, d1, n); /* the quad's normal for its vertex order (diagonals' cross) */
-        sub3(ref_g, p[0], to_ref);
+        vec_sub(p[2], p[0], d0);
+        vec_sub(p[3], p[1], d1);
+        vec_cross(d0, d1, n); /* the quad's normal for its vertex order (diagonals' cross) */
+        vec_sub(ref_g, p[0], to_ref);
         flip = (n[0] * to_ref[0] + n[1] * to_ref[1] + n[2] * to_ref[2] > 0) == part->outward;
         len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * (flip ? -1.0f : 1.0f);
         for (int c = 0; c < 4; c++) {
@@ -250,13 +238,13 @@ static int run(int argc, char **argv, bool teapot_command)
     const cli_option options[] = {
         {NULL, NULL, "  cornell             the Cornell box (published measurements, metres, one area light)\n"
                      "  teapot              the Utah teapot as in the classic OpenGL 1.x example\n",
-         CLI_TEXT, NULL, 0, 0, NULL, NULL},
+         CLI_TEXT, NULL, 0, 0, NULL, NULL, NULL},
         {"-o, --output", "FILE", "the file to write, in the format its name says: .gltf JSON with\n"
                                  "the buffer embedded, .glb binary glTF (any other name is a usage error)",
-         CLI_STRING, CLI_AS(const char *, &out), 0, 0, NULL, NULL},
+         CLI_STRING, CLI_AS(const char *, &out), 0, 0, NULL, NULL, "*.gltf *.glb"},
         {"--level", "N", "teapot: N x N grid cells per Bezier patch, 1..256 (default 8);\n"
                          "64 N^2 - 8 N triangles",
-         CLI_INT, CLI_AS(int, &level), 1, SCENE_TEAPOT_MAX_LEVEL, "an integer 1..256", NULL},
+         CLI_INT, CLI_AS(int, &level), 1, SCENE_TEAPOT_MAX_LEVEL, "an integer 1..256", NULL, NULL},
     };
     const cli_command cmd = {
         .name = teapot_command ? "teapot" : "scene",
@@ -267,7 +255,7 @@ static int run(int argc, char **argv, bool teapot_command)
         /* gonio teapot has no scene names to list */
         .options = options + teapot_command, .num_options = (int)(sizeof options / sizeof *options) - teapot_command,
         .min_args = teapot_command ? 0 : 1, .max_args = teapot_command ? 0 : 1,
-        .missing = "which scene? (cornell or teapot)"};
+        .missing = "which scene? (cornell or teapot)", .complete_args = teapot_command ? NULL : "cornell teapot"};
     cli_args args;
     int rc = cli_parse(&cmd, argc, argv, &args);
     if (rc >= 0)

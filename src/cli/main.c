@@ -17,6 +17,7 @@ static const struct {
     {"devices", cmd_devices, "list the Vulkan devices"},
     {"compare", cmd_compare, "flat vs Gouraud vs per-pixel Phong vs path traced, side by side"},
     {"merge", cmd_merge, "combine renders of one scene with different seeds, exactly"},
+    {"denoise", cmd_denoise, "denoise an EXR render (Intel Open Image Denoise)"},
     {"diff", cmd_diff, "compare two EXR images (RMSE, PSNR, bias); exit 1 above thresholds"},
     {"bench", cmd_bench, "measure BVH build, ray throughput and path tracing (--paths)"},
     {"brdf", cmd_brdf, "virtual goniophotometer: BRDF lobe plots, albedo, material balls"},
@@ -35,6 +36,23 @@ static void usage(FILE *f)
                "\nOptions take their value as --opt value or --opt=value.\n");
 }
 
+/* gonio __complete WORD... (completion/gonio; not in --help): what may stand in place of
+ * the last word after the others, one candidate a line (cli_complete). */
+static int complete(int n, char **words)
+{
+    if (n <= 1) { /* the command itself */
+        for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
+            printf("%s\n", commands[i].name);
+        printf("--help\n--version\n");
+        return 0;
+    }
+    cli_complete(words[n - 1]);
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
+        if (!strcmp(words[0], commands[i].name))
+            return commands[i].fn(n - 1, words);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     cli_set_command_line(argc, argv);
@@ -46,6 +64,8 @@ int main(int argc, char **argv)
         usage(stdout);
         return 0;
     }
+    if (!strcmp(argv[1], "__complete"))
+        return complete(argc - 2, argv + 2);
     if (!strcmp(argv[1], "--version")) {
         printf("gonio %s\n", GONIO_VERSION);
         return 0;

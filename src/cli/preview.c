@@ -15,9 +15,11 @@
 
 #include "camera.h"
 #include "cli.h"
+#include "denoise.h"
 #include "environment.h"
 #include "display.h" /* spv_display: glsl/kernels/display.comp compiled by the build */
 #include "image.h"
+#include "preview_denoise.h"
 #include "render_output.h"
 #include "render.h"
 #include "scene.h"
@@ -29,6 +31,7 @@ _Static_assert(IMAGE_TONEMAP_CLAMP == GN_TONEMAP_CLAMP && IMAGE_TONEMAP_ACES == 
 #define PREVIEW_FRAME_SECONDS (1.0 / 30) /* GPU time per frame the pass batch aims at */
 #define PREVIEW_MAX_BATCH 64             /* passes per frame at most */
 #define PREVIEW_IDLE_SECONDS 0.05        /* event wait once converged: repaints, not spins */
+#define PREVIEW_DENOISE_FIRST_SPP 8      /* the denoised view's first image; then at 2x, 4x, ... */
 
 GN_STATIC_ASSERT(GN_MODE_COUNT <= 9, "a number key per mode");
 static const char keys_help_rest[] =
@@ -40,6 +43,8 @@ static const char keys_help_rest[] =
     "  R                   reset the camera\n"
     "  + / -               exposure up / down by half a stop\n"
     "  T                   next tonemap (clamp, reinhard, aces)\n"
+    "  N                   denoised view on/off (path mode; OIDN, as render --denoise):\n"
+    "                      denoised at 8 spp, then each time the samples double\n"
     "  P                   write the accumulated image as EXR and PNG\n"
     "  H                   this help\n"
     "  Esc                 quit\n";
@@ -93,6 +98,18 @@ typedef struct preview {
     const char *prefix;
     double paths_per_second, frame_seconds;
     char title[256];
+
+    /* The denoised view (N, --denoise): made on preview_denoise's thread from the
+     * accumulation at PREVIEW_DENOISE_FIRST_SPP spp and each doubling after, shown through the
+     * display kernel from `denoised` (RGBA means, so inv_spp 1). A restart bumps generation,
+     * so a result of an older accumulation is dropped. */
+    bool denoise_view, denoise_unavailable;
+    preview_denoiser denoiser;
+    unsigned generation;
+    int denoised_spp, denoise_next; /* shown (0: none yet); the spp of the next job */
+    double denoise_seconds;
+    gpu_buffer denoised;
+    gpu_pipeline display_denoised;
 } preview;
 
 /* ---- camera ----------------------------------------------------------------------------- */
@@ -209,6 +226,8 @@ static void fly(preview *p, float dt)
 
 /* ---- keys and output files -------------------------------------------------------------- */
 
+static void denoise_toggle(preview *p);
+
 static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
 {
     preview *p = glfwGetWindowUserPointer(w);
@@ -245,10 +264,77 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     case GLFW_KEY_EQUAL: case GLFW_KEY_KP_ADD: p->exposure += 0.5f; p->redraw = true; break;
     case GLFW_KEY_MINUS: case GLFW_KEY_KP_SUBTRACT: p->exposure -= 0.5f; p->redraw = true; break;
     case GLFW_KEY_T: p->tonemap = (image_tonemap)((p->tonemap + 1) % 3); p->redraw = true; break;
+    case GLFW_KEY_N: denoise_toggle(p); break;
     case GLFW_KEY_P: p->save = true; break;
     case GLFW_KEY_H: fputs(keys_help(), stdout); fflush(stdout); break;
     default: break;
     }
+}
+
+/* ---- the denoised view ------------------------------------------------------------------ */
+
+/* N: the view on or off. Turning it on the first time loads the library (a message and the
+ * noisy view when it is missing) and, when the render lacks the guides, restarts it with
+ * them. */
+static void denoise_toggle(preview *p)
+{
+    if (!p->denoise_view && !p->denoiser.started) {
+        if (p->denoise_unavailable || !denoise_load() || !preview_denoiser_start(&p->denoiser)) {
+            p->denoise_unavailable = true; /* said why */
+            p->redraw = true;
+            return;
+        }
+    }
+    p->denoise_view = !p->denoise_view;
+    if (p->denoise_view && (p->s.aov & (RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL)) != (RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL)) {
+        p->s.aov |= RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL;
+        p->restart = true;
+    }
+    p->redraw = true;
+}
+
+/* After the frame's fence: collects a finished denoise into `denoised`, and hands the
+ * accumulation to the thread when it has reached denoise_next samples (or its last). */
+static void denoise_step(preview *p)
+{
+    float *rgba;
+    int w, h, spp;
+    unsigned generation;
+    double seconds;
+    bool ok;
+    if (!p->denoiser.started)
+        return;
+    if (preview_denoiser_take(&p->denoiser, &rgba, &w, &h, &spp, &generation, &seconds, &ok)) {
+        if (!ok) {
+            p->denoise_view = false;
+            p->denoise_unavailable = true;
+        } else if (generation == p->generation && w == p->r.width && h == p->r.height &&
+                   p->denoised.size >= 16 * (VkDeviceSize)w * (VkDeviceSize)h) {
+            memcpy(p->denoised.mapped, rgba, 16 * (size_t)w * (size_t)h);
+            p->denoised_spp = spp;
+            p->denoise_seconds = seconds;
+            p->redraw = true;
+        }
+        free(rgba);
+    }
+    /* A restart pending (the guides just asked for among others): the buffers are the old
+     * render's, which may lack them. */
+    if (!p->denoise_view || p->restart || p->s.mode != GN_MODE_PATH || p->spp == 0 ||
+        preview_denoiser_busy(&p->denoiser) || !(p->s.aov & RENDER_AOV_ALBEDO))
+        return;
+    if (p->spp >= p->denoise_next || (p->max_spp > 0 && p->spp >= p->max_spp && p->spp > p->denoised_spp)) {
+        image img = {0};
+        renderer_resolve(&p->r, p->spp, RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL, &img);
+        preview_denoiser_submit(&p->denoiser, &img, p->spp, p->generation);
+        while (p->denoise_next <= p->spp)
+            p->denoise_next *= 2;
+    }
+}
+
+/* Whether the window shows the denoised image now. */
+static bool denoise_shown(const preview *p)
+{
+    return p->denoise_view && p->denoised_spp > 0 && p->s.mode == GN_MODE_PATH;
 }
 
 /* PREFIX-NNN.exr and .png with the first NNN for which neither exists. */
@@ -261,7 +347,7 @@ static bool save_accumulated(preview *p)
      * view, so --camera FILE.exr renders it again). */
     render_header h;
     render_stats st = {.spp = p->spp};
-    render_header_build(&h, &p->r, &p->s, &st, NULL);
+    render_header_build(&h, &p->r, &p->s, &st, NULL, cli_command_line());
     if (p->spp == 0)
         return true;
     for (int n = 1;; n++) {
@@ -272,7 +358,9 @@ static bool save_accumulated(preview *p)
     }
     if (!util_check_output(exr) || !util_check_output(png))
         return false;
-    renderer_resolve(&p->r, p->spp, false, &img);
+    /* With the guides when the render has them (the denoised view; not while a restart
+     * that adds them is pending): gonio denoise reads them. */
+    renderer_resolve(&p->r, p->spp, p->restart ? 0u : p->s.aov & (RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL), &img);
     ok = image_write_exr(&img, exr, h.attrs, h.count) &&
          render_write_png(&img, p->s.mode, png, p->exposure, p->tonemap); /* as gonio render's */
     if (ok) {
@@ -447,13 +535,22 @@ static void display_resize(preview *p)
     gpu_pipeline_desc pd = {.name = "display", .code = spv_display, .code_size = sizeof spv_display,
                             .local_size = {GN_TILE_X, GN_TILE_Y, 1},
                             .push_size = sizeof(GnDisplayPush), .bindings = b, .num_bindings = 2};
-    if (p->display_width == p->r.width && p->display_height == p->r.height)
+    if (p->display_width == p->r.width && p->display_height == p->r.height &&
+        (!p->denoiser.started || p->denoised.buffer))
         return;
     gpu_pipeline_destroy(&p->g, &p->display);
     gpu_buffer_destroy(&p->g, &p->texels);
     gpu_buffer_create(&p->g, &p->texels, 4 * (VkDeviceSize)p->r.width * (VkDeviceSize)p->r.height,
                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
     gpu_pipeline_create(&p->g, &p->display, &pd);
+    gpu_pipeline_destroy(&p->g, &p->display_denoised);
+    gpu_buffer_destroy(&p->g, &p->denoised);
+    if (p->denoiser.started) { /* the denoised view's input: the display kernel on `denoised` */
+        gpu_buffer_create(&p->g, &p->denoised, 16 * (VkDeviceSize)p->r.width * (VkDeviceSize)p->r.height,
+                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+        b[0].buffer = &p->denoised;
+        gpu_pipeline_create(&p->g, &p->display_denoised, &pd);
+    }
     p->display_width = p->r.width;
     p->display_height = p->r.height;
     p->shown = false;
@@ -480,7 +577,12 @@ static void record_frame(preview *p, VkImage target, int passes)
     push.flags = bgra ? GN_DISPLAY_BGRA : 0u;
     push.inv_spp = 1.0f / (float)(p->spp + passes > 0 ? p->spp + passes : 1);
     push.scale = exp2f(p->exposure);
-    gpu_dispatch(cmd, &p->display, &push, push.width, push.height, 1);
+    if (denoise_shown(p)) {
+        push.inv_spp = 1.0f; /* `denoised` holds means */
+        gpu_dispatch(cmd, &p->display_denoised, &push, push.width, push.height, 1);
+    } else {
+        gpu_dispatch(cmd, &p->display, &push, push.width, push.height, 1);
+    }
 
     /* The texels, written by the kernel, are read by the copy; the image (whose old contents
      * do not matter) becomes a copy destination once the acquire semaphore, waited on at the
@@ -518,6 +620,15 @@ static void update_title(preview *p)
     snprintf(t, sizeof t, "gonio preview: %s | %dx%d | %d spp | %.2f Mpaths/s | %.1f ms | EV %+.1f %s",
              render_mode_name(p->s.mode), p->r.width, p->r.height, p->spp, p->paths_per_second * 1e-6,
              p->frame_seconds * 1e3, p->exposure, image_tonemap_name(p->tonemap));
+    if (p->denoise_unavailable)
+        snprintf(t + strlen(t), sizeof t - strlen(t), " | denoiser unavailable");
+    else if (p->denoise_view && p->s.mode != GN_MODE_PATH)
+        snprintf(t + strlen(t), sizeof t - strlen(t), " | denoise: path mode only");
+    else if (denoise_shown(p))
+        snprintf(t + strlen(t), sizeof t - strlen(t), " | denoised at %d spp (%.2f s)", p->denoised_spp,
+                 p->denoise_seconds);
+    else if (p->denoise_view)
+        snprintf(t + strlen(t), sizeof t - strlen(t), " | denoising at %d spp", p->denoise_next);
     if (strcmp(t, p->title)) {
         strcpy(p->title, t);
         glfwSetWindowTitle(p->window, t);
@@ -552,6 +663,7 @@ static bool frame(preview *p, double *submit_time, int *last_passes)
     if (*last_passes > 0)
         renderer_finish(&p->r, p->s.mode, (uint32_t)p->spp);
     *last_passes = 0;
+    denoise_step(p);
     if (p->save) {
         p->save = false;
         save_accumulated(p);
@@ -571,6 +683,9 @@ static bool frame(preview *p, double *submit_time, int *last_passes)
         display_resize(p);
         p->spp = 0;
         p->restart = false;
+        p->generation++;
+        p->denoised_spp = 0;
+        p->denoise_next = PREVIEW_DENOISE_FIRST_SPP;
     }
 
     res = vkAcquireNextImageKHR(dev, p->swapchain, UINT64_MAX, p->acquired, VK_NULL_HANDLE, &index);
@@ -699,12 +814,16 @@ static bool teardown(preview *p)
             vkFreeCommandBuffers(dev, p->g.pool, 1, &p->cmd);
         gpu_pipeline_destroy(&p->g, &p->display);
         gpu_buffer_destroy(&p->g, &p->texels);
+        gpu_pipeline_destroy(&p->g, &p->display_denoised);
+        gpu_buffer_destroy(&p->g, &p->denoised);
         renderer_destroy(&p->r);
     }
     if (p->surface)
         vkDestroySurfaceKHR(p->g.instance, p->surface, NULL);
     if (p->window)
         glfwDestroyWindow(p->window);
+    preview_denoiser_stop(&p->denoiser);
+    denoise_shutdown();
     return cli_gpu_finish(&p->g);
 }
 
@@ -726,35 +845,29 @@ int cmd_preview(int argc, char **argv)
     p->s = (render_settings){.mode = GN_MODE_PATH, .camera = -1};
     p->prefix = "gonio-preview";
     p->batch = 1;
-    bool no_shadows = false, quiet = false, outside = false;
+    bool no_shadows = false, quiet = false, outside = false, denoise = false;
     int scene_index = -1;
     const cli_option options[] = {
-        {"--mode", "M", render_mode_help(), CLI_CALL, &p->s.mode, 0, 0, NULL, cli_take_mode},
-        {"--spp", "N", "stop accumulating at N samples per pixel (default: never)", CLI_INT, CLI_AS(int, &p->max_spp), 1,
-         1 << 24, "an integer 1..16777216", NULL},
-        {"--size", "WxH", "initial window size (default 640 wide, the camera's aspect)", CLI_CALL, size, 0, 0,
-         "WxH, e.g. 640x480", cli_take_size},
+        CLI_OPT_MODE(&p->s.mode),
+        CLI_OPT_SPP(&p->max_spp, "stop accumulating at N samples per pixel (default: never)"),
+        CLI_OPT_SIZE(size, "initial window size (default 640 wide, the camera's aspect)"),
         CAMERA_OPTIONS(&cam),
-        {"--scene", "N", "show the file's glTF scene N (default: its default scene)", CLI_INT, CLI_AS(int, &scene_index),
-         0, 1 << 20, "an index >= 0", NULL},
-        {"--variant", "NAME", "the glTF KHR_materials_variants variant NAME's materials", CLI_CALL, NULL, 0, 0,
-         NULL, cli_take_variant},
+        CLI_OPT_SCENE(&scene_index, "show the file's glTF scene N (default: its default scene)"),
+        CLI_OPT_VARIANT("the glTF KHR_materials_variants variant NAME's materials"),
         CLI_OPT_ALLOW_OUTSIDE_FILES(&outside),
-        {"--seed", "S", "random seed (default 0)", CLI_U32, CLI_AS(uint32_t, &p->s.seed), 0, 4294967295.0,
-         "an integer 0..4294967295", NULL},
-        {"--max-depth", "N", "path tracer: maximum path length (default 0: roulette only)", CLI_INT, CLI_AS(int, &p->s.max_depth), 0, 1 << 16, "an integer >= 0", NULL},
+        CLI_OPT_SEED(&p->s.seed, "random seed (default 0)"),
+        CLI_OPT_MAX_DEPTH(&p->s.max_depth, "path tracer: maximum path length (default 0: roulette only)"),
         ENV_OPTIONS(&env),
-        {"--no-shadows", NULL, "local modes: no shadow rays", CLI_FLAG, CLI_AS(bool, &no_shadows), 0, 0, NULL, NULL},
-        {"--exposure", "E", "display scale 2^E (default 0)", CLI_FLOAT, CLI_AS(float, &p->exposure), -1e6, 1e6, "a number",
-         NULL},
-        {"--tonemap", "T", "clamp (default), reinhard, aces", CLI_CALL, &p->tonemap, 0, 0,
-         "clamp, reinhard or aces", cli_take_tonemap},
+        CLI_OPT_NO_SHADOWS(&no_shadows),
+        CLI_OPT_EXPOSURE(&p->exposure, "display scale 2^E (default 0)"),
+        CLI_OPT_TONEMAP(&p->tonemap, "clamp (default), reinhard, aces"),
+        CLI_OPT_DENOISE(&denoise, "start with the denoised view (key N; OIDN, as render --denoise)"),
         {"--prefix", "P", "P writes P-NNN.exr and P-NNN.png (default gonio-preview)", CLI_STRING, CLI_AS(const char *, &p->prefix),
-         0, 0, NULL, NULL},
+         0, 0, NULL, NULL, NULL},
         {"--frames", "N", "quit after N frames (scripts, tests)", CLI_INT, CLI_AS(int, &max_frames), 1, 1 << 30,
-         "an integer >= 1", NULL},
+         "an integer >= 1", NULL, NULL},
         {"--screenshot", "FILE", "on quitting, write what the window shows as PNG", CLI_STRING, CLI_AS(const char *, &screenshot), 0,
-         0, NULL, NULL},
+         0, NULL, NULL, "*.png"},
         CLI_OPT_DEVICE(&device),
         CLI_OPT_VALIDATE(&validate),
         CLI_OPT_QUIET(&quiet, "no informational messages"),
@@ -762,7 +875,7 @@ int cmd_preview(int argc, char **argv)
     const cli_command command = {.name = "preview", .synopsis = "SCENE.gltf|.glb [options]",
                                  .intro = "Opens a window and shows the render converging; press H in it for the keys.\n",
                                  CLI_OPTIONS(options), .epilog = keys_help(), .min_args = 1, .max_args = 1,
-                                 .missing = "no scene given"};
+                                 .missing = "no scene given", .complete_args = "*.gltf *.glb"};
     cli_args args;
     int rc = cli_parse(&command, argc, argv, &args);
     if (rc >= 0)
@@ -809,6 +922,16 @@ int cmd_preview(int argc, char **argv)
         height = (int)fmaxf(1.0f, 640.0f / start_view.aspect + 0.5f);
     p->start_camera = p->s.camera;
 
+    if (denoise) { /* the library, before the window: a clear error and exit 1 without it */
+        if (!denoise_load() || !preview_denoiser_start(&p->denoiser)) {
+            image_destroy(&env_map);
+            scene_destroy(&p->sc);
+            glfwTerminate();
+            return 1;
+        }
+        p->denoise_view = true;
+        p->s.aov |= RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL;
+    }
     if (setup(p, device, validate, width, height)) {
         util_info("preview: %s on %s; press H in the window for the keys", scene_path,
                   p->g.props.deviceName);

@@ -5,6 +5,7 @@
 #include "draw.h"
 #include "image.h"
 #include "util.h"
+#include "vec.h"
 
 #include <assert.h>
 #include <math.h>
@@ -171,7 +172,6 @@ static bool span(float a, float b, int n, int *lo, int *hi)
     return true;
 }
 
-static float clamp01(float v) { return v < 0 ? 0 : v > 1 ? 1 : v; }
 
 void draw_line(draw_canvas *c, float x0, float y0, float x1, float y1, float thickness, uint32_t color)
 {
@@ -183,8 +183,8 @@ void draw_line(draw_canvas *c, float x0, float y0, float x1, float y1, float thi
     for (int j = j0; j <= j1; j++) {
         for (int i = i0; i <= i1; i++) {
             float px = (float)i + 0.5f - x0, py = (float)j + 0.5f - y0;
-            float t = len2 > 0 ? clamp01((px * dx + py * dy) / len2) : 0;
-            blend(c, i, j, color, clamp01(r + 0.5f - hypotf(px - t * dx, py - t * dy)));
+            float t = len2 > 0 ? vec_clamp01((px * dx + py * dy) / len2) : 0;
+            blend(c, i, j, color, vec_clamp01(r + 0.5f - hypotf(px - t * dx, py - t * dy)));
         }
     }
 }
@@ -198,7 +198,7 @@ void draw_circle(draw_canvas *c, float cx, float cy, float r, float thickness, u
     for (int j = j0; j <= j1; j++) {
         for (int i = i0; i <= i1; i++) {
             float d = fabsf(hypotf((float)i + 0.5f - cx, (float)j + 0.5f - cy) - r);
-            blend(c, i, j, color, clamp01(0.5f * thickness + 0.5f - d));
+            blend(c, i, j, color, vec_clamp01(0.5f * thickness + 0.5f - d));
         }
     }
 }

@@ -92,7 +92,7 @@ void gpu_buffer_fill_zero(gpu *g, gpu_buffer *b);
 void gpu_buffer_create_storage(gpu *g, gpu_buffer *b, const void *data, VkDeviceSize size);
 
 /* A uniform texel buffer of RGBA32UI texels (size: bytes, a multiple of 16) holding data
- * (zeros without): read in GLSL through a usamplerBuffer with texelFetch, bits unchanged. */
+ * (zeros without): read in GLSL through a utextureBuffer with texelFetch, bits unchanged. */
 void gpu_buffer_create_texels(gpu *g, gpu_buffer *b, const void *data, VkDeviceSize size);
 /* The same with texels of another format (size: a multiple of its texel size). */
 void gpu_buffer_create_texels_as(gpu *g, gpu_buffer *b, const void *data, VkDeviceSize size,

@@ -5,6 +5,7 @@
 #include "util.h"
 
 #include <assert.h>
+#include <errno.h>
 #include <math.h>
 #include <openexr.h>
 #include <png.h>
@@ -12,6 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 /* Corrupt headers may claim any size; refuse what no render of ours would produce rather than
  * let util_malloc stop the program. */
@@ -40,12 +43,31 @@ void image_destroy(image *img)
     memset(img, 0, sizeof *img);
 }
 
+bool image_inside_frame(const image *img)
+{
+    return !img->full_width || (img->x0 >= 0 && img->y0 >= 0 && img->width <= img->full_width - img->x0 &&
+                                img->height <= img->full_height - img->y0);
+}
+
 int image_channel(const image *img, const char *name)
 {
     for (int c = 0; c < img->num_channels; c++)
         if (strcmp(img->names[c], name) == 0)
             return c;
     return -1;
+}
+
+void image_remove_channel(image *img, int c)
+{
+    assert(c >= 0 && c < img->num_channels);
+    free(img->planes[c]);
+    for (int k = c; k + 1 < img->num_channels; k++) {
+        memcpy(img->names[k], img->names[k + 1], sizeof img->names[k]);
+        img->planes[k] = img->planes[k + 1];
+    }
+    img->num_channels--;
+    img->planes[img->num_channels] = NULL;
+    img->names[img->num_channels][0] = 0;
 }
 
 /* ---- OpenEXR ------------------------------------------------------------------------- */
@@ -67,6 +89,50 @@ static exr_context_initializer_t exr_init(void)
     init.error_handler_fn = exr_capture;
     exr_message[0] = 0;
     return init;
+}
+
+/* OpenEXR reads and writes through gonio's own descriptors: an input is opened by
+ * util_open_read (regular files only, never blocking on a FIFO), an output is
+ * util_out_open's exclusive temporary file. */
+static int64_t exr_pread(exr_const_context_t ctxt, void *user, void *buf, uint64_t size, uint64_t offset,
+                         exr_stream_error_func_ptr_t error_cb)
+{
+    int fd = *(int *)user;
+    uint64_t done = 0;
+    while (done < size) {
+        ssize_t n = pread(fd, (char *)buf + done, size - done, (off_t)(offset + done));
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0)
+            return error_cb(ctxt, EXR_ERR_READ_IO, "read failed: %s", strerror(errno)), -1;
+        if (n == 0)
+            break;
+        done += (uint64_t)n;
+    }
+    return (int64_t)done;
+}
+
+static int64_t exr_fsize(exr_const_context_t ctxt, void *user)
+{
+    struct stat st;
+    (void)ctxt;
+    return fstat(*(int *)user, &st) == 0 ? (int64_t)st.st_size : -1;
+}
+
+static int64_t exr_pwrite(exr_const_context_t ctxt, void *user, const void *buf, uint64_t size, uint64_t offset,
+                          exr_stream_error_func_ptr_t error_cb)
+{
+    int fd = *(int *)user;
+    uint64_t done = 0;
+    while (done < size) {
+        ssize_t n = pwrite(fd, (const char *)buf + done, size - done, (off_t)(offset + done));
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            return error_cb(ctxt, EXR_ERR_WRITE_IO, "write failed: %s", n < 0 ? strerror(errno) : "no space"), -1;
+        done += (uint64_t)n;
+    }
+    return (int64_t)done;
 }
 
 static void exr_report(const char *path, const char *what, exr_result_t rv)
@@ -100,6 +166,12 @@ bool image_exr_compression_from_name(const char *name, int *out)
             return true;
         }
     return false;
+}
+
+const char *image_exr_compression_list(void)
+{
+    static char list[128];
+    return list[0] ? list : util_join(list, sizeof list, exr_compression_names, EXR_WRITABLE_COMPRESSIONS);
 }
 
 /* B44 packs HALF channels only; the rest of a chunk is stored as is, channel by channel, so
@@ -137,11 +209,14 @@ bool image_write_exr_with(const image *img, const char *path, const image_attr *
     exr_context_t ctx = NULL;
     bool encoding = false;
     int part = 0, lines = 0;
-    char tmp[4096];
+    util_out out;
     exr_result_t rv;
 
-    util_tmp_path(tmp, sizeof tmp, path);
-    rv = exr_start_write(&ctx, tmp, EXR_WRITE_FILE_DIRECTLY, &init);
+    if (!util_out_open(&out, path))
+        return false;
+    init.user_data = &out.fd;
+    init.write_fn = exr_pwrite;
+    rv = exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init);
     if (!rv)
         rv = exr_add_part(ctx, NULL, EXR_STORAGE_SCANLINE, &part);
     if (!rv && img->full_width > 0) {
@@ -220,13 +295,31 @@ bool image_write_exr_with(const image *img, const char *path, const image_attr *
     }
     if (rv)
         exr_report(path, "cannot write EXR", rv);
-    return util_commit_file(tmp, path, rv == EXR_ERR_SUCCESS);
+    return util_out_commit(&out, rv == EXR_ERR_SUCCESS);
+}
+
+static void exr_close_input(exr_const_context_t ctxt, void *user, int failed)
+{
+    (void)ctxt, (void)failed;
+    close(*(int *)user);
+    free(user);
 }
 
 static bool exr_open(exr_context_t *ctx, const char *path)
 {
     exr_context_initializer_t init = exr_init();
-    exr_result_t rv = exr_start_read(ctx, path, &init);
+    exr_result_t rv;
+    int *fd = util_malloc(sizeof *fd);
+    *ctx = NULL;
+    if ((*fd = util_open_read(path)) < 0) {
+        free(fd);
+        return false;
+    }
+    init.user_data = fd;
+    init.read_fn = exr_pread;
+    init.size_fn = exr_fsize;
+    init.destroy_fn = exr_close_input;
+    rv = exr_start_read(ctx, path, &init);
     if (rv) {
         exr_report(path, "cannot read EXR", rv);
         *ctx = NULL;
@@ -305,21 +398,35 @@ static bool exr_prepare(exr_context_t ctx, const char *path, image *img, exr_att
             util_error("%s: EXR channel '%s' is subsampled (not supported)", path, e->name.str);
             return false;
         }
+        if (e->pixel_type != EXR_PIXEL_UINT && e->pixel_type != EXR_PIXEL_HALF && e->pixel_type != EXR_PIXEL_FLOAT) {
+            util_error("%s: EXR channel '%s' has an unknown pixel type %d", path, e->name.str, (int)e->pixel_type);
+            return false;
+        }
         names[c] = e->name.str;
     }
     image_create(img, (int)w, (int)h, chl->num_channels, names);
+    for (int c = 0; c < chl->num_channels; c++)
+        img->stored[c] = chl->entries[c].pixel_type == EXR_PIXEL_UINT   ? IMAGE_STORED_UINT
+                         : chl->entries[c].pixel_type == EXR_PIXEL_HALF ? IMAGE_STORED_HALF
+                                                                         : IMAGE_STORED_FLOAT;
     {
         exr_attr_box2i_t disp;
         if (!exr_get_display_window(ctx, 0, &disp) &&
             (disp.min.x != dw->min.x || disp.min.y != dw->min.y || disp.max.x != dw->max.x ||
              disp.max.y != dw->max.y)) {
             long long fw = (long long)disp.max.x - disp.min.x + 1, fh = (long long)disp.max.y - disp.min.y + 1;
-            if (fw >= 1 && fh >= 1 && fw <= IMAGE_MAX_DIM && fh <= IMAGE_MAX_DIM) {
-                img->full_width = (int)fw;
-                img->full_height = (int)fh;
-                img->x0 = (int)((long long)dw->min.x - disp.min.x);
-                img->y0 = (int)((long long)dw->min.y - disp.min.y);
+            long long x0 = (long long)dw->min.x - disp.min.x, y0 = (long long)dw->min.y - disp.min.y;
+            if (fw < 1 || fh < 1 || fw > IMAGE_MAX_DIM || fh > IMAGE_MAX_DIM || llabs(x0) > IMAGE_MAX_DIM ||
+                llabs(y0) > IMAGE_MAX_DIM) {
+                util_error("%s: unsupported EXR display window %lldx%lld (data window at %lld,%lld of it)", path,
+                           fw, fh, x0, y0);
+                image_destroy(img);
+                return false;
             }
+            img->full_width = (int)fw;
+            img->full_height = (int)fh;
+            img->x0 = (int)x0;
+            img->y0 = (int)y0;
         }
     }
     return true;
@@ -439,6 +546,71 @@ bool image_exr_size(const char *path, int *width, int *height)
     return ok;
 }
 
+/* The attributes OpenEXR requires of every file, which the writer sets itself. */
+static bool exr_required_attr(const char *name)
+{
+    static const char *const names[] = {"channels", "compression", "dataWindow", "displayWindow", "lineOrder",
+                                        "pixelAspectRatio", "screenWindowCenter", "screenWindowWidth", "tiles",
+                                        "type", "name", "version", "chunkCount"};
+    for (size_t k = 0; k < sizeof names / sizeof *names; k++)
+        if (!strcmp(name, names[k]))
+            return true;
+    return false;
+}
+
+bool image_exr_attrs(const char *path, image_attr_list *out)
+{
+    exr_context_t ctx;
+    int32_t n = 0;
+    memset(out, 0, sizeof *out);
+    if (!exr_open(&ctx, path))
+        return false;
+    if (exr_get_attribute_count(ctx, 0, &n) != EXR_ERR_SUCCESS || n < 0)
+        n = 0;
+    out->attrs = util_calloc((size_t)n + 1, sizeof *out->attrs);
+    for (int32_t k = 0; k < n; k++) {
+        const exr_attribute_t *a;
+        image_attr *d = &out->attrs[out->count];
+        if (exr_get_attribute_by_index(ctx, 0, EXR_ATTR_LIST_FILE_ORDER, k, &a) != EXR_ERR_SUCCESS ||
+            exr_required_attr(a->name))
+            continue;
+        switch (a->type) {
+        case EXR_ATTR_STRING: {
+            char *s = util_malloc((size_t)a->string->length + 1);
+            memcpy(s, a->string->str ? a->string->str : "", (size_t)a->string->length);
+            s[a->string->length] = 0;
+            *d = (image_attr){NULL, IMAGE_ATTR_STRING, s, 0, 0, NULL};
+            break;
+        }
+        case EXR_ATTR_INT: *d = (image_attr){NULL, IMAGE_ATTR_INT, NULL, a->i, 0, NULL}; break;
+        case EXR_ATTR_FLOAT: *d = (image_attr){NULL, IMAGE_ATTR_DOUBLE, NULL, 0, a->f, NULL}; break;
+        case EXR_ATTR_DOUBLE: *d = (image_attr){NULL, IMAGE_ATTR_DOUBLE, NULL, 0, a->d, NULL}; break;
+        case EXR_ATTR_M44F: {
+            float *m = util_malloc(sizeof a->m44f->m);
+            memcpy(m, a->m44f->m, sizeof a->m44f->m);
+            *d = (image_attr){NULL, IMAGE_ATTR_M44F, NULL, 0, 0, m};
+            break;
+        }
+        default: continue; /* types the writer does not write */
+        }
+        d->name = strcpy(util_malloc(strlen(a->name) + 1), a->name);
+        out->count++;
+    }
+    exr_finish(&ctx);
+    return true;
+}
+
+void image_attr_list_destroy(image_attr_list *l)
+{
+    for (int k = 0; k < l->count; k++) {
+        free((char *)l->attrs[k].name);
+        free((char *)l->attrs[k].s);
+        free((float *)l->attrs[k].m);
+    }
+    free(l->attrs);
+    memset(l, 0, sizeof *l);
+}
+
 /* ---- 8-bit output and PNG ------------------------------------------------------------ */
 
 static uint8_t srgb8(float value, float scale, image_tonemap tm)
@@ -475,19 +647,23 @@ void image_to_srgb8(const float *r, const float *g, const float *b, int width, i
 bool image_write_png(const char *path, const uint8_t *rgba8, int width, int height)
 {
     png_image pi;
-    char tmp[4096];
+    util_out out;
+    FILE *f;
     bool ok;
     memset(&pi, 0, sizeof pi);
     pi.version = PNG_IMAGE_VERSION;
     pi.width = (png_uint_32)width;
     pi.height = (png_uint_32)height;
     pi.format = PNG_FORMAT_RGBA;
-    util_tmp_path(tmp, sizeof tmp, path);
-    ok = png_image_write_to_file(&pi, tmp, 0, rgba8, 0, NULL) != 0;
+    if (!util_out_open(&out, path))
+        return false;
+    if (!(f = util_out_file(&out)))
+        return util_out_commit(&out, false);
+    ok = png_image_write_to_stdio(&pi, f, 0, rgba8, 0, NULL) != 0;
     if (!ok)
         util_error("%s: cannot write PNG: %s", path, pi.message);
     png_image_free(&pi);
-    return util_commit_file(tmp, path, ok);
+    return util_out_commit(&out, ok);
 }
 
 bool image_write_png_from(const image *img, const char *path, float exposure, image_tonemap tm)
@@ -506,17 +682,22 @@ bool image_write_png_from(const image *img, const char *path, float exposure, im
 bool image_read_png(const char *path, uint8_t **rgba8, int *width, int *height)
 {
     png_image pi;
+    FILE *f;
     memset(&pi, 0, sizeof pi);
     pi.version = PNG_IMAGE_VERSION;
     *rgba8 = NULL;
-    if (!png_image_begin_read_from_file(&pi, path)) {
+    if (!(f = util_fopen_read(path)))
+        return false;
+    if (!png_image_begin_read_from_stdio(&pi, f)) {
         util_error("%s: cannot read PNG: %s", path, pi.message);
         png_image_free(&pi);
+        fclose(f);
         return false;
     }
     if ((long long)pi.width * pi.height > IMAGE_MAX_PIXELS) {
         util_error("%s: PNG too large (%ux%u)", path, (unsigned)pi.width, (unsigned)pi.height);
         png_image_free(&pi);
+        fclose(f);
         return false;
     }
     pi.format = PNG_FORMAT_RGBA;
@@ -524,10 +705,12 @@ bool image_read_png(const char *path, uint8_t **rgba8, int *width, int *height)
     if (!png_image_finish_read(&pi, NULL, *rgba8, 0, NULL)) {
         util_error("%s: cannot read PNG: %s", path, pi.message);
         png_image_free(&pi);
+        fclose(f);
         free(*rgba8);
         *rgba8 = NULL;
         return false;
     }
+    fclose(f);
     *width = (int)pi.width;
     *height = (int)pi.height;
     return true;
@@ -636,3 +819,9 @@ bool image_tonemap_from_name(const char *name, image_tonemap *out)
 }
 
 const char *image_tonemap_name(image_tonemap tm) { return tonemap_names[tm]; }
+
+const char *image_tonemap_list(void)
+{
+    static char list[64];
+    return list[0] ? list : util_join(list, sizeof list, tonemap_names, 3);
+}

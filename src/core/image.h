@@ -17,7 +17,14 @@ typedef struct image {
     int num_channels;
     char names[IMAGE_MAX_CHANNELS][32]; /* EXR channel names, e.g. "R", "G", "B", "A", "normal.X" */
     float *planes[IMAGE_MAX_CHANNELS];  /* width * height floats each, rows top to bottom */
+    /* How image_read_exr found each channel stored (IMAGE_STORED_NONE for an image made in
+     * memory): data that must be exact (a --resume file's sums) must have been float. */
+    unsigned char stored[IMAGE_MAX_CHANNELS];
 } image;
+enum { IMAGE_STORED_NONE, IMAGE_STORED_UINT, IMAGE_STORED_HALF, IMAGE_STORED_FLOAT };
+/* The data window lies inside the display window (always, for an image that is the whole
+ * frame). */
+bool image_inside_frame(const image *img);
 
 typedef enum image_attr_type { IMAGE_ATTR_STRING, IMAGE_ATTR_INT, IMAGE_ATTR_DOUBLE, IMAGE_ATTR_M44F } image_attr_type;
 
@@ -35,6 +42,8 @@ void image_create(image *img, int width, int height, int num_channels, const cha
 void image_destroy(image *img); /* accepts a zeroed struct */
 /* Index of a channel by name, or -1. */
 int image_channel(const image *img, const char *name);
+/* Removes channel c (its plane freed); the later channels move up one. */
+void image_remove_channel(image *img, int c);
 
 /* The file formats an output name can ask for, by its extension (case-insensitive). */
 typedef enum image_format { IMAGE_FORMAT_UNKNOWN, IMAGE_FORMAT_EXR, IMAGE_FORMAT_PNG } image_format;
@@ -52,6 +61,8 @@ typedef struct image_exr_options {
  * (pxr24 is lossy for float channels, b44/b44a for half ones and keep float ones whole).
  * False for any other name. */
 bool image_exr_compression_from_name(const char *name, int *out);
+/* The names image_exr_compression_from_name takes, ", "-separated. */
+const char *image_exr_compression_list(void);
 /* Writes every channel as 32-bit float (or half, opt->half) with opt->compression (NULL:
  * IMAGE_EXR_DEFAULTS) and the given header attributes; the data window is the image, at
  * (x0, y0) of a full_width x full_height display window when full_width > 0. Written to a temporary file beside
@@ -74,12 +85,24 @@ bool image_exr_attr_double(const char *path, const char *name, double *out);
 bool image_exr_attr_string(const char *path, const char *name, char *out, int cap);
 /* The size of an EXR's data window; false if path is not a readable EXR. */
 bool image_exr_size(const char *path, int *width, int *height);
+/* The header attributes of an EXR that image_write_exr_with can write again: string, int,
+ * double, m44f, and float (as double); OpenEXR's required attributes (channels, windows,
+ * compression...) and other types left out. False (with an error) if path is not a readable
+ * EXR. The list owns its names and values: image_attr_list_destroy frees them. */
+typedef struct image_attr_list {
+    int count;
+    image_attr *attrs;
+} image_attr_list;
+bool image_exr_attrs(const char *path, image_attr_list *out);
+void image_attr_list_destroy(image_attr_list *l); /* accepts a zeroed struct */
 
 typedef enum image_tonemap { IMAGE_TONEMAP_CLAMP, IMAGE_TONEMAP_ACES, IMAGE_TONEMAP_REINHARD } image_tonemap;
 
 /* "clamp", "aces", "reinhard" <-> image_tonemap; false for an unknown name. */
 bool image_tonemap_from_name(const char *name, image_tonemap *out);
 const char *image_tonemap_name(image_tonemap tm);
+/* Every tonemap's name, ", "-separated. */
+const char *image_tonemap_list(void);
 
 /* Linear RGB planes -> 8-bit sRGB RGBA (alpha 255): scale by 2^exposure, tonemap, sRGB
  * transfer function, round. NaN maps to 0. */

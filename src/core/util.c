@@ -2,9 +2,10 @@
 #define _POSIX_C_SOURCE 200809L
 #include "util.h"
 
+#include <assert.h>
 #include <dirent.h>
 #include <errno.h>
-#include <signal.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <math.h>
 #include <signal.h>
@@ -13,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/random.h>
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
@@ -20,13 +22,69 @@
 static bool quiet_flag, silent_flag;
 static int warnings;
 
+/* One character of s at *p, escaped when it is a control character, into out (room for 7
+ * bytes); advances *p past what it used. */
+static int escape_one(const unsigned char **p, char *out)
+{
+    const unsigned char c = **p;
+    if (c < 0x20 || c == 0x7f) {
+        (*p)++;
+        return sprintf(out, "\\x%02x", c);
+    }
+    if (c == 0xc2 && (*p)[1] >= 0x80 && (*p)[1] <= 0x9f) { /* U+0080..U+009F, the C1 controls */
+        int n = sprintf(out, "\\u%04x", (*p)[1]);
+        *p += 2;
+        return n;
+    }
+    out[0] = (char)c;
+    (*p)++;
+    return 1;
+}
+
+void util_fputs_safe(const char *s, FILE *f)
+{
+    char e[8];
+    for (const unsigned char *p = (const unsigned char *)s; *p;)
+        fwrite(e, 1, (size_t)escape_one(&p, e), f);
+}
+
+const char *util_escape(const char *s, char *buf, size_t cap)
+{
+    size_t len = 0;
+    char e[8];
+    for (const unsigned char *p = (const unsigned char *)s; *p;) {
+        int n = escape_one(&p, e);
+        if (len + (size_t)n >= cap)
+            break;
+        memcpy(buf + len, e, (size_t)n);
+        len += (size_t)n;
+    }
+    buf[len] = 0;
+    return buf;
+}
+
+/* A message is one line: text from files and the command line (names, URIs, values) goes
+ * through util_fputs_safe, so a name cannot move the cursor, recolour the terminal or
+ * forge a line of its own. */
 static void vreport(const char *prefix, const char *fmt, va_list ap)
 {
+    char buf[1024], *text = buf;
+    va_list again;
+    int n;
     if (silent_flag)
         return;
+    va_copy(again, ap);
+    n = vsnprintf(buf, sizeof buf, fmt, ap);
+    if (n >= (int)sizeof buf) {
+        text = util_malloc((size_t)n + 1);
+        vsnprintf(text, (size_t)n + 1, fmt, again);
+    }
+    va_end(again);
     fprintf(stderr, "gonio: %s", prefix);
-    vfprintf(stderr, fmt, ap);
+    util_fputs_safe(n >= 0 ? text : fmt, stderr);
     fputc('\n', stderr);
+    if (text != buf)
+        free(text);
 }
 
 void util_error(const char *fmt, ...)
@@ -156,31 +214,64 @@ bool util_parse_size(const char *s, int *w, int *h)
     if (!x)
         return false;
     *x = 0;
-    if (!util_parse_int(buf, 1, 16384, &lw) || !util_parse_int(x + 1, 1, 16384, &lh))
+    if (!util_parse_int(buf, 1, UTIL_SIZE_MAX, &lw) || !util_parse_int(x + 1, 1, UTIL_SIZE_MAX, &lh))
         return false;
     *w = (int)lw;
     *h = (int)lh;
     return true;
 }
 
+const char *util_join(char *buf, size_t cap, const char *const *names, int n)
+{
+    size_t len = 0;
+    buf[0] = 0;
+    for (int i = 0; i < n && len < cap; i++)
+        len += (size_t)snprintf(buf + len, cap - len, "%s%s", i ? ", " : "", names[i]);
+    return buf;
+}
+
+/* O_NONBLOCK: opening a FIFO for reading would otherwise wait for a writer, forever. It is
+ * cleared once the file is known to be regular (where it means nothing anyway). */
+int util_open_read(const char *path)
+{
+    struct stat st;
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    if (fd < 0) {
+        util_error("%s: cannot open: %s", path, strerror(errno));
+        return -1;
+    }
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        util_error("%s: %s; gonio reads only regular files", path,
+                   S_ISDIR(st.st_mode) ? "is a directory" : S_ISFIFO(st.st_mode) ? "is a FIFO (named pipe)"
+                   : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "is a device"
+                   : S_ISSOCK(st.st_mode) ? "is a socket" : "is not a regular file");
+        close(fd);
+        return -1;
+    }
+    fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+    return fd;
+}
+
+FILE *util_fopen_read(const char *path)
+{
+    int fd = util_open_read(path);
+    FILE *f = fd >= 0 ? fdopen(fd, "rb") : NULL;
+    if (fd >= 0 && !f) {
+        util_error("%s: cannot open: %s", path, strerror(errno));
+        close(fd);
+    }
+    return f;
+}
+
 void *util_read_file(const char *path, size_t *size)
 {
-    FILE *f = fopen(path, "rb");
+    FILE *f = util_fopen_read(path);
     char *data;
     long len;
-    struct stat st;
-    if (!f) {
-        util_error("%s: cannot open: %s", path, strerror(errno));
+    if (!f)
         return NULL;
-    }
-    /* A directory opens and seeks on Linux (ftell gives LONG_MAX): only regular files. */
-    if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode)) {
-        util_error("%s: not a regular file", path);
-        fclose(f);
-        return NULL;
-    }
     if (fseek(f, 0, SEEK_END) != 0 || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
-        util_error("%s: cannot read (not a regular file?)", path);
+        util_error("%s: cannot read: %s", path, strerror(errno));
         fclose(f);
         return NULL;
     }
@@ -202,28 +293,19 @@ void *util_read_file(const char *path, size_t *size)
  * one at a time, since every writer commits before the next starts. The flag is cleared
  * while the name changes and after the rename, so the handler never reads a half-written
  * name and at worst unlinks a name that no longer exists. */
-static char pending_tmp[4096];
+static char pending_tmp[PATH_MAX];
 static volatile sig_atomic_t pending;
-/* The temporary name: "DIR/.NAME.tmp-PID". */
+/* The temporary name: "DIR/.NAME.tmp-PID-XXXXXX", XXXXXX random: nobody can have made it
+ * in advance, and it is created exclusively all the same. */
 #define TMP_PREFIX "."
 #define TMP_INFIX ".tmp-"
-#define TMP_EXTRA (sizeof TMP_PREFIX + sizeof TMP_INFIX + 10)
+#define TMP_RANDOM 6
+#define TMP_EXTRA (sizeof TMP_PREFIX + sizeof TMP_INFIX + 10 + 1 + TMP_RANDOM)
 
 bool util_has_suffix(const char *s, const char *suffix)
 {
     size_t n = strlen(s), m = strlen(suffix);
     return n >= m && strcasecmp(s + n - m, suffix) == 0;
-}
-
-void util_tmp_path(char *out, size_t cap, const char *final_path)
-{
-    const char *slash = strrchr(final_path, '/');
-    int dirlen = slash ? (int)(slash - final_path + 1) : 0;
-    snprintf(out, cap, "%.*s" TMP_PREFIX "%s" TMP_INFIX "%ld", dirlen, final_path,
-             slash ? slash + 1 : final_path, (long)getpid());
-    pending = 0;
-    snprintf(pending_tmp, sizeof pending_tmp, "%s", out);
-    pending = 1;
 }
 
 void util_remove_pending_tmp(void)
@@ -232,8 +314,9 @@ void util_remove_pending_tmp(void)
         unlink(pending_tmp);
 }
 
-/* Removes "DIR/.NAME.tmp-PID" files left by a gonio that was killed (SIGKILL, power loss)
- * while writing NAME: only regular files, and only of processes that no longer exist. */
+/* Removes "DIR/.NAME.tmp-PID-XXXXXX" files left by a gonio that was killed (SIGKILL, power
+ * loss) while writing NAME: only regular files of this user, and only of processes that
+ * no longer exist. */
 static void remove_stale_tmp(const char *dir, const char *name)
 {
     DIR *d = opendir(dir);
@@ -242,17 +325,21 @@ static void remove_stale_tmp(const char *dir, const char *name)
     if (!d)
         return;
     while ((e = readdir(d))) {
-        const char *n = e->d_name, *pid_text = n + 1 + len + strlen(TMP_INFIX);
-        char path[PATH_MAX];
+        const char *n = e->d_name, *pid_text = n + 1 + len + strlen(TMP_INFIX), *dash;
+        char path[PATH_MAX], pid_buf[16];
         struct stat st;
         long pid;
         if (n[0] != '.' || strncmp(n + 1, name, len) || strncmp(n + 1 + len, TMP_INFIX, strlen(TMP_INFIX)) ||
-            !util_parse_int(pid_text, 1, LONG_MAX, &pid) || pid == (long)getpid())
+            !(dash = strchr(pid_text, '-')) || dash - pid_text >= (long)sizeof pid_buf ||
+            strlen(dash + 1) != TMP_RANDOM)
+            continue;
+        snprintf(pid_buf, sizeof pid_buf, "%.*s", (int)(dash - pid_text), pid_text);
+        if (!util_parse_int(pid_buf, 1, LONG_MAX, &pid) || pid == (long)getpid())
             continue;
         if (kill((pid_t)pid, 0) == 0 || errno != ESRCH)
             continue;
         if (snprintf(path, sizeof path, "%s/%s", dir, n) < (int)sizeof path && lstat(path, &st) == 0 &&
-            S_ISREG(st.st_mode) && unlink(path) == 0)
+            S_ISREG(st.st_mode) && st.st_uid == geteuid() && unlink(path) == 0)
             util_info("%s: removed a stale temporary file of process %ld", path, pid);
     }
     closedir(d);
@@ -331,38 +418,118 @@ bool util_check_output(const char *path)
     return true;
 }
 
-FILE *util_tmp_open(char *tmp, size_t cap, const char *final_path, const char *mode)
+/* Six characters of [0-9a-z] from the kernel's random numbers (or the clock, where they
+ * are unavailable: the name only has to be hard to guess; exclusivity is O_EXCL's). */
+static void random_suffix(char out[TMP_RANDOM + 1])
 {
-    FILE *f;
-    util_tmp_path(tmp, cap, final_path);
-    if (!(f = fopen(tmp, mode)))
-        util_error("%s: cannot write: %s", final_path, strerror(errno));
-    return f;
+    static const char digits[] = "0123456789abcdefghijklmnopqrstuvwxyz";
+    unsigned char bytes[TMP_RANDOM];
+    if (getrandom(bytes, sizeof bytes, GRND_NONBLOCK) != (ssize_t)sizeof bytes) {
+        uint64_t x = (uint64_t)(util_now() * 1e9) ^ (uint64_t)getpid() << 32;
+        for (int i = 0; i < TMP_RANDOM; i++, x = x * 6364136223846793005ull + 1442695040888963407ull)
+            bytes[i] = (unsigned char)(x >> 56);
+    }
+    for (int i = 0; i < TMP_RANDOM; i++)
+        out[i] = digits[bytes[i] % 36];
+    out[TMP_RANDOM] = 0;
 }
 
-bool util_commit_file(const char *tmp_path, const char *final_path, bool ok)
+bool util_out_open(util_out *o, const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    int dirlen = slash ? (int)(slash - path + 1) : 0;
+    memset(o, 0, sizeof *o);
+    o->path = path;
+    o->fd = -1;
+    for (int attempt = 0; attempt < 16 && o->fd < 0; attempt++) {
+        char r[TMP_RANDOM + 1];
+        random_suffix(r);
+        if (snprintf(o->tmp, sizeof o->tmp, "%.*s" TMP_PREFIX "%s" TMP_INFIX "%ld-%s", dirlen, path,
+                     slash ? slash + 1 : path, (long)getpid(), r) >= (int)sizeof o->tmp) {
+            util_error("%s: cannot write: the path is too long", path);
+            return false;
+        }
+        /* O_EXCL: a new file or nothing; a link (even one to nowhere) at the name fails. The
+         * mode is the umask's, as a shell's > gives a new file. */
+        o->fd = open(o->tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC | O_NOCTTY, 0666);
+        if (o->fd < 0 && errno != EEXIST) {
+            util_error("%s: cannot write: %s", path, strerror(errno));
+            return false;
+        }
+    }
+    struct stat st;
+    if (o->fd < 0 || fstat(o->fd, &st) != 0) {
+        util_error("%s: cannot create a temporary file beside it", path);
+        if (o->fd >= 0)
+            close(o->fd);
+        return false;
+    }
+    o->dev = (uint64_t)st.st_dev;
+    o->ino = (uint64_t)st.st_ino;
+    pending = 0;
+    snprintf(pending_tmp, sizeof pending_tmp, "%s", o->tmp);
+    pending = 1;
+    return true;
+}
+
+FILE *util_out_file(util_out *o)
+{
+    assert(o->fd >= 0 && !o->file);
+    if (!(o->file = fdopen(o->fd, "wb")))
+        util_error("%s: cannot write: %s", o->path, strerror(errno));
+    return o->file;
+}
+
+/* The temporary file is still the one util_out_open created (nobody renamed another file
+ * to its name since). */
+static bool still_ours(const util_out *o)
+{
+    struct stat st;
+    return lstat(o->tmp, &st) == 0 && S_ISREG(st.st_mode) && (uint64_t)st.st_dev == o->dev &&
+           (uint64_t)st.st_ino == o->ino;
+}
+
+bool util_out_commit(util_out *o, bool ok)
 {
     struct stat st;
     bool exists;
+    int fd = o->file ? fileno(o->file) : o->fd;
+    if (ok && o->file && (fflush(o->file) != 0 || ferror(o->file))) {
+        util_error("%s: cannot write: %s", o->path, strerror(errno));
+        ok = false;
+    }
     /* Checked again here: the path may have changed since util_check_output, and not every
      * writer's caller checks. */
-    if (ok && !replaceable(final_path, &st, &exists))
+    if (ok && !replaceable(o->path, &st, &exists))
         ok = false;
-    /* A replaced file keeps its permissions (and its owner, where we may give it). */
+    /* A replaced file keeps its permissions (and its owner, where we may give it), set
+     * through the descriptor: no name is followed. */
     if (ok && exists) {
-        if (chmod(tmp_path, st.st_mode & 07777) != 0) {
-            util_error("%s: cannot write: %s", final_path, strerror(errno));
+        if (fchmod(fd, st.st_mode & 07777) != 0) {
+            util_error("%s: cannot write: %s", o->path, strerror(errno));
             ok = false;
-        } else if ((st.st_uid != geteuid() || st.st_gid != getegid()) && chown(tmp_path, st.st_uid, st.st_gid) != 0) {
+        } else if ((st.st_uid != geteuid() || st.st_gid != getegid()) && fchown(fd, st.st_uid, st.st_gid) != 0) {
             /* Not ours to give away: the new file is the writer's, as with any rename. */
         }
     }
-    if (ok && rename(tmp_path, final_path) != 0) {
-        util_error("%s: cannot write: %s", final_path, strerror(errno));
+    if (o->file ? fclose(o->file) != 0 : close(o->fd) != 0) {
+        if (ok)
+            util_error("%s: cannot write: %s", o->path, strerror(errno));
         ok = false;
     }
-    if (!ok)
-        unlink(tmp_path);
+    o->file = NULL;
+    o->fd = -1;
+    if (ok && !still_ours(o)) {
+        util_error("%s: its temporary file %s was replaced by another process; nothing written", o->path, o->tmp);
+        pending = 0;
+        return false;
+    }
+    if (ok && rename(o->tmp, o->path) != 0) {
+        util_error("%s: cannot write: %s", o->path, strerror(errno));
+        ok = false;
+    }
+    if (!ok && still_ours(o))
+        unlink(o->tmp);
     pending = 0;
     return ok;
 }

@@ -1,4 +1,4 @@
-/* brdf.c: the table of BRDF models (docs/brdf.md, glsl/lib/brdf.glsl) with their parameters,
+/* brdf.c: the table of BRDF models (docs/brdf.md, glsl/lib/brdf_*.glsl) with their parameters,
  * strict `--PARAM VALUE` parsing, and the runner of the BRDF test kernel. */
 #include "brdf.h"
 
@@ -8,6 +8,8 @@
 #include <string.h>
 
 #include "brdf_test.h" /* spv_brdf_test, generated from glsl/kernels/brdf_test.comp */
+#include "render_material.h"
+#include "scene.h"
 #include "util.h"
 
 #define P(slot) (BRDF_SLOT_PARAMS + (slot))
@@ -40,6 +42,8 @@ void brdf_setting_init(brdf_setting *s, const brdf_model *m)
 {
     memset(s, 0, sizeof *s);
     s->model = m;
+    scene_material_default(&s->m);
+    s->m.brdf = m->id;
     for (int i = 0; i < m->num_params; i++)
         memcpy(&s->v[m->params[i].slot], m->params[i].def, sizeof(float) * (size_t)m->params[i].count);
 }
@@ -174,21 +178,14 @@ bool brdf_spec_check(const char *spec)
 bool brdf_setting_two_sided(const brdf_setting *s)
 {
     return s->model->id == BRDF_DIELECTRIC ||
-           (s->model->id == BRDF_GLTF && (s->v[BRDF_SLOT_EXTRA + 3] > 0 || s->v[BRDF_SLOT_DT + 3] > 0));
+           (s->model->id == BRDF_GLTF && (s->m.transmission > 0 || s->m.diffuse_transmission > 0));
 }
 
 void brdf_setting_to_query(const brdf_setting *s, BrdfQuery *q)
 {
-    const float *v = s->v;
-    q->model = s->model->id;
-    q->color = (vec3){v[0], v[1], v[2]};
-    q->params = (vec4){v[3], v[4], v[5], v[6]};
-    q->extra = (vec4){v[7], v[8], v[9], v[10]};
-    q->layer = (vec4){v[11], v[12], v[13], v[BRDF_SLOT_COAT_TILT]};
-    q->sheen = (vec4){v[14], v[15], v[16], 0};
-    q->aniso = (vec4){v[BRDF_SLOT_ANISO], v[BRDF_SLOT_ANISO + 1], 0, 0};
-    q->irid = (vec4){v[BRDF_SLOT_IRID], v[BRDF_SLOT_IRID + 1], v[BRDF_SLOT_IRID + 2], 0};
-    q->dt = (vec4){v[BRDF_SLOT_DT], v[BRDF_SLOT_DT + 1], v[BRDF_SLOT_DT + 2], v[BRDF_SLOT_DT + 3]};
+    q->material = s->m;
+    q->material.brdf = s->model->id;
+    q->coat_tilt = s->coat_tilt;
 }
 
 static void format_setting(char *out, size_t cap, const brdf_setting *s, bool changed_only)
@@ -216,30 +213,13 @@ void brdf_format_title(char *out, size_t cap, const brdf_setting *s)
         snprintf(out + strlen(out), cap - strlen(out), " (the rest at their defaults)");
 }
 
-uint32_t brdf_query_features(const BrdfQuery *q)
+GnFeatures brdf_query_features(const BrdfQuery *q)
 {
-    uint32_t f;
     if (q->op & BRDF_OP_FRESNEL)
         return GN_FEAT_ALL;
-    if (q->model != BRDF_GLTF) {
-        /* an override model: its row of the table, as the renderer specialises on it (an id
-         * unknown to the table keeps every feature) */
-        for (int i = 0; i < brdf_num_models; i++)
-            if (brdf_models[i].id == q->model)
-                return brdf_models[i].features | GN_FEAT_MODELS;
-        return GN_FEAT_ALL;
-    }
-    /* bsdf_gltf (its lobe, mirror, Schlick's F and the coupled diffuse at any roughness and
-     * metalness), glass where it transmits, the layers and the film where a factor is
-     * nonzero (NaN counts as nonzero), the anisotropy where it has a strength */
-    f = GN_FEAT_GLTF | GN_FEAT_MIRROR | GN_FEAT_GGX | GN_FEAT_FRESNEL_SCHLICK | GN_FEAT_COUPLED;
-    if (!(q->extra.w <= 0))
-        f |= GN_FEAT_GLASS;
-    if (!(q->layer.x <= 0 && q->sheen.x <= 0 && q->sheen.y <= 0 && q->sheen.z <= 0 && q->irid.x <= 0 && q->dt.w <= 0))
-        f |= GN_FEAT_LAYERS;
-    if (!(q->aniso.x <= 0))
-        f |= GN_FEAT_ANISO;
-    return f;
+    /* the material's, as the renderer specialises its kernels on them; the NDF queries read
+     * the base's GGX at any roughness (where the material alone would have its mirror) */
+    return material_features(&q->material) | (q->op & BRDF_OP_NDF ? GN_FEAT_GGX : GN_FEAT_NONE);
 }
 
 void brdf_runner_create(brdf_runner *r, gpu *g, uint32_t capacity)
@@ -258,7 +238,7 @@ void brdf_runner_create(brdf_runner *r, gpu *g, uint32_t capacity)
 }
 
 /* The kernel specialised on features: a kept one, or a new one in the next slot. */
-static gpu_pipeline *runner_pipeline(brdf_runner *r, uint32_t features)
+static gpu_pipeline *runner_pipeline(brdf_runner *r, GnFeatures features)
 {
     gpu_pipeline *p;
     for (uint32_t i = 0; i < BRDF_RUNNER_KERNELS; i++)
@@ -273,8 +253,11 @@ static gpu_pipeline *runner_pipeline(brdf_runner *r, uint32_t features)
         {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->results},
         {BRDF_BIND_SHEEN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->sheen},
     };
-    VkSpecializationMapEntry entry = {1, 0, sizeof features}; /* brdf_test.comp's FEATURES */
-    VkSpecializationInfo spec = {1, &entry, sizeof features, &features};
+    /* brdf_test.comp's FEATURES and FEATURES_HI, as path.comp's */
+    const uint32_t words[2] = {(uint32_t)features, (uint32_t)(features >> 32)};
+    const VkSpecializationMapEntry entries[2] = {{GN_SPEC_FEATURES, 0, sizeof(uint32_t)},
+                                                 {GN_SPEC_FEATURES_HI, sizeof(uint32_t), sizeof(uint32_t)}};
+    VkSpecializationInfo spec = {2, entries, sizeof words, words};
     gpu_pipeline_desc pd = {.name = "brdf_test", .code = spv_brdf_test, .code_size = sizeof spv_brdf_test,
                             .local_size = {64, 1, 1}, .push_size = 4, .bindings = bind, .num_bindings = 3,
                             .specialization = &spec};
@@ -297,7 +280,8 @@ void brdf_runner_destroy(brdf_runner *r)
 void brdf_runner_run(brdf_runner *r, const BrdfQuery *q, BrdfResult *out, size_t n)
 {
     for (size_t done = 0; done < n;) {
-        uint32_t count = (uint32_t)(n - done < r->capacity ? n - done : r->capacity), features = 0;
+        uint32_t count = (uint32_t)(n - done < r->capacity ? n - done : r->capacity);
+        GnFeatures features = GN_FEAT_NONE;
         VkCommandBuffer cmd;
         for (uint32_t i = 0; i < count && !r->all_features && features != GN_FEAT_ALL; i++)
             features |= brdf_query_features(&q[done + i]);

@@ -1,6 +1,6 @@
 /* brdf.h: the BRDF model table (names, parameters, defaults and ranges of the models in
  * glsl/lib/brdf_models.h) with strict parsing of `--PARAM VALUE` settings, and a runner that
- * batches queries through glsl/kernels/brdf_test.comp, i.e. through the renderer's own brdf.glsl. */
+ * batches queries through glsl/kernels/brdf_test.comp, i.e. through the renderer's own brdf_*.glsl. */
 #ifndef GONIO_BRDF_H
 #define GONIO_BRDF_H
 
@@ -12,25 +12,16 @@
 #include "gpu.h"
 #include "sheen_albedo.h"
 
-/* Where a setting's values go: v[0..2] the colour, v[3..6] the four scalars (brdf_params),
- * v[7..10] glTF's extra (specular colour, transmission), v[11..13] glTF's layers (clearcoat,
- * clearcoat roughness, sheen roughness), v[14..16] the sheen colour (BrdfQuery.layer, .sheen),
- * then the slots below. */
-#define BRDF_SLOT_COLOR 0
-#define BRDF_SLOT_PARAMS 3
-#define BRDF_SLOT_EXTRA 7
-#define BRDF_SLOT_LAYER 11
-#define BRDF_SLOT_SHEEN 14
-#define BRDF_SLOT_COAT_TILT 17 /* the coat normal's tilt (BrdfQuery.layer.w): no parameter, tests only */
-#define BRDF_SLOT_ANISO 18 /* anisotropy strength, rotation (BrdfQuery.aniso) */
-#define BRDF_SLOT_IRID 20  /* iridescence factor, film ior, thickness in nm (BrdfQuery.irid) */
-#define BRDF_SLOT_DT 23    /* diffuse transmission colour (3), factor (BrdfQuery.dt) */
-#define BRDF_NUM_SLOTS 27
+/* Where a setting's values go: the words of a GnMaterial (glsl/lib/material.h), the colour
+ * of a model in base_color.rgb, its four scalars in brdf_params, the glTF model's parameters
+ * in their own fields. */
+#define BRDF_SLOT_COLOR ((int)GN_MAT_WORD(base_color))
+#define BRDF_SLOT_PARAMS ((int)GN_MAT_WORD(brdf_params))
 #define BRDF_MAX_PARAMS 18
 
 typedef struct brdf_param {
     const char *name; /* option name without the leading "--" */
-    int slot;         /* first value in brdf_setting.v */
+    int slot;         /* its first word in brdf_setting.v (GnMaterial's words) */
     int count;        /* 1: a scalar; 3: a colour ("R,G,B" or one value for all three) */
     float def[3];
     float min, max;   /* accepted range of every component */
@@ -42,16 +33,22 @@ typedef struct brdf_model {
     const char *summary;
     int num_params;
     brdf_param params[BRDF_MAX_PARAMS];
-    uint32_t features; /* GN_FEAT_* its Bsdf can need (the table's lobe_feats | feats) */
+    GnFeatures features; /* GN_FEAT_* its Bsdf can need (the table's lobe_feats | feats) */
 } brdf_model;
 
+/* A model and its parameters' values: a material (glTF's every field, a model's colour and
+ * four scalars), untextured, the rest at glTF's defaults (scene_material_default). */
 typedef struct brdf_setting {
     const brdf_model *model;
-    float v[BRDF_NUM_SLOTS];
+    union {
+        GnMaterial m;
+        float v[GN_MATERIAL_WORDS]; /* the same, by word (brdf_param.slot) */
+    };
+    float coat_tilt; /* the coat normal's tilt (BrdfQuery.coat_tilt): no parameter, tests only */
 } brdf_setting;
 
 /* The sheen's directional albedo (glsl/lib/sheen_albedo.h), SHEEN_N x SHEEN_N floats, which every
- * kernel that builds a sheen reads from a texel buffer (brdf.glsl: brdf_sheen_table). */
+ * kernel that builds a sheen reads from a texel buffer (brdf_scatter.glsl: brdf_sheen_table). */
 extern const float brdf_sheen_table[];
 #define BRDF_SHEEN_TABLE_SIZE (SHEEN_N * SHEEN_N)
 
@@ -76,7 +73,7 @@ bool brdf_spec_check(const char *spec);
 const brdf_param *brdf_param_find(const brdf_model *m, const char *name);
 /* Does the setting transmit (a dielectric interface: light below the surface matters)? */
 bool brdf_setting_two_sided(const brdf_setting *s);
-/* Fills the material fields (model, color, params, extra) of a test-kernel query. */
+/* Fills the material (its model in .brdf) and the coat's tilt of a test-kernel query. */
 void brdf_setting_to_query(const brdf_setting *s, BrdfQuery *q);
 /* "name param=value ..." (colours as one value when grey, else R,G,B): the `gonio brdf
  * --list` line of a default setting. */
@@ -87,9 +84,9 @@ void brdf_format_setting(char *out, size_t cap, const brdf_setting *s);
 void brdf_format_title(char *out, size_t cap, const brdf_setting *s);
 
 /* The GN_FEAT_* the kernel needs for query q (brdf_test.comp is specialised on them, as
- * the renderer's kernels are): a model's row of the table, for glTF the parts its factors
- * turn on; every feature for the Fresnel queries. */
-uint32_t brdf_query_features(const BrdfQuery *q);
+ * the renderer's kernels are): its material's (material_features); every feature for the
+ * Fresnel queries. */
+GnFeatures brdf_query_features(const BrdfQuery *q);
 
 /* Batches BrdfQuery records through brdf_test.comp, a kernel specialised on the features of
  * each batch's queries (one pipeline kept per feature set, BRDF_RUNNER_KERNELS at most), or
@@ -99,13 +96,13 @@ typedef struct brdf_runner {
     gpu *g;
     gpu_buffer queries, results, sheen;
     gpu_pipeline pipelines[BRDF_RUNNER_KERNELS];
-    uint32_t features[BRDF_RUNNER_KERNELS]; /* pipelines[i]'s, when its pipeline exists */
+    GnFeatures features[BRDF_RUNNER_KERNELS]; /* pipelines[i]'s, when its pipeline exists */
     uint32_t next;                          /* the slot the next new kernel replaces */
     uint32_t capacity;
     bool all_features;
 } brdf_runner;
 
-/* capacity: queries per dispatch (buffers of 96 and 64 bytes per query). */
+/* capacity: queries per dispatch (buffers of sizeof(BrdfQuery) and sizeof(BrdfResult) bytes per query). */
 void brdf_runner_create(brdf_runner *r, gpu *g, uint32_t capacity);
 void brdf_runner_destroy(brdf_runner *r); /* accepts a zeroed struct */
 /* Runs n queries (in batches of the capacity) and writes their n results. */

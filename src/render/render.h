@@ -16,6 +16,20 @@
 #include "image.h"
 #include "scene.h"
 
+/* Progress reports of renderer_render, for a display (the command line's: src/cli/progress.c):
+ * RENDER_PROGRESS_START before the first pass, RENDER_PROGRESS_BATCH after each batch of
+ * passes, RENDER_PROGRESS_END once after the last (s->stop tells whether a stop ended it).
+ * done: the samples per pixel taken so far; elapsed: seconds since the passes began (with a
+ * time limit, the work done is the time, not the spp). */
+typedef enum render_progress_event {
+    RENDER_PROGRESS_START,
+    RENDER_PROGRESS_BATCH,
+    RENDER_PROGRESS_END,
+} render_progress_event;
+struct render_settings;
+typedef void render_progress_fn(void *user, const struct render_settings *s,
+                                render_progress_event event, int done, double elapsed);
+
 /* What to render. A zero field is the default where one exists (mode path, seed 0, no AOVs,
  * shadows on, unbounded depth, a black environment, MIS, the whole image, no resume, no
  * progress); width, height and spp must be given, and camera (-1: frame the scene). */
@@ -32,7 +46,8 @@ typedef struct render_settings {
     float env[3];           /* constant environment radiance */
     bool ambient_set;       /* local modes: ambient replaces the scene's global ambient light */
     float ambient[3];
-    bool progress;          /* progress bar on stderr */
+    render_progress_fn *progress; /* NULL: no progress reports */
+    void *progress_user;          /* progress's first argument */
     volatile sig_atomic_t *stop; /* set asynchronously to end after the current pass */
     const GnCamera *camera_override; /* non-NULL: this camera (aspect from the image), not `camera` */
     const scene_camera *view; /* non-NULL: this camera (aspect from the image), not `camera`
@@ -64,6 +79,8 @@ void render_region(const render_settings *s, int region[4]);
 #define RENDER_AOV_GPU (RENDER_AOV_NORMAL | RENDER_AOV_ALBEDO | RENDER_AOV_DEPTH)
 /* "normal", "albedo", "depth", "variance" -> RENDER_AOV_*; 0 when unknown. */
 uint32_t render_aov_from_name(const char *name);
+/* Every AOV's name, ", "-separated. */
+const char *render_aov_list(void);
 
 typedef struct render_stats {
     int spp;                /* samples per pixel actually taken */
@@ -97,9 +114,9 @@ typedef struct renderer {
     double env_weight;        /* its selection weight */
     int width, height;
     double setup_seconds;
-    uint32_t material_features; /* GN_FEAT_* the materials need (renderer_create) */
-    uint32_t path_features;     /* ... and the current path render (renderer_begin) */
-    uint32_t pipeline_features[GN_MODE_COUNT]; /* what each cached kernel was built for */
+    GnFeatures material_features; /* GN_FEAT_* the materials need (renderer_create) */
+    GnFeatures path_features;     /* ... and the current path render (renderer_begin) */
+    GnFeatures pipeline_features[GN_MODE_COUNT]; /* what each cached kernel was built for */
     uint32_t path_samples;      /* samples per path dispatch (1..GN_PATH_SAMPLES) */
     bool failed;                /* renderer_create refused the scene: nothing renders */
     VkDeviceSize vcolor_bytes;  /* Gouraud's colours: more than a storage buffer holds when
@@ -129,10 +146,11 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame);
 uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
 
 /* Specialization constants of the render kernels: constant 0 = mode (or a kernel's own
- * variant); constant 1 = the GN_FEAT_* set (the path kernel reads it; others ignore it). */
+ * variant); constants GN_SPEC_FEATURES and GN_SPEC_FEATURES_HI = the GN_FEAT_* set's two words (the
+ * path kernel reads them; others ignore them). */
 typedef struct renderer_spec {
-    uint32_t values[4];
-    VkSpecializationMapEntry entries[4];
+    uint32_t values[5];
+    VkSpecializationMapEntry entries[5];
     VkSpecializationInfo info;
 } renderer_spec;
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec);
@@ -152,8 +170,9 @@ uint32_t renderer_finish(renderer *r, uint32_t mode, uint32_t next); /* returns 
 void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out);
 /* Appends the exact accumulation sums to out, the state --resume goes on from: sum.R/G/B/A
  * always, sum.normal.X/Y/Z, sum.albedo.R/G/B, sum.depth.Z with the GPU AOVs of aov, and
- * sum2.R/G/B (the squares) with variance. The EXR keeps them as 32-bit floats. */
-void renderer_sums(const renderer *r, uint32_t aov, image *out);
+ * sum2.R/G/B (the squares) with variance; and sum.N, each pixel's sample count (spp), which
+ * --resume checks against the header. The EXR keeps them as 32-bit floats. */
+void renderer_sums(const renderer *r, int spp, uint32_t aov, image *out);
 
 /* Renders and fills `out` with R, G, B, A (A = coverage) and the channels of the AOVs in
  * s->aov, in the order normal.X/Y/Z, albedo.R/G/B, depth.Z, variance.R/G/B. Each is the
@@ -163,12 +182,6 @@ void renderer_sums(const renderer *r, uint32_t aov, image *out);
  * with the same bits: every batch of samples goes through all bands in turn (their sums
  * kept on the host), so --time, a stop and the progress act on whole rounds of bands. */
 bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats);
-
-/* Applies BRDF-model overrides to the scene's materials (GnMaterial.brdf, brdf_params and
- * the model's colour): each material's extras {"gonio": {"brdf": NAME, PARAM: VALUE...}}
- * and, when brdf is not NULL, "NAME[:PARAM=VALUE...]" for every material (winning over
- * extras). False with an error naming the scene and material on a bad name or value. */
-bool render_material_overrides(scene *sc, const char *brdf);
 
 /* The render modes (glsl/lib/shared.h: GN_MODES) as the host reads them, indexed by GN_MODE_*. */
 typedef struct render_mode_info {

@@ -12,7 +12,6 @@
 #include <zlib.h>
 
 #include "camera.h"
-#include "cli.h"
 #include "draw.h"
 #include "util.h"
 
@@ -70,7 +69,7 @@ static void add_attr(render_header *h, image_attr a)
 }
 
 void render_header_build(render_header *h, const renderer *r, const render_settings *s,
-                         const render_stats *st, const char *brdf)
+                         const render_stats *st, const char *brdf, const char *command)
 {
     const bool lit = render_modes[s->mode].flags & GN_MODEF_LIT;
     GnCamera cam;
@@ -130,7 +129,7 @@ void render_header_build(render_header *h, const renderer *r, const render_setti
     if (brdf)
         add_string(h, "gonio:brdf", "%s", brdf);
     add_attr(h, (image_attr){"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, st->seconds, NULL});
-    add_attr(h, (image_attr){"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL});
+    add_attr(h, (image_attr){"gonio:command", IMAGE_ATTR_STRING, command, 0, 0, NULL});
     add_attr(h, (image_attr){"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL});
 }
 

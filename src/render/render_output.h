@@ -40,9 +40,10 @@ extern const char *const render_identity_names[];
  * gonio:seed (int), gonio:scene-path; the view: gonio:camera-name (s->camera_label),
  * gonio:look-at, gonio:view (src/scene/camera.h), gonio:fov or gonio:ortho-half-height (double),
  * worldToCamera (m44f, OpenEXR's), gonio:environment (s->env_label); then gonio:brdf (when
- * brdf is not NULL), gonio:seconds, gonio:command, gonio:version. */
+ * brdf is not NULL), gonio:seconds, gonio:command (`command`, the command line),
+ * gonio:version. */
 void render_header_build(render_header *h, const renderer *r, const render_settings *s,
-                         const render_stats *st, const char *brdf);
+                         const render_stats *st, const char *brdf, const char *command);
 
 /* The gonio:seed of an EXR header: an OpenEXR int is signed, so seeds of 2^31 and above are
  * stored as their two's complement and read back here. False when absent or not an int. */

@@ -6,141 +6,28 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <unistd.h>
 
-#include "cli.h"
 #include "image.h"
 #include "util.h"
-
-/* Parses n comma-separated finite floats (n in [min_n, max_n]); returns how many, 0 on error. */
-static int parse_floats(const char *s, float *out, int min_n, int max_n)
-{
-    int n = 0;
-    const char *p = s;
-    char *end = NULL;
-    while (n < max_n) {
-        float v = strtof(p, &end);
-        if (end == p || !isfinite(v))
-            return 0;
-        out[n++] = v;
-        if (*end == 0)
-            break;
-        if (*end != ',')
-            return 0;
-        p = end + 1;
-    }
-    return n >= min_n && *end == 0 ? n : 0;
-}
-
-static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-static void cross3(const float a[3], const float b[3], float out[3])
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static bool normalize3(float v[3])
-{
-    float l = sqrtf(dot3(v, v));
-    if (!(l > 0) || !isfinite(l))
-        return false;
-    for (int k = 0; k < 3; k++)
-        v[k] /= l;
-    return true;
-}
+#include "vec.h"
 
 /* The orthonormal frame of eye, target and up; false when the view is degenerate (target
  * at the eye, or up along the view). */
-static bool look_at_frame(const float eye[3], const float target[3], const float up[3], scene_camera *out)
+bool camera_look_at_frame(const float eye[3], const float target[3], const float up[3], scene_camera *out)
 {
     float f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]}, r[3], u[3];
-    if (!normalize3(f))
+    if (!vec_normalize(f))
         return false;
-    cross3(f, up, r);
-    if (!normalize3(r) || fabsf(dot3(f, up)) > 0.9999f * sqrtf(dot3(up, up)))
+    vec_cross(f, up, r);
+    if (!vec_normalize(r) || fabsf(vec_dot(f, up)) > 0.9999f * sqrtf(vec_dot(up, up)))
         return false;
-    cross3(r, f, u);
+    vec_cross(r, f, u);
     memcpy(out->position, eye, sizeof out->position);
     memcpy(out->forward, f, sizeof out->forward);
     memcpy(out->right, r, sizeof out->right);
     memcpy(out->up, u, sizeof out->up);
     return true;
-}
-
-
-/* --camera FILE.exr: the view gonio recorded in the file's header (camera_record_attrs). */
-static int camera_from_exr(camera_option *c, const char *cmd, const char *path)
-{
-    char view[256];
-    double fov = 0, ortho = 0;
-    if (!image_exr_attr_string(path, "gonio:look-at", view, sizeof view))
-        return cli_usage_error(cmd, "--camera '%s': not an EXR with a gonio:look-at header (written by "
-                                    "gonio render or preview)", path);
-    float v[9];
-    if (parse_floats(view, v, 9, 9) != 9)
-        return cli_usage_error(cmd, "--camera '%s': gonio:look-at '%s' is not 9 numbers", path, view);
-    image_exr_attr_double(path, "gonio:fov", &fov);
-    image_exr_attr_double(path, "gonio:ortho-half-height", &ortho);
-    if (!(fov > 0 && fov < 180) && !(ortho > 0 && isfinite(ortho)))
-        return cli_usage_error(cmd, "--camera '%s': no valid gonio:fov or gonio:ortho-half-height", path);
-    c->kind = CAMERA_LOOK_AT;
-    memcpy(c->eye, v, sizeof c->eye);
-    memcpy(c->target, v + 3, sizeof c->target);
-    memcpy(c->up, v + 6, sizeof c->up);
-    c->ortho_half_height = ortho > 0 ? (float)ortho : 0;
-    /* The exact frame, when recorded: the look-at form loses the last bits of the view
-     * direction (target - eye), which moves some silhouette pixels. */
-    if (image_exr_attr_string(path, "gonio:view", view, sizeof view) && parse_floats(view, c->frame, 15, 15) == 15)
-        c->exact = true;
-    if (!image_exr_size(path, &c->width, &c->height))
-        c->width = c->height = 0;
-    if (c->fov == 0 && fov > 0 && !c->exact) /* gonio:view has the exact yfov */
-        c->fov = (float)fov;
-    return 1;
-}
-
-int camera_parse_option(camera_option *c, const char *cmd, const char *opt, const char *val)
-{
-    long v;
-    if (!strcmp(opt, "--camera")) {
-        if (!strcmp(val, "frame")) {
-            c->kind = CAMERA_FRAME;
-        } else if (util_has_suffix(val, ".exr")) {
-            return camera_from_exr(c, cmd, val);
-        } else if (util_parse_int(val, 0, 1 << 20, &v)) {
-            c->kind = CAMERA_INDEX;
-            c->index = (int)v;
-        } else {
-            return cli_usage_error(cmd, "--camera '%s': expected an index >= 0, 'frame' or FILE.exr", val);
-        }
-        return 1;
-    }
-    if (!strcmp(opt, "--look-at")) {
-        float f[9] = {0, 0, 0, 0, 0, 0, 0, 1, 0};
-        int n = parse_floats(val, f, 6, 9);
-        if (n != 6 && n != 9)
-            return cli_usage_error(cmd, "--look-at '%s': expected EX,EY,EZ,TX,TY,TZ[,UX,UY,UZ]", val);
-        scene_camera probe;
-        if (!look_at_frame(f, f + 3, f + 6, &probe))
-            return cli_usage_error(cmd, "--look-at '%s': the target must differ from the eye and the "
-                                        "up vector must not point along the view", val);
-        c->kind = CAMERA_LOOK_AT;
-        c->exact = false;
-        memcpy(c->eye, f, sizeof c->eye);
-        memcpy(c->target, f + 3, sizeof c->target);
-        memcpy(c->up, f + 6, sizeof c->up);
-        c->ortho_half_height = 0;
-        return 1;
-    }
-    if (!strcmp(opt, "--fov")) {
-        float f;
-        if (!util_parse_float(val, &f) || !(f > 0 && f < 180))
-            return cli_usage_error(cmd, "--fov '%s': expected degrees in (0, 180)", val);
-        c->fov = f;
-        return 1;
-    }
-    return 0;
 }
 
 bool camera_resolve(const camera_option *c, const scene *sc, float aspect, scene_camera *out)
@@ -169,7 +56,7 @@ bool camera_resolve(const camera_option *c, const scene *sc, float aspect, scene
             memcpy(out->right, c->frame + 3, sizeof out->right);
             memcpy(out->up, c->frame + 6, sizeof out->up);
             memcpy(out->forward, c->frame + 9, sizeof out->forward);
-        } else if (!look_at_frame(c->eye, c->target, c->up, out)) {
+        } else if (!camera_look_at_frame(c->eye, c->target, c->up, out)) {
             util_error("--look-at: degenerate view");
             return false;
         }
@@ -236,7 +123,7 @@ void camera_world_to_camera(const scene_camera *c, float m[16])
     for (int j = 0; j < 3; j++) {
         for (int i = 0; i < 3; i++)
             m[4 * i + j] = axes[j][i];
-        m[12 + j] = -dot3(c->position, axes[j]);
+        m[12 + j] = -vec_dot(c->position, axes[j]);
         m[4 * j + 3] = 0;
     }
     m[15] = 1;
@@ -257,9 +144,4 @@ void camera_frame_string(const scene_camera *c, char *buf, size_t cap)
         for (int k = 0; k < 3; k++)
             n += (size_t)snprintf(buf + n, n < cap ? cap - n : 0, "%s%.9g", n ? "," : "", v[i][k]);
     snprintf(buf + n, n < cap ? cap - n : 0, ",%.9g,%.9g,%.9g", c->znear, c->zfar, c->yfov);
-}
-
-bool camera_take_option(const char *cmd, const char *opt, const char *val, void *dest)
-{
-    return camera_parse_option((camera_option *)dest, cmd, opt, val) == 1;
 }

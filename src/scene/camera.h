@@ -32,27 +32,9 @@ typedef struct camera_option {
     float fov;                       /* vertical, degrees; 0 = the camera's own (45 else) */
 } camera_option;
 
-/* The camera options every rendering command takes, for its --help. */
-/* The camera options of render, preview and compare (cli.h: a cli_option list for a table). */
-#define CAMERA_OPTIONS(cam)                                                                    \
-    {"--camera", "C",                                                                          \
-     "N: the scene's N-th camera (0 = the first in the default scene's\n"                      \
-     "node order, the default); frame: frame the bounds from a raised\n"                       \
-     "three-quarter view (the default without a camera); FILE.exr: the\n"                      \
-     "view recorded by gonio render or preview",                                               \
-     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, camera_take_option},                                         \
-    {"--look-at", "E,T[,U]",                                                                   \
-     "place a camera: eye EX,EY,EZ, target TX,TY,TZ, up UX,UY,UZ\n"                            \
-     "(default 0,1,0), world coordinates",                                                     \
-     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, camera_take_option},                                         \
-    {"--fov", "DEGREES", "vertical field of view (default: the camera's own, else 45)",        \
-     CLI_CALL, CLI_AS(camera_option, cam), 0, 0, NULL, camera_take_option}
-
-/* Takes opt (with its value val) when it is a camera option: returns 1 when taken, 0 when
- * opt is not a camera option, 2 after printing a usage error for command cmd. */
-int camera_parse_option(camera_option *c, const char *cmd, const char *opt, const char *val);
-/* camera_parse_option as a cli_option's call (dest: the camera_option). */
-bool camera_take_option(const char *cmd, const char *opt, const char *val, void *dest);
+/* The orthonormal frame (position, right, up, forward) of a camera at eye looking at
+ * target; false when the view is degenerate (target at the eye, or up along the view). */
+bool camera_look_at_frame(const float eye[3], const float target[3], const float up[3], scene_camera *out);
 
 /* The camera c selects in sc for an image of the given aspect (width / height > 0). False,
  * with an error naming the scene, when c names a camera sc does not have. */

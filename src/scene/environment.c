@@ -10,40 +10,9 @@
 
 #include <stb_image.h>
 
-#include "cli.h"
 #include "util.h"
+#include "vec.h"
 
-
-/* Radiance beyond this overflows the flux products in float (--env 1e38 wrote NaN pixels). */
-#define ENV_MAX 1e9f
-
-int env_parse_option(env_option *e, const char *cmd, const char *opt, const char *val)
-{
-    if (!strcmp(opt, "--env")) {
-        e->given = true;
-        e->path = NULL;
-        e->studio = !strcmp(val, "studio");
-        if (e->studio)
-            return 1;
-        if (util_has_suffix(val, ".exr") || util_has_suffix(val, ".hdr"))
-            e->path = val;
-        else if (!util_parse_rgb(val, e->color) || e->color[0] > ENV_MAX || e->color[1] > ENV_MAX || e->color[2] > ENV_MAX)
-            return cli_usage_error(cmd, "--env '%s': expected R,G,B or one value in [0, %g], FILE.exr, FILE.hdr or studio",
-                                   val, ENV_MAX);
-        return 1;
-    }
-    if (!strcmp(opt, "--env-rotate")) {
-        if (!util_parse_float(val, &e->rotation) || !isfinite(e->rotation))
-            return cli_usage_error(cmd, "--env-rotate '%s': expected degrees", val);
-        return 1;
-    }
-    if (!strcmp(opt, "--env-intensity")) {
-        if (!util_parse_float(val, &e->intensity) || !(e->intensity > 0) || !(e->intensity <= ENV_MAX))
-            return cli_usage_error(cmd, "--env-intensity '%s': expected a number in (0, %g]", val, ENV_MAX);
-        return 1;
-    }
-    return 0;
-}
 
 bool env_scene_has_light(const scene *sc)
 {
@@ -83,11 +52,11 @@ static float smoothstepf(float a, float b, float x)
     return t * t * (3 - 2 * t);
 }
 
+/* The unit vector along v (the studio's directions). */
 static void unit(const float v[3], float out[3])
 {
-    float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    for (int k = 0; k < 3; k++)
-        out[k] = v[k] / l;
+    memcpy(out, v, 3 * sizeof *out);
+    vec_normalize(out);
 }
 
 /* A soft disc of angular radius r degrees about unit direction c: 1 inside 70 % of r, 0 outside. */
@@ -98,7 +67,7 @@ static float soft_disc(const float d[3], const float c[3], float r)
     return 1 - smoothstepf(0.7f * r, r, a);
 }
 
-static void studio(image *out, bool with_key)
+void environment_studio(image *out, bool with_key)
 {
     static const char *const names[3] = {"R", "G", "B"};
     float key[3], fill[3];
@@ -120,8 +89,6 @@ static void studio(image *out, bool with_key)
                 out->planes[k][(size_t)y * STUDIO_WIDTH + x] = L;
         }
 }
-
-void environment_studio(image *out) { studio(out, true); }
 
 void environment_studio_key(GnLight *out)
 {
@@ -159,23 +126,47 @@ void environment_mean(const image *map, float out[3])
 
 /* ---- Radiance .hdr ---------------------------------------------------------------------- */
 
+/* The size line of a Radiance header (after the header's empty line): "-Y H +X W", the
+ * orientation stb_image reads. False when it is not there: stb_image names the problem. */
+static bool hdr_size(FILE *f, long *w, long *h)
+{
+    char line[256];
+    bool blank = false;
+    for (int n = 0; n < 4096 && fgets(line, sizeof line, f); n++) {
+        if (blank) {
+            char sy, sx;
+            return sscanf(line, "%cY %ld %cX %ld", &sy, h, &sx, w) == 4;
+        }
+        blank = line[0] == '\n';
+    }
+    return false;
+}
+
 bool environment_read_hdr(image *out, const char *path)
 {
     static const char *const names[3] = {"R", "G", "B"};
+    const long max_pixels = 1L << 28;
     int w, h, comp;
+    long fw, fh;
     memset(out, 0, sizeof *out);
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        util_error("%s: cannot open: %s", path, strerror(errno));
+    FILE *f = util_fopen_read(path);
+    if (!f)
         return false;
-    }
     /* stb_image would convert an 8-bit image to "HDR" through a guessed gamma: refuse it. */
     if (!stbi_is_hdr_from_file(f)) {
         fclose(f);
         util_error("%s: not a Radiance HDR (RGBE) file", path);
         return false;
     }
-    if (!stbi_info_from_file(f, &w, &h, &comp) || (double)w * h > (double)(1 << 28)) {
+    /* stb_image refuses a huge image as one of no format it knows ("not BMP"): say why. */
+    if (hdr_size(f, &fw, &fh) && (fw < 1 || fh < 1 || fw > max_pixels / (fh > 0 ? fh : 1))) {
+        fclose(f);
+        util_error("%s: a Radiance HDR of %ldx%ld pixels: %s", path, fw, fh,
+                   fw < 1 || fh < 1 ? "an empty image" : "too large (at most 2^28 pixels)");
+        return false;
+    }
+    rewind(f);
+    if (!stbi_info_from_file(f, &w, &h, &comp) || (double)w * h > (double)max_pixels) {
         fclose(f);
         util_error("%s: %s", path, stbi_failure_reason() ? stbi_failure_reason() : "image too large");
         return false;
@@ -194,61 +185,3 @@ bool environment_read_hdr(image *out, const char *path)
     return true;
 }
 
-/* ---- the commands' rule --------------------------------------------------------------- */
-
-bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_settings *s, bool *studio_used)
-{
-    float scale = e->intensity > 0 ? e->intensity : 1, mean[3] = {0, 0, 0};
-    bool local = s->mode != GN_MODE_PATH;
-    *studio_used = false;
-    memset(map, 0, sizeof *map);
-    s->env_map = NULL;
-    s->env_rotation = e->rotation;
-    if (e->given && !e->path && !e->studio) {
-        for (int k = 0; k < 3; k++)
-            mean[k] = s->env[k] = e->color[k] * scale;
-    } else if (e->given || !env_scene_has_light(sc)) {
-        if (e->path) {
-            bool ok = util_has_suffix(e->path, ".hdr") ? environment_read_hdr(map, e->path) : image_read_exr(map, e->path);
-            if (!ok)
-                return false;
-        } else {
-            *studio_used = true;
-            if (!quiet && !e->studio)
-                util_info("%s has no lights: lit by gonio's studio environment (--env 0 for black)", sc->path);
-            if (local) {
-                /* The local modes see the studio as its key light plus the mean of the rest. */
-                GnLight key;
-                environment_studio_key(&key);
-                /* --env-rotate turns the key with the map (R_Y, as path.comp turns the map). */
-                float ca = cosf(e->rotation * (float)(M_PI / 180)), sa = sinf(e->rotation * (float)(M_PI / 180));
-                vec3 d = key.direction;
-                key.direction = (vec3){ca * d.x + sa * d.z, d.y, -sa * d.x + ca * d.z};
-                sc->lights = util_realloc(sc->lights, (sc->num_lights + 1) * sizeof *sc->lights);
-                sc->lights[sc->num_lights++] = key;
-                studio(map, false);
-            } else {
-                studio(map, true);
-            }
-        }
-        if (scale != 1)
-            for (int c = 0; c < map->num_channels; c++)
-                for (size_t i = 0; i < (size_t)map->width * map->height; i++)
-                    map->planes[c][i] *= scale;
-        environment_mean(map, mean);
-        s->env_map = map;
-    }
-    /* The local modes: the environment is the Phong model's ambient light, unless --ambient
-     * (the path tracer does not read it). */
-    if (!s->ambient_set) {
-        for (int k = 0; k < 3; k++)
-            s->ambient[k] = sc->ambient[k] + mean[k];
-        s->ambient_set = true;
-    }
-    return true;
-}
-
-bool env_take_option(const char *cmd, const char *opt, const char *val, void *dest)
-{
-    return env_parse_option((env_option *)dest, cmd, opt, val) == 1;
-}

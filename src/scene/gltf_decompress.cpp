@@ -136,14 +136,36 @@ bool meshopt_view(Out &o, size_t i)
 
 /* ---- KHR_draco_mesh_compression ------------------------------------------------------------ */
 
+/* The decoded values of attribute a as the accessor declares them: floats (Draco
+ * dequantizes and normalizes what it stored as integers), or the accessor's own integer
+ * type when Draco stored integers (JOINTS_n as unsigned byte or short, normalized colours),
+ * so the loader's checks of each attribute's formats see what the file declares. */
+template <class T>
+bool draco_values(const draco::PointAttribute *a, size_t np, int nc, std::vector<unsigned char> &bytes)
+{
+    T val[4];
+    bytes.resize(np * size_t(nc) * sizeof(T));
+    for (size_t k = 0; k < np; k++) {
+        if (!a->ConvertValue<T>(a->mapped_index(draco::PointIndex(uint32_t(k))), int8_t(nc), val))
+            return false;
+        memcpy(&bytes[k * size_t(nc) * sizeof(T)], val, size_t(nc) * sizeof(T));
+    }
+    return true;
+}
+
+bool draco_is_integer(draco::DataType t)
+{
+    return t == draco::DT_INT8 || t == draco::DT_UINT8 || t == draco::DT_INT16 || t == draco::DT_UINT16 ||
+           t == draco::DT_INT32 || t == draco::DT_UINT32;
+}
+
 bool draco_primitive(Out &o, size_t mi, size_t pi)
 {
     tinygltf::Model &m = o.m;
     tinygltf::Primitive &p = m.meshes[mi].primitives[pi];
     const tinygltf::Value &e = *ext(p.extensions, "KHR_draco_mesh_compression");
-    std::string what = "mesh " + std::to_string(mi) +
-                       (m.meshes[mi].name.empty() ? "" : " '" + m.meshes[mi].name + "'") + " primitive " +
-                       std::to_string(pi) + " (KHR_draco_mesh_compression)";
+    std::string what = "meshes[" + std::to_string(mi) + "].primitives[" + std::to_string(pi) +
+                       "].extensions.KHR_draco_mesh_compression";
     long long view = member(e, "bufferView");
     if (view < 0 || size_t(view) >= m.bufferViews.size())
         return o.error(what + ": bufferView " + std::to_string(view) + " does not exist");
@@ -183,21 +205,34 @@ bool draco_primitive(Out &o, size_t mi, size_t pi)
             return o.error(what + ": " + name + " accessor " + std::to_string(it->second) + " (" +
                            std::to_string(acc.count) + " elements) does not match the " + std::to_string(np) +
                            " decoded points");
+        if (a->num_components() != nc)
+            return o.error(what + ".attributes." + name + ": accessors[" + std::to_string(it->second) + "] has " +
+                           std::to_string(nc) + " components, but Draco attribute " + std::to_string(id) + " has " +
+                           std::to_string(int(a->num_components())));
         if (np > o.max_elements)
             return o.error(what + ": " + std::to_string(np) + " points exceed the limit");
-        if (!o.take(what, np * size_t(nc) * 4))
-            return false;
-        std::vector<unsigned char> bytes(np * size_t(nc) * 4);
-        float val[4];
-        for (size_t k = 0; k < np; k++) {
-            if (!a->ConvertValue<float>(a->mapped_index(draco::PointIndex(uint32_t(k))), int8_t(nc), val))
-                return o.error(what + ": Draco cannot convert " + name + " to float");
-            memcpy(&bytes[k * size_t(nc) * 4], val, size_t(nc) * 4);
-        }
+        const int ct = acc.componentType;
+        const bool as_float = ct == TINYGLTF_COMPONENT_TYPE_FLOAT;
+        if (!as_float && !draco_is_integer(a->data_type()))
+            return o.error(what + ".attributes." + name + ": accessors[" + std::to_string(it->second) +
+                           "] declares component type " + std::to_string(ct) + ", but Draco attribute " +
+                           std::to_string(id) + " decodes to floats");
+        const size_t size = as_float ? 4 : size_t(tinygltf::GetComponentSizeInBytes(uint32_t(ct)));
+        if (size < 1 || size > 4 || !o.take(what, np * size_t(nc) * size))
+            return size >= 1 && size <= 4 ? false : o.error(what + ": " + name + " has an unknown component type");
+        std::vector<unsigned char> bytes;
+        bool ok = ct == TINYGLTF_COMPONENT_TYPE_BYTE             ? draco_values<int8_t>(a, np, nc, bytes)
+                  : ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE  ? draco_values<uint8_t>(a, np, nc, bytes)
+                  : ct == TINYGLTF_COMPONENT_TYPE_SHORT          ? draco_values<int16_t>(a, np, nc, bytes)
+                  : ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? draco_values<uint16_t>(a, np, nc, bytes)
+                  : ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT   ? draco_values<uint32_t>(a, np, nc, bytes)
+                                                                 : draco_values<float>(a, np, nc, bytes);
+        if (!ok)
+            return o.error(what + ": Draco cannot convert " + name + " to the accessor's component type");
         acc.bufferView = add_view(m, std::move(bytes), 0);
         acc.byteOffset = 0;
-        acc.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
-        acc.normalized = false; /* ConvertValue normalizes integer data that was */
+        if (as_float)
+            acc.normalized = false; /* ConvertValue normalizes integer data that was */
         acc.sparse.isSparse = false;
     }
     if (p.indices < 0) { /* the decoded points are not in drawing order: index them */

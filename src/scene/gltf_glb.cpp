@@ -34,15 +34,14 @@ extern "C" bool gltf_write_glb_from_json(const char *path, const char *json, siz
             return false;
         }
         const std::string bytes = glb.str();
-        char tmp[4096];
-        FILE *f = util_tmp_open(tmp, sizeof tmp, path, "wb");
-        if (!f)
+        util_out out;
+        if (!util_out_open(&out, path))
             return false;
-        bool ok = fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
-        ok = fclose(f) == 0 && ok;
-        if (!ok)
+        FILE *f = util_out_file(&out);
+        bool ok = f && fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+        if (f && !ok)
             util_error("%s: write failed (disk full?)", path);
-        return util_commit_file(tmp, path, ok);
+        return util_out_commit(&out, ok);
     } catch (const std::exception &e) {
         util_error("%s: cannot write GLB: %s", path, e.what());
         return false;

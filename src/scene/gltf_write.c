@@ -429,7 +429,7 @@ static bool write_glb(const char *path, const gltf_write_desc *desc, const uint8
 
 bool gltf_write_file(const char *path, const gltf_write_desc *desc)
 {
-    char tmp[4096];
+    util_out out;
     size_t size = 0;
     uint8_t *buf = make_buffer(desc, &size);
     const char *dot = strrchr(path, '.');
@@ -440,16 +440,13 @@ bool gltf_write_file(const char *path, const gltf_write_desc *desc)
         free(buf);
         return ok;
     }
-    f = util_tmp_open(tmp, sizeof tmp, path, "wb");
-    if (!f) {
+    if (!util_out_open(&out, path) || !(f = util_out_file(&out))) {
+        if (out.fd >= 0)
+            util_out_commit(&out, false);
         free(buf);
         return false;
     }
     write_json(f, desc, buf, size);
     free(buf);
-    ok = !ferror(f);
-    ok = fclose(f) == 0 && ok;
-    if (!ok)
-        util_error("%s: write failed (disk full?)", path);
-    return util_commit_file(tmp, path, ok);
+    return util_out_commit(&out, true);
 }

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "util.h"
+#include "vec.h"
 
 static uint64_t splitmix64(uint64_t *state)
 {
@@ -259,8 +260,8 @@ static void compute_normals(meshgen_mesh *m)
                     *p2 = m->positions + 3 * i[2];
         float e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
         float e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
-        float n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                      e1[0] * e2[1] - e1[1] * e2[0]};
+        float n[3];
+        vec_cross(e1, e2, n);
         for (int k = 0; k < 3; k++)
             for (int a = 0; a < 3; a++)
                 m->normals[3 * i[k] + a] += n[a];

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "util.h"
+#include "vec.h"
 
 void scene_destroy(scene *s)
 {
@@ -22,6 +23,7 @@ void scene_destroy(scene *s)
     free(s->material_extras);
     free(s->material_names);
     free(s->variant_names);
+    free(s->extensions);
     free(s->lights);
     free(s->images);
     free(s->textures);
@@ -55,9 +57,7 @@ void scene_triangle_cross(const scene *s, uint32_t t, double out[3])
         e1[k] = p[1][k] - p[0][k];
         e2[k] = p[2][k] - p[0][k];
     }
-    out[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    out[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    out[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    vec_cross_d(e1, e2, out);
 }
 
 static bool position_ok(const vec3 *p)
@@ -134,30 +134,20 @@ void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *
     out->zfar = 2.0f * (dist + r);
 }
 
+/* The table's defaults: a factor's own, each component; a texture slot's none. */
+static void set_default(float *v, int n, float def)
+{
+    for (int k = 0; k < n; k++)
+        v[k] = def;
+}
+#define DEFAULT_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) \
+    set_default((float *)&m->name, GN_MAT_COUNT_##type, (float)(def));
+#define DEFAULT_TEX(name, word, ext, json, space, gate, uses) m->name = GN_INVALID;
+
 void scene_material_default(GnMaterial *m)
 {
     memset(m, 0, sizeof *m);
-    m->base_color = (vec4){1, 1, 1, 1};
-    m->metallic = 1;
-    m->roughness = 1;
-    m->specular_color = (vec3){1, 1, 1};
-    m->specular = 1;
-    m->ior = 1.5f;
-    m->normal_scale = 1;
-    m->occlusion_strength = 1;
-    m->alpha_cutoff = 0.5f;
-    m->tex_base = m->tex_mr = m->tex_normal = m->tex_emissive = m->tex_occlusion = GN_INVALID;
-    m->attenuation_color = (vec3){1, 1, 1}; /* KHR_materials_volume: no absorption */
-    m->attenuation_distance = INFINITY;
-    m->tex_clearcoat = m->tex_clearcoat_roughness = m->tex_clearcoat_normal = GN_INVALID;
-    m->tex_sheen_color = m->tex_sheen_roughness = GN_INVALID;
-    m->tex_anisotropy = m->tex_iridescence = m->tex_iridescence_thickness = GN_INVALID;
-    m->tex_diffuse_transmission = m->tex_diffuse_transmission_color = GN_INVALID;
-    m->clearcoat_normal_scale = 1;
-    m->iridescence_ior = 1.3f; /* KHR_materials_iridescence's defaults */
-    m->iridescence_thickness_min = 100;
-    m->iridescence_thickness_max = 400;
-    m->diffuse_transmission_color = (vec3){1, 1, 1};
+    GN_MATERIAL(DEFAULT_PARAM, DEFAULT_TEX, GN_MAT_NO_FIELD)
     scene_phong_from_pbr(m);
 }
 

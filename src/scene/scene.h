@@ -1,9 +1,11 @@
 /* scene.h: a renderable scene in world space, loaded from glTF 2.0 (.gltf or .glb).
  *
- * The loader (scene_gltf.cpp) hides tinygltf behind scene_load. It walks the node
- * hierarchy (matrix and TRS), bakes every mesh primitive instance into world space and
+ * The loader (scene_gltf.cpp and the gltf_*.cpp files: gltf_internal.h names them) hides
+ * tinygltf behind scene_load. It walks the node hierarchy (matrix and TRS, animated at the
+ * time scene_animation_time gives), bakes every mesh primitive instance into world space and
  * merges them into one triangle list; per-vertex data stays indexed. Materials and lights
- * are stored directly in their GPU form (glsl/lib/shared.h). */
+ * are stored directly in their GPU form (glsl/lib/shared.h; a material's fields and where
+ * the file sets them: glsl/lib/material.h). */
 #ifndef GONIO_SCENE_H
 #define GONIO_SCENE_H
 
@@ -44,6 +46,21 @@ typedef struct scene_material_extras {
     bool has_phong;             /* "phong": {...} was present; fields already in GnMaterial */
 } scene_material_extras;
 
+/* How gonio handles a glTF extension (the loader's table of extensions, gltf_material.cpp). */
+typedef enum scene_support {
+    SCENE_UNSUPPORTED, /* not read (how: why, and what the file gets instead) */
+    SCENE_PARTLY,      /* read, with something left out (how: what) */
+    SCENE_SUPPORTED,   /* read as its specification says (how: by what) */
+} scene_support;
+
+/* An extension a file lists (extensionsUsed, extensionsRequired). */
+typedef struct scene_extension {
+    char name[64];         /* as the file spells it, cut to 63 bytes */
+    bool required;         /* in extensionsRequired (the file is refused if unsupported) */
+    scene_support support;
+    const char *how;       /* a static sentence: what gonio does with it */
+} scene_extension;
+
 typedef struct scene {
     char path[1024];
 
@@ -66,6 +83,9 @@ typedef struct scene {
     uint32_t num_variants;      /* KHR_materials_variants of the file (any one selected or not) */
     char (*variant_names)[64];
 
+    uint32_t num_extensions;    /* the extensions the file lists, once each, in its order */
+    scene_extension *extensions;
+
     uint32_t num_lights;
     GnLight *lights;
 
@@ -82,22 +102,32 @@ typedef struct scene {
     bool vertex_colors;         /* some mesh has COLOR_0 (GnVertex.color; 1 elsewhere) */
 } scene;
 
-/* Loads a .gltf or .glb file (GLB chosen by its magic, or by the extension). Every buffer,
- * view, accessor and reference is validated before use; structural errors (anything that
- * could make a read go out of bounds, unresolved references, node loops, non-finite
- * transforms, required extensions other than KHR_lights_punctual, KHR_materials_{unlit,
- * specular, transmission, ior, emissive_strength, variants, volume, dispersion},
- * KHR_draco_mesh_compression and
- * EXT_meshopt_compression, compressed data its decoder rejects) print an error naming the file and the
- * problem and return false with *out zeroed. What can be skipped or repaired safely prints a
- * warning naming the file and the feature: points/lines primitives (strips and fans become
- * triangles), orthographic or invalid cameras, invalid lights, unknown optional extensions (one warning each),
- * unknown alpha modes (rendered opaque), texCoord > 1 and missing or undecodable images (texture
- * slot GN_INVALID; PNG and JPEG only), out-of-range material values (clamped), non-unit
- * normals (renormalised), skins, morph targets, COLOR_0. Primitives without NORMAL get flat
- * normals (de-indexed). Triangles with non-finite or absurdly large (|x| > 1e15) vertices
- * are dropped with one warning. A scene without any triangle is an error ("no triangles"). */
+/* Loads a .gltf or .glb file (GLB chosen by its magic, or by the extension); false with
+ * *out zeroed on an error, which names the file and the problem.
+ * Errors: the GLB container; JSON the glTF schema does not allow in what gonio reads (a wrong
+ * type, an index that is no integer or names nothing, a size or offset out of range, an
+ * unknown enum: the message names the JSON path, materials[2].extensions.KHR_materials_sheen.
+ * sheenRoughnessFactor, and is the same for every extension); anything that could make a read
+ * go out of bounds (buffers, views, accessors and their sparse parts, attribute formats,
+ * indices), node loops, non-finite transforms, bad animation samplers, compressed data its
+ * decoder rejects; an extension in extensionsRequired that gonio does not support
+ * (scene_extension_support); files outside the scene's folder (scene_allow_outside_files);
+ * a scene too large (SCENE_MAX_*) or without any triangle ("no triangles").
+ * Warnings, naming the file and the feature, for what is skipped or repaired: a material
+ * factor out of its range (clamped, or the default kept: its row of glsl/lib/material.h
+ * says which), unsupported extensions in extensionsUsed (ignored, one warning each),
+ * points/lines primitives (strips and fans become triangles), invalid cameras and lights,
+ * texCoord > 1 and missing or undecodable images (PNG and JPEG only: the slot is
+ * GN_INVALID), non-unit normals (renormalised), skins, morph targets, bad COLOR_0,
+ * triangles with non-finite or absurdly large (|x| > 1e15) vertices (dropped, one warning).
+ * Primitives without NORMAL get flat normals (de-indexed); normal maps, clearcoat normal maps
+ * and anisotropy get MikkTSpace tangents where a mesh has no TANGENT. out->extensions lists
+ * the extensions the file uses and how gonio handles each. */
 bool scene_load(scene *out, const char *path);
+
+/* How gonio handles the glTF extension `name`: its support and a static sentence saying how
+ * (also for a name it does not know: SCENE_UNSUPPORTED, "unknown to gonio"). */
+scene_support scene_extension_support(const char *name, const char **how);
 
 /* Limits of a decoded scene, checked before anything is allocated, with the numbers in the
  * error: triangles and vertices after instancing (about 300 bytes each through loading and

@@ -23,6 +23,7 @@
 
 #include "tangent.h"
 #include "util.h"
+#include "vec.h"
 
 typedef struct {
     float attr[8]; /* position, normal, uv */
@@ -72,15 +73,13 @@ static void unite(uint32_t *parent, uint32_t a, uint32_t b)
         parent[a > b ? a : b] = a < b ? a : b;
 }
 
-static double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
 /* x minus its component along unit n, normalised; false when nothing is left. */
 static int project(const double *x, const double *n, double *out)
 {
-    double d = dot3(x, n), len;
+    double d = vec_dot_d(x, n), len;
     for (int k = 0; k < 3; k++)
         out[k] = x[k] - d * n[k];
-    len = sqrt(dot3(out, out));
+    len = sqrt(vec_dot_d(out, out));
     if (!(len > 1e-20))
         return 0;
     for (int k = 0; k < 3; k++)
@@ -121,7 +120,7 @@ size_t tangent_generate(size_t nv, const float *pos, const float *nrm, const flo
             continue;
         for (int k = 0; k < 3; k++)
             t[k] = (t2 * e1[k] - t1 * e2[k]) * (area > 0 ? 1 : -1);
-        len = sqrt(dot3(t, t));
+        len = sqrt(vec_dot_d(t, t));
         if (!(len > 0) || !isfinite(len))
             continue;
         for (int k = 0; k < 3; k++)
@@ -176,7 +175,7 @@ size_t tangent_generate(size_t nv, const float *pos, const float *nrm, const flo
         }
         if (!project(&ftan[3 * f], n, t) || !project(a, n, pa) || !project(b, n, pb))
             continue;
-        double c = dot3(pa, pb), angle = acos(c < -1 ? -1 : c > 1 ? 1 : c);
+        double c = vec_dot_d(pa, pb), angle = acos(c < -1 ? -1 : c > 1 ? 1 : c);
         uint32_t r = find(parent, (uint32_t)i);
         for (int k = 0; k < 3; k++)
             sum[3 * r + k] += angle * t[k];
@@ -195,13 +194,13 @@ size_t tangent_generate(size_t nv, const float *pos, const float *nrm, const flo
         size_t j = i, good = nc;
         while (j < nc && order[j] >> 32 == order[i] >> 32) {
             uint32_t r = src[(uint32_t)order[j]];
-            if (good == nc && dot3(&sum[3 * r], &sum[3 * r]) > 0)
+            if (good == nc && vec_dot_d(&sum[3 * r], &sum[3 * r]) > 0)
                 good = r;
             j++;
         }
         for (size_t k = i; k < j && good != nc; k++) {
             uint32_t c = (uint32_t)order[k], r = src[c];
-            if (!(dot3(&sum[3 * r], &sum[3 * r]) > 0))
+            if (!(vec_dot_d(&sum[3 * r], &sum[3 * r]) > 0))
                 src[c] = (uint32_t)good;
         }
         i = j;

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "util.h"
+#include "vec.h"
 
 /* Data (numbers only): Martin Newell's teapot as distributed in Steve Baker's "teaset"
  * (sjbaker.org/teapot/teaset.tgz, the Utah data with a 4-patch bottom added), here as in
@@ -192,9 +193,7 @@ static void patch_eval(int patch, double u, double v, double p[3], double n[3])
                 pv[k] += bu[i] * dbv[j] * c[k];
             }
         }
-    n[0] = pv[1] * pu[2] - pv[2] * pu[1];
-    n[1] = pv[2] * pu[0] - pv[0] * pu[2];
-    n[2] = pv[0] * pu[1] - pv[1] * pu[0];
+    vec_cross_d(pv, pu, n);
 }
 
 typedef struct raw_vertex {
@@ -207,8 +206,6 @@ static int compare_x(const void *a, const void *b)
     double xa = sort_base[*(const uint32_t *)a].p[0], xb = sort_base[*(const uint32_t *)b].p[0];
     return (xa > xb) - (xa < xb);
 }
-
-static double length3(const double v[3]) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 
 /* Merges vertices closer than TEAPOT_WELD_EPS: sweep in x order; the first vertex of a
  * cluster represents it. Returns the number of welded vertices; remap[raw] -> welded;
@@ -232,7 +229,7 @@ static uint32_t weld(const raw_vertex *raw, uint32_t count, uint32_t *remap, dou
         for (uint32_t b = a; b < count && raw[order[b]].p[0] - r->p[0] < TEAPOT_WELD_EPS; b++) {
             const raw_vertex *s = &raw[order[b]];
             double d[3] = {s->p[0] - r->p[0], s->p[1] - r->p[1], s->p[2] - r->p[2]};
-            if (remap[order[b]] != UINT32_MAX || length3(d) >= TEAPOT_WELD_EPS)
+            if (remap[order[b]] != UINT32_MAX || vec_length_d(d) >= TEAPOT_WELD_EPS)
                 continue;
             remap[order[b]] = num;
             for (int k = 0; k < 3; k++)
@@ -261,13 +258,13 @@ void teapot_tessellate(teapot_mesh *out, int level)
                 raw_vertex *r = &raw[patch * per_patch + i * side + j];
                 double u = (double)i / n, v = (double)j / n, len;
                 patch_eval(patch, u, v, r->p, r->n);
-                len = length3(r->n);
+                len = vec_length_d(r->n);
                 if (len < 1e-9) {
                     /* A pole, where dp/dv vanishes: the normal just inside the patch is
                      * the limit; the weld averages these around the pole. */
                     double p[3];
                     patch_eval(patch, u + (0.5 - u) * 1e-4, v + (0.5 - v) * 1e-4, p, r->n);
-                    len = length3(r->n);
+                    len = vec_length_d(r->n);
                 }
                 assert(len > 0.0);
                 for (int k = 0; k < 3; k++)
@@ -284,7 +281,7 @@ void teapot_tessellate(teapot_mesh *out, int level)
     out->positions = util_malloc(3 * (size_t)num * sizeof(float));
     out->normals = util_malloc(3 * (size_t)num * sizeof(float));
     for (uint32_t i = 0; i < num; i++) {
-        double len = length3(nrm[i]);
+        double len = vec_length_d(nrm[i]);
         assert(len > 0.0);
         out->positions[3 * i + 0] = (float)(pos[i][0] * TEAPOT_SCALE);
         out->positions[3 * i + 1] = (float)(pos[i][2] * TEAPOT_SCALE);

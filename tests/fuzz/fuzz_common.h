@@ -1,4 +1,4 @@
-/* fuzz_common.h: what both libFuzzer targets share. The loaders take a path (one code path
+/* fuzz_common.h: what the libFuzzer targets share. The loaders take a path (one code path
  * for real loads and fuzzing), so each input is written to a file in a private folder,
  * on /dev/shm when there is one. */
 #ifndef GONIO_FUZZ_COMMON_H
@@ -12,19 +12,21 @@
 
 #include "util.h"
 
-/* The path of the input file for this process: DIR/NAME in a folder made once. */
+/* The path of file NAME in this process's folder, made once. Four names at a time (each
+ * call's path stays valid for the next three calls). */
 static const char *fuzz_input_path(const char *name)
 {
-    static char path[256];
-    if (!path[0]) {
-        char dir[128];
+    static char dir[128], paths[4][256];
+    static int next;
+    char *path = paths[next++ & 3];
+    if (!dir[0]) {
         snprintf(dir, sizeof dir, "%s/gonio-fuzz-XXXXXX", access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp");
         if (!mkdtemp(dir)) {
             perror("gonio fuzz: mkdtemp");
             abort();
         }
-        snprintf(path, sizeof path, "%s/%s", dir, name);
     }
+    snprintf(path, sizeof paths[0], "%s/%s", dir, name);
     return path;
 }
 

@@ -17,7 +17,7 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 export VK_ICD_FILENAMES=${VK_ICD_FILENAMES:-$(ls /usr/share/vulkan/icd.d/lvp_icd*.json | head -n 1)}
 
 # Seeds are symbolic links to the files where they are (libFuzzer follows them).
-mkdir -p "$tmp/seed-scene" "$tmp/seed-exr"
+mkdir -p "$tmp/seed-scene" "$tmp/seed-exr" "$tmp/seed-merge"
 n=0
 link() { ln -s "$(realpath "$2")" "$1/$n-$(basename "$2")"; n=$((n + 1)); }
 for f in scenes/*.gltf; do link "$tmp/seed-scene" "$f"; done
@@ -34,12 +34,28 @@ for c in none rle zips zip piz pxr24 b44 b44a; do
         exrmaketiled -z $c -t 8 8 "$tmp/seed-exr/$c-half.exr" "$tmp/seed-exr/$c-tiled.exr" >/dev/null 2>&1 # no zips: tiles are zip
     fi
 done
-echo "seeds: $(ls "$tmp/seed-scene" | wc -l) scenes, $(ls "$tmp/seed-exr" | wc -l) EXRs"
+# Resumable partials (sum.* channels) and tile sets for merge: a merge seed is two EXRs, a
+# 4-byte little-endian length then the first file, then the second (tests/fuzz/fuzz_merge.c).
+P="scenes/cornell.gltf --size 12x8 --spp 2 --quiet"
+"$GONIO" render $P -o "$tmp/seed-exr/partial.exr" --resumable --aov normal,albedo,depth,variance
+"$GONIO" render $P -o "$tmp/seed-exr/partial-none.exr" --resumable --compression none
+"$GONIO" render $P -o "$tmp/t-left.exr" --crop 0,0,6,8 --compression none
+"$GONIO" render $P -o "$tmp/t-right.exr" --crop 6,0,12,8 --compression none
+"$GONIO" render $P -o "$tmp/t-seed1.exr" --seed 1 --aov variance
+"$GONIO" render $P -o "$tmp/t-seed2.exr" --seed 2 --aov variance
+"$GONIO" render $P -o "$tmp/t-part.exr" --seed 3 --resumable
+pair() { python3 -c 'import struct, sys; a = open(sys.argv[1], "rb").read(); b = open(sys.argv[2], "rb").read()
+open(sys.argv[3], "wb").write(struct.pack("<I", len(a)) + a + b)' "$1" "$2" "$3"; }
+pair "$tmp/t-left.exr" "$tmp/t-right.exr" "$tmp/seed-merge/tiles"
+pair "$tmp/t-seed1.exr" "$tmp/t-seed2.exr" "$tmp/seed-merge/seeds"
+pair "$tmp/t-part.exr" "$tmp/t-seed1.exr" "$tmp/seed-merge/partial"
+echo "seeds: $(ls "$tmp/seed-scene" | wc -l) scenes, $(ls "$tmp/seed-exr" | wc -l) EXRs, $(ls "$tmp/seed-merge" | wc -l) merges"
 
 failed=0
 for f in "$@"; do
     t=$(basename "$f")
-    case $t in *scene*) seeds=$tmp/seed-scene; len=65536 ;; *) seeds=$tmp/seed-exr; len=16384 ;; esac
+    case $t in *scene*) seeds=$tmp/seed-scene; len=65536 ;; *merge*) seeds=$tmp/seed-merge; len=32768 ;;
+        *) seeds=$tmp/seed-exr; len=16384 ;; esac
     mkdir -p "$tmp/corpus-$t"
     "$f" "$tmp/corpus-$t" "$seeds" -max_total_time="$T" -max_len=$len -timeout=10 -rss_limit_mb=2048 \
         -artifact_prefix="$tmp/crash-$t-" -print_final_stats=1 >"$tmp/$t.log" 2>&1

@@ -30,6 +30,17 @@ for c in "render $C -o $tmp/x.exr --spp" "preview $C --frames" "bench --seconds"
     check "${c%% *} ${c##* }=bogus: the option's own message" \
         sh -c "grep -q bogus '$tmp/last' && ! grep -q 'unknown option' '$tmp/last'"
 done
+# Options several commands take are defined once: the same range and message everywhere.
+for c in "render $C -o $tmp/x.exr" "preview $C"; do
+    check_fails "${c%% *} --max-depth 65537" 2 "$G" $c --max-depth 65537
+    check "... names the range" grep -q "out of range: must be in \[0, 65536\]" "$tmp/last"
+done
+for c in "render $C -o $tmp/x.exr" "preview $C" "compare $C -o $tmp/cmp" "brdf lambert --sphere -o $tmp/b.exr"; do
+    check_fails "${c%% *} --spp 0" 2 "$G" $c --spp 0
+    check "... names the range" grep -q "out of range: must be in \[1, 16777216\]" "$tmp/last"
+    check_fails "${c%% *} --size 0x8" 2 "$G" $c --size 0x8
+    check "... names the range" grep -q "expected WxH, e.g. 640x480 (each 1..16384)" "$tmp/last"
+done
 check_fails "a flag given a value" 2 "$G" render $C -o "$tmp/x.exr" --quiet=yes
 check "... says it takes none" grep -q -- "--quiet takes no value" "$tmp/last"
 check "--name=value splits at the first =" "$G" brdf torrance-sparrow --exponent=64 --albedo
@@ -140,6 +151,22 @@ if command -v help2man >/dev/null && command -v man >/dev/null; then
     check "completion: diff offers EXRs" test "$(cd "$tmp/files" && complete_words gonio diff '')" = "a.exr "
     check "completion: render offers glTF files" test "$(cd "$tmp/files" && complete_words gonio render '')" = "c.gltf d.glb "
     check "completion: --png offers PNGs" test "$(cd "$tmp/files" && complete_words gonio render c.gltf --png '')" = "b.png "
+    check "completion: --env offers maps and studio" \
+        test "$(cd "$tmp/files" && complete_words gonio render c.gltf --env '')" = "a.exr studio "
+    check "completion: scene offers its scenes" test "$(complete_words gonio scene '')" = "cornell teapot "
+    # The program's option tables are the one source: every long option each command's
+    # --help lists (so any option added to a table) is offered, nothing else is, and the
+    # script itself names none of them.
+    all_opts=
+    for c in render preview info devices compare merge diff bench brdf "brdf phong" scene teapot denoise; do
+        want=$({ "$G" $c --help | sed -n 's/^ \{1,4\}\(-[-a-zA-Z]*\)\(, \(--[-a-z]*\)\)\{0,1\}.*/\1 \3/p'
+            echo --help; } | tr ' ' '\n' | grep -- '^--' | grep -v -- '--PARAM' | sort -u | tr '\n' ' ')
+        check "completion: gonio $c -- offers the options of its --help" \
+            test "$(complete_words gonio $c --)" = "$want"
+        all_opts="$all_opts $want"
+    done
+    named=$(for o in $all_opts; do grep -qF -- "$o" "$comp" && echo "$o"; done | sort -u | tr '\n' ' ')
+    check "completion: the script names no option ($named)" test -z "$named"
 else
     echo "  note: help2man or man is missing (make test-deps installs them): make install not checked"
 fi

@@ -36,7 +36,7 @@ d["buffers"][-1]["uri"] = head + "," + base64.b64encode(bytes(raw)).decode()
 json.dump(d, open(sys.argv[2], "w"))
 PY
     check_fails "$k: corrupt data is an error" 1 "$G" render "$tmp/bad-$k.gltf" -o "$tmp/bad-$k.exr" $R
-    what=$([ $k = draco ] && echo "primitive 0 (KHR_draco_mesh_compression): Draco cannot decode" ||
+    what=$([ $k = draco ] && echo "primitives\[0\].extensions.KHR_draco_mesh_compression: Draco cannot decode" ||
         echo "(EXT_meshopt_compression): meshoptimizer cannot decode")
     check "$k: the error names the file and the part" grep -q "bad-$k.gltf: .*$what" "$tmp/last"
     check "$k: no output" test ! -e "$tmp/bad-$k.exr"

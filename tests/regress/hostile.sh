@@ -51,7 +51,7 @@ check "render --allow-outside-files too" "$G" render "$B/up.gltf" --allow-outsid
 check_fails "render refuses it by default" 1 "$G" render "$B/up.gltf" -o "$tmp/up2.exr" --size 8x8 --spp 1 --quiet
 check "... and writes nothing" test ! -e "$tmp/up2.exr"
 check_fails "a directory as the scene is an error" 1 "$G" info "$tmp"
-check "... naming it, not 'out of memory'" sh -c "grep -q 'not a regular file' '$tmp/last' && ! grep -q 'out of memory' '$tmp/last'"
+check "... naming it, not 'out of memory'" sh -c "grep -q 'is a directory; gonio reads only regular files' '$tmp/last' && ! grep -q 'out of memory' '$tmp/last'"
 
 # A camera aspect ratio from the file suggests the size, within the longer side's 512.
 python3 - "$B/ok.gltf" "$B/thin.gltf" <<'PY'
@@ -237,15 +237,15 @@ if [ "$(id -u)" = 0 ] && id nobody >/dev/null 2>&1; then
     chown nobody "$O/mode.exr"
     check "... and its owner (root writing)" sh -c "'$G' render '$B/ok.gltf' -o '$O/mode.exr' $R && test \"\$(stat -c %U '$O/mode.exr')\" = nobody"
 fi
-# A gonio killed while writing leaves .NAME.tmp-PID: the next write of NAME removes it when
-# that process is gone, and leaves other names and live processes' files alone.
+# A gonio killed while writing leaves .NAME.tmp-PID-XXXXXX: the next write of NAME removes it
+# when that process is gone, and leaves other names and live processes' files alone.
 dead=$(sh -c 'echo $$')
-echo half > "$O/.out.exr.tmp-$dead"
-echo live > "$O/.out.exr.tmp-$$"
-echo other > "$O/.other.exr.tmp-$dead"
+echo half > "$O/.out.exr.tmp-$dead-a1b2c3"
+echo live > "$O/.out.exr.tmp-$$-a1b2c3"
+echo other > "$O/.other.exr.tmp-$dead-a1b2c3"
 check "a stale temporary file is cleaned up" "$G" render "$B/ok.gltf" -o "$O/out.exr" $R
-check "... the dead process's one is gone" test ! -e "$O/.out.exr.tmp-$dead"
-check "... a live process's and another name's stay" test -e "$O/.out.exr.tmp-$$" -a -e "$O/.other.exr.tmp-$dead"
+check "... the dead process's one is gone" test ! -e "$O/.out.exr.tmp-$dead-a1b2c3"
+check "... a live process's and another name's stay" test -e "$O/.out.exr.tmp-$$-a1b2c3" -a -e "$O/.other.exr.tmp-$dead-a1b2c3"
 # Every command that writes checks the same way, before any work.
 "$G" render "$B/ok.gltf" -o "$O/a.exr" $R --seed 1 && "$G" render "$B/ok.gltf" -o "$O/b.exr" $R --seed 2
 check_fails "merge -o a symbolic link is refused" 1 "$G" merge "$O/a.exr" "$O/b.exr" -o "$O/link.exr"

@@ -37,7 +37,7 @@ std::string base64(const std::vector<unsigned char> &d)
     return s;
 }
 
-/* An accessor's elements as tightly packed bytes (element size = components x 4 bytes). */
+/* An accessor's elements as tightly packed bytes (element size = components x component size). */
 std::vector<unsigned char> packed(const tinygltf::Model &m, int ai, size_t *elem)
 {
     const auto &a = m.accessors[size_t(ai)];
@@ -73,16 +73,25 @@ int encode_draco(const tinygltf::Model &m, json &j, std::vector<unsigned char> &
             json ids = json::object();
             for (const auto &at : p.attributes) {
                 const auto &a = m.accessors[size_t(at.second)];
-                if (a.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
-                    return fprintf(stderr, "compress: %s is not float\n", at.first.c_str()), 1;
+                /* Integer attributes (JOINTS_n, normalized colours and weights) keep their
+                 * type: Draco stores them as integers, lossless too. */
+                const int ct = a.componentType;
+                const draco::DataType dt = ct == TINYGLTF_COMPONENT_TYPE_FLOAT            ? draco::DT_FLOAT32
+                                           : ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE  ? draco::DT_UINT8
+                                           : ct == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? draco::DT_UINT16
+                                           : ct == TINYGLTF_COMPONENT_TYPE_BYTE           ? draco::DT_INT8
+                                           : ct == TINYGLTF_COMPONENT_TYPE_SHORT          ? draco::DT_INT16
+                                                                                          : draco::DT_UINT32;
                 int nc = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+                int cs = tinygltf::GetComponentSizeInBytes(uint32_t(ct));
                 draco::GeometryAttribute::Type t = at.first == "POSITION" ? draco::GeometryAttribute::POSITION
                                                    : at.first == "NORMAL" ? draco::GeometryAttribute::NORMAL
                                                    : at.first.compare(0, 8, "TEXCOORD") == 0
                                                        ? draco::GeometryAttribute::TEX_COORD
-                                                       : draco::GeometryAttribute::GENERIC;
+                                                   : at.first.compare(0, 6, "COLOR_") == 0 ? draco::GeometryAttribute::COLOR
+                                                                                           : draco::GeometryAttribute::GENERIC;
                 draco::GeometryAttribute ga;
-                ga.Init(t, nullptr, int8_t(nc), draco::DT_FLOAT32, false, int64_t(4 * nc), 0);
+                ga.Init(t, nullptr, int8_t(nc), dt, a.normalized, int64_t(cs * nc), 0);
                 int id = mesh.AddAttribute(ga, true, uint32_t(np));
                 size_t es;
                 std::vector<unsigned char> d = packed(m, at.second, &es);

@@ -297,7 +297,109 @@ static int pick_channel(const char *in, const char *from, const char *out)
     return ok ? 0 : 1;
 }
 
-/* Prints channel `name` of pixel (x, y) with %.9g. */
+/* IN.exr -> OUT.exr with channels renamed or dropped: SPEC is "OLD=NEW,OLD2=,..." (an
+ * empty NEW drops the channel): other renderers' layer names, files without a beauty. */
+static int rename_channels(const char *in, const char *out, const char *spec)
+{
+    image a;
+    char buf[1024], *tok, *save;
+    bool ok;
+    if (!image_read_exr(&a, in))
+        return 1;
+    snprintf(buf, sizeof buf, "%s", spec);
+    for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        char *eq = strchr(tok, '=');
+        int c;
+        if (!eq || (*eq = 0, (c = image_channel(&a, tok)) < 0) || strlen(eq + 1) >= sizeof a.names[0]) {
+            fprintf(stderr, "%s: bad rename '%s' (no such channel, or no '=')\n", in, tok);
+            image_destroy(&a);
+            return 1;
+        }
+        if (eq[1])
+            strcpy(a.names[c], eq + 1);
+        else
+            image_remove_channel(&a, c);
+    }
+    ok = image_write_exr(&a, out, NULL, 0);
+    image_destroy(&a);
+    return ok ? 0 : 1;
+}
+
+/* IN.exr -> OUT.exr with channel `name` of pixel (x, y) set to value ("nan", "inf" too). */
+static int poke_value(const char *in, const char *name, int x, int y, const char *value, const char *out)
+{
+    image a;
+    int c;
+    bool ok;
+    if (!image_read_exr(&a, in))
+        return 1;
+    c = image_channel(&a, name);
+    if (c < 0 || x < 0 || y < 0 || x >= a.width || y >= a.height) {
+        fprintf(stderr, "%s: no channel %s or pixel (%d, %d)\n", in, name, x, y);
+        image_destroy(&a);
+        return 1;
+    }
+    a.planes[c][(size_t)y * a.width + x] = strtof(value, NULL);
+    ok = image_write_exr(&a, out, NULL, 0);
+    image_destroy(&a);
+    return ok ? 0 : 1;
+}
+
+/* The denoiser's figures (tests/denoise/quality.sh) of TEST.exr's R, G, B against REF.exr:
+ * "rmse X corrected X display X display-corrected X mean X ref-noise X": the RMSE in linear
+ * RGB; the same less the reference's own noise (the mean of its variance.R/G/B channels,
+ * when it has them: sqrt(max(0, rmse^2 - noise^2))); the RMSE of both clamped to [0, 1]
+ * (what the default PNG shows before its sRGB curve), and the same less the noise of the
+ * reference's values below 1 (clamping leaves those as they are and flattens the rest);
+ * mean(TEST) / mean(REF) - 1; and the reference's noise. */
+static int denoise_errors(const char *test, const char *refp)
+{
+    static const char *const rgb[3] = {"R", "G", "B"}, *const var[3] = {"variance.R", "variance.G", "variance.B"};
+    image a, b;
+    double se = 0, sd = 0, ma = 0, mb = 0, noise = 0, noise_d = 0;
+    int rc = 1;
+    if (!image_read_exr(&a, test))
+        return 1;
+    if (!image_read_exr(&b, refp)) {
+        image_destroy(&a);
+        return 1;
+    }
+    size_t n = (size_t)a.width * (size_t)a.height;
+    if (a.width != b.width || a.height != b.height) {
+        fprintf(stderr, "%s and %s differ in size\n", test, refp);
+        goto done;
+    }
+    for (int c = 0; c < 3; c++) {
+        int ca = image_channel(&a, rgb[c]), cb = image_channel(&b, rgb[c]), cv = image_channel(&b, var[c]);
+        if (ca < 0 || cb < 0) {
+            fprintf(stderr, "no channel %s in %s or %s\n", rgb[c], test, refp);
+            goto done;
+        }
+        for (size_t p = 0; p < n; p++) {
+            double x = a.planes[ca][p], y = b.planes[cb][p];
+            double xd = fmin(fmax(x, 0.0), 1.0), yd = fmin(fmax(y, 0.0), 1.0);
+            se += (x - y) * (x - y);
+            sd += (xd - yd) * (xd - yd);
+            ma += x;
+            mb += y;
+            noise += cv >= 0 ? b.planes[cv][p] : 0.0;
+            /* Clamped, a value well below 1 keeps its noise, one above loses it (nearly all). */
+            noise_d += cv >= 0 && y < 1.0 ? b.planes[cv][p] : 0.0;
+        }
+    }
+    se /= 3.0 * (double)n;
+    sd /= 3.0 * (double)n;
+    noise /= 3.0 * (double)n;
+    noise_d /= 3.0 * (double)n;
+    printf("rmse %.6f corrected %.6f display %.6f display-corrected %.6f mean %+.6f ref-noise %.6f\n", sqrt(se),
+           sqrt(fmax(0.0, se - noise)), sqrt(sd), sqrt(fmax(0.0, sd - noise_d)), ma / mb - 1, sqrt(noise));
+    rc = 0;
+done:
+    image_destroy(&a);
+    image_destroy(&b);
+    return rc;
+}
+
 /* The value of channel `name` at each pixel (x, y) of xy (n pairs), a line each: one read of
  * the file for the many pixels a probe checks. */
 static int print_values(const char *in, const char *name, char **xy, int n)
@@ -457,6 +559,18 @@ int main(int argc, char **argv)
         return print_values(argv[2], argv[3], argv + 4, (argc - 4) / 2);
     if (argc == 5 && !strcmp(argv[1], "png") && (!strcmp(argv[2], "depth") || !strcmp(argv[2], "normal")))
         return check_png(argv[2], argv[3], argv[4]);
+    if (argc == 4 && !strcmp(argv[1], "png")) { /* IN.exr -> OUT.png as render --png writes it */
+        image a;
+        bool ok = image_read_exr(&a, argv[2]) && image_write_png_from(&a, argv[3], 0.0f, IMAGE_TONEMAP_CLAMP);
+        image_destroy(&a);
+        return ok ? 0 : 1;
+    }
+    if (argc == 4 && !strcmp(argv[1], "errors"))
+        return denoise_errors(argv[2], argv[3]);
+    if (argc == 5 && !strcmp(argv[1], "rename"))
+        return rename_channels(argv[2], argv[3], argv[4]);
+    if (argc == 8 && !strcmp(argv[1], "poke"))
+        return poke_value(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]), argv[6], argv[7]);
     if (argc == 5 && !strcmp(argv[1], "pick"))
         return pick_channel(argv[2], argv[3], argv[4]);
     if (argc == 5 && !strcmp(argv[1], "compress") && (!strcmp(argv[2], "draco") || !strcmp(argv[2], "meshopt")))
@@ -469,7 +583,9 @@ int main(int argc, char **argv)
     fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool compress draco|meshopt IN.gltf OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n"
                     "       testtool png depth|normal PNG REF.exr | testtool pick IN.exr CHANNEL OUT.exr\n"
                     "       testtool at IN.exr CHANNEL X Y [X Y...] | testtool same WHOLE.exr PART.exr | testtool rgb IN.exr\n"
-                    "       testtool moments IN.exr\n"
+                    "       testtool moments IN.exr | testtool rename IN.exr OUT.exr OLD=NEW,OLD2=,...\n"
+                    "       testtool poke IN.exr CHANNEL X Y VALUE OUT.exr | testtool errors TEST.exr REF.exr\n"
+                    "       testtool png IN.exr OUT.png\n"
                     "       testtool sheen-table\n");
     return 2;
 }

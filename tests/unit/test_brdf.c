@@ -1,4 +1,4 @@
-/* test_brdf.c: the BRDF library (glsl/lib/brdf.glsl) proven physical on the GPU through
+/* test_brdf.c: the BRDF library (glsl/lib/brdf_*.glsl) proven physical on the GPU through
  * glsl/kernels/brdf_test.comp: finiteness and positivity everywhere, Helmholtz reciprocity, energy
  * conservation (white-furnace albedo <= 1, = albedo for Lambert), sampling against the pdf
  * by a chi-square test (as pbrt-v4 and Mitsuba 3 do), pdf normalisation, weight = f cos/pdf,
@@ -118,7 +118,7 @@ static bool make_setting(const config *c, brdf_setting *s)
             return false;
         *eq = 0;
         if (!strcmp(tok, "tilt"))
-            s->v[BRDF_SLOT_COAT_TILT] = (float)(atof(eq + 1) * PI / 180);
+            s->coat_tilt = (float)(atof(eq + 1) * PI / 180);
         else if (!brdf_setting_set(s, tok, eq + 1))
             return false;
     }
@@ -497,8 +497,8 @@ TEST(brdf, model_table)
     CHECK(!brdf_setting_set(&s, "diffuse", "1.5"));
     CHECK(s.v[0] == 0.1f && s.v[BRDF_SLOT_PARAMS + BRDF_P_SHAPE] == 64); /* failures change nothing */
     brdf_setting_init(&s, brdf_model_find("gltf"));
-    CHECK(brdf_setting_set(&s, "transmission", "0.5") && s.v[BRDF_SLOT_EXTRA + 3] == 0.5f);
-    CHECK(brdf_setting_set(&s, "specular-color", "1,0.5,0.25") && s.v[BRDF_SLOT_EXTRA + 2] == 0.25f);
+    CHECK(brdf_setting_set(&s, "transmission", "0.5") && s.m.transmission == 0.5f);
+    CHECK(brdf_setting_set(&s, "specular-color", "1,0.5,0.25") && s.m.specular_color.z == 0.25f);
     for (int i = 0; i < num_cases(); i++)
         CHECKF(make_setting(&cases[i], &s), "config %s", describe(&cases[i]));
     /* the table: ids unique and glTF's the special one; every model tested (num_cases) */
@@ -615,8 +615,8 @@ TEST(brdf, specialised_same)
                        !memcmp(&(&r[i].s_weight.x)[c], &(&unspec[i].s_weight.x)[c], sizeof(float)) &&
                        !memcmp(&(&r[i].s_f.x)[c], &(&unspec[i].s_f.x)[c], sizeof(float));
             if (!same && differ++ < 2)
-                fprintf(stderr, "  %s (features 0x%08x): query %d: f %g pdf %g w %g flags %u, unspecialised f %g pdf %g "
-                        "w %g flags %u\n", describe(&cases[ci]), brdf_query_features(&q[i]), i, a[0], r[i].pdf,
+                fprintf(stderr, "  %s (features 0x%016llx): query %d: f %g pdf %g w %g flags %u, unspecialised f %g pdf %g "
+                        "w %g flags %u\n", describe(&cases[ci]), (unsigned long long)brdf_query_features(&q[i]), i, a[0], r[i].pdf,
                         r[i].s_weight.x, r[i].s_flags, b[0], unspec[i].pdf, unspec[i].s_weight.x, unspec[i].s_flags);
         }
         CHECKF(differ == 0, "%s: %d of %d queries differ from the unspecialised kernel's", describe(&cases[ci]), differ, N);
@@ -641,9 +641,9 @@ TEST(brdf, reciprocity)
         make_setting(&cases[ci], &s);
         bool sides = brdf_setting_two_sided(&s);
         /* (a diffuse transmission is reciprocal as it is: no index changes across it) */
-        bool refracts = s.model->id == BRDF_DIELECTRIC || s.v[BRDF_SLOT_EXTRA + 3] > 0;
+        bool refracts = s.model->id == BRDF_DIELECTRIC || s.m.transmission > 0;
         double ior = s.model->id == BRDF_DIELECTRIC ? s.v[BRDF_SLOT_PARAMS + BRDF_P_DIELECTRIC_IOR]
-                                                     : s.v[BRDF_SLOT_PARAMS + 3];
+                                                     : s.m.ior;
         for (int i = 0; i < N; i++) {
             double zo = rnd(), zi = rnd();
             if (sides && i % 4 == 1)
@@ -685,9 +685,8 @@ TEST(brdf, reciprocity)
         bool dirac = !strcmp(s.model->name, "mirror") ||
                      (s.model->id == BRDF_CONDUCTOR && s.v[BRDF_SLOT_PARAMS + BRDF_P_ALPHA] == 0) ||
                      (s.model->id == BRDF_DIELECTRIC && s.v[BRDF_SLOT_PARAMS + BRDF_P_DIELECTRIC_ALPHA] == 0) ||
-                     (s.model->id == BRDF_GLTF && s.v[BRDF_SLOT_PARAMS + 1] == 0 && s.v[BRDF_SLOT_EXTRA + 3] == 1 &&
-                      s.v[BRDF_SLOT_LAYER + 1] == 0 && sum3((vec3){s.v[BRDF_SLOT_SHEEN], s.v[BRDF_SLOT_SHEEN + 1],
-                                                                  s.v[BRDF_SLOT_SHEEN + 2]}) == 0); /* smooth glass, smooth coat */
+                     (s.model->id == BRDF_GLTF && s.m.roughness == 0 && s.m.transmission == 1 &&
+                      s.m.clearcoat_roughness == 0 && sum3(s.m.sheen_color) == 0); /* smooth glass, smooth coat */
         CHECKF(dirac || nonzero > N / 4, "%s: only %d non-zero values", describe(&cases[ci]), nonzero);
     }
     close_runner();
@@ -850,9 +849,9 @@ TEST(brdf, fresnel)
     for (int i = 0; i < N; i++) {
         double c = i < 40 ? cos(rad(90.0 * i / 39)) : 0;
         q[i].op = BRDF_OP_FRESNEL;
-        q[i].params = (vec4){(float)eta, 0.04f, 1, 0};
-        q[i].color = v3(cn[0], cn[1], cn[2]);
-        q[i].extra = (vec4){(float)ck[0], (float)ck[1], (float)ck[2], 0};
+        q[i].args = (vec4){(float)eta, 0.04f, 1, 0};
+        q[i].material.base_color = (vec4){(float)cn[0], (float)cn[1], (float)cn[2], 1};
+        q[i].material.brdf_params = (vec4){(float)ck[0], (float)ck[1], (float)ck[2], 0};
         q[i].wo.z = (float)c;
     }
     q[40].wo.z = (float)cos(brewster);
@@ -861,8 +860,8 @@ TEST(brdf, fresnel)
     q[43].wo.z = (float)cos(rad(40));
     q[44].wo.z = (float)-sqrt(1 - sin(rad(40)) * sin(rad(40)) / (eta * eta)); /* the refracted ray of 43 */
     q[45].wo.z = 0.5f;
-    q[45].color = v3(1.5, 0.3, 2); /* k = 0: a dielectric */
-    q[45].extra = (vec4){0, 0, 0, 0};
+    q[45].material.base_color = (vec4){1.5f, 0.3f, 2, 1}; /* k = 0: a dielectric */
+    q[45].material.brdf_params = (vec4){0, 0, 0, 0};
     brdf_runner_run(&runner, q, r, N);
     double f0 = pow((eta - 1) / (eta + 1), 2);
     CHECKF(fabs(r[0].f.x - f0) < 1e-6, "F(normal) %g != %g", r[0].f.x, f0);
@@ -1039,7 +1038,7 @@ TEST(brdf, sheen_albedo)
         for (int j = 0; j < 5; j++, n++) {
             q[n].op = BRDF_OP_FRESNEL;
             q[n].wo.z = (float)cs[i];
-            q[n].params.w = (float)rs[j];
+            q[n].args.w = (float)rs[j];
         }
     brdf_runner_run(&runner, q, r, (size_t)n);
     rng_state = 8;
@@ -1066,7 +1065,7 @@ TEST(brdf, sheen_albedo)
         for (int t = 0; t < 4; t++) {
             double th = rad(t * 25.0);
             measure m;
-            BrdfQuery e = {.op = BRDF_OP_FRESNEL, .wo = {0, 0, (float)cos(th)}, .params = {0, 0, 0, (float)rs[j]}};
+            BrdfQuery e = {.op = BRDF_OP_FRESNEL, .wo = {0, 0, (float)cos(th)}, .args = {0, 0, 0, (float)rs[j]}};
             BrdfResult er;
             brdf_runner_run(&runner, &e, &er, 1);
             measure_case(&s, polar(th, 0.4), true, 1, 1, &m);
@@ -1160,7 +1159,7 @@ TEST(brdf, anisotropy_ndf)
                    ndf_cases[k], wo_deg[t], visible, wo.z);
         }
         /* 20 degrees off the normal along the direction and across it */
-        double rot = s.v[BRDF_SLOT_ANISO + 1];
+        double rot = s.m.anisotropy_rotation;
         q[0] = query(&s, BRDF_OP_NDF, v3(0, 0, 1), polar(rad(20), rot), v3(0, 0, 0));
         q[1] = query(&s, BRDF_OP_NDF, v3(0, 0, 1), polar(rad(20), rot + PI / 2), v3(0, 0, 0));
         brdf_runner_run(&runner, q, r, 2);

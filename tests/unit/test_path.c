@@ -17,6 +17,7 @@
 #include "image.h"
 #include "meshgen.h"
 #include "render.h"
+#include "render_material.h"
 #include "scene.h"
 #include "test.h"
 

@@ -836,7 +836,9 @@ static bool load_tri_scene(scene *s, const char *body)
 }
 
 /* KHR_materials_volume and _dispersion: the values read, glTF's defaults, thicknessFactor 0
- * as thin-walled (no medium), and a warning for each bad value (the default kept, or clamped). */
+ * as thin-walled (no medium), and a warning for each bad value (the default kept, or clamped);
+ * a thicknessTexture that names no texture is an error with its JSON path, as every texture
+ * slot's is. */
 TEST(scene, volume)
 {
     const char *body =
@@ -848,15 +850,14 @@ TEST(scene, volume)
         "\"KHR_materials_dispersion\":{\"dispersion\":0.4}}},"
         "{\"extensions\":{\"KHR_materials_volume\":{}}},"
         "{\"extensions\":{\"KHR_materials_volume\":{\"thicknessFactor\":1,\"attenuationColor\":[1.5,0,0],"
-        "\"attenuationDistance\":0,\"thicknessTexture\":{\"index\":3}},\"KHR_materials_dispersion\":{\"dispersion\":-1}}}],"
+        "\"attenuationDistance\":0},\"KHR_materials_dispersion\":{\"dispersion\":-1}}}],"
         "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]";
     scene s;
     int w0 = util_warning_count();
     CHECKF(load_tri_scene(&s, body), "%s", load_log);
-    CHECKF(util_warning_count() - w0 == 4, "%d warnings:\n%s", util_warning_count() - w0, load_log);
+    CHECKF(util_warning_count() - w0 == 3, "%d warnings:\n%s", util_warning_count() - w0, load_log);
     CHECK(strstr(load_log, "material 2: attenuationColor") && strstr(load_log, "material 2: attenuationDistance 0") &&
-          strstr(load_log, "material 2: thicknessTexture") && strstr(load_log, "material 2: dispersion -1") &&
-          !strstr(load_log, "unsupported"));
+          strstr(load_log, "material 2: dispersion -1") && !strstr(load_log, "unsupported"));
     CHECK(s.num_materials == 3);
     if (s.num_materials != 3) {
         scene_destroy(&s);
@@ -870,6 +871,10 @@ TEST(scene, volume)
     CHECK(m[2].volume == 1 && near3(m[2].attenuation_color, 1, 1, 1, 0) && isinf(m[2].attenuation_distance) &&
           m[2].dispersion == 0);
     scene_destroy(&s);
+    CHECK(!load_tri_scene(&s, "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":3,\"material\":0}]}],"
+                              "\"materials\":[{\"extensions\":{\"KHR_materials_volume\":{\"thicknessFactor\":1,"
+                              "\"thicknessTexture\":{\"index\":3}}}}],\"nodes\":[{\"mesh\":0}]") &&
+          strstr(load_log, "materials[0].extensions.KHR_materials_volume.thicknessTexture.index: 3 does not exist"));
 }
 
 TEST(scene, transforms)
@@ -965,7 +970,8 @@ TEST(scene, bad_geometry)
     } bad[] = {
         {"{\"bufferView\":0,\"componentType\":5126,\"count\":5,\"type\":\"VEC3\"}", "\"POSITION\":6", "does not fit in buffer view 0"},
         {"{\"bufferView\":0,\"byteOffset\":2,\"componentType\":5126,\"count\":1,\"type\":\"VEC3\"}", "\"POSITION\":6", "not a multiple"},
-        {"{\"bufferView\":6,\"componentType\":5126,\"count\":1,\"type\":\"VEC3\"}", "\"POSITION\":6", "does not fit in buffer 0"},
+        {"{\"bufferView\":6,\"componentType\":5126,\"count\":1,\"type\":\"VEC3\"}", "\"POSITION\":6",
+         "bufferViews[6]: bytes 160 to 260 lie beyond buffers[0].byteLength 168"},
         {"{\"bufferView\":6,\"componentType\":5126,\"count\":2,\"type\":\"VEC3\"}", "\"POSITION\":6", "smaller than the element size"},
         {"{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"}", "\"POSITION\":6", "not allowed for attribute POSITION"},
         {"{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"}", "\"POSITION\":0,\"NORMAL\":6", "same count"},
@@ -1301,4 +1307,113 @@ TEST(scene, anisotropy)
              "\"nodes\":[{\"mesh\":0}]");
     CHECK(!load_tri_scene(&s, body) &&
           strstr(load_log, "materials[0].extensions.KHR_materials_anisotropy.anisotropyStrength"));
+}
+
+/* ---- the material table's rows and the extension table (src/scene/gltf_material.cpp) ------ */
+
+/* The rows as the loader reads them: JSON path, components (a texture slot: 0) and word. */
+static const struct material_row {
+    const char *ext, *json;
+    int n;
+    int word;
+} material_rows[] = {
+#define ROW_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf) {ext, json, GN_MAT_COUNT_##type, word},
+#define ROW_TEX(name, word, ext, json, space, gate, uses) {ext, json, 0, word},
+    GN_MATERIAL(ROW_PARAM, ROW_TEX, GN_MAT_NO_FIELD)
+#undef ROW_PARAM
+#undef ROW_TEX
+};
+
+/* A material that sets row r's JSON path to `value`: the path's objects nested (each with an
+ * index, for those that are textureInfos), in the row's extension object. */
+static void material_json(char *out, size_t cap, const struct material_row *r, const char *value)
+{
+    char path[128], *part[4];
+    int n = 0;
+    size_t len = 0;
+    snprintf(path, sizeof path, "%s", r->json);
+    for (char *save = NULL, *t = strtok_r(path, ".", &save); t && n < 4; t = strtok_r(NULL, ".", &save))
+        part[n++] = t;
+    len += (size_t)snprintf(out + len, cap - len, "{");
+    if (*r->ext)
+        len += (size_t)snprintf(out + len, cap - len, "\"extensions\":{\"%s\":{", r->ext);
+    for (int k = 0; k < n - 1; k++)
+        len += (size_t)snprintf(out + len, cap - len, "\"%s\":{\"index\":0,", part[k]);
+    len += (size_t)snprintf(out + len, cap - len, "\"%s\":%s", part[n - 1], value);
+    for (int k = 0; k < n - 1; k++)
+        len += (size_t)snprintf(out + len, cap - len, "}");
+    snprintf(out + len, cap - len, "%s}", *r->ext ? "}}" : "");
+}
+
+/* Every row of the material table is read and checked alike, in the core and in every
+ * extension: a factor of the wrong JSON type is an error naming its JSON path ("... is not a
+ * number", "... is not an array"), a texture slot's index of the wrong type is one too; a
+ * slot's texture is read, with its texCoord (TEXCOORD_1: the slot's own copy of the texture);
+ * and every extension a row names is one the table of extensions supports. */
+TEST(scene, material_rows)
+{
+    char head[1024], material[1024], body[8192], path[256], want[512];
+    snprintf(head, sizeof head, "\"images\":[{\"uri\":\"data:image/png;base64,%s\"}],\"textures\":[{\"source\":0}],"
+             "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TANGENT\":2},\"indices\":3,"
+             "\"material\":0}]}],\"nodes\":[{\"mesh\":0}],", png_ga8);
+    for (size_t i = 0; i < sizeof material_rows / sizeof *material_rows; i++) {
+        const struct material_row *r = &material_rows[i];
+        scene s;
+        snprintf(path, sizeof path, "materials[0]%s%s.%s", *r->ext ? ".extensions." : "", r->ext, r->json);
+        if (*r->ext) {
+            const char *how = NULL;
+            scene_support sup = scene_extension_support(r->ext, &how);
+            CHECKF(sup != SCENE_UNSUPPORTED && how && *how, "%s: the extension of row %s is not a supported one", r->ext,
+                   r->json);
+        }
+        /* a wrong type */
+        material_json(material, sizeof material, r, r->n ? "\"x\"" : "{\"index\":\"x\"}");
+        snprintf(body, sizeof body, "%s\"materials\":[%s]", head, material);
+        snprintf(want, sizeof want, r->n ? "%s: \"x\" is not a" : "%s.index: \"x\" is not an integer", path);
+        CHECKF(!load_tri_scene(&s, body) && strstr(load_log, want), "row %s: no error \"%s\":\n%s", path, want, load_log);
+        if (r->n)
+            continue;
+        /* a texture slot read, through TEXCOORD_1 */
+        material_json(material, sizeof material, r, "{\"index\":0,\"texCoord\":1}");
+        snprintf(body, sizeof body, "%s\"materials\":[%s]", head, material);
+        bool ok = load_tri_scene(&s, body);
+        CHECKF(ok, "row %s: %s", path, load_log);
+        if (ok && s.num_materials >= 1) {
+            uint32_t t = ((const uint32_t *)&s.materials[0])[r->word];
+            CHECKF(t < s.num_textures && s.textures[t].flags == GN_TEX_UV1, "row %s: slot %u (of %u textures) is not the "
+                   "texture read through TEXCOORD_1", path, t, s.num_textures);
+        }
+        if (ok)
+            scene_destroy(&s);
+    }
+}
+
+/* The extensions a file lists, once each in its order, with how gonio handles each: the
+ * table's supported, partly and unsupported ones, and a name it does not know; a required
+ * unsupported one refuses the file, naming it and why. */
+TEST(scene, extension_list)
+{
+    scene s;
+    int w0 = util_warning_count();
+    CHECKF(load_tri_scene(&s, TRI_MESH ",\"nodes\":[{\"mesh\":0}],\"extensionsUsed\":[\"KHR_materials_sheen\","
+                              "\"KHR_materials_volume\",\"KHR_materials_pbrSpecularGlossiness\",\"EXT_gonio_unknown\","
+                              "\"KHR_materials_sheen\"],\"extensionsRequired\":[\"KHR_materials_volume\","
+                              "\"KHR_texture_transform\"]"), "%s", load_log);
+    CHECKF(util_warning_count() - w0 == 2 && strstr(load_log, "uses unsupported extension KHR_materials_pbrSpecularGlossiness "
+                                                              "(ignored: the specular-glossiness workflow is not read") &&
+               strstr(load_log, "uses unsupported extension EXT_gonio_unknown (ignored)"), "%s", load_log);
+    static const struct { const char *name; bool required; scene_support support; } want[] = {
+        {"KHR_materials_sheen", false, SCENE_SUPPORTED}, {"KHR_materials_volume", true, SCENE_PARTLY},
+        {"KHR_materials_pbrSpecularGlossiness", false, SCENE_UNSUPPORTED}, {"EXT_gonio_unknown", false, SCENE_UNSUPPORTED},
+        {"KHR_texture_transform", true, SCENE_SUPPORTED}};
+    CHECK(s.num_extensions == 5);
+    for (uint32_t i = 0; i < 5 && i < s.num_extensions; i++)
+        CHECKF(!strcmp(s.extensions[i].name, want[i].name) && s.extensions[i].required == want[i].required &&
+                   s.extensions[i].support == want[i].support && s.extensions[i].how && *s.extensions[i].how,
+               "extension %u: %s", i, s.extensions[i].name);
+    CHECK(!strcmp(s.extensions[3].how, "unknown to gonio"));
+    scene_destroy(&s);
+    CHECK(!load_tri_scene(&s, TRI_MESH ",\"nodes\":[{\"mesh\":0}],\"extensionsUsed\":[\"KHR_texture_basisu\"],"
+                              "\"extensionsRequired\":[\"KHR_texture_basisu\"]") &&
+          strstr(load_log, "requires unsupported extension KHR_texture_basisu (KTX2 images are not decoded"));
 }

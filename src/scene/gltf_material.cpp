@@ -1,0 +1,745 @@
+/* gltf_material.cpp: what a glTF file's materials read: the table of extensions gonio knows
+ * (each one's support, and a material extension's own rules), images (PNG and JPEG, each
+ * distinct one decoded once), samplers, textures with their texCoord and
+ * KHR_texture_transform, KHR_materials_variants, and the materials, read and checked from the
+ * JSON document row by row of the material table (glsl/lib/material.h), as cgltf reads each
+ * extension into its struct: the types are checked while reading, so the check and the read
+ * cannot drift, and a wrong type is the same error everywhere. */
+#include "gltf_json.h"
+
+#include <stb_image.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+namespace gltf {
+
+/* ---- the extensions gonio knows: one table ---------------------------------------------------
+ * A material extension's factors and textures are its rows of the material table
+ * (glsl/lib/material.h), read by material_read; `read` is what the table cannot say (a
+ * factor that scales another, a flag). Adding one: docs/architecture.md, "Adding a glTF
+ * material extension". */
+struct Extension {
+    const char *name;
+    scene_support support;
+    const char *how;  /* what gonio does with it (partly: what is left out; unsupported: why) */
+    bool material;    /* an extension of materials: its object is read by material_read */
+    void (*read)(Doc &d, const Json &e, const std::string &p, MaterialDraft &m); /* after its rows */
+};
+
+/* A factor of an extension object that is no row of the table (it scales one): the row
+ * reader's checks and messages. */
+bool read_number(Doc &d, const Json &o, const char *key, const std::string &p, const std::string &what, double lo,
+                 double hi, float *out);
+
+void read_emissive_strength(Doc &d, const Json &e, const std::string &p, MaterialDraft &m)
+{
+    float s = 1;
+    if (read_number(d, e, "emissiveStrength", p, m.what, 0, MAX_RADIANCE, &s)) {
+        m.g.emissive.x *= s;
+        m.g.emissive.y *= s;
+        m.g.emissive.z *= s;
+    }
+}
+
+/* thicknessFactor 0 (its default) means thin-walled: no medium. Any other thickness only
+ * says there is one: the path tracer follows the real geometry (docs/path-tracing.md). */
+void read_volume(Doc &, const Json &, const std::string &, MaterialDraft &m) { m.g.volume = m.g.thickness > 0; }
+
+void read_unlit(Doc &, const Json &, const std::string &, MaterialDraft &m) { m.g.flags |= GN_MAT_UNLIT; }
+
+const Extension EXTENSIONS[] = {
+    {"KHR_materials_emissive_strength", SCENE_SUPPORTED, "emissiveStrength scales emissiveFactor", true,
+     read_emissive_strength},
+    {"KHR_materials_specular", SCENE_SUPPORTED, "specularFactor, specularColorFactor and their textures", true, nullptr},
+    {"KHR_materials_transmission", SCENE_SUPPORTED,
+     "transmissionFactor and transmissionTexture: refraction through rough or smooth glass", true, nullptr},
+    {"KHR_materials_ior", SCENE_SUPPORTED, "the index of the Fresnel factor and of refraction", true, nullptr},
+    {"KHR_materials_volume", SCENE_PARTLY,
+     "absorption in the medium a closed mesh bounds; thicknessFactor and thicknessTexture only say there is one "
+     "(the path tracer follows the real geometry)",
+     true, read_volume},
+    {"KHR_materials_dispersion", SCENE_SUPPORTED, "an index per colour channel from the Abbe number", true, nullptr},
+    {"KHR_materials_clearcoat", SCENE_SUPPORTED, "a GGX coat with its own roughness and normal map", true, nullptr},
+    {"KHR_materials_sheen", SCENE_SUPPORTED, "a Charlie sheen over the base", true, nullptr},
+    {"KHR_materials_anisotropy", SCENE_SUPPORTED, "anisotropic GGX along the tangent frame's direction", true, nullptr},
+    {"KHR_materials_iridescence", SCENE_SUPPORTED, "a thin film over the base's Fresnel factor", true, nullptr},
+    {"KHR_materials_diffuse_transmission", SCENE_SUPPORTED, "a Lambert lobe through the surface", true, nullptr},
+    {"KHR_materials_unlit", SCENE_SUPPORTED, "the base colour is the radiance", true, read_unlit},
+    {"KHR_texture_transform", SCENE_SUPPORTED, "offset, rotation, scale and texCoord of every texture slot", false,
+     nullptr},
+    {"KHR_materials_variants", SCENE_SUPPORTED, "the variant that --variant names", false, nullptr},
+    {"KHR_lights_punctual", SCENE_SUPPORTED,
+     "point, spot and directional lights (intensities read as radiometric: W/sr, W/m^2)", false, nullptr},
+    {"KHR_mesh_quantization", SCENE_SUPPORTED, "integer vertex attributes", false, nullptr},
+    {"KHR_draco_mesh_compression", SCENE_SUPPORTED, "decoded by Draco", false, nullptr},
+    {"EXT_meshopt_compression", SCENE_SUPPORTED, "decoded by meshoptimizer", false, nullptr},
+    {"KHR_materials_pbrSpecularGlossiness", SCENE_UNSUPPORTED,
+     "the specular-glossiness workflow is not read: the materials' metallic-roughness values are", false, nullptr},
+    {"KHR_texture_basisu", SCENE_UNSUPPORTED, "KTX2 images are not decoded: a texture's PNG or JPEG source is", false,
+     nullptr},
+    {"EXT_texture_webp", SCENE_UNSUPPORTED, "WebP images are not decoded: a texture's PNG or JPEG source is", false,
+     nullptr},
+    {"EXT_mesh_gpu_instancing", SCENE_UNSUPPORTED, "the instances are not drawn, only the node's own mesh", false,
+     nullptr},
+    {"KHR_xmp_json_ld", SCENE_UNSUPPORTED, "metadata: nothing in it is rendered", false, nullptr},
+    {"KHR_xmp", SCENE_UNSUPPORTED, "metadata (KHR_xmp_json_ld's draft): nothing in it is rendered", false, nullptr},
+};
+
+const Extension *find_extension(const std::string &name)
+{
+    for (const Extension &e : EXTENSIONS)
+        if (name == e.name)
+            return &e;
+    return nullptr;
+}
+
+bool supported(const Extension *e) { return e && e->support != SCENE_UNSUPPORTED; }
+
+std::string why_not(const Extension *e) { return e ? std::string(" (") + e->how + ")" : std::string(); }
+
+bool check_extensions(Ctx &c)
+{
+    for (const auto &e : c.m.extensionsRequired)
+        if (!supported(find_extension(e)))
+            fail(c, "requires unsupported extension %s%s", e.c_str(), why_not(find_extension(e)).c_str());
+    std::vector<std::string> warned; /* one warning each, however often the file lists it */
+    for (const auto &e : c.m.extensionsUsed)
+        if (!supported(find_extension(e)) && std::find(warned.begin(), warned.end(), e) == warned.end()) {
+            const Extension *x = find_extension(e);
+            warn(c, "uses unsupported extension %s (ignored%s%s)", e.c_str(), x ? ": " : "", x ? x->how : "");
+            warned.push_back(e);
+        }
+    return !c.failed;
+}
+
+void list_extensions(Ctx &c, scene *out)
+{
+    std::vector<std::string> names;
+    for (const auto &e : c.m.extensionsUsed)
+        if (std::find(names.begin(), names.end(), e) == names.end())
+            names.push_back(e);
+    for (const auto &e : c.m.extensionsRequired)
+        if (std::find(names.begin(), names.end(), e) == names.end())
+            names.push_back(e);
+    out->extensions = static_cast<scene_extension *>(util_calloc(names.size() + 1, sizeof(scene_extension)));
+    for (const auto &name : names) {
+        scene_extension &x = out->extensions[out->num_extensions++];
+        snprintf(x.name, sizeof x.name, "%s", name.c_str());
+        x.required = std::find(c.m.extensionsRequired.begin(), c.m.extensionsRequired.end(), name) !=
+                     c.m.extensionsRequired.end();
+        x.support = scene_extension_support(x.name, &x.how);
+    }
+}
+
+/* Decodes PNG or JPEG, the formats glTF 2.0 allows. Anything else is refused before stb_image
+ * sees it: its other decoders are not needed, and the 16-bit PNM path of the stb bundled with
+ * tinygltf 2.7 overflows its buffer. On failure returns the reason. */
+std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned char *bytes, size_t size)
+{
+    static const unsigned char png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    bool is_png = size >= 8 && memcmp(bytes, png, 8) == 0;
+    bool is_jpeg = size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF;
+    if (!is_png && !is_jpeg)
+        return "not a PNG or JPEG image";
+    if (size > size_t(INT32_MAX))
+        return "image data too large";
+    /* The same bytes are decoded once (a file listing one PNG 500 times decoded it 500 times). */
+    std::pair<uint32_t, size_t> key(uint32_t(crc32_z(crc32_z(0, nullptr, 0), bytes, size)), size);
+    auto seen = c.decoded.find(key);
+    if (seen != c.decoded.end()) {
+        c.image_alias[idx] = seen->second;
+        return "";
+    }
+    int w = 0, h = 0, comp = 0;
+    if (!stbi_info_from_memory(bytes, int(size), &w, &h, &comp))
+        return "cannot decode";
+    if (c.texels + uint64_t(w) * uint64_t(h) > SCENE_MAX_TEXELS) {
+        char msg[256];
+        snprintf(msg, sizeof msg, "images too large: %llu texels with image %d (%dx%d), the limit is %llu",
+                 (unsigned long long)(c.texels + uint64_t(w) * uint64_t(h)), idx, w, h,
+                 (unsigned long long)SCENE_MAX_TEXELS);
+        if (c.limit_error.empty())
+            c.limit_error = msg;
+        return msg;
+    }
+    c.texels += uint64_t(w) * uint64_t(h);
+    c.decoded[key] = idx;
+    std::string err, warn_text;
+    if (!tinygltf::LoadImageData(img, idx, &err, &warn_text, 0, 0, bytes, int(size), nullptr))
+        return err.empty() ? "cannot decode" : err;
+    return "";
+}
+
+/* tinygltf image callback. Images in buffer views arrive before any buffer view is checked, so
+ * they are decoded later (decode_view_images); a file that fails to decode is recorded rather
+ * than failing the whole load, and its textures are dropped with a warning. */
+bool image_callback(tinygltf::Image *img, const int idx, std::string *, std::string *, int, int,
+                    const unsigned char *bytes, int size, void *user)
+{
+    Ctx &c = *static_cast<Ctx *>(user);
+    if (img->bufferView >= 0)
+        return true;
+    std::string why = decode_image(c, img, idx, bytes, size_t(size));
+    if (!why.empty())
+        c.image_errors[idx] = why;
+    return true;
+}
+
+bool check_textures(Ctx &c)
+{
+    const auto &m = c.m;
+    for (size_t i = 0; i < m.textures.size(); i++) {
+        const auto &t = m.textures[i];
+        if (t.source != -1 && !in_range(t.source, m.images.size()))
+            fail(c, "texture %zu refers to image %d, which does not exist", i, t.source);
+        if (t.sampler != -1 && !in_range(t.sampler, m.samplers.size()))
+            fail(c, "texture %zu refers to sampler %d, which does not exist", i, t.sampler);
+    }
+    return !c.failed;
+}
+
+/* The names of the file's KHR_materials_variants, in order (empty without the extension). */
+std::vector<std::string> variant_names(const tinygltf::Model &m)
+{
+    std::vector<std::string> names;
+    auto it = m.extensions.find("KHR_materials_variants");
+    if (it == m.extensions.end() || !it->second.Has("variants") || !it->second.Get("variants").IsArray())
+        return names;
+    const tinygltf::Value &v = it->second.Get("variants");
+    for (size_t i = 0; i < v.ArrayLen(); i++) {
+        const tinygltf::Value &e = v.Get(int(i));
+        names.push_back(e.Has("name") && e.Get("name").IsString() ? e.Get("name").Get<std::string>() : "");
+    }
+    return names;
+}
+
+/* KHR_materials_variants: with a variant selected (scene_select_variant), each primitive's
+ * mapping that lists it replaces the primitive's material, before the materials are checked;
+ * a primitive without one keeps its own. No variant selected: the file's default materials. */
+bool select_variant(Ctx &c)
+{
+    if (variant.empty())
+        return true;
+    std::vector<std::string> names = variant_names(c.m);
+    auto at = std::find(names.begin(), names.end(), variant);
+    if (at == names.end()) {
+        std::string list;
+        for (const auto &n : names)
+            list += (list.empty() ? "" : ", ") + ("'" + n + "'");
+        return fail(c, "has no material variant '%s' (%s%s)", variant.c_str(), list.empty() ? "no variants" : "variants: ",
+                    list.c_str());
+    }
+    double want = double(at - names.begin());
+    for (size_t mi = 0; mi < c.m.meshes.size(); mi++)
+        for (auto &p : c.m.meshes[mi].primitives) {
+            auto e = p.extensions.find("KHR_materials_variants");
+            if (e == p.extensions.end() || !e->second.Has("mappings") || !e->second.Get("mappings").IsArray())
+                continue;
+            const tinygltf::Value &maps = e->second.Get("mappings");
+            for (size_t k = 0; k < maps.ArrayLen(); k++) {
+                const tinygltf::Value &mp = maps.Get(int(k));
+                if (!mp.Has("variants") || !mp.Get("variants").IsArray() || !mp.Has("material") ||
+                    !mp.Get("material").IsNumber())
+                    continue;
+                const tinygltf::Value &vs = mp.Get("variants");
+                for (size_t j = 0; j < vs.ArrayLen(); j++)
+                    if (vs.Get(int(j)).IsNumber() && vs.Get(int(j)).GetNumberAsDouble() == want)
+                        p.material = mp.Get("material").GetNumberAsInt();
+            }
+        }
+    return true;
+}
+
+/* The texture slots of a material (the table's TEX rows). */
+#define COUNT_TEX(name, word, ext, json, space, gate, uses) +1
+const size_t NUM_TEXTURE_SLOTS = 0 GN_MATERIAL(GN_MAT_NO_PARAM, COUNT_TEX, GN_MAT_NO_FIELD);
+#undef COUNT_TEX
+
+void decode_view_images(Ctx &c)
+{
+    for (size_t i = 0; i < c.m.images.size(); i++) {
+        tinygltf::Image &img = c.m.images[i];
+        if (img.bufferView < 0) /* tinygltf checked that the view exists, check_buffers_and_views that it fits */
+            continue;
+        const auto &v = c.m.bufferViews[size_t(img.bufferView)];
+        std::string why = decode_image(c, &img, int(i), view_data(c, img.bufferView, 0), v.byteLength);
+        if (!why.empty())
+            c.image_errors[int(i)] = why;
+    }
+}
+
+/* Decoded image -> RGBA8: grey, grey+alpha and RGB expand as glTF samples them; 16-bit
+ * channels round to 8 bits (v * 255 / 65535 = v / 257). */
+bool convert_image(const tinygltf::Image &img, scene_image &out)
+{
+    int comps = img.component, bytes = img.bits / 8;
+    if (img.width < 1 || img.height < 1 || comps < 1 || comps > 4 || (img.bits != 8 && img.bits != 16) ||
+        size_t(img.width) * size_t(img.height) > MAX_PIXELS ||
+        img.image.size() != size_t(img.width) * size_t(img.height) * size_t(comps * bytes))
+        return false;
+    size_t n = size_t(img.width) * size_t(img.height);
+    out.width = uint32_t(img.width);
+    out.height = uint32_t(img.height);
+    out.rgba8 = static_cast<uint8_t *>(util_malloc(n * 4));
+    const uint8_t *src = img.image.data();
+    if (comps == 4 && bytes == 1) { /* what tinygltf's decoder delivers */
+        memcpy(out.rgba8, src, n * 4);
+        return true;
+    }
+    for (size_t p = 0; p < n; p++) {
+        uint8_t ch[4] = {0, 0, 0, 255};
+        for (int k = 0; k < comps; k++) {
+            const uint8_t *s = src + (p * size_t(comps) + size_t(k)) * size_t(bytes);
+            if (bytes == 1) {
+                ch[k] = s[0];
+            } else {
+                uint16_t v;
+                memcpy(&v, s, 2);
+                ch[k] = uint8_t((v + 128) / 257);
+            }
+        }
+        if (comps <= 2) { /* luminance (+ alpha) */
+            ch[3] = comps == 2 ? ch[1] : 255;
+            ch[1] = ch[2] = ch[0];
+        }
+        memcpy(out.rgba8 + p * 4, ch, 4);
+    }
+    return true;
+}
+
+uint32_t wrap_mode(Ctx &c, size_t sampler, int mode)
+{
+    switch (mode) {
+    case TINYGLTF_TEXTURE_WRAP_REPEAT: return GN_WRAP_REPEAT;
+    case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return GN_WRAP_CLAMP;
+    case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return GN_WRAP_MIRROR;
+    default: warn(c, "sampler %zu: invalid wrap mode %d (using REPEAT)", sampler, mode); return GN_WRAP_REPEAT;
+    }
+}
+
+/* GN_TEX_NEAREST or 0 for a sampler's filters. The kernels look a texture up at one point
+ * of its full-resolution image per sample, and the samples of a pixel average what it
+ * covers, which is the minification (no mipmaps are needed for that); so magFilter decides
+ * between nearest and bilinear, and without one, minFilter's filter within a level does. */
+uint32_t filter_mode(Ctx &c, size_t sampler, int mag, int min)
+{
+    if (mag != -1 && mag != TINYGLTF_TEXTURE_FILTER_NEAREST && mag != TINYGLTF_TEXTURE_FILTER_LINEAR) {
+        warn(c, "sampler %zu: invalid magFilter %d (using LINEAR)", sampler, mag);
+        mag = TINYGLTF_TEXTURE_FILTER_LINEAR;
+    }
+    bool min_nearest = min == TINYGLTF_TEXTURE_FILTER_NEAREST || min == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
+                       min == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR;
+    if (min != -1 && !min_nearest && min != TINYGLTF_TEXTURE_FILTER_LINEAR &&
+        min != TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST && min != TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR)
+        warn(c, "sampler %zu: invalid minFilter %d (ignored)", sampler, min);
+    if (mag == -1)
+        return min_nearest ? GN_TEX_NEAREST : 0u;
+    return mag == TINYGLTF_TEXTURE_FILTER_NEAREST ? GN_TEX_NEAREST : 0u;
+}
+
+void load_images_and_textures(Ctx &c, scene *out)
+{
+    const auto &m = c.m;
+    decode_view_images(c);
+    out->images = static_cast<scene_image *>(util_calloc(m.images.size(), sizeof(scene_image)));
+    c.image_map.assign(m.images.size(), GN_INVALID);
+    for (size_t i = 0; i < m.images.size(); i++) {
+        const auto &img = m.images[i];
+        if (c.image_alias.count(int(i)))
+            continue; /* below, once its original is in */
+        if (c.image_errors.count(int(i)) || !convert_image(img, out->images[out->num_images])) {
+            std::string why = c.image_errors.count(int(i)) ? c.image_errors[int(i)] : "file missing or unreadable";
+            while (!why.empty() && why.back() == '\n')
+                why.pop_back();
+            warn(c, "%s%s%s: %s; textures using it are ignored", label("image", int(i), img.name).c_str(),
+                 img.uri.empty() ? "" : " ", img.uri.substr(0, 200).c_str(), why.c_str());
+            continue;
+        }
+        c.image_map[i] = out->num_images++;
+        std::vector<unsigned char>().swap(c.m.images[i].image); /* keep one copy at a time */
+    }
+    for (const auto &alias : c.image_alias)
+        c.image_map[size_t(alias.first)] = c.image_map[size_t(alias.second)];
+    /* room for texture_slot's variants too: one per texture slot of a material at most */
+    c.textures_room = m.textures.size() + NUM_TEXTURE_SLOTS * m.materials.size();
+    out->textures = static_cast<scene_texture *>(util_calloc(c.textures_room, sizeof(scene_texture)));
+    c.textures_out = out;
+    c.texture_map.assign(m.textures.size(), GN_INVALID);
+    for (size_t i = 0; i < m.textures.size(); i++) {
+        const auto &t = m.textures[i];
+        if (t.source < 0) {
+            warn(c, "texture %zu has no image source (ignored)", i);
+            continue;
+        }
+        if (c.image_map[size_t(t.source)] == GN_INVALID)
+            continue;
+        uint32_t flags = 0;
+        if (t.sampler >= 0) {
+            const auto &s = m.samplers[size_t(t.sampler)];
+            flags = wrap_mode(c, size_t(t.sampler), s.wrapS) | wrap_mode(c, size_t(t.sampler), s.wrapT) << 2 |
+                    filter_mode(c, size_t(t.sampler), s.magFilter, s.minFilter);
+        }
+        out->textures[out->num_textures] = scene_texture{c.image_map[size_t(t.source)], flags, {1, 0, 0, 0, 1, 0}};
+        c.texture_map[i] = out->num_textures++;
+    }
+}
+
+/* ---- materials: the table's rows read from the JSON document -------------------------------- */
+
+/* How messages name a row: its JSON path, less the pbrMetallicRoughness object the core's
+ * factors sit in ("baseColorFactor", "occlusionTexture.strength"). */
+const char *shown(const char *json)
+{
+    static const char pbr[] = "pbrMetallicRoughness.";
+    return strncmp(json, pbr, sizeof pbr - 1) == 0 ? json + sizeof pbr - 1 : json;
+}
+
+/* A number in [lo, hi]; outside -> warning and clamped. */
+float ranged(Ctx &c, double v, double lo, double hi, const std::string &what, const char *name)
+{
+    if (v >= lo && v <= hi)
+        return float(v);
+    warn(c, "%s: %s %g is out of range [%g, %g] (clamped)", what.c_str(), name, v, lo, hi);
+    return float(v < lo ? lo : hi);
+}
+
+/* The object a row's path leads to from o (its last part the value's key), and that path;
+ * nullptr when an object on the way is absent or not an object (the latter is the error of
+ * the row that reads that object, reported once). */
+const Json *row_object(const Json &o, const char *json, std::string &path, std::string &key)
+{
+    const Json *at = &o;
+    std::string rest = json;
+    for (size_t dot; (dot = rest.find('.')) != std::string::npos; rest = rest.substr(dot + 1)) {
+        std::string part = rest.substr(0, dot);
+        auto it = at->find(part);
+        if (it == at->end() || !it->is_object())
+            return nullptr;
+        at = &*it;
+        path = Doc::at(path, part.c_str());
+    }
+    key = rest;
+    return at;
+}
+
+/* Row (json, n numbers, [lo, hi], rule) of object o at JSON path p into out[n]: a wrong type
+ * is an error (Doc), a value out of range gets the rule (GN_MAT_RULE_*). True when the file
+ * has a value there of the right type. */
+bool read_param(Doc &d, const Json &o, std::string p, const std::string &what, const char *json, int n, float *out,
+                double lo, double hi, int rule)
+{
+    std::string key;
+    const Json *obj = row_object(o, json, p, key);
+    double v[4];
+    if (!obj)
+        return false;
+    if (n == 1) {
+        const Json *x = d.member(*obj, key.c_str(), p);
+        if (!x || !d.is_number(*x, Doc::at(p, key.c_str())))
+            return false;
+        v[0] = x->get<double>();
+    } else {
+        if (!d.numbers(*obj, key.c_str(), p, size_t(n)))
+            return false;
+        for (int k = 0; k < n; k++)
+            v[k] = (*obj)[key][size_t(k)].get<double>();
+    }
+    bool in = true;
+    for (int k = 0; k < n; k++)
+        in = in && v[k] >= lo && v[k] <= hi;
+    switch (rule) {
+    case GN_MAT_RULE_CLAMP:
+        for (int k = 0; k < n; k++)
+            out[k] = ranged(d.c, v[k], lo, hi, what, shown(json));
+        break;
+    case GN_MAT_RULE_CHECK:
+        if (in)
+            for (int k = 0; k < n; k++)
+                out[k] = float(v[k]);
+        else if (n == 1)
+            warn(d.c, "%s: %s %g must be in [%g, %g] (ignored)", what.c_str(), shown(json), v[0], lo, hi);
+        else
+            warn(d.c, "%s: %s must be %d numbers in [%g, %g] (ignored)", what.c_str(), shown(json), n, lo, hi);
+        break;
+    case GN_MAT_RULE_POSITIVE:
+        if (v[0] > 0)
+            out[0] = float(v[0]); /* beyond float's range: +inf */
+        else
+            warn(d.c, "%s: %s %g must be positive (ignored)", what.c_str(), shown(json), v[0]);
+        break;
+    case GN_MAT_RULE_IOR: /* KHR_materials_ior allows 0 besides [1, inf): F0 = ((ior-1)/(ior+1))^2 = 1, a mirror */
+        out[0] = v[0] == 0 ? 0.0f : ranged(d.c, v[0], lo, hi, what, shown(json));
+        break;
+    case GN_MAT_RULE_ANGLE: /* reduced to [-pi, pi], so that float keeps its precision */
+        if (std::isfinite(v[0]))
+            out[0] = float(std::remainder(v[0], 2 * M_PI));
+        break;
+    }
+    return true;
+}
+
+bool read_number(Doc &d, const Json &o, const char *key, const std::string &p, const std::string &what, double lo,
+                 double hi, float *out)
+{
+    return read_param(d, o, p, what, key, 1, out, lo, hi, GN_MAT_RULE_CLAMP);
+}
+
+/* A textureInfo of object o at JSON path p (json: its key there, or a path to it): the
+ * texture, its set and its KHR_texture_transform. */
+void read_texture(Doc &d, const Json &o, std::string p, const std::string &what, const char *json, TextureRef &t)
+{
+    std::string key;
+    const Json *obj = row_object(o, json, p, key);
+    const Json *ti = obj ? d.object(*obj, key.c_str(), p) : nullptr;
+    if (!ti)
+        return;
+    p = Doc::at(p, key.c_str());
+    t.index = int(d.index(*ti, "index", p, "textures", true));
+    int64_t set = d.integer(*ti, "texCoord", p, 0, INT32_MAX);
+    t.tex_coord = set < 0 ? 0 : int(set);
+    const Json *ex = d.object(*ti, "extensions", p);
+    const std::string pe = Doc::at(p, "extensions"), pt = Doc::at(pe, "KHR_texture_transform");
+    const Json *tt = ex ? d.object(*ex, "KHR_texture_transform", pe) : nullptr;
+    if (!tt)
+        return;
+    double offset[2] = {0, 0}, scale[2] = {1, 1}, rotation = 0;
+    const char *pairs[2] = {"offset", "scale"};
+    double *vals[2] = {offset, scale};
+    for (int k = 0; k < 2; k++)
+        if (d.numbers(*tt, pairs[k], pt, 2)) {
+            const Json &v = (*tt)[pairs[k]];
+            if (std::isfinite(v[0].get<double>()) && std::isfinite(v[1].get<double>())) {
+                vals[k][0] = v[0].get<double>();
+                vals[k][1] = v[1].get<double>();
+            } else {
+                warn(d.c, "%s: %s: KHR_texture_transform %s is not two finite numbers (ignored)", what.c_str(),
+                     shown(json), pairs[k]);
+            }
+        }
+    if (const Json *r = d.member(*tt, "rotation", pt)) {
+        if (d.is_number(*r, Doc::at(pt, "rotation")) && std::isfinite(r->get<double>()))
+            rotation = r->get<double>();
+        else if (r->is_number())
+            warn(d.c, "%s: %s: KHR_texture_transform rotation is not finite (ignored)", what.c_str(), shown(json));
+    }
+    set = d.integer(*tt, "texCoord", pt, 0, INT32_MAX);
+    if (set >= 0)
+        t.tex_coord = int(set);
+    /* KHR_texture_transform: uv' = T R S uv, R = [cos sin; -sin cos] */
+    double cr = std::cos(rotation), sr = std::sin(rotation);
+    double r[6] = {cr * scale[0], sr * scale[1], offset[0], -sr * scale[0], cr * scale[1], offset[1]};
+    for (int k = 0; k < 6; k++) {
+        t.transform[k] = float(r[k]);
+        t.transformed |= t.transform[k] != (k == 0 || k == 4 ? 1.0f : 0.0f);
+    }
+}
+
+void materials_read(Ctx &c, const Json &root)
+{
+    auto it = root.find("materials");
+    c.materials.assign(it != root.end() && it->is_array() ? it->size() : 0, MaterialDraft());
+}
+
+/* The object a row reads from: the material itself (ext "") or its extension object. */
+const Json *row_base(const Json &m, const Json *ex, const char *ext, const std::string &p, std::string &base_path)
+{
+    if (!*ext) {
+        base_path = p;
+        return &m;
+    }
+    auto it = ex ? ex->find(ext) : Json::const_iterator();
+    if (!ex || it == ex->end() || !it->is_object())
+        return nullptr;
+    base_path = Doc::at(Doc::at(p, "extensions"), ext);
+    return &*it;
+}
+
+void material_read(Doc &d, const Json &m, const std::string &p, size_t i)
+{
+    MaterialDraft &out = d.c.materials[i];
+    auto name = m.find("name");
+    out.name = name != m.end() && name->is_string() ? name->get<std::string>() : "";
+    out.what = label("material", int(i), out.name);
+    scene_material_default(&out.g);
+    /* the objects the rows read from, each checked once */
+    d.object(m, "pbrMetallicRoughness", p);
+    const Json *ex = d.object(m, "extensions", p);
+    for (const Extension &e : EXTENSIONS)
+        if (ex && e.material)
+            d.object(*ex, e.name, Doc::at(p, "extensions"));
+    std::string bp;
+#define READ_PARAM(name, type, word, ext, json, def, lo, hi, rule, feat, brdf)                                              \
+    if (const Json *base = row_base(m, ex, ext, p, bp))                                                               \
+        read_param(d, *base, bp, out.what, json, GN_MAT_COUNT_##type, (float *)&out.g.name, lo, hi, GN_MAT_RULE_##rule);
+#define READ_TEX(name, word, ext, json, space, gate, uses)                                                            \
+    if (const Json *base = row_base(m, ex, ext, p, bp))                                                               \
+        read_texture(d, *base, bp, out.what, json, out.tex[word]);
+    GN_MATERIAL(READ_PARAM, READ_TEX, GN_MAT_NO_FIELD)
+#undef READ_PARAM
+#undef READ_TEX
+    for (const Extension &e : EXTENSIONS)
+        if (e.read)
+            if (const Json *base = row_base(m, ex, e.name, p, bp))
+                e.read(d, *base, bp, out);
+    /* the core's own flags */
+    d.boolean(m, "doubleSided", p);
+    d.enum_str(m, "alphaMode", p, {"OPAQUE", "MASK", "BLEND"});
+    auto ds = m.find("doubleSided");
+    if (ds != m.end() && ds->is_boolean() && ds->get<bool>())
+        out.g.flags |= GN_MAT_DOUBLE_SIDED;
+    auto am = m.find("alphaMode");
+    if (am != m.end() && *am == "MASK")
+        out.g.flags |= GN_MAT_MASK;
+    else if (am != m.end() && *am == "BLEND")
+        out.g.flags |= GN_MAT_BLEND;
+    auto extras = m.find("extras");
+    if (extras != m.end())
+        out.extras = *extras;
+}
+
+int material_tangent_set(const Ctx &c, uint32_t material)
+{
+    if (material >= c.materials.size())
+        return -1;
+    const MaterialDraft &d = c.materials[material];
+    const TextureRef &normal = d.tex[GN_MAT_WORD(tex_normal)], &coat = d.tex[GN_MAT_WORD(tex_clearcoat_normal)];
+    const TextureRef &aniso = d.tex[GN_MAT_WORD(tex_anisotropy)];
+    if (normal.index >= 0)
+        return normal.tex_coord;
+    if (coat.index >= 0)
+        return coat.tex_coord;
+    if (d.g.anisotropy_strength > 0)
+        return aniso.index >= 0 ? aniso.tex_coord : 0;
+    return -1;
+}
+
+/* The scene texture a material slot uses: the glTF texture's own one, or, when the
+ * reference reads TEXCOORD_1 or has a KHR_texture_transform, a copy with its set and
+ * transform (GnTexture), so each slot stays one index. */
+uint32_t texture_slot(Ctx &c, const TextureRef &ref, const std::string &what, const char *slot)
+{
+    if (ref.index < 0 || c.texture_map[size_t(ref.index)] == GN_INVALID)
+        return GN_INVALID;
+    if (ref.tex_coord > 1) {
+        warn(c, "%s: %s uses TEXCOORD_%d, only TEXCOORD_0 and TEXCOORD_1 are supported (texture ignored)", what.c_str(),
+             slot, ref.tex_coord);
+        return GN_INVALID;
+    }
+    uint32_t base = c.texture_map[size_t(ref.index)];
+    if (ref.tex_coord == 0 && !ref.transformed)
+        return base;
+    scene *out = c.textures_out;
+    if (out->num_textures == c.textures_room) { /* a caller beyond one call per slot */
+        c.textures_room *= 2;
+        out->textures = static_cast<scene_texture *>(util_realloc(out->textures, c.textures_room * sizeof(scene_texture)));
+    }
+    scene_texture t = out->textures[base];
+    t.flags |= ref.tex_coord == 1 ? GN_TEX_UV1 : 0u;
+    memcpy(t.transform, ref.transform, sizeof t.transform);
+    out->textures[out->num_textures] = t;
+    return out->num_textures++;
+}
+
+bool number_triple(const Json &v, float out[3])
+{
+    if (!v.is_array() || v.size() != 3)
+        return false;
+    for (size_t k = 0; k < 3; k++) {
+        if (!v[k].is_number())
+            return false;
+        out[k] = float(v[k].get<double>());
+    }
+    return true;
+}
+
+/* extras: {"gonio": {"brdf": NAME, PARAM: number, ..., "phong": {...}}} */
+void read_gonio_extras(Ctx &c, const Json &extras, const std::string &what, GnMaterial &g, scene_material_extras &x)
+{
+    if (!extras.is_object() || !extras.count("gonio"))
+        return;
+    const Json &go = extras["gonio"];
+    if (!go.is_object()) {
+        warn(c, "%s: extras.gonio is not an object (ignored)", what.c_str());
+        return;
+    }
+    for (auto it = go.begin(); it != go.end(); ++it) {
+        const std::string &key = it.key();
+        const Json &v = it.value();
+        if (key == "brdf") {
+            if (!v.is_string() || v.get_ref<const std::string &>().size() >= sizeof x.brdf)
+                warn(c, "%s: extras.gonio.brdf must be a name of at most %zu characters (ignored)", what.c_str(), sizeof x.brdf - 1);
+            else
+                snprintf(x.brdf, sizeof x.brdf, "%s", v.get_ref<const std::string &>().c_str());
+        } else if (key == "phong") {
+            if (!v.is_object()) {
+                warn(c, "%s: extras.gonio.phong is not an object (ignored)", what.c_str());
+                continue;
+            }
+            x.has_phong = true;
+            struct { const char *name; vec3 *dst; } cols[] = {{"ambient", &g.phong_ambient}, {"diffuse", &g.phong_diffuse},
+                                                              {"specular", &g.phong_specular}, {"emission", &g.phong_emission}};
+            for (auto &col : cols) {
+                float t[3];
+                if (!v.count(col.name))
+                    continue;
+                if (number_triple(v[col.name], t) && t[0] >= 0 && t[1] >= 0 && t[2] >= 0)
+                    *col.dst = vec3{t[0], t[1], t[2]};
+                else
+                    warn(c, "%s: extras.gonio.phong.%s must be 3 non-negative numbers (ignored)", what.c_str(), col.name);
+            }
+            if (v.count("shininess")) {
+                const Json &s = v["shininess"];
+                if (s.is_number() && s.get<double>() >= 0)
+                    g.phong_shininess = float(s.get<double>());
+                else
+                    warn(c, "%s: extras.gonio.phong.shininess must be a non-negative number (ignored)", what.c_str());
+            }
+        } else if (!v.is_number() || x.num_params == 8 || key.size() >= sizeof x.param_names[0]) {
+            warn(c, "%s: extras.gonio.%s ignored (parameters are up to 8 numbers with names of at most %zu characters)",
+                 what.c_str(), key.substr(0, 64).c_str(), sizeof x.param_names[0] - 1);
+        } else {
+            snprintf(x.param_names[x.num_params], sizeof x.param_names[0], "%s", key.c_str());
+            x.param_values[x.num_params++] = float(v.get<double>());
+        }
+    }
+}
+
+void load_materials(Ctx &c, scene *out)
+{
+    size_t n = c.materials.size();
+    bool need_default = false;
+    for (uint32_t t = 0; t < out->num_triangles; t++)
+        need_default |= out->tri_material[t] == n;
+    out->num_materials = uint32_t(n + (need_default ? 1 : 0));
+    out->materials = static_cast<GnMaterial *>(util_calloc(out->num_materials, sizeof(GnMaterial)));
+    out->material_extras = static_cast<scene_material_extras *>(util_calloc(out->num_materials, sizeof(scene_material_extras)));
+    out->material_names = static_cast<char(*)[64]>(util_calloc(out->num_materials, 64));
+    for (size_t i = 0; i < n; i++) {
+        const MaterialDraft &d = c.materials[i];
+        GnMaterial &g = out->materials[i];
+        g = d.g;
+#define RESOLVE_TEX(name, word, ext, json, space, gate, uses) g.name = texture_slot(c, d.tex[word], d.what, shown(json));
+        GN_MATERIAL(GN_MAT_NO_PARAM, RESOLVE_TEX, GN_MAT_NO_FIELD)
+#undef RESOLVE_TEX
+        scene_phong_from_pbr(&g);
+        read_gonio_extras(c, d.extras, d.what, g, out->material_extras[i]);
+        snprintf(out->material_names[i], 64, "%s", d.name.empty() ? ("material " + std::to_string(i)).c_str() : d.name.c_str());
+    }
+    if (need_default) {
+        scene_material_default(&out->materials[n]);
+        snprintf(out->material_names[n], 64, "default");
+    }
+}
+
+} // namespace gltf
+
+scene_support scene_extension_support(const char *name, const char **how)
+{
+    const gltf::Extension *e = gltf::find_extension(name);
+    *how = e ? e->how : "unknown to gonio";
+    return e ? e->support : SCENE_UNSUPPORTED;
+}
