@@ -739,12 +739,16 @@ TEST(brdf, lambert_albedo)
 }
 
 /* The directions bsdf_sample draws follow bsdf_pdf (chi-square, Sidak-corrected 1% level
- * over all cases); pdf integrates to the fraction of non-Dirac samples (1 where sampling
- * never fails); each sample's weight and pdf equal f cos / pdf and pdf at its wi; the mean
- * weight equals the quadrature of f cos; and that albedo is <= 1 (energy conservation). */
-TEST(brdf, sampling_matches_pdf)
+ * over all cases and angles of both tiers); pdf integrates to the fraction of non-Dirac
+ * samples (1 where sampling never fails); each sample's weight and pdf equal f cos / pdf and
+ * pdf at its wi; the mean weight equals the quadrature of f cos; and that albedo is <= 1
+ * (energy conservation). Every (case, angle) is one measurement of NSAMPLES samples, as
+ * before the split into tiers: the fast tier has every case at one angle from outside (40
+ * degrees) and, for the two-sided, one from inside (110); the slow tier the other angles
+ * (0, 75 and 160). Each check's level, and so its power, is what it was as one test. */
+static const double sampling_theta[] = {0, 40, 75, 110, 160};
+static void sampling_matches_pdf_at(bool slow_angles, unsigned seed)
 {
-    const double theta[] = {0, 40, 75, 110, 160};
     int tests = 0;
     if (!open_runner())
         return;
@@ -753,14 +757,17 @@ TEST(brdf, sampling_matches_pdf)
         make_setting(&cases[ci], &s);
         tests += brdf_setting_two_sided(&s) ? 5 : 3;
     }
-    rng_state = 4;
+    rng_state = seed;
     for (int ci = 0; ci < num_cases(); ci++) {
         brdf_setting s;
         make_setting(&cases[ci], &s);
         for (int t = 0; t < (brdf_setting_two_sided(&s) ? 5 : 3); t++) {
+            const double *theta = sampling_theta;
             const char *what = describe(&cases[ci]);
             char why[200];
             measure m;
+            if ((t == 1 || t == 3) == slow_angles)
+                continue;
             measure_case(&s, polar(rad(theta[t]), 1.0), true, 1, 1, &m);
             CHECKF(m.nonfinite == 0, "%s wo %.0f: %d NaN/Inf", what, theta[t], m.nonfinite);
             CHECKF(m.bad_samples == 0, "%s wo %.0f: %d samples whose weight or pdf disagree with eval/pdf", what,
@@ -772,21 +779,27 @@ TEST(brdf, sampling_matches_pdf)
     }
     close_runner();
 }
+TEST(brdf, sampling_matches_pdf) { sampling_matches_pdf_at(false, 4); }
+TEST_SLOW(brdf, sampling_matches_pdf_more_angles) { sampling_matches_pdf_at(true, 14); }
 
 /* Energy conservation from normal to grazing incidence (and from inside glass): the sampled
- * white-furnace albedo is <= 1 within its error. */
-TEST(brdf, energy)
+ * white-furnace albedo is <= 1 within its error. The fast tier has every case at 30 and
+ * 89.9 degrees (and 135 from inside), the slow tier the other angles, each as before. */
+static const double energy_theta[] = {0, 30, 60, 80, 85, 89, 89.9, 100, 135, 179};
+static void energy_at(bool slow_angles, unsigned seed)
 {
-    const double theta[] = {0, 30, 60, 80, 85, 89, 89.9, 100, 135, 179};
     if (!open_runner())
         return;
-    rng_state = 5;
+    rng_state = seed;
     for (int ci = 0; ci < num_cases(); ci++) {
         brdf_setting s;
         make_setting(&cases[ci], &s);
         for (int t = 0; t < (brdf_setting_two_sided(&s) ? 10 : 7); t++) {
+            const double *theta = energy_theta;
             measure m;
             char why[200];
+            if ((t == 1 || t == 6 || t == 8) == slow_angles)
+                continue;
             measure_case(&s, polar(rad(theta[t]), 2.0), false, 1, 1, &m);
             CHECKF(m.nonfinite == 0, "%s wo %.1f: %d NaN/Inf", describe(&cases[ci]), theta[t], m.nonfinite);
             CHECKF(check_energy(&m, false, why, sizeof why), "%s wo %.1f deg: %s", describe(&cases[ci]), theta[t],
@@ -795,6 +808,8 @@ TEST(brdf, energy)
     }
     close_runner();
 }
+TEST(brdf, energy) { energy_at(false, 5); }
+TEST_SLOW(brdf, energy_more_angles) { energy_at(true, 15); }
 
 /* The checks have teeth: a pdf scaled by 1.1 fails the chi-square and the normalisation, and
  * a Lambert without its 1/pi (f scaled by pi) fails energy conservation and the agreement of
