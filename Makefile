@@ -1,7 +1,7 @@
 # gonio: build, run, test, bench.
 #   make [config=release|debug|sanitize]   -> build/$(config)/gonio, linked as build/gonio
-#   make run | test | check-layers | test-farm | bench | bench-peer | bench-denoise | denoiser | docs-images
-#   make clean | install [PREFIX=/usr/local] [DESTDIR=]
+#   make run | test | test-slow | test-full | mutants | check-layers | test-farm | bench | bench-peer
+#   make bench-denoise | denoiser | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
 #   make fuzz (libFuzzer targets, clang, in build/fuzz) | fuzz-run [FUZZ_TIME=60]
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
 # is printed and make stops.
@@ -161,9 +161,9 @@ FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
 	echo 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n) { return 0; }' | \
 	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
 
-.PHONY: device-check all deps test-deps run test check-layers unit regress bench clean install shaders docs-images \
-	fuzz fuzz-deps fuzz-targets fuzz-run fuzz-partials test-farm bench-peer denoiser denoiser-if-possible \
-	bench-denoise
+.PHONY: all deps test-deps run test test-build test-slow test-full mutants check-layers unit regress \
+	bench clean install shaders docs-images fuzz fuzz-deps fuzz-targets fuzz-run fuzz-partials test-farm \
+	bench-peer denoiser denoiser-if-possible bench-denoise device-check
 all: $(GONIO) build/gonio
 
 deps:
@@ -222,8 +222,20 @@ run: all
 	@mkdir -p out
 	$(GONIO) render scenes/cornell.gltf -o out/cornell.exr --png out/cornell.png
 
-test: check-layers all $(UNIT) $(TESTTOOL) test-deps denoiser-if-possible
-	@GONIO=$(GONIO) UNIT=$(UNIT) TESTTOOL=$(TESTTOOL) CONFIG=$(config) tests/run.sh
+# The tests in two tiers (tests/README.md): make test is the fast one (at most 5 minutes on
+# 2 cores), test-slow the rest, test-full both. TESTS=NAME... runs only the jobs whose names
+# contain a NAME (unit/brdf, regress/path.sh, ...); TEST_JOBS=N runs N at once (default: the CPUs).
+TEST_ENV = GONIO=$(GONIO) UNIT=$(UNIT) TESTTOOL=$(TESTTOOL) CONFIG=$(config)
+test-build: check-layers all $(UNIT) $(TESTTOOL) test-deps denoiser-if-possible
+test: test-build
+	@$(TEST_ENV) tests/run.sh --tier fast $(TESTS)
+test-slow: test-build
+	@$(TEST_ENV) tests/run.sh --tier slow $(TESTS)
+test-full: test-build
+	@$(TEST_ENV) tests/run.sh --tier full $(TESTS)
+# Deliberate bugs, each built in a scratch copy, that the fast tier must catch (tests/mutants.sh).
+mutants: test-build
+	@config=$(config) tests/mutants.sh $(TESTS)
 
 # Intel Open Image Denoise 2 for `render --denoise` and `gonio denoise` (src/core/denoise.h,
 # docs/denoise.md). Debian 12 packages no OIDN 2: its CPU libraries (the RT filter's

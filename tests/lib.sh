@@ -1,26 +1,72 @@
 # lib.sh: helpers for the regression scripts (sourced). Each script counts checks with
 # pass/fail, and ends with `finish`, which prints "NAME: N passed, N failed" and exits.
+# A check whose command takes longer than the budget of a test (10 s, tests/README.md)
+# prints a note with its time.
 set -u
 name=$(basename "$0" .sh)
 n_pass=0
 n_fail=0
-tmp=${TEST_TMP:-$(mktemp -d)}/$name
+tmp=${TEST_TMP:-$(mktemp -d)}/$(basename "$(dirname "$0")")/$name
 mkdir -p "$tmp"
+TEST_BUDGET_S=10
 pass() { n_pass=$((n_pass + 1)); }
 fail() { n_fail=$((n_fail + 1)); echo "  FAIL: $*"; }
+# over_budget WHAT T0: the note for a check that started at $EPOCHREALTIME T0, if it was slow.
+over_budget() {
+    awk -v a="$2" -v b="$EPOCHREALTIME" -v lim=$TEST_BUDGET_S -v what="$1" \
+        'BEGIN { if (b - a > lim) printf "  note: \"%s\" took %.1f s, over the %d s budget of a test (tests/README.md)\n", what, b - a, lim }'
+}
 check() { # check DESCRIPTION COMMAND...: passes when the command succeeds
-    local what=$1; shift
+    local what=$1 t0=$EPOCHREALTIME; shift
     if "$@" >"$tmp/out" 2>&1; then pass; else fail "$what"; sed 's/^/    /' "$tmp/out" | tail -n 20; fi
+    over_budget "$what" "$t0"
 }
 check_fails() { # check_fails DESCRIPTION EXPECTED_STATUS COMMAND...
-    local what=$1 want=$2; shift 2
+    local what=$1 want=$2 t0=$EPOCHREALTIME; shift 2
     "$@" >"$tmp/out" 2>&1
     local got=$?
     cp "$tmp/out" "$tmp/last" # what the command printed, for checks that follow
     if [ "$got" = "$want" ]; then pass; else fail "$what (exit $got, expected $want)"; sed 's/^/    /' "$tmp/out" | tail -n 20; fi
+    over_budget "$what" "$t0"
 }
 skip_all() { echo "  skipped: $*"; exit 77; }
+# in_tier fast|slow: whether this run has that tier's checks ($GONIO_TEST_TIER, which
+# tests/run.sh sets: fast, slow or full; a script run by hand has both). A script with slow
+# checks puts them under `if in_tier slow; then`, and tests/run.sh runs it in the slow tier
+# too; its fast checks go under `if in_tier fast; then` (tests/README.md).
+in_tier() {
+    case ${GONIO_TEST_TIER:-full} in full) return 0 ;; "$1") return 0 ;; *) return 1 ;; esac
+}
 finish() {
     echo "$name: $n_pass passed, $n_fail failed"
     [ "$n_fail" = 0 ]
+}
+
+# fixture NAME COMMAND...: the path of a file that several scripts use, made once a run.
+# COMMAND makes it, with the first {} in its arguments standing for the file it writes
+# (a name with NAME's extension); it runs in
+# the first script that asks, under a lock, while the others wait for it. Prints the path;
+# a COMMAND that fails (or writes nothing) makes every asker fail, with its output.
+# $TEST_FIXTURES is the run's fixture folder (tests/run.sh); a script run alone gets its own.
+fixture() {
+    local fname=$1; shift
+    local dir=${TEST_FIXTURES:-${TEST_TMP:-$tmp}/fixtures}
+    local f=$dir/$fname part=$dir/.part-$fname args=() a done_=0
+    for a in "$@"; do
+        if [ $done_ = 0 ] && [ "$a" = "{}" ]; then args+=("$part"); done_=1; else args+=("$a"); fi
+    done
+    mkdir -p "$dir"
+    (
+        flock 9
+        [ -e "$f" ] && exit 0
+        [ -e "$f.failed" ] && { cat "$f.failed" >&2; exit 1; }
+        if "${args[@]}" >"$f.log" 2>&1 && [ -s "$part" ]; then
+            mv "$part" "$f"
+        else
+            { echo "fixture $fname: '${args[*]}' failed:"; cat "$f.log"; } >"$f.failed"
+            cat "$f.failed" >&2
+            exit 1
+        fi
+    ) 9>"$f.lock" || return 1
+    echo "$f"
 }

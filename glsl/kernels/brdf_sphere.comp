@@ -5,6 +5,13 @@
 // one path per pixel per dispatch, accumulated. Uses the renderer's brdf_material.glsl.
 #extension GL_GOOGLE_include_directive : require
 
+// Specialised on its material's features (src/cli/cmd_brdf.c: material_features), as the
+// renderer's kernels are: llvmpipe runs both sides of every branch and compiles all of them.
+#define GN_HAS(f) (((FEATURES & (f).x) | (FEATURES_HI & (f).y)) != 0u)
+#include "shared.h"
+layout(constant_id = GN_SPEC_FEATURES) const uint FEATURES = 0xffffffffu;    // GN_FEAT_* bits 0-31
+layout(constant_id = GN_SPEC_FEATURES_HI) const uint FEATURES_HI = 0xffffffffu; // ... 32-63
+
 // The ball's material has no textures (every slot GN_INVALID): no lookup is ever made.
 #define MATERIAL_TEXTURE(index, uv, srgb) vec4(1.0)
 #include "brdf_material.glsl"

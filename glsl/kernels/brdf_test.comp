@@ -3,7 +3,16 @@
 // queries (one per invocation) so the unit tests and `gonio brdf` measure the shader code
 // itself: eval and pdf at given directions, sample with given random numbers, and the
 // Fresnel functions (BrdfQuery/BrdfResult in brdf_models.h).
+// Specialised, as the renderer's kernels are, on the GN_FEAT_* that a batch's queries need
+// (src/render/brdf.c: brdf_query_features): llvmpipe runs both sides of a branch, so the code
+// of every model a query does not use would cost it as much time as its own (20 times a
+// Lambert's). Every bit set (GONIO_ALL_FEATURES) is the unspecialised kernel.
 #extension GL_GOOGLE_include_directive : require
+
+#define GN_HAS(f) (((FEATURES & (f).x) | (FEATURES_HI & (f).y)) != 0u)
+#include "shared.h"
+layout(constant_id = GN_SPEC_FEATURES) const uint FEATURES = 0xffffffffu;    // GN_FEAT_* bits 0-31
+layout(constant_id = GN_SPEC_FEATURES_HI) const uint FEATURES_HI = 0xffffffffu; // ... 32-63
 
 // The queries' materials have no textures (every slot GN_INVALID): no lookup is ever made.
 #define MATERIAL_TEXTURE(index, uv, srgb) vec4(1.0)

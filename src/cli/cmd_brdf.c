@@ -13,6 +13,7 @@
 #include "cli.h"
 #include "draw.h"
 #include "image.h"
+#include "render_material.h"
 #include "util.h"
 #include "vec.h"
 
@@ -299,7 +300,7 @@ static void run_albedo(brdf_runner *r, const brdf_setting *s)
 static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char *png, int w, int h, int spp)
 {
     BrdfQuery q;
-    BrdfSphere scene;
+    BrdfSphere ball;
     gpu_buffer sbuf, accum, sheen;
     gpu_pipeline p;
     image img;
@@ -308,16 +309,16 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
     vec4 *px = util_malloc(sizeof *px * (size_t)w * (size_t)h);
     bool ok = true;
     memset(&q, 0, sizeof q);
-    memset(&scene, 0, sizeof scene);
+    memset(&ball, 0, sizeof ball);
     brdf_setting_to_query(s, &q);
-    scene.material = q.material;
-    scene.light_dir = (vec3){-0.5f / 0.9718f, 0.6f / 0.9718f, 0.55f / 0.9718f}; /* upper left, front */
-    scene.light_irradiance = (vec3){2.5f, 2.5f, 2.5f};
-    scene.env = (vec3){0.3f, 0.3f, 0.3f};
-    scene.width = (uint32_t)w;
-    scene.height = (uint32_t)h;
-    scene.max_depth = 8;
-    gpu_buffer_create_storage(g, &sbuf, &scene, sizeof scene);
+    ball.material = q.material;
+    ball.light_dir = (vec3){-0.5f / 0.9718f, 0.6f / 0.9718f, 0.55f / 0.9718f}; /* upper left, front */
+    ball.light_irradiance = (vec3){2.5f, 2.5f, 2.5f};
+    ball.env = (vec3){0.3f, 0.3f, 0.3f};
+    ball.width = (uint32_t)w;
+    ball.height = (uint32_t)h;
+    ball.max_depth = 8;
+    gpu_buffer_create_storage(g, &sbuf, &ball, sizeof ball);
     gpu_buffer_create(g, &accum, sizeof *px * (VkDeviceSize)w * (VkDeviceSize)h, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
                       GPU_MEMORY_HOST);
     gpu_buffer_fill_zero(g, &accum);
@@ -327,9 +328,16 @@ static int run_sphere(gpu *g, const brdf_setting *s, const char *out, const char
         const gpu_binding bind[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &sbuf},
                                     {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &accum},
                                     {BRDF_BIND_SHEEN, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &sheen}};
+        /* the kernel specialised on the material's features, as the renderer's are (every
+         * feature with GONIO_ALL_FEATURES, which the tests compare it with) */
+        GnFeatures features = getenv("GONIO_ALL_FEATURES") ? GN_FEAT_ALL : material_features(&ball.material);
+        const uint32_t words[2] = {(uint32_t)features, (uint32_t)(features >> 32)};
+        const VkSpecializationMapEntry entries[2] = {{GN_SPEC_FEATURES, 0, sizeof(uint32_t)},
+                                                     {GN_SPEC_FEATURES_HI, sizeof(uint32_t), sizeof(uint32_t)}};
+        VkSpecializationInfo spec = {2, entries, sizeof words, words};
         gpu_pipeline_desc pd = {.name = "brdf_sphere", .code = spv_brdf_sphere, .code_size = sizeof spv_brdf_sphere,
                                 .local_size = {GN_TILE_X, GN_TILE_Y, 1}, .push_size = sizeof(GnPush),
-                                .bindings = bind, .num_bindings = 3};
+                                .bindings = bind, .num_bindings = 3, .specialization = &spec};
         gpu_pipeline_create(g, &p, &pd);
     }
     /* a few samples per submission keeps every dispatch short (GPU watchdogs) */

@@ -83,12 +83,23 @@ void brdf_format_setting(char *out, size_t cap, const brdf_setting *s);
 #define BRDF_TITLE_PARAMS 8
 void brdf_format_title(char *out, size_t cap, const brdf_setting *s);
 
-/* Batches BrdfQuery records through brdf_test.comp. */
+/* The GN_FEAT_* the kernel needs for query q (brdf_test.comp is specialised on them, as
+ * the renderer's kernels are): its material's (material_features); every feature for the
+ * Fresnel queries. */
+GnFeatures brdf_query_features(const BrdfQuery *q);
+
+/* Batches BrdfQuery records through brdf_test.comp, a kernel specialised on the features of
+ * each batch's queries (one pipeline kept per feature set, BRDF_RUNNER_KERNELS at most), or
+ * the unspecialised kernel where all_features is set (GONIO_ALL_FEATURES, or a test). */
+#define BRDF_RUNNER_KERNELS 32
 typedef struct brdf_runner {
     gpu *g;
     gpu_buffer queries, results, sheen;
-    gpu_pipeline pipeline;
+    gpu_pipeline pipelines[BRDF_RUNNER_KERNELS];
+    GnFeatures features[BRDF_RUNNER_KERNELS]; /* pipelines[i]'s, when its pipeline exists */
+    uint32_t next;                          /* the slot the next new kernel replaces */
     uint32_t capacity;
+    bool all_features;
 } brdf_runner;
 
 /* capacity: queries per dispatch (buffers of sizeof(BrdfQuery) and sizeof(BrdfResult) bytes per query). */

@@ -4,6 +4,35 @@
 . "$(dirname "$0")/../lib.sh"
 G=$GONIO
 C=$PWD/scenes/cornell.gltf
+# wait_for FILE PATTERN: until FILE has a line matching PATTERN (at most 60 s).
+wait_for() { for _ in $(seq 600); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
+
+# ---- the slow tier (lib.sh: in_tier) ---------------------------------------------------------
+if in_tier slow; then
+    # compare.sh sweeps the built-in teapot in the fast tier, and the commands run from
+    # elsewhere below show that nothing reads the source tree
+    mkdir -p "$tmp/elsewhere-slow"
+    check "compare --sweep, elsewhere" sh -c \
+        "cd '$tmp/elsewhere-slow' && exec '$G' compare --sweep 1,2 teapot -o sweep --size 16x16 --quiet"
+    # ...and while the image is being written (a large one): the temporary file is removed.
+    "$G" render $C -o "$tmp/big.exr" --size 6000x6000 --mode depth --time 60 2>"$tmp/b.err" &
+    pid=$!
+    wait_for "$tmp/b.err" 'spp'
+    kill -INT $pid
+    for _ in $(seq 2000); do ls -a "$tmp" | grep -q '\.big\.exr\.tmp-' && break; sleep 0.005; done
+    if ls -a "$tmp" | grep -q '\.big\.exr\.tmp-'; then
+        kill -INT $pid
+        wait $pid
+        rc=$?
+        check "SIGINT during the write: exit 130 (got $rc)" test $rc = 130
+        check "SIGINT during the write: no output, no temporary file" \
+            sh -c "! ls -a '$tmp' | grep -q 'big\.exr'"
+    else
+        wait $pid
+        echo "  note: the write ended before it could be interrupted: not checked"
+    fi
+fi
+in_tier fast || { finish; exit; }
 
 # ---- --opt=value --------------------------------------------------------------------------
 # The same command in both forms gives the same bits.
@@ -119,7 +148,6 @@ cd "$tmp/elsewhere" && {
     check "devices, elsewhere" "$G" devices
     check "brdf --sphere, elsewhere" "$G" brdf lambert --sphere -o b.exr --size 16x16 --spp 1
     check "compare, elsewhere" "$G" compare c.gltf -o cmp --size 16x16 --spp 1 --modes flat,phong --quiet
-    check "compare --sweep, elsewhere" "$G" compare --sweep 1,2 teapot -o sweep --size 16x16 --quiet
     cd - >/dev/null
 }
 
@@ -199,8 +227,6 @@ else
 fi
 
 # ---- interrupts ---------------------------------------------------------------------------
-# wait_for FILE PATTERN: until FILE has a line matching PATTERN (at most 60 s).
-wait_for() { for _ in $(seq 600); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
 # SIGINT (or SIGTERM) once: the render ends after its pass, writes what it has, exits 128 + N.
 for sig in INT TERM; do
     want=$((128 + $(kill -l $sig)))
@@ -229,23 +255,6 @@ kill -INT $pid
 wait $pid
 check "SIGINT twice: exit 130 (got $?)" test $? = 130
 check "SIGINT twice: no output" test ! -e "$tmp/i.exr"
-# ...and while the image is being written (a large one): the temporary file is removed.
-"$G" render $C -o "$tmp/big.exr" --size 6000x6000 --mode depth --time 60 2>"$tmp/b.err" &
-pid=$!
-wait_for "$tmp/b.err" 'spp'
-kill -INT $pid
-for _ in $(seq 2000); do ls -a "$tmp" | grep -q '\.big\.exr\.tmp-' && break; sleep 0.005; done
-if ls -a "$tmp" | grep -q '\.big\.exr\.tmp-'; then
-    kill -INT $pid
-    wait $pid
-    rc=$?
-    check "SIGINT during the write: exit 130 (got $rc)" test $rc = 130
-    check "SIGINT during the write: no output, no temporary file" \
-        sh -c "! ls -a '$tmp' | grep -q 'big\.exr'"
-else
-    wait $pid
-    echo "  note: the write ended before it could be interrupted: not checked"
-fi
 
 check "no output after usage errors" test ! -e "$tmp/x.exr"
 finish

@@ -6,6 +6,9 @@
 G=$GONIO
 C=scenes/cornell.gltf
 
+# The fast tier has one case of each kind below; the slow tier (lib.sh: in_tier) the same
+# checks on more models, scenes and settings.
+if in_tier fast; then
 check "path is the default mode" "$G" render $C -o "$tmp/d.exr" --spp 2 --size 32x32 --quiet
 exrheader "$tmp/d.exr" >"$tmp/hdr.txt" 2>&1
 check "mode recorded as path" grep -q 'gonio:mode (type string): "path"' "$tmp/hdr.txt"
@@ -16,15 +19,27 @@ check "variance channels written" grep -q 'variance.R,' "$tmp/hdr.txt"
 check_fails "an unknown BRDF model is a usage error" 2 "$G" render $C -o "$tmp/x.exr" --brdf nosuch --quiet
 check "the message names the models" grep -q 'torrance-sparrow' "$tmp/last"
 check_fails "a missing environment map fails" 1 "$G" render $C -o "$tmp/x.exr" --env "$tmp/none.exr" --quiet
+fi
+# (an environment map for the checks below, in the slow tier alone too)
+[ -e "$tmp/d.exr" ] || "$G" render $C -o "$tmp/d.exr" --spp 2 --size 32x32 --quiet
+
+# base SCENE FLAGS...: the path of SCENE's render as it is (3 spp, 24x24, FLAGS), made once
+# in this script (with GONIO_WALK_ARRAY as set now): the checks below compare several
+# variants of a render against it.
+base() {
+    local f=$tmp/base-$(printf '%s\n' "${GONIO_WALK_ARRAY:-}" "$@" | md5sum | cut -c1-16).exr
+    [ -e "$f" ] || "$G" render "$1" -o "$f" --spp 3 --size 24x24 --quiet "${@:2}" || return 1
+    echo "$f"
+}
 
 # same_pixels WHAT ENV NAME SCENE FLAGS...: a render as it is and one with the environment
 # assignment ENV must give identical pixels; the check is named "WHAT: NAME".
 same_pixels() {
-    local what=$1 env=$2 name=$3 scene=$4; shift 4
-    if "$G" render "$scene" -o "$tmp/one.exr" --spp 3 --size 24x24 --quiet "$@" 2>"$tmp/spec.err" &&
+    local what=$1 env=$2 name=$3 scene=$4 one; shift 4
+    if one=$(base "$scene" "$@" 2>"$tmp/spec.err") &&
         env "$env" "$G" render "$scene" -o "$tmp/two.exr" --spp 3 --size 24x24 --quiet "$@" \
             2>>"$tmp/spec.err"; then
-        check_fails "$what: $name" 0 "$G" diff "$tmp/one.exr" "$tmp/two.exr" --max-error 0
+        check_fails "$what: $name" 0 "$G" diff "$one" "$tmp/two.exr" --max-error 0
     else
         fail "$what: $name (render failed)"; sed 's/^/    /' "$tmp/spec.err"
     fi
@@ -36,37 +51,72 @@ same_pixels() {
 # estimator, the AOVs, both kinds of environment, and sample models with textures, normal
 # maps, glass, punctual lights and vertex colours.
 same_as_unspecialised() { same_pixels "specialised = unspecialised" GONIO_ALL_FEATURES=1 "$@"; }
-same_as_unspecialised "Cornell box" $C
+# Fast: a lobe of each kind (diffuse, glossy, rough glass, Dirac conductor, glTF's layers);
+# slow: every other model of the table and glTF setting.
 models=$("$G" brdf --list | cut -d' ' -f1) # every model of the table, at its defaults
-check "brdf --list names models" test -n "$models"
-for model in $models conductor:alpha=0 dielectric:alpha=0.3 \
-    gltf:metallic=0.5:roughness=0.02 gltf:transmission=1:roughness=0.4 \
-    gltf:roughness=0.4:clearcoat=1:clearcoat-roughness=0.2:sheen-color=0.6,0.4,0.2:sheen-roughness=0.5 \
-    gltf:roughness=0:metallic=1:clearcoat=0.7; do
-    same_as_unspecialised "--brdf $model" $C --brdf "$model" --env 0.2
-done
-same_as_unspecialised "light sampling only" $C --estimator light
-same_as_unspecialised "BSDF sampling only" $C --estimator bsdf
-same_as_unspecialised "AOVs" $C --aov albedo,normal,depth,variance
-same_as_unspecialised "an environment map" scenes/teapot.gltf --env "$tmp/d.exr"
+fast_models="lambert ggx conductor:alpha=0 dielectric:alpha=0.3
+    gltf:roughness=0.4:clearcoat=1:clearcoat-roughness=0.2:sheen-color=0.6,0.4,0.2:sheen-roughness=0.5"
 A=${GONIO_ASSETS:-}/gltf
-for m in DamagedHelmet TransmissionRoughnessTest LightsPunctualLamp NormalTangentTest; do
-    f=$A/$m/glTF/$m.gltf
-    [ -f "$f" ] && same_as_unspecialised "$m" "$f" --env 0.5
-done
-f=${GONIO_ASSETS:-}/asset-generator/Material_MetallicRoughness/Material_MetallicRoughness_01.gltf
-[ -f "$f" ] && same_as_unspecialised "vertex colours (Asset Generator)" "$f" --env 0.5
+if in_tier fast; then
+    same_as_unspecialised "Cornell box" $C
+    check "brdf --list names models" test -n "$models"
+    for model in $fast_models; do
+        same_as_unspecialised "--brdf $model" $C --brdf "$model" --env 0.2
+    done
+    same_as_unspecialised "light sampling only" $C --estimator light
+    same_as_unspecialised "BSDF sampling only" $C --estimator bsdf
+    same_as_unspecialised "AOVs" $C --aov albedo,normal,depth,variance
+    same_as_unspecialised "an environment map" scenes/teapot.gltf --env "$tmp/d.exr"
+    # textures and normal maps; punctual lights
+    for m in DamagedHelmet LightsPunctualLamp; do
+        f=$A/$m/glTF/$m.gltf
+        [ -f "$f" ] && same_as_unspecialised "$m" "$f" --env 0.5
+    done
+    f=${GONIO_ASSETS:-}/asset-generator/Material_MetallicRoughness/Material_MetallicRoughness_01.gltf
+    [ -f "$f" ] && same_as_unspecialised "vertex colours (Asset Generator)" "$f" --env 0.5
+fi
+if in_tier slow; then
+    for model in $models conductor:alpha=0 dielectric:alpha=0.3 \
+        gltf:metallic=0.5:roughness=0.02 gltf:transmission=1:roughness=0.4 \
+        gltf:roughness=0.4:clearcoat=1:clearcoat-roughness=0.2:sheen-color=0.6,0.4,0.2:sheen-roughness=0.5 \
+        gltf:roughness=0:metallic=1:clearcoat=0.7; do
+        case " $(echo $fast_models) " in *" $model "*) continue ;; esac
+        same_as_unspecialised "--brdf $model" $C --brdf "$model" --env 0.2
+    done
+    for m in TransmissionRoughnessTest NormalTangentTest; do
+        f=$A/$m/glTF/$m.gltf
+        [ -f "$f" ] && same_as_unspecialised "$m" "$f" --env 0.5
+    done
+    # gonio brdf --sphere's kernel is specialised on its material by the same rule
+    # (material_features; the fast tier's unit test brdf.specialised_same checks that rule on
+    # the BSDF queries): the same pixels as the unspecialised kernel.
+    k=0
+    for m in "lambert" "dielectric --alpha 0.3" "conductor" \
+        "gltf --roughness 0.4 --clearcoat 1 --sheen-color 0.6,0.4,0.2 --anisotropy 0.5 --iridescence 0.5 --transmission 0.5"; do
+        k=$((k + 1))
+        if "$G" brdf $m --sphere -o "$tmp/ball$k.exr" --size 32x32 --spp 4 2>"$tmp/ball.err" &&
+            GONIO_ALL_FEATURES=1 "$G" brdf $m --sphere -o "$tmp/ball$k-all.exr" --size 32x32 --spp 4 2>>"$tmp/ball.err"; then
+            check_fails "brdf --sphere specialised = unspecialised: $m" 0 "$G" diff "$tmp/ball$k.exr" "$tmp/ball$k-all.exr" --max-error 0
+        else
+            fail "brdf --sphere $m (render failed)"; sed 's/^/    /' "$tmp/ball.err"
+        fi
+    done
+fi
 
 # The walk keeps its stack in registers for trees of up to GN_WALK_REGS_MAX levels
 # (glsl/lib/bvh.glsl): every pixel must be what the stack in memory gives (GONIO_WALK_ARRAY=1),
 # in the path kernel and the local modes.
 same_as_stack_array() { same_pixels "stack in registers = in memory" GONIO_WALK_ARRAY=1 "$@"; }
-d=$("$G" info $C | awk '$1 == "bvh" && $2 == "depth" {print $3}')
-check "the Cornell box's tree is shallow enough for the register stack (depth $d <= 8)" test "$d" -le 8
-same_as_stack_array "Cornell box" $C
-same_as_stack_array "Cornell box, light sampling only" $C --estimator light
-same_as_stack_array "Cornell box, --mode phong" $C --mode phong
-same_as_stack_array "Cornell box, --mode gouraud" $C --mode gouraud
+if in_tier fast; then
+    d=$("$G" info $C | awk '$1 == "bvh" && $2 == "depth" {print $3}')
+    check "the Cornell box's tree is shallow enough for the register stack (depth $d <= 8)" test "$d" -le 8
+    same_as_stack_array "Cornell box" $C
+    same_as_stack_array "Cornell box, --mode phong" $C --mode phong
+fi
+if in_tier slow; then
+    same_as_stack_array "Cornell box, light sampling only" $C --estimator light
+    same_as_stack_array "Cornell box, --mode gouraud" $C --mode gouraud
+fi
 
 # llvmpipe's loop cap: a path whose walk runs out of its SIMD group's loop passes is saved
 # and finished by the next dispatch (docs/architecture.md). With the cap lowered
@@ -75,11 +125,11 @@ same_as_stack_array "Cornell box, --mode gouraud" $C --mode gouraud
 # every pixel and AOV must be what the render at the normal cap gives, and resuming must
 # really have happened (GONIO_DEBUG_RESUMES).
 same_interrupted() {
-    local name=$1 scene=$2; shift 2
-    if "$G" render "$scene" -o "$tmp/one.exr" --spp 3 --size 24x24 --quiet "$@" 2>"$tmp/cap.err" &&
+    local name=$1 scene=$2 one; shift 2
+    if one=$(base "$scene" "$@" 2>"$tmp/cap.err") &&
         env GONIO_LOOP_CAP=3000 GONIO_DEBUG_RESUMES=1 "$G" render "$scene" -o "$tmp/two.exr" \
             --spp 3 --size 24x24 --quiet "$@" 2>>"$tmp/cap.err"; then
-        check "interrupted paths = whole paths: $name" "$TESTTOOL" same "$tmp/one.exr" "$tmp/two.exr"
+        check "interrupted paths = whole paths: $name" "$TESTTOOL" same "$one" "$tmp/two.exr"
         n=$(sed -n 's/^gonio: debug: \([0-9]*\) dispatch.*/\1/p' "$tmp/cap.err")
         check "... and some were interrupted ($name: ${n:-no} resuming dispatches)" test "${n:-0}" -gt 0
         check "... none cut short ($name)" sh -c "! grep -q 'internal error\|cut short' '$tmp/cap.err'"
@@ -87,21 +137,28 @@ same_interrupted() {
         fail "interrupted paths: $name (render failed)"; sed 's/^/    /' "$tmp/cap.err"
     fi
 }
-same_interrupted "Cornell box" $C
-same_interrupted "Cornell box, AOVs" $C --aov albedo,normal,depth,variance
-same_interrupted "Cornell box, environment, --max-depth 6" $C --env 0.3 --max-depth 6 --seed 5
-GONIO_WALK_ARRAY=1 same_interrupted "Cornell box, GONIO_WALK_ARRAY=1" $C
-same_interrupted "teapot, an environment map" scenes/teapot.gltf --env "$tmp/d.exr"
-same_interrupted "teapot, glass" scenes/teapot.gltf --camera 0 --brdf dielectric
-for m in DamagedHelmet LightsPunctualLamp TransmissionTest; do
-    f=$A/$m/glTF/$m.gltf
-    [ -f "$f" ] && same_interrupted "$m" "$f" --env 0.5
-done
-# The teapot's glass paths inside it once ran out of their walk budget and were cut short
-# (a warning, and pixels too dark); now none is.
-check_fails "the teapot from its camera" 0 "$G" render scenes/teapot.gltf --camera 0 --spp 64 \
-    --size 128x128 -o "$tmp/teapot.exr"
-check "... warns of nothing" sh -c "! grep -q warning '$tmp/last'"
+if in_tier fast; then
+    same_interrupted "Cornell box" $C
+    same_interrupted "Cornell box, AOVs" $C --aov albedo,normal,depth,variance
+    GONIO_WALK_ARRAY=1 same_interrupted "Cornell box, GONIO_WALK_ARRAY=1" $C
+    same_interrupted "teapot, glass" scenes/teapot.gltf --camera 0 --brdf dielectric
+    f=$A/DamagedHelmet/glTF/DamagedHelmet.gltf
+    [ -f "$f" ] && same_interrupted "DamagedHelmet" "$f" --env 0.5
+fi
+if in_tier slow; then
+    same_interrupted "Cornell box, environment, --max-depth 6" $C --env 0.3 --max-depth 6 --seed 5
+    same_interrupted "teapot, an environment map" scenes/teapot.gltf --env "$tmp/d.exr"
+    for m in LightsPunctualLamp TransmissionTest; do
+        f=$A/$m/glTF/$m.gltf
+        [ -f "$f" ] && same_interrupted "$m" "$f" --env 0.5
+    done
+    # The teapot's glass paths inside it once ran out of their walk budget and were cut short
+    # (a warning, and pixels too dark); now none is (the fast tier: "teapot, glass" above).
+    check_fails "the teapot from its camera" 0 "$G" render scenes/teapot.gltf --camera 0 --spp 64 \
+        --size 128x128 -o "$tmp/teapot.exr"
+    check "... warns of nothing" sh -c "! grep -q warning '$tmp/last'"
+fi
+in_tier fast || { finish; exit; }
 
 # Ctrl-C: the render stops after the current pass, writes what it has and exits 130.
 "$G" render $C -o "$tmp/int.exr" --time 60 --size 32x32 --quiet &

@@ -12,6 +12,7 @@
  *   testtool ktx2 MODE IN.png OUT.ktx2 [rg]   a KTX2 image by Basis Universal's encoder
  *   testtool texels IMAGE REF.png CHANNELS MAX_ERR MAX_RMSE   a WebP or KTX2 image as gonio
  *                                      decodes it, against the PNG it was made from
+ *   testtool at IN.exr CHANNEL X Y [X Y...]  the channel's value at each pixel, a line each
  */
 #include <math.h>
 #include <stdio.h>
@@ -404,22 +405,26 @@ done:
     return rc;
 }
 
-/* Prints channel `name` of pixel (x, y) with %.9g. */
-static int print_value(const char *in, const char *name, int x, int y)
+/* The value of channel `name` at each pixel (x, y) of xy (n pairs), a line each: one read of
+ * the file for the many pixels a probe checks. */
+static int print_values(const char *in, const char *name, char **xy, int n)
 {
     image a;
-    int c;
+    int c, rc = 0;
     if (!image_read_exr(&a, in))
         return 1;
     c = image_channel(&a, name);
-    if (c < 0 || x < 0 || y < 0 || x >= a.width || y >= a.height) {
-        fprintf(stderr, "%s: no channel %s or pixel (%d, %d)\n", in, name, x, y);
-        image_destroy(&a);
-        return 1;
+    for (int i = 0; i < n && rc == 0; i++) {
+        int x = atoi(xy[2 * i]), y = atoi(xy[2 * i + 1]);
+        if (c < 0 || x < 0 || y < 0 || x >= a.width || y >= a.height) {
+            fprintf(stderr, "%s: no channel %s or pixel (%d, %d)\n", in, name, x, y);
+            rc = 1;
+        } else {
+            printf("%.9g\n", a.planes[c][(size_t)y * (size_t)a.width + (size_t)x]);
+        }
     }
-    printf("%.9g\n", a.planes[c][(size_t)y * (size_t)a.width + (size_t)x]);
     image_destroy(&a);
-    return 0;
+    return rc;
 }
 
 /* Per channel of R, G, B over the whole image: the mean and the centroid's x (the
@@ -598,8 +603,8 @@ int main(int argc, char **argv)
         return rgb_stats(argv[2]);
     if (argc == 3 && !strcmp(argv[1], "moments"))
         return moments(argv[2]);
-    if (argc == 6 && !strcmp(argv[1], "at"))
-        return print_value(argv[2], argv[3], atoi(argv[4]), atoi(argv[5]));
+    if (argc >= 6 && argc % 2 == 0 && !strcmp(argv[1], "at"))
+        return print_values(argv[2], argv[3], argv + 4, (argc - 4) / 2);
     if (argc == 5 && !strcmp(argv[1], "png") && (!strcmp(argv[2], "depth") || !strcmp(argv[2], "normal")))
         return check_png(argv[2], argv[3], argv[4]);
     if (argc == 4 && !strcmp(argv[1], "png")) { /* IN.exr -> OUT.png as render --png writes it */
@@ -629,7 +634,7 @@ int main(int argc, char **argv)
                          argc == 8 ? atof(argv[7]) : 0.0);
     fprintf(stderr, "usage: testtool scene NAME OUT.gltf | testtool compress draco|meshopt IN.gltf OUT.gltf | testtool ref NAME depth|normal W H OUT.exr\n"
                     "       testtool png depth|normal PNG REF.exr | testtool pick IN.exr CHANNEL OUT.exr\n"
-                    "       testtool at IN.exr CHANNEL X Y | testtool same WHOLE.exr PART.exr | testtool rgb IN.exr\n"
+                    "       testtool at IN.exr CHANNEL X Y [X Y...] | testtool same WHOLE.exr PART.exr | testtool rgb IN.exr\n"
                     "       testtool moments IN.exr | testtool rename IN.exr OUT.exr OLD=NEW,OLD2=,...\n"
                     "       testtool poke IN.exr CHANNEL X Y VALUE OUT.exr | testtool errors TEST.exr REF.exr\n"
                     "       testtool png IN.exr OUT.png\n"

@@ -42,15 +42,19 @@ bool test_open_gpu(struct gpu *g);
 
 /* TEST(suite, name) { ... } defines a test and registers it (a constructor runs before
  * main), so a test is written in one place: tests/unit/test_SUITE.c. They run in the order
- * of their files' names, and in a file in the order they are written. */
+ * of their files' names, and in a file in the order they are written. TEST_SLOW is the
+ * same for a test of the slow tier (make test-full; tests/README.md): one that cannot be
+ * made to fit the fast tier's budget of 10 s. */
 typedef void (*test_fn)(void);
-void test_register(const char *suite, const char *name, test_fn fn, const char *file, int line);
-#define TEST(suite, name)                                                                  \
+void test_register(const char *suite, const char *name, test_fn fn, const char *file, int line, bool slow);
+#define TEST_TIER(suite, name, slow)                                                       \
     static void test_##suite##_##name(void);                                               \
     __attribute__((constructor)) static void test_register_##suite##_##name(void)          \
     {                                                                                      \
-        test_register(#suite, #name, test_##suite##_##name, __FILE__, __LINE__);           \
+        test_register(#suite, #name, test_##suite##_##name, __FILE__, __LINE__, slow);     \
     }                                                                                      \
     static void test_##suite##_##name(void)
+#define TEST(suite, name) TEST_TIER(suite, name, false)
+#define TEST_SLOW(suite, name) TEST_TIER(suite, name, true)
 
 #endif

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "brdf.h"
 #include "test.h"
@@ -166,33 +167,49 @@ static brdf_runner runner;
 #define CHUNK 65536 /* queries per batch: small buffers keep page faults (and ASan) cheap */
 static BrdfQuery *qbuf; /* CHUNK queries and results, reused by every batch */
 static BrdfResult *rbuf;
+static int messages_before; /* validation messages when the running test began */
 
 static void grid_init(void);
 
-static bool open_runner(void)
-{
-    gpu_desc d = {.device_index = -1};
-    const char *env = getenv("GONIO_VALIDATE");
-    d.validate = env && !strcmp(env, "1");
-    if (!gpu_create(&test_gpu, &d)) {
-        CHECKF(false, "no Vulkan device");
-        return false;
-    }
-    brdf_runner_create(&runner, &test_gpu, CHUNK);
-    grid_init();
-    return true;
-}
-
-static void close_runner(void)
+/* At exit: the runner and device the tests shared, destroyed; a validation message in
+ * that makes the run fail. */
+static void destroy_runner(void)
 {
     brdf_runner_destroy(&runner);
-    CHECK(gpu_validation_message_count() == 0);
     gpu_destroy(&test_gpu);
     free(qbuf);
     free(rbuf);
-    qbuf = NULL;
-    rbuf = NULL;
+    if (gpu_validation_message_count() > messages_before) {
+        fprintf(stderr, "test_brdf.c: validation messages while destroying the runner\n");
+        _exit(1);
+    }
 }
+
+/* The runner, its device and its kernels are made once a process and shared by the tests
+ * (each specialised kernel is compiled once: brdf_runner keeps them). */
+static bool open_runner(void)
+{
+    static bool opened, failed;
+    if (!opened && !failed) {
+        gpu_desc d = {.device_index = -1};
+        const char *env = getenv("GONIO_VALIDATE");
+        d.validate = env && !strcmp(env, "1");
+        if (!gpu_create(&test_gpu, &d)) {
+            failed = true;
+        } else {
+            brdf_runner_create(&runner, &test_gpu, CHUNK);
+            grid_init();
+            atexit(destroy_runner);
+            opened = true;
+        }
+    }
+    CHECKF(opened, "no Vulkan device");
+    messages_before = gpu_validation_message_count();
+    return opened;
+}
+
+/* The end of a test: no validation message while it ran. */
+static void close_runner(void) { CHECK(gpu_validation_message_count() == messages_before); }
 
 /* ---- statistics --------------------------------------------------------------------- */
 
@@ -556,6 +573,57 @@ TEST(brdf, finite_and_positive)
     close_runner();
 }
 
+/* The kernel specialised on a query's features (brdf_query_features, as the renderer's
+ * kernels are on a scene's) computes what the unspecialised one does, bit for bit, for
+ * every setting: over the same random, grazing and degenerate directions as above, eval,
+ * sample and the NDF queries. A feature missing from brdf_query_features would compile code out from under
+ * the tests that follow (they run the specialised kernel); this finds it. */
+TEST(brdf, specialised_same)
+{
+    enum { N = 4096 };
+    static BrdfResult unspec[N];
+    if (!open_runner())
+        return;
+    BrdfQuery *q = qbuf;
+    BrdfResult *r = rbuf;
+    rng_state = 10;
+    for (int ci = 0; ci < num_cases(); ci++) {
+        brdf_setting s;
+        int differ = 0;
+        make_setting(&cases[ci], &s);
+        for (int i = 0; i < N; i++) {
+            vec3 wo = polar(acos(1 - 2 * rnd()), 2 * PI * rnd()), wi = polar(acos(1 - 2 * rnd()), 2 * PI * rnd());
+            if (i % 4 == 1)
+                wo = polar(acos(pow(10.0, -2.0 - 6.0 * rnd())), 2 * PI * rnd()); /* grazing */
+            if (i % 4 == 2)
+                wi = wo;
+            q[i] = query(&s, i % 8 == 7 ? BRDF_OP_NDF : BRDF_OP_EVAL | BRDF_OP_SAMPLE, wo, wi, rnd_u());
+        }
+        runner.all_features = true;
+        brdf_runner_run(&runner, q, unspec, N);
+        runner.all_features = false;
+        brdf_runner_run(&runner, q, r, N);
+        for (int i = 0; i < N; i++) {
+            const float *a = &r[i].f.x, *b = &unspec[i].f.x;
+            bool same = !memcmp(&r[i].pdf, &unspec[i].pdf, sizeof(float)) &&
+                        !memcmp(&r[i].s_pdf, &unspec[i].s_pdf, sizeof(float)) &&
+                        !memcmp(&r[i].s_pdf_eval, &unspec[i].s_pdf_eval, sizeof(float)) &&
+                        r[i].s_flags == unspec[i].s_flags;
+            for (int c = 0; c < 3; c++)
+                same = same && !memcmp(&a[c], &b[c], sizeof(float)) &&
+                       !memcmp(&(&r[i].s_wi.x)[c], &(&unspec[i].s_wi.x)[c], sizeof(float)) &&
+                       !memcmp(&(&r[i].s_weight.x)[c], &(&unspec[i].s_weight.x)[c], sizeof(float)) &&
+                       !memcmp(&(&r[i].s_f.x)[c], &(&unspec[i].s_f.x)[c], sizeof(float));
+            if (!same && differ++ < 2)
+                fprintf(stderr, "  %s (features 0x%016llx): query %d: f %g pdf %g w %g flags %u, unspecialised f %g pdf %g "
+                        "w %g flags %u\n", describe(&cases[ci]), (unsigned long long)brdf_query_features(&q[i]), i, a[0], r[i].pdf,
+                        r[i].s_weight.x, r[i].s_flags, b[0], unspec[i].pdf, unspec[i].s_weight.x, unspec[i].s_flags);
+        }
+        CHECKF(differ == 0, "%s: %d of %d queries differ from the unspecialised kernel's", describe(&cases[ci]), differ, N);
+    }
+    close_runner();
+}
+
 /* Helmholtz reciprocity f(wo, wi) = f(wi, wo) for every reflection; refraction instead obeys
  * f(wo, wi) / eta(wi)^2 = f(wi, wo) / eta(wo)^2 (eta of the side each direction is on),
  * because the transmitted solid angle is compressed by (eta_t / eta_i)^2. */
@@ -671,12 +739,16 @@ TEST(brdf, lambert_albedo)
 }
 
 /* The directions bsdf_sample draws follow bsdf_pdf (chi-square, Sidak-corrected 1% level
- * over all cases); pdf integrates to the fraction of non-Dirac samples (1 where sampling
- * never fails); each sample's weight and pdf equal f cos / pdf and pdf at its wi; the mean
- * weight equals the quadrature of f cos; and that albedo is <= 1 (energy conservation). */
-TEST(brdf, sampling_matches_pdf)
+ * over all cases and angles of both tiers); pdf integrates to the fraction of non-Dirac
+ * samples (1 where sampling never fails); each sample's weight and pdf equal f cos / pdf and
+ * pdf at its wi; the mean weight equals the quadrature of f cos; and that albedo is <= 1
+ * (energy conservation). Every (case, angle) is one measurement of NSAMPLES samples, as
+ * before the split into tiers: the fast tier has every case at one angle from outside (40
+ * degrees) and, for the two-sided, one from inside (110); the slow tier the other angles
+ * (0, 75 and 160). Each check's level, and so its power, is what it was as one test. */
+static const double sampling_theta[] = {0, 40, 75, 110, 160};
+static void sampling_matches_pdf_at(bool slow_angles, unsigned seed)
 {
-    const double theta[] = {0, 40, 75, 110, 160};
     int tests = 0;
     if (!open_runner())
         return;
@@ -685,14 +757,17 @@ TEST(brdf, sampling_matches_pdf)
         make_setting(&cases[ci], &s);
         tests += brdf_setting_two_sided(&s) ? 5 : 3;
     }
-    rng_state = 4;
+    rng_state = seed;
     for (int ci = 0; ci < num_cases(); ci++) {
         brdf_setting s;
         make_setting(&cases[ci], &s);
         for (int t = 0; t < (brdf_setting_two_sided(&s) ? 5 : 3); t++) {
+            const double *theta = sampling_theta;
             const char *what = describe(&cases[ci]);
             char why[200];
             measure m;
+            if ((t == 1 || t == 3) == slow_angles)
+                continue;
             measure_case(&s, polar(rad(theta[t]), 1.0), true, 1, 1, &m);
             CHECKF(m.nonfinite == 0, "%s wo %.0f: %d NaN/Inf", what, theta[t], m.nonfinite);
             CHECKF(m.bad_samples == 0, "%s wo %.0f: %d samples whose weight or pdf disagree with eval/pdf", what,
@@ -704,21 +779,27 @@ TEST(brdf, sampling_matches_pdf)
     }
     close_runner();
 }
+TEST(brdf, sampling_matches_pdf) { sampling_matches_pdf_at(false, 4); }
+TEST_SLOW(brdf, sampling_matches_pdf_more_angles) { sampling_matches_pdf_at(true, 14); }
 
 /* Energy conservation from normal to grazing incidence (and from inside glass): the sampled
- * white-furnace albedo is <= 1 within its error. */
-TEST(brdf, energy)
+ * white-furnace albedo is <= 1 within its error. The fast tier has every case at 30 and
+ * 89.9 degrees (and 135 from inside), the slow tier the other angles, each as before. */
+static const double energy_theta[] = {0, 30, 60, 80, 85, 89, 89.9, 100, 135, 179};
+static void energy_at(bool slow_angles, unsigned seed)
 {
-    const double theta[] = {0, 30, 60, 80, 85, 89, 89.9, 100, 135, 179};
     if (!open_runner())
         return;
-    rng_state = 5;
+    rng_state = seed;
     for (int ci = 0; ci < num_cases(); ci++) {
         brdf_setting s;
         make_setting(&cases[ci], &s);
         for (int t = 0; t < (brdf_setting_two_sided(&s) ? 10 : 7); t++) {
+            const double *theta = energy_theta;
             measure m;
             char why[200];
+            if ((t == 1 || t == 6 || t == 8) == slow_angles)
+                continue;
             measure_case(&s, polar(rad(theta[t]), 2.0), false, 1, 1, &m);
             CHECKF(m.nonfinite == 0, "%s wo %.1f: %d NaN/Inf", describe(&cases[ci]), theta[t], m.nonfinite);
             CHECKF(check_energy(&m, false, why, sizeof why), "%s wo %.1f deg: %s", describe(&cases[ci]), theta[t],
@@ -727,6 +808,8 @@ TEST(brdf, energy)
     }
     close_runner();
 }
+TEST(brdf, energy) { energy_at(false, 5); }
+TEST_SLOW(brdf, energy_more_angles) { energy_at(true, 15); }
 
 /* The checks have teeth: a pdf scaled by 1.1 fails the chi-square and the normalisation, and
  * a Lambert without its 1/pi (f scaled by pi) fails energy conservation and the agreement of

@@ -83,27 +83,33 @@ static void tmp_file(char *out, size_t cap, const char *name)
     snprintf(out, cap, "/tmp/gonio-test-path-%d-%s", (int)getpid(), name);
 }
 
-TEST(path, furnace)
+/* The white furnace: a sphere under a unit environment returns the light it receives: an
+ * albedo of 1 gives 1, a Lambertian of 0.5 gives 0.5 (within Z_MAX standard errors), a lossy
+ * material at most 1; background pixels show the environment exactly. The fast tier has the
+ * exact cases and two lossy ones (a rough conductor, the glTF layers together); the slow tier
+ * the other lossy materials, each render as before. */
+static void furnace(bool slow)
 {
     static const struct {
         const char *extras; /* NULL: glTF Lambertian (specular 0) of albedo 0.5 */
         double expect;      /* < 0: lossy, at most 1 */
+        bool slow;          /* in the slow tier */
     } cases[] = {
-        {NULL, 0.5},
-        {"{\"gonio\":{\"brdf\":\"lambert\",\"diffuse\":1}}", 1},
-        {"{\"gonio\":{\"brdf\":\"mirror\",\"reflectance\":1}}", 1},
-        {"{\"gonio\":{\"brdf\":\"dielectric\",\"tint\":1,\"ior\":1.5}}", 1},
-        {"{\"gonio\":{\"brdf\":\"dielectric\",\"tint\":1,\"ior\":1.5,\"alpha\":0.3}}", -1}, /* single scattering */
-        {"{\"gonio\":{\"brdf\":\"conductor\",\"alpha\":0.3}}", -1},
-        {"{\"gonio\":{\"brdf\":\"ggx\",\"diffuse\":0.5,\"specular\":0.5,\"alpha\":0.5}}", -1},
-        {"{\"gonio\":{\"brdf\":\"torrance-sparrow\",\"diffuse\":0.5,\"specular\":0.5}}", -1},
-        {"{\"gonio\":{\"brdf\":\"phong\",\"diffuse\":0.5,\"specular\":0.5}}", -1},
+        {NULL, 0.5, false},
+        {"{\"gonio\":{\"brdf\":\"lambert\",\"diffuse\":1}}", 1, false},
+        {"{\"gonio\":{\"brdf\":\"mirror\",\"reflectance\":1}}", 1, false},
+        {"{\"gonio\":{\"brdf\":\"dielectric\",\"tint\":1,\"ior\":1.5}}", 1, false},
+        {"{\"gonio\":{\"brdf\":\"dielectric\",\"tint\":1,\"ior\":1.5,\"alpha\":0.3}}", -1, true}, /* single scattering */
+        {"{\"gonio\":{\"brdf\":\"conductor\",\"alpha\":0.3}}", -1, false},
+        {"{\"gonio\":{\"brdf\":\"ggx\",\"diffuse\":0.5,\"specular\":0.5,\"alpha\":0.5}}", -1, true},
+        {"{\"gonio\":{\"brdf\":\"torrance-sparrow\",\"diffuse\":0.5,\"specular\":0.5}}", -1, true},
+        {"{\"gonio\":{\"brdf\":\"phong\",\"diffuse\":0.5,\"specular\":0.5}}", -1, true},
         /* glTF layers over a white base: a smooth and a rough coat, a sheen, all three */
-        {"{\"gonio\":{\"brdf\":\"gltf\",\"base-color\":1,\"clearcoat\":1}}", -1},
-        {"{\"gonio\":{\"brdf\":\"gltf\",\"base-color\":1,\"clearcoat\":1,\"clearcoat-roughness\":0.4}}", -1},
-        {"{\"gonio\":{\"brdf\":\"gltf\",\"base-color\":1,\"sheen-color\":1,\"sheen-roughness\":0.3}}", -1},
+        {"{\"gonio\":{\"brdf\":\"gltf\",\"base-color\":1,\"clearcoat\":1}}", -1, true},
+        {"{\"gonio\":{\"brdf\":\"gltf\",\"base-color\":1,\"clearcoat\":1,\"clearcoat-roughness\":0.4}}", -1, true},
+        {"{\"gonio\":{\"brdf\":\"gltf\",\"base-color\":1,\"sheen-color\":1,\"sheen-roughness\":0.3}}", -1, true},
         {"{\"gonio\":{\"brdf\":\"gltf\",\"base-color\":1,\"metallic\":1,\"roughness\":0.2,\"clearcoat\":1,"
-         "\"clearcoat-roughness\":0.1,\"sheen-color\":1}}", -1},
+         "\"clearcoat-roughness\":0.1,\"sheen-color\":1}}", -1, false},
     };
     char path[256];
     gpu g = {0};
@@ -111,6 +117,8 @@ TEST(path, furnace)
         return;
     tmp_file(path, sizeof path, "furnace.gltf");
     for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
+        if (cases[i].slow != slow)
+            continue;
         gltf_write_material mat = {.base_color = {0.5f, 0.5f, 0.5f, 1}, .roughness = 1,
                                    .has_specular = true, .specular_color = {1, 1, 1},
                                    .extras = cases[i].extras};
@@ -144,6 +152,8 @@ TEST(path, furnace)
     unlink(path);
     gpu_destroy(&g);
 }
+TEST(path, furnace) { furnace(false); }
+TEST_SLOW(path, furnace_more_materials) { furnace(true); }
 
 /* KHR_materials_unlit: the base colour is the radiance the surface sends, whatever lights
  * it, and it reflects nothing: an unlit sphere seen by camera rays under no, a unit and a
@@ -262,8 +272,9 @@ static double max_block_z(const image *a, const image *b, int bs)
  * and a sheen: KHR_materials_clearcoat, _sheen): MIS, light sampling only and BSDF sampling
  * only converge to the same image; and the test notices a missing bounce. 256 spp: BSDF
  * sampling finds the small light rarely, and below that its variance estimates run low (at
- * 128 spp the z of a correct render reaches 9). */
-TEST(path, estimators)
+ * 128 spp the z of a correct render reaches 9). The fast tier has the GGX walls, the slow
+ * tier the layered ones, each at its 256 spp as before. */
+static void estimators(int k)
 {
     static const uint32_t strategies[] = {0, GN_FRAME_LIGHT_ONLY, GN_FRAME_BSDF_ONLY};
     static const char *brdfs[] = {"ggx:alpha=0.25:specular=0.3",
@@ -272,7 +283,7 @@ TEST(path, estimators)
     gpu g = {0};
     if (!test_open_gpu(&g))
         return;
-    for (int k = 0; k < 2; k++) {
+    {
         const char *brdf = brdfs[k];
         image img[3] = {{0}}, direct = {0};
         render_settings s = {.width = 32, .height = 32, .spp = 256, .camera = 0};
@@ -298,6 +309,8 @@ TEST(path, estimators)
     }
     gpu_destroy(&g);
 }
+TEST(path, estimators) { estimators(0); }
+TEST_SLOW(path, estimators_layers) { estimators(1); }
 
 static double rmse_rgb(const image *a, const image *b)
 {

@@ -15,6 +15,28 @@
 #include "test.h"
 #include "util.h"
 
+/* This process's scratch files: runs at once (a job pool, other trees on the machine) must
+ * not write each other's. */
+static char tmp_gltf[64], tmp_glb[64];
+static void tmp_remove(void)
+{
+    if (*tmp_gltf)
+        unlink(tmp_gltf);
+    if (*tmp_glb)
+        unlink(tmp_glb);
+}
+static const char *tmp_path(const char *ext)
+{
+    char *p = strcmp(ext, "glb") ? tmp_gltf : tmp_glb;
+    if (!*tmp_gltf && !*tmp_glb)
+        atexit(tmp_remove);
+    if (!*p)
+        snprintf(p, sizeof tmp_gltf, "/tmp/gonio_scene_test-%d.%s", (int)getpid(), ext);
+    return p;
+}
+#define TMP_GLTF tmp_path("gltf")
+#define TMP_GLB tmp_path("glb")
+
 /* ---- helpers ------------------------------------------------------------------------------ */
 
 static char load_log[16384];
@@ -875,8 +897,8 @@ static void write_tri_scene(const char *path, const char *body)
 
 static bool load_tri_scene(scene *s, const char *body)
 {
-    write_tri_scene("/tmp/gonio_scene_test.gltf", body);
-    return load(s, "/tmp/gonio_scene_test.gltf");
+    write_tri_scene(TMP_GLTF, body);
+    return load(s, TMP_GLTF);
 }
 
 /* KHR_materials_volume and _dispersion: the values read, glTF's defaults, thicknessFactor 0
@@ -982,9 +1004,9 @@ TEST(scene, bad_geometry)
     const char *fmt = "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[%s],\"bufferViews\":[{\"buffer\":0,\"byteLength\":108}],"
                       "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":9,\"type\":\"VEC3\"}],"
                       "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}],\"nodes\":[{\"mesh\":0}]}";
-    write_gltf("/tmp/gonio_scene_test.gltf", fmt, pos, sizeof pos);
+    write_gltf(TMP_GLTF, fmt, pos, sizeof pos);
     int w0 = util_warning_count();
-    CHECKF(load(&s, "/tmp/gonio_scene_test.gltf"), "%s", load_log);
+    CHECKF(load(&s, TMP_GLTF), "%s", load_log);
     CHECK(s.num_triangles == 1 && strstr(load_log, "dropped 2 triangle"));
     CHECK(util_warning_count() > w0);
     CHECK(s.bounds_max[0] == 1 && s.bounds_max[1] == 1);
@@ -992,8 +1014,8 @@ TEST(scene, bad_geometry)
     /* Only huge triangles: nothing left. */
     for (int v = 0; v < 9; v++)
         pos[v][2] = 1e16f;
-    write_gltf("/tmp/gonio_scene_test.gltf", fmt, pos, sizeof pos);
-    CHECK(!load(&s, "/tmp/gonio_scene_test.gltf") && strstr(load_log, "no triangles") && s.vertices == NULL);
+    write_gltf(TMP_GLTF, fmt, pos, sizeof pos);
+    CHECK(!load(&s, TMP_GLTF) && strstr(load_log, "no triangles") && s.vertices == NULL);
     /* Transforms that overflow: two nested scales of 1e200. */
     CHECK(!load_tri_scene(&s, TRI_MESH ",\"nodes\":[{\"children\":[1],\"scale\":[1e200,1,1]},{\"mesh\":0,\"scale\":[1e200,1,1]}]") &&
           strstr(load_log, "node 1: world transform is not finite"));
@@ -1040,8 +1062,8 @@ TEST(scene, bad_geometry)
                  "\"meshes\":[{\"primitives\":[{\"attributes\":{%s}}]}],\"nodes\":[{\"mesh\":0}]}",
                  i == 2 ? "{\"buffer\":0,\"byteOffset\":160,\"byteLength\":100}" : "{\"buffer\":0,\"byteLength\":48,\"byteStride\":8}",
                  bad[i].accessor, bad[i].attributes);
-        write_gltf("/tmp/gonio_scene_test.gltf", json, &tri_buf, sizeof tri_buf);
-        CHECKF(!load(&s, "/tmp/gonio_scene_test.gltf") && strstr(load_log, bad[i].message), "case %zu:\n%s", i, load_log);
+        write_gltf(TMP_GLTF, json, &tri_buf, sizeof tri_buf);
+        CHECKF(!load(&s, TMP_GLTF) && strstr(load_log, bad[i].message), "case %zu:\n%s", i, load_log);
         scene_destroy(&s);
     }
     /* Bad rotation, wrong matrix size. */
@@ -1074,8 +1096,8 @@ TEST(scene, truncated_files)
         const size_t cuts[] = {0, 1, 4, 11, 12, 19, 20, 21, 100, size / 3, size / 2, size - 4, size - 1};
         for (size_t i = 0; i < sizeof cuts / sizeof cuts[0]; i++) {
             scene s;
-            write_bytes(f == 1 ? "/tmp/gonio_scene_test.gltf" : "/tmp/gonio_scene_test.glb", data, cuts[i]);
-            bool ok = load(&s, f == 1 ? "/tmp/gonio_scene_test.gltf" : "/tmp/gonio_scene_test.glb");
+            write_bytes(f == 1 ? TMP_GLTF : TMP_GLB, data, cuts[i]);
+            bool ok = load(&s, f == 1 ? TMP_GLTF : TMP_GLB);
             CHECKF(!ok && strstr(load_log, "error: "), "%s cut at %zu: %s", files[f], cuts[i], load_log);
             scene_destroy(&s);
         }
@@ -1102,23 +1124,23 @@ TEST(scene, glb_container)
     memcpy(glb + 20 + jlen, bh, 8);
     memcpy(glb + 28 + jlen, &tri_buf, sizeof tri_buf);
     memcpy(glb + 28 + jlen + blen, uh, 8);
-    write_bytes("/tmp/gonio_scene_test.glb", glb, total);
+    write_bytes(TMP_GLB, glb, total);
     scene s;
     int w0 = util_warning_count();
-    CHECKF(load(&s, "/tmp/gonio_scene_test.glb"), "%s", load_log);
+    CHECKF(load(&s, TMP_GLB), "%s", load_log);
     CHECK(s.num_triangles == 1 && util_warning_count() == w0 + 1 && strstr(load_log, "unknown GLB chunk"));
     if (s.num_triangles == 1)
         CHECK(near3(s.vertices[s.indices[1]].position, 1, 0, 0, 0));
     scene_destroy(&s);
     /* The same bytes named .gltf are still read as GLB (by the magic), and a broken BIN length
      * (past the end) is refused. */
-    write_bytes("/tmp/gonio_scene_test.gltf", glb, total);
-    CHECKF(load(&s, "/tmp/gonio_scene_test.gltf"), "%s", load_log);
+    write_bytes(TMP_GLTF, glb, total);
+    CHECKF(load(&s, TMP_GLTF), "%s", load_log);
     scene_destroy(&s);
     bh[0] = 4096;
     memcpy(glb + 20 + jlen, bh, 8);
-    write_bytes("/tmp/gonio_scene_test.glb", glb, total);
-    CHECK(!load(&s, "/tmp/gonio_scene_test.glb") && strstr(load_log, "runs past the end"));
+    write_bytes(TMP_GLB, glb, total);
+    CHECK(!load(&s, TMP_GLB) && strstr(load_log, "runs past the end"));
     free(glb);
 }
 
@@ -1142,8 +1164,8 @@ TEST(scene, sparse_accessor)
              "\"sparse\":{\"count\":1,\"indices\":{\"bufferView\":4,\"componentType\":5123},\"values\":{\"bufferView\":5}}},"
              "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"
              "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1}}]}],\"nodes\":[{\"mesh\":0}]}");
-    write_gltf("/tmp/gonio_scene_test.gltf", fmt, &buf, sizeof buf);
-    CHECKF(load(&s, "/tmp/gonio_scene_test.gltf"), "%s", load_log);
+    write_gltf(TMP_GLTF, fmt, &buf, sizeof buf);
+    CHECKF(load(&s, TMP_GLTF), "%s", load_log);
     if (s.num_vertices == 3)
         CHECK(near3(s.vertices[0].position, 0, 0, 0, 0) && near3(s.vertices[1].position, 5, 0, 0, 0) &&
               near3(s.vertices[2].position, 0, 1, 0, 0));
