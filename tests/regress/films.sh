@@ -28,11 +28,13 @@ def quad(z, a, down):
 def scene(name, sheet_ext, irid=None):
     pos = quad(0.0, 1.0, False) + quad(H, A, True)
     raw = b"".join(struct.pack("<3f", *p) for p in pos)
+    # double-sided: the camera sees the sheet's back, where the light comes through (a
+    # single-sided sheet is culled for camera rays there, as glTF's doubleSided false says)
     sheet = {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0, "roughnessFactor": 1},
-             "extensions": dict({"KHR_materials_specular": {"specularFactor": 0}}, **sheet_ext)}
+             "extensions": dict({"KHR_materials_specular": {"specularFactor": 0}}, **sheet_ext), "doubleSided": True}
     if irid is not None:
         sheet = {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 1, "roughnessFactor": 0.3},
-                 "extensions": irid}
+                 "extensions": irid, "doubleSided": True}
         pos[:6] = quad(0.0, 1.0, True)  # faces the camera: the emitter's light reflected
         raw = b"".join(struct.pack("<3f", *p) for p in pos)
     emitter = {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [1, 1, 1],

@@ -60,7 +60,10 @@ static void quat(const view *v, float q[4])
 static int write_scene(const char *name, const char *out)
 {
     gltf_write_camera cam = {.name = "camera", .aspect = 1.0f, .znear = 0.001f};
-    gltf_write_material mat = {.name = "grey", .base_color = {0.5f, 0.5f, 0.5f, 1}, .roughness = 1};
+    /* double-sided: the sphere is seen from inside, the back of its outward winding (a
+     * single-sided one would be culled for camera rays, as glTF's doubleSided false says) */
+    gltf_write_material mat = {.name = "grey", .base_color = {0.5f, 0.5f, 0.5f, 1}, .roughness = 1,
+                               .double_sided = true};
     gltf_write_node nodes[2] = {{.name = "mesh", .kind = GLTF_WRITE_NODE_MESH},
                                 {.name = "camera", .kind = GLTF_WRITE_NODE_CAMERA}};
     gltf_write_mesh mesh = {.name = name};
