@@ -95,44 +95,60 @@ void scene_default_camera(const scene *s, float aspect, scene_camera *out)
 void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *out)
 {
     assert(aspect > 0 && isfinite(aspect) && yfov > 0 && yfov < (float)M_PI);
-    const float half_v = 0.5f * yfov;
-    const float half_h = atanf(tanf(half_v) * aspect);
-    const float fit = fminf(half_v, half_h);
-    float c[3] = {0, 0, 0}, r = 1;
+    const float tan_v = tanf(0.5f * yfov), tan_h = tan_v * aspect;
+    float c[3] = {0, 0, 0}, half[3] = {0.5f, 0.5f, 0.5f};
     if (s->bounds_min[0] <= s->bounds_max[0]) {
-        float d2 = 0, cmax = 0;
+        float cmax = 0;
         for (int k = 0; k < 3; k++) {
-            float e = s->bounds_max[k] - s->bounds_min[k];
             c[k] = 0.5f * (s->bounds_min[k] + s->bounds_max[k]);
-            d2 += e * e;
+            half[k] = 0.5f * (s->bounds_max[k] - s->bounds_min[k]);
             cmax = fmaxf(cmax, fabsf(c[k]));
         }
-        /* A point (or a box below float resolution at its position) still needs a sphere
-         * the camera can stand outside of. */
+        /* A point (or a box below float resolution at its position) still needs a box the
+         * camera can stand outside of. */
         float floor = 1e-5f * fmaxf(1.0f, cmax);
-        r = fmaxf(0.5f * sqrtf(d2), floor);
+        for (int k = 0; k < 3; k++)
+            half[k] = fmaxf(half[k], floor);
     }
-    float dist = r / sinf(fit);
     /* A raised three-quarter view, as model viewers open a file: glTF models face +Z with +Y
      * up, so the camera stands in front (+Z), turned toward +X and raised, looking at the
      * centre with a level horizon. Straight down an axis, a box looks like a flat square. */
     const float az = (float)(SCENE_FRAME_AZIMUTH * M_PI / 180), el = (float)(SCENE_FRAME_ELEVATION * M_PI / 180);
     const float dir[3] = {sinf(az) * cosf(el), sinf(el), cosf(az) * cosf(el)};
+    const float right[3] = {cosf(az), 0, -sinf(az)};                                   /* forward x (0, 1, 0) */
+    const float up[3] = {-sinf(el) * sinf(az), cosf(el), -sinf(el) * cosf(az)}; /* right x forward */
+    /* The nearest distance along dir from which every corner of the bounding box projects
+     * inside the frame, less SCENE_FRAME_MARGIN: the box, not its bounding sphere, so that a
+     * model fills the frame (a cube's sphere leaves it at 58 % of the width). A corner at
+     * depth z toward the camera and offset x across it fits when |x| <= tan * (dist - z). */
+    float dist = 0, zmin = INFINITY, zmax = -INFINITY;
+    for (int i = 0; i < 8; i++) {
+        float p[3] = {i & 1 ? half[0] : -half[0], i & 2 ? half[1] : -half[1], i & 4 ? half[2] : -half[2]};
+        float x = 0, y = 0, z = 0;
+        for (int k = 0; k < 3; k++) {
+            x += p[k] * right[k];
+            y += p[k] * up[k];
+            z += p[k] * dir[k];
+        }
+        float fit = 1 - SCENE_FRAME_MARGIN;
+        dist = fmaxf(dist, fmaxf(fabsf(x) / (fit * tan_h), fabsf(y) / (fit * tan_v)) + z);
+        zmin = fminf(zmin, z);
+        zmax = fmaxf(zmax, z);
+    }
+    /* Every corner in front of the camera, with room for a near plane. */
+    dist = fmaxf(dist, 1.01f * zmax + 1e-6f * (zmax - zmin));
     memset(out, 0, sizeof *out);
     strcpy(out->name, "framing");
     for (int k = 0; k < 3; k++) {
         out->position[k] = c[k] + dist * dir[k];
         out->forward[k] = -dir[k];
+        out->right[k] = right[k];
+        out->up[k] = up[k];
     }
-    out->right[0] = cosf(az); /* forward x (0, 1, 0), normalised */
-    out->right[2] = -sinf(az);
-    out->up[0] = -sinf(el) * sinf(az); /* right x forward */
-    out->up[1] = cosf(el);
-    out->up[2] = -sinf(el) * cosf(az);
     out->yfov = yfov;
     out->aspect = aspect;
-    out->znear = 0.5f * (dist - r);
-    out->zfar = 2.0f * (dist + r);
+    out->znear = 0.5f * (dist - zmax);
+    out->zfar = 2.0f * (dist - zmin);
 }
 
 /* The table's defaults: a factor's own, each component; a texture slot's none. */
