@@ -640,7 +640,6 @@ static int render_run(const render_job *job)
     s.view = &view;
     camera_describe(&cam, &sc, camera_text, sizeof camera_text);
     s.camera_label = camera_text;
-    s.env_label = studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none";
     if (!cli_gpu_create(&g, device, job->validate)) {
         scene_destroy(&sc);
         image_destroy(&env_map);
@@ -648,6 +647,18 @@ static int render_run(const render_job *job)
     }
     catch_signals(quiet);
     renderer_create(&r, &g, &sc);
+    if (env_probe_applies(&env, &sc)) { /* the file's own light: is the view dark? */
+        float lit = env_probe_lit_fraction(&r, &s);
+        if (env_probe_is_dark(lit)) {
+            env_add_studio(&env, &sc, quiet, lit, job->s.ambient_set, &env_map, &s);
+            studio = true;
+            if (s.mode != GN_MODE_PATH) { /* the studio's key light joined the scene's lights */
+                renderer_destroy(&r);
+                renderer_create(&r, &g, &sc);
+            }
+        }
+    }
+    s.env_label = studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none";
     if ((!resume_path || check_resume(resume_path, &r, &s, brdf, &prev)) && renderer_render(&r, &s, &img, &st)) {
         char seconds[32];
         render_header h;
