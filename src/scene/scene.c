@@ -111,7 +111,7 @@ void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *
             half[k] = fmaxf(half[k], floor);
     }
     /* A raised three-quarter view, as model viewers open a file: glTF models face +Z with +Y
-     * up, so the camera stands in front (+Z), turned toward +X and raised, looking at the
+     * up, so the camera stands in front (+Z), turned toward +X and raised, looking toward the
      * centre with a level horizon. Straight down an axis, a box looks like a flat square. */
     const float az = (float)(SCENE_FRAME_AZIMUTH * M_PI / 180), el = (float)(SCENE_FRAME_ELEVATION * M_PI / 180);
     const float dir[3] = {sinf(az) * cosf(el), sinf(el), cosf(az) * cosf(el)};
@@ -120,27 +120,45 @@ void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *
     /* The nearest distance along dir from which every corner of the bounding box projects
      * inside the frame, less SCENE_FRAME_MARGIN: the box, not its bounding sphere, so that a
      * model fills the frame (a cube's sphere leaves it at 58 % of the width). A corner at
-     * depth z toward the camera and offset x across it fits when |x| <= tan * (dist - z). */
-    float dist = 0, zmin = INFINITY, zmax = -INFINITY;
+     * depth z toward the camera and offset x across it fits when |x - shift| <= tan * (dist -
+     * z). Perspective makes the near corners' side of the picture larger, so the camera also
+     * moves across (shift, keeping its direction) until the picture is centred: a few rounds
+     * of centring, then the distance at which every corner fits with the final shift. */
+    const float fit = 1 - SCENE_FRAME_MARGIN;
+    float px[8], py[8], pz[8], zmin = INFINITY, zmax = -INFINITY;
     for (int i = 0; i < 8; i++) {
         float p[3] = {i & 1 ? half[0] : -half[0], i & 2 ? half[1] : -half[1], i & 4 ? half[2] : -half[2]};
-        float x = 0, y = 0, z = 0;
+        px[i] = py[i] = pz[i] = 0;
         for (int k = 0; k < 3; k++) {
-            x += p[k] * right[k];
-            y += p[k] * up[k];
-            z += p[k] * dir[k];
+            px[i] += p[k] * right[k];
+            py[i] += p[k] * up[k];
+            pz[i] += p[k] * dir[k];
         }
-        float fit = 1 - SCENE_FRAME_MARGIN;
-        dist = fmaxf(dist, fmaxf(fabsf(x) / (fit * tan_h), fabsf(y) / (fit * tan_v)) + z);
-        zmin = fminf(zmin, z);
-        zmax = fmaxf(zmax, z);
+        zmin = fminf(zmin, pz[i]);
+        zmax = fmaxf(zmax, pz[i]);
     }
-    /* Every corner in front of the camera, with room for a near plane. */
-    dist = fmaxf(dist, 1.01f * zmax + 1e-6f * (zmax - zmin));
+    float dist = 0, sx = 0, sy = 0;
+    for (int round = 0; round < 8; round++) {
+        dist = 0;
+        for (int i = 0; i < 8; i++)
+            dist = fmaxf(dist, fmaxf(fabsf(px[i] - sx) / (fit * tan_h), fabsf(py[i] - sy) / (fit * tan_v)) + pz[i]);
+        /* Every corner in front of the camera, with room for a near plane. */
+        dist = fmaxf(dist, 1.01f * zmax + 1e-6f * (zmax - zmin));
+        if (round == 7)
+            break;
+        float lox = INFINITY, hix = -INFINITY, loy = INFINITY, hiy = -INFINITY;
+        for (int i = 0; i < 8; i++) {
+            float d = dist - pz[i];
+            lox = fminf(lox, (px[i] - sx) / d), hix = fmaxf(hix, (px[i] - sx) / d);
+            loy = fminf(loy, (py[i] - sy) / d), hiy = fmaxf(hiy, (py[i] - sy) / d);
+        }
+        sx += 0.5f * (lox + hix) * dist;
+        sy += 0.5f * (loy + hiy) * dist;
+    }
     memset(out, 0, sizeof *out);
     strcpy(out->name, "framing");
     for (int k = 0; k < 3; k++) {
-        out->position[k] = c[k] + dist * dir[k];
+        out->position[k] = c[k] + sx * right[k] + sy * up[k] + dist * dir[k];
         out->forward[k] = -dir[k];
         out->right[k] = right[k];
         out->up[k] = up[k];

@@ -166,7 +166,8 @@ void scene_destroy(scene *s);
  * SCENE_FRAME_ELEVATION degrees, level horizon) from the nearest distance at which every corner
  * of the bounding box projects inside the vertical and horizontal field of view (yfov 45
  * degrees) for the given image aspect (width / height, > 0), less a margin of
- * SCENE_FRAME_MARGIN of the half-width: the model fills the frame, whatever its size. znear
+ * SCENE_FRAME_MARGIN of the half-width, moved across (its direction kept) so that the box's
+ * picture is centred: the model fills the frame, whatever its size. znear
  * and zfar enclose the box with a factor of 2 to spare. Empty or single-point bounds still
  * give a valid camera (a tiny box around the point, or the unit box at the origin). */
 #define SCENE_FRAME_AZIMUTH 35.0
