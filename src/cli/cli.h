@@ -237,6 +237,18 @@ bool cli_take_env(const char *cmd, const char *opt, const char *val, void *dest)
  * map. */
 bool env_setup(const env_option *e, struct scene *sc, bool quiet, struct image *map, struct render_settings *s,
                bool *studio);
+/* The dark-view rule (options.c): whether it applies (no --env, no image-based light, and
+ * the file has light of its own), the lit fraction of a probe render of s's view with the
+ * file's lights (-1 when no pixel sees the model), whether that is dark, and the studio
+ * added to the file's lights, saying so unless quiet (ambient_given: --ambient was given,
+ * the local modes' ambient stays). In the local modes the studio's key light is added to
+ * sc's lights: a renderer made before must be made again. */
+struct renderer;
+bool env_probe_applies(const env_option *e, const struct scene *sc);
+float env_probe_lit_fraction(struct renderer *r, const struct render_settings *s);
+bool env_probe_is_dark(float lit);
+void env_add_studio(const env_option *e, struct scene *sc, bool quiet, float lit, bool ambient_given,
+                    struct image *map, struct render_settings *s);
 
 /* "gonio CMD: MESSAGE" and the hint to use --help; returns 2. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);

@@ -663,7 +663,6 @@ static int render_run(const render_job *job)
     s.view = &view;
     camera_describe(&cam, &sc, camera_text, sizeof camera_text);
     s.camera_label = camera_text;
-    s.env_label = studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none";
     if (cache && cache->gpu_live) {
         gp = &cache->g;
     } else if (!cli_gpu_create(gp, device, job->validate)) {
@@ -700,6 +699,19 @@ static int render_run(const render_job *job)
     } else {
         renderer_create(rp, gp, &sc);
     }
+    scene *scp = cache ? &cache->sc : &sc; /* (a frame's scene moves into the cache) */
+    if (env_probe_applies(&env, scp)) { /* the file's own light: is the view dark? */
+        float lit = env_probe_lit_fraction(rp, &s);
+        if (env_probe_is_dark(lit)) {
+            env_add_studio(&env, scp, quiet, lit, job->s.ambient_set, &env_map, &s);
+            studio = true;
+            if (s.mode != GN_MODE_PATH) { /* the studio's key light joined the scene's lights */
+                renderer_destroy(rp);
+                renderer_create(rp, gp, scp);
+            }
+        }
+    }
+    s.env_label = studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none";
     if ((!resume_path || check_resume(resume_path, rp, &s, brdf, &prev)) && renderer_render(rp, &s, &img, &st)) {
         char seconds[32];
         render_header h;

@@ -213,6 +213,25 @@ bool cli_take_env(const char *cmd, const char *opt, const char *val, void *dest)
     return env_parse_option((env_option *)dest, cmd, opt, val) == 1;
 }
 
+/* The studio in map; the local modes see it as its key light (added to sc's lights) plus
+ * the mean of the rest. */
+static void studio_setup(const env_option *e, scene *sc, bool local, image *map)
+{
+    if (local) {
+        GnLight key;
+        environment_studio_key(&key);
+        /* --env-rotate turns the key with the map (R_Y, as path.comp turns the map). */
+        float ca = cosf(e->rotation * (float)(M_PI / 180)), sa = sinf(e->rotation * (float)(M_PI / 180));
+        vec3 d = key.direction;
+        key.direction = (vec3){ca * d.x + sa * d.z, d.y, -sa * d.x + ca * d.z};
+        sc->lights = util_realloc(sc->lights, (sc->num_lights + 1) * sizeof *sc->lights);
+        sc->lights[sc->num_lights++] = key;
+        environment_studio(map, false);
+    } else {
+        environment_studio(map, true);
+    }
+}
+
 bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_settings *s, bool *studio_used)
 {
     float scale = e->intensity > 0 ? e->intensity : 1, mean[3] = {0, 0, 0};
@@ -248,20 +267,7 @@ bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_se
             *studio_used = true;
             if (!quiet && !e->studio)
                 util_info("%s has no lights: lit by gonio's studio environment (--env 0 for black)", sc->path);
-            if (local) {
-                /* The local modes see the studio as its key light plus the mean of the rest. */
-                GnLight key;
-                environment_studio_key(&key);
-                /* --env-rotate turns the key with the map (R_Y, as path.comp turns the map). */
-                float ca = cosf(e->rotation * (float)(M_PI / 180)), sa = sinf(e->rotation * (float)(M_PI / 180));
-                vec3 d = key.direction;
-                key.direction = (vec3){ca * d.x + sa * d.z, d.y, -sa * d.x + ca * d.z};
-                sc->lights = util_realloc(sc->lights, (sc->num_lights + 1) * sizeof *sc->lights);
-                sc->lights[sc->num_lights++] = key;
-                environment_studio(map, false);
-            } else {
-                environment_studio(map, true);
-            }
+            studio_setup(e, sc, local, map);
         }
         if (scale != 1)
             for (int c = 0; c < map->num_channels; c++)
@@ -278,4 +284,85 @@ bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_se
         s->ambient_set = true;
     }
     return true;
+}
+
+/* ---- a view the file's own light leaves dark ---------------------------------------------
+ * The rule (docs/path-tracing.md, "Light when the scene has none"): a probe render of the
+ * view with the file's lights alone (path tracing, ENV_PROBE_SIZE pixels on the longer side,
+ * ENV_PROBE_SPP samples); of the pixels that see the model, the fraction brighter than
+ * ENV_PROBE_LEVEL (1/40 of what a white surface reflects under the studio) is the lit
+ * fraction; below ENV_PROBE_LIT the view is dark and the studio is added to the file's lights. */
+#define ENV_PROBE_SIZE 64
+#define ENV_PROBE_SPP 8
+#define ENV_PROBE_LEVEL 0.02f
+#define ENV_PROBE_LIT 0.6f
+
+bool env_probe_applies(const env_option *e, const scene *sc)
+{
+    return !e->given && !sc->environment.num_channels && env_scene_has_light(sc);
+}
+
+float env_probe_lit_fraction(renderer *r, const render_settings *s)
+{
+    render_settings p = *s;
+    p.mode = GN_MODE_PATH;
+    if (s->width >= s->height) {
+        p.width = ENV_PROBE_SIZE;
+        p.height = (int)fmaxf(1, roundf((float)ENV_PROBE_SIZE * (float)s->height / (float)s->width));
+    } else {
+        p.height = ENV_PROBE_SIZE;
+        p.width = (int)fmaxf(1, roundf((float)ENV_PROBE_SIZE * (float)s->width / (float)s->height));
+    }
+    p.spp = ENV_PROBE_SPP;
+    p.time_limit = 0;
+    p.aov = 0;
+    p.progress = NULL;
+    p.stop = NULL;
+    p.env_map = NULL;
+    p.env[0] = p.env[1] = p.env[2] = 0;
+    p.strategy = 0;
+    p.crop_x0 = p.crop_y0 = p.crop_x1 = p.crop_y1 = 0;
+    p.resume = NULL;
+    p.resume_spp = 0;
+    image img = {0};
+    render_stats st;
+    if (!renderer_render(r, &p, &img, &st))
+        return -1;
+    int ch[4] = {image_channel(&img, "R"), image_channel(&img, "G"), image_channel(&img, "B"), image_channel(&img, "A")};
+    long seen = 0, lit = 0;
+    for (size_t i = 0; ch[0] >= 0 && ch[1] >= 0 && ch[2] >= 0 && ch[3] >= 0 && i < (size_t)img.width * img.height; i++) {
+        if (!(img.planes[ch[3]][i] > 0.5f))
+            continue;
+        float lum = 0.2126f * img.planes[ch[0]][i] + 0.7152f * img.planes[ch[1]][i] + 0.0722f * img.planes[ch[2]][i];
+        seen++;
+        lit += lum > ENV_PROBE_LEVEL;
+    }
+    image_destroy(&img);
+    return seen ? (float)lit / (float)seen : -1;
+}
+
+bool env_probe_is_dark(float lit)
+{
+    return lit >= 0 && lit < ENV_PROBE_LIT;
+}
+
+void env_add_studio(const env_option *e, scene *sc, bool quiet, float lit, bool ambient_given, image *map,
+                    render_settings *s)
+{
+    float scale = e->intensity > 0 ? e->intensity : 1, mean[3];
+    if (!quiet)
+        util_info("%s: its own light leaves the view dark (%.0f %% of the model brighter than %g, under %.0f %%): "
+                  "added gonio's studio environment (--env 0 for the file's light alone)",
+                  sc->path, 100 * lit, ENV_PROBE_LEVEL, 100 * ENV_PROBE_LIT);
+    image_destroy(map);
+    studio_setup(e, sc, s->mode != GN_MODE_PATH, map);
+    if (scale != 1)
+        for (int c = 0; c < map->num_channels; c++)
+            for (size_t i = 0; i < (size_t)map->width * map->height; i++)
+                map->planes[c][i] *= scale;
+    environment_mean(map, mean);
+    s->env_map = map;
+    if (!ambient_given)
+        for (int k = 0; k < 3; k++)
+            s->ambient[k] += mean[k];
 }

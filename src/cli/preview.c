@@ -903,6 +903,7 @@ int cmd_preview(int argc, char **argv)
         glfwTerminate();
         return 1;
     }
+    const bool ambient_given = p->s.ambient_set;
     if (!env_setup(&env, &p->sc, false, &env_map, &p->s, &studio) ||
         !camera_resolve(&cam, &p->sc, size_given ? (float)width / (float)height : 1.0f, &start_view)) {
         image_destroy(&env_map);
@@ -932,7 +933,19 @@ int cmd_preview(int argc, char **argv)
         p->denoise_view = true;
         p->s.aov |= RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL;
     }
-    if (setup(p, device, validate, width, height)) {
+    const bool started = setup(p, device, validate, width, height);
+    if (started && env_probe_applies(&env, &p->sc)) {
+        float lit = env_probe_lit_fraction(&p->r, &p->s); /* the file's own light: a dark view? */
+        if (env_probe_is_dark(lit)) {
+            env_add_studio(&env, &p->sc, false, lit, ambient_given, &env_map, &p->s);
+            if (p->s.mode != GN_MODE_PATH) { /* the studio's key light joined the scene's lights */
+                renderer_destroy(&p->r);
+                renderer_create(&p->r, &p->g, &p->sc);
+            }
+            p->restart = true;
+        }
+    }
+    if (started) {
         util_info("preview: %s on %s; press H in the window for the keys", scene_path,
                   p->g.props.deviceName);
         last_frame = util_now();

@@ -104,44 +104,78 @@ void scene_default_camera(const scene *s, float aspect, scene_camera *out)
 void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *out)
 {
     assert(aspect > 0 && isfinite(aspect) && yfov > 0 && yfov < (float)M_PI);
-    const float half_v = 0.5f * yfov;
-    const float half_h = atanf(tanf(half_v) * aspect);
-    const float fit = fminf(half_v, half_h);
-    float c[3] = {0, 0, 0}, r = 1;
+    const float tan_v = tanf(0.5f * yfov), tan_h = tan_v * aspect;
+    float c[3] = {0, 0, 0}, half[3] = {0.5f, 0.5f, 0.5f};
     if (s->bounds_min[0] <= s->bounds_max[0]) {
-        float d2 = 0, cmax = 0;
+        float cmax = 0;
         for (int k = 0; k < 3; k++) {
-            float e = s->bounds_max[k] - s->bounds_min[k];
             c[k] = 0.5f * (s->bounds_min[k] + s->bounds_max[k]);
-            d2 += e * e;
+            half[k] = 0.5f * (s->bounds_max[k] - s->bounds_min[k]);
             cmax = fmaxf(cmax, fabsf(c[k]));
         }
-        /* A point (or a box below float resolution at its position) still needs a sphere
-         * the camera can stand outside of. */
+        /* A point (or a box below float resolution at its position) still needs a box the
+         * camera can stand outside of. */
         float floor = 1e-5f * fmaxf(1.0f, cmax);
-        r = fmaxf(0.5f * sqrtf(d2), floor);
+        for (int k = 0; k < 3; k++)
+            half[k] = fmaxf(half[k], floor);
     }
-    float dist = r / sinf(fit);
     /* A raised three-quarter view, as model viewers open a file: glTF models face +Z with +Y
-     * up, so the camera stands in front (+Z), turned toward +X and raised, looking at the
+     * up, so the camera stands in front (+Z), turned toward +X and raised, looking toward the
      * centre with a level horizon. Straight down an axis, a box looks like a flat square. */
     const float az = (float)(SCENE_FRAME_AZIMUTH * M_PI / 180), el = (float)(SCENE_FRAME_ELEVATION * M_PI / 180);
     const float dir[3] = {sinf(az) * cosf(el), sinf(el), cosf(az) * cosf(el)};
+    const float right[3] = {cosf(az), 0, -sinf(az)};                                   /* forward x (0, 1, 0) */
+    const float up[3] = {-sinf(el) * sinf(az), cosf(el), -sinf(el) * cosf(az)}; /* right x forward */
+    /* The nearest distance along dir from which every corner of the bounding box projects
+     * inside the frame, less SCENE_FRAME_MARGIN: the box, not its bounding sphere, so that a
+     * model fills the frame (a cube's sphere leaves it at 58 % of the width). A corner at
+     * depth z toward the camera and offset x across it fits when |x - shift| <= tan * (dist -
+     * z). Perspective makes the near corners' side of the picture larger, so the camera also
+     * moves across (shift, keeping its direction) until the picture is centred: a few rounds
+     * of centring, then the distance at which every corner fits with the final shift. */
+    const float fit = 1 - SCENE_FRAME_MARGIN;
+    float px[8], py[8], pz[8], zmin = INFINITY, zmax = -INFINITY;
+    for (int i = 0; i < 8; i++) {
+        float p[3] = {i & 1 ? half[0] : -half[0], i & 2 ? half[1] : -half[1], i & 4 ? half[2] : -half[2]};
+        px[i] = py[i] = pz[i] = 0;
+        for (int k = 0; k < 3; k++) {
+            px[i] += p[k] * right[k];
+            py[i] += p[k] * up[k];
+            pz[i] += p[k] * dir[k];
+        }
+        zmin = fminf(zmin, pz[i]);
+        zmax = fmaxf(zmax, pz[i]);
+    }
+    float dist = 0, sx = 0, sy = 0;
+    for (int round = 0; round < 8; round++) {
+        dist = 0;
+        for (int i = 0; i < 8; i++)
+            dist = fmaxf(dist, fmaxf(fabsf(px[i] - sx) / (fit * tan_h), fabsf(py[i] - sy) / (fit * tan_v)) + pz[i]);
+        /* Every corner in front of the camera, with room for a near plane. */
+        dist = fmaxf(dist, 1.01f * zmax + 1e-6f * (zmax - zmin));
+        if (round == 7)
+            break;
+        float lox = INFINITY, hix = -INFINITY, loy = INFINITY, hiy = -INFINITY;
+        for (int i = 0; i < 8; i++) {
+            float d = dist - pz[i];
+            lox = fminf(lox, (px[i] - sx) / d), hix = fmaxf(hix, (px[i] - sx) / d);
+            loy = fminf(loy, (py[i] - sy) / d), hiy = fmaxf(hiy, (py[i] - sy) / d);
+        }
+        sx += 0.5f * (lox + hix) * dist;
+        sy += 0.5f * (loy + hiy) * dist;
+    }
     memset(out, 0, sizeof *out);
     strcpy(out->name, "framing");
     for (int k = 0; k < 3; k++) {
-        out->position[k] = c[k] + dist * dir[k];
+        out->position[k] = c[k] + sx * right[k] + sy * up[k] + dist * dir[k];
         out->forward[k] = -dir[k];
+        out->right[k] = right[k];
+        out->up[k] = up[k];
     }
-    out->right[0] = cosf(az); /* forward x (0, 1, 0), normalised */
-    out->right[2] = -sinf(az);
-    out->up[0] = -sinf(el) * sinf(az); /* right x forward */
-    out->up[1] = cosf(el);
-    out->up[2] = -sinf(el) * cosf(az);
     out->yfov = yfov;
     out->aspect = aspect;
-    out->znear = 0.5f * (dist - r);
-    out->zfar = 2.0f * (dist + r);
+    out->znear = 0.5f * (dist - zmax);
+    out->zfar = 2.0f * (dist - zmin);
 }
 
 /* The table's defaults: a factor's own, each component; a texture slot's none. */

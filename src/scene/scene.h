@@ -219,13 +219,16 @@ void scene_destroy(scene *s);
 
 /* A camera that frames the whole scene: a raised three-quarter view of the centre of the
  * bounds (from the +Z side, turned SCENE_FRAME_AZIMUTH degrees toward +X and raised
- * SCENE_FRAME_ELEVATION degrees, level horizon) from a distance at which the bounding sphere
- * fits in the vertical and horizontal field of view (yfov 45 degrees) for the given image
- * aspect (width / height, > 0); znear and zfar enclose the sphere with a factor of 2 to
- * spare. Empty or single-point bounds still give a valid camera (a tiny sphere around the
- * point, or the unit sphere at the origin). */
+ * SCENE_FRAME_ELEVATION degrees, level horizon) from the nearest distance at which every corner
+ * of the bounding box projects inside the vertical and horizontal field of view (yfov 45
+ * degrees) for the given image aspect (width / height, > 0), less a margin of
+ * SCENE_FRAME_MARGIN of the half-width, moved across (its direction kept) so that the box's
+ * picture is centred: the model fills the frame, whatever its size. znear
+ * and zfar enclose the box with a factor of 2 to spare. Empty or single-point bounds still
+ * give a valid camera (a tiny box around the point, or the unit box at the origin). */
 #define SCENE_FRAME_AZIMUTH 35.0
 #define SCENE_FRAME_ELEVATION 25.0
+#define SCENE_FRAME_MARGIN 0.05f
 void scene_default_camera(const scene *s, float aspect, scene_camera *out);
 /* The same with another vertical field of view (radians, in (0, pi)). */
 void scene_frame_camera(const scene *s, float aspect, float yfov, scene_camera *out);

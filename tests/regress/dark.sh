@@ -1,0 +1,125 @@
+#!/usr/bin/env bash
+# dark.sh: the dark-view rule (docs/path-tracing.md, "Light when the scene has none") and the
+# framing view's fit. A file whose own light leaves its view dark gets the studio added with
+# a one-line message; a file whose light is deliberate (the Cornell box, a point light over a
+# floor written here) renders bit for bit as with --env 0; --env 0 keeps a dark file dark.
+# The framing view fills the frame with a tiny and a huge model (the red cube's box in the
+# render, measured by testtool). Scenes are glTF JSON written here by Python.
+. "$(dirname "$0")/../lib.sh"
+G=$GONIO
+command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
+R() { "$G" render --spp 4 --compression none "$@"; }
+ADDED="added gonio's studio environment (--env 0 for the file's light alone)"
+# The lit fraction of a render, as the rule defines it, computed here from the EXR by an
+# independent reader: of the pixels with A > 0.5, the share with luminance above 0.02.
+lit() {
+    python3 -c "
+import sys; sys.path.insert(0, '$(dirname "$0")/../tool'); import exrtool
+a, ch = exrtool.read('$1')
+R, G, B, A = (ch[c][1] for c in 'RGBA')
+L = [0.2126 * r + 0.7152 * g + 0.0722 * b for r, g, b, al in zip(R, G, B, A) if al > 0.5]
+print('%.3f' % (sum(x > 0.02 for x in L) / max(1, len(L))))"
+}
+env_of() { grep -a -o 'studio\|none' <<<"$(exrheader "$1" 2>/dev/null | grep 'gonio:environment')" | head -n 1; }
+
+# ---- deliberate light: unchanged --------------------------------------------------------
+check "Cornell box renders" R scenes/cornell.gltf -o "$tmp/cornell.exr" --size 48x48
+grep -q "$ADDED" "$tmp/out" && fail "Cornell box: the studio was added" || pass
+check "Cornell box with --env 0" R scenes/cornell.gltf -o "$tmp/cornell-0.exr" --size 48x48 --env 0
+check "Cornell box: the same pixels as --env 0, bit for bit" "$TESTTOOL" same "$tmp/cornell.exr" "$tmp/cornell-0.exr"
+
+# A white floor and a grey cube under a point light above the front: deliberate light that
+# lights the view (no camera: the framing view).
+python3 - "$tmp" <<'PY'
+import base64, json, struct, sys
+out = sys.argv[1]
+def cube(s, c):
+    p, n, i = [], [], []
+    for ax in range(3):
+        for sg in (-1, 1):
+            u, v = [(ax + 1) % 3, (ax + 2) % 3]
+            base = len(p) // 3
+            for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+                q = [0, 0, 0]; q[ax] = sg; q[u] = a; q[v] = b
+                p += [c[k] + s * q[k] for k in range(3)]
+                nn = [0, 0, 0]; nn[ax] = sg; n += nn
+            i += [base, base + 1, base + 2, base, base + 2, base + 3] if sg > 0 else [base, base + 2, base + 1, base, base + 3, base + 2]
+    return p, n, i
+def write(name, size, centre, with_floor, light, color):
+    P, N, I = cube(size, centre)
+    if with_floor:
+        b = len(P) // 3; f = 4 * size; y = centre[1] - size
+        P += [centre[0] - f, y, centre[2] - f, centre[0] + f, y, centre[2] - f, centre[0] + f, y, centre[2] + f, centre[0] - f, y, centre[2] + f]
+        N += [0, 1, 0] * 4; I += [b, b + 2, b + 1, b, b + 3, b + 2]
+    nv = len(P) // 3
+    blob = struct.pack("<%df" % len(P), *P) + struct.pack("<%df" % len(N), *N) + struct.pack("<%dI" % len(I), *I)
+    lo = [min(P[k::3]) for k in range(3)]; hi = [max(P[k::3]) for k in range(3)]
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0] + ([1] if light else [])}],
+           "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+           "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 12 * nv}, {"buffer": 0, "byteOffset": 12 * nv, "byteLength": 12 * nv},
+                           {"buffer": 0, "byteOffset": 24 * nv, "byteLength": 4 * len(I)}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": nv, "type": "VEC3", "min": lo, "max": hi},
+                         {"bufferView": 1, "componentType": 5126, "count": nv, "type": "VEC3"},
+                         {"bufferView": 2, "componentType": 5125, "count": len(I), "type": "SCALAR"}],
+           "materials": [{"pbrMetallicRoughness": {"baseColorFactor": color + [1], "metallicFactor": 0, "roughnessFactor": 1}}],
+           "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "material": 0}]}],
+           "nodes": [{"mesh": 0}]}
+    if light:
+        doc["extensionsUsed"] = ["KHR_lights_punctual"]
+        doc["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": light}]}}
+        doc["nodes"].append({"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [centre[0] + 1.5 * size, centre[1] + 4 * size, centre[2] + 3 * size]})
+    json.dump(doc, open(f"{out}/{name}.gltf", "w"))
+write("lit", 1.0, [0, 0, 0], True, 60.0, [0.8, 0.8, 0.8])
+write("dim", 1.0, [0, 0, 0], True, 0.05, [0.8, 0.8, 0.8])
+write("tiny", 1e-3, [5e-3, -2e-3, 1e-3], False, 0, [1, 0, 0])
+write("huge", 1e4, [3e4, 1e4, -2e4], False, 0, [1, 0, 0])
+PY
+check "a point light over a floor renders" R "$tmp/lit.gltf" -o "$tmp/lit.exr" --size 48x48
+grep -q "$ADDED" "$tmp/out" && fail "a deliberate point light: the studio was added" || pass
+got=$(lit "$tmp/lit.exr")
+check "the point light lights the view itself (lit fraction $got >= 0.6)" python3 -c "assert $got >= 0.6"
+check "the point light with --env 0" R "$tmp/lit.gltf" -o "$tmp/lit-0.exr" --size 48x48 --env 0
+check "a deliberate point light: the same pixels as --env 0, bit for bit" "$TESTTOOL" same "$tmp/lit.exr" "$tmp/lit-0.exr"
+
+# ---- a dark view: the studio added, with the message; --env 0 keeps it dark ---------------
+check "a dim point light renders" R "$tmp/dim.gltf" -o "$tmp/dim.exr" --size 48x48
+cp "$tmp/out" "$tmp/msg" # check writes each command's output to $tmp/out
+check "a dim point light: the studio added, saying so" grep -qF "$ADDED" "$tmp/msg"
+check "the message is one line" test "$(grep -c "studio" "$tmp/msg")" = 1
+check "the header says studio" test "$(env_of "$tmp/dim.exr")" = studio
+got=$(lit "$tmp/dim.exr")
+check "with the studio the view is lit (lit fraction $got >= 0.6)" python3 -c "assert $got >= 0.6"
+check "a dim point light, --env 0" R "$tmp/dim.gltf" -o "$tmp/dim-0.exr" --size 48x48 --env 0
+grep -q "studio" "$tmp/out" && fail "--env 0: the studio was added" || pass
+got=$(lit "$tmp/dim-0.exr")
+check "--env 0 keeps the dark file dark (lit fraction $got < 0.6)" python3 -c "assert $got < 0.6"
+check "--env studio given: no message of the rule" R "$tmp/dim.gltf" -o "$tmp/dim-s.exr" --size 48x48 --env studio
+grep -q "$ADDED" "$tmp/out" && fail "an explicit --env studio printed the rule's message" || pass
+
+A=${GONIO_ASSETS:-}
+if [ -n "$A" ] && [ -d "$A/gltf/IridescenceSuzanne" ] && [ -d "$A/gltf/LightsPunctualLamp" ]; then
+    for m in IridescenceSuzanne LightsPunctualLamp; do
+        check "$m renders" R "$A/gltf/$m/glTF/$m.gltf" -o "$tmp/$m.exr" --size 64x32
+        cp "$tmp/out" "$tmp/msg"
+        check "$m: the studio added, saying so" grep -qF "$ADDED" "$tmp/msg"
+        check "$m: the header says studio" test "$(env_of "$tmp/$m.exr")" = studio
+        check "$m, --env 0" R "$A/gltf/$m/glTF/$m.gltf" -o "$tmp/$m-0.exr" --size 64x32 --env 0
+        got=$(lit "$tmp/$m-0.exr")
+        check "$m: its own light leaves it dark (lit fraction $got < 0.6)" python3 -c "assert $got < 0.6"
+    done
+else
+    echo "  note: no IridescenceSuzanne / LightsPunctualLamp in GONIO_ASSETS: those checks skipped"
+fi
+
+# ---- the framing view fills the frame ----------------------------------------------------
+# A red cube under a constant environment: its projected box (testtool's red box) spans at
+# least 85 % of the frame along its limiting axis, whatever its size and position.
+for m in tiny huge; do
+    check "$m cube renders" R "$tmp/$m.gltf" -o "$tmp/$m.exr" --size 64x64 --env 1
+    box=$("$TESTTOOL" stats "$tmp/$m.exr" | awk '{print $8, $9, $10, $11}')
+    check "$m cube fills the frame (red box $box in 64x64)" sh -c \
+        "echo $box | awk '{w = \$3 - \$1 + 1; h = \$4 - \$2 + 1; exit !(\$1 >= 0 && (w >= 0.85 * 64 || h >= 0.85 * 64) && w <= 64 && h <= 64)}'"
+    check "$m cube: no pixel of it at the image's edge" sh -c \
+        "echo $box | awk '{exit !(\$1 > 0 && \$2 > 0 && \$3 < 63 && \$4 < 63)}'"
+done
+finish
