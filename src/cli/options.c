@@ -232,6 +232,17 @@ static void studio_setup(const env_option *e, scene *sc, bool local, image *map)
     }
 }
 
+/* map, scaled by --env-intensity, as the render's environment; mean: its mean radiance. */
+static void env_use_map(image *map, float scale, float mean[3], render_settings *s)
+{
+    if (scale != 1)
+        for (int c = 0; c < map->num_channels; c++)
+            for (size_t i = 0; i < (size_t)map->width * map->height; i++)
+                map->planes[c][i] *= scale;
+    environment_mean(map, mean);
+    s->env_map = map;
+}
+
 bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_settings *s, bool *studio_used)
 {
     float scale = e->intensity > 0 ? e->intensity : 1, mean[3] = {0, 0, 0};
@@ -252,12 +263,7 @@ bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_se
             memcpy(map->planes[c], src->planes[c], sizeof(float) * (size_t)src->width * src->height);
         if (!quiet)
             util_info("%s: lit by its image-based light (%s; --env replaces it)", sc->path, sc->environment_what);
-        if (scale != 1)
-            for (int c = 0; c < 3; c++)
-                for (size_t i = 0; i < (size_t)map->width * map->height; i++)
-                    map->planes[c][i] *= scale;
-        environment_mean(map, mean);
-        s->env_map = map;
+        env_use_map(map, scale, mean, s);
     } else if (e->given || !env_scene_has_light(sc)) {
         if (e->path) {
             bool ok = util_has_suffix(e->path, ".hdr") ? environment_read_hdr(map, e->path) : image_read_exr(map, e->path);
@@ -269,12 +275,7 @@ bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_se
                 util_info("%s has no lights: lit by gonio's studio environment (--env 0 for black)", sc->path);
             studio_setup(e, sc, local, map);
         }
-        if (scale != 1)
-            for (int c = 0; c < map->num_channels; c++)
-                for (size_t i = 0; i < (size_t)map->width * map->height; i++)
-                    map->planes[c][i] *= scale;
-        environment_mean(map, mean);
-        s->env_map = map;
+        env_use_map(map, scale, mean, s);
     }
     /* The local modes: the environment is the Phong model's ambient light, unless --ambient
      * (the path tracer does not read it). */
@@ -356,12 +357,7 @@ void env_add_studio(const env_option *e, scene *sc, bool quiet, float lit, bool 
                   sc->path, 100 * lit, ENV_PROBE_LEVEL, 100 * ENV_PROBE_LIT);
     image_destroy(map);
     studio_setup(e, sc, s->mode != GN_MODE_PATH, map);
-    if (scale != 1)
-        for (int c = 0; c < map->num_channels; c++)
-            for (size_t i = 0; i < (size_t)map->width * map->height; i++)
-                map->planes[c][i] *= scale;
-    environment_mean(map, mean);
-    s->env_map = map;
+    env_use_map(map, scale, mean, s);
     if (!ambient_given)
         for (int k = 0; k < 3; k++)
             s->ambient[k] += mean[k];
