@@ -595,8 +595,6 @@ void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc)
                                      {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 0}};
     VkDescriptorPoolCreateInfo dpci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     VkDescriptorSetAllocateInfo dsai = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    VkDescriptorBufferInfo infos[32];
-    VkWriteDescriptorSet writes[32];
     VkShaderModule module;
 
     assert(desc->num_bindings <= 32);
@@ -648,16 +646,23 @@ void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc)
     dsai.descriptorSetCount = 1;
     dsai.pSetLayouts = &p->set_layout;
     GPU_CHECK(vkAllocateDescriptorSets(g->device, &dsai, &p->set));
-    for (uint32_t i = 0; i < desc->num_bindings; i++) {
-        infos[i] = (VkDescriptorBufferInfo){desc->bindings[i].buffer->buffer, 0, VK_WHOLE_SIZE};
-        bool texel = desc->bindings[i].type == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    gpu_pipeline_bind(g, p, desc->bindings, desc->num_bindings);
+}
+
+void gpu_pipeline_bind(gpu *g, gpu_pipeline *p, const gpu_binding *bindings, uint32_t num_bindings)
+{
+    VkDescriptorBufferInfo infos[32];
+    VkWriteDescriptorSet writes[32];
+    assert(num_bindings <= 32 && p->set);
+    for (uint32_t i = 0; i < num_bindings; i++) {
+        infos[i] = (VkDescriptorBufferInfo){bindings[i].buffer->buffer, 0, VK_WHOLE_SIZE};
+        bool texel = bindings[i].type == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
         writes[i] = (VkWriteDescriptorSet){VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, NULL, p->set,
-                                           desc->bindings[i].binding, 0, 1,
-                                           desc->bindings[i].type, NULL,
+                                           bindings[i].binding, 0, 1, bindings[i].type, NULL,
                                            texel ? NULL : &infos[i],
-                                           texel ? &desc->bindings[i].buffer->view : NULL};
+                                           texel ? &bindings[i].buffer->view : NULL};
     }
-    vkUpdateDescriptorSets(g->device, desc->num_bindings, writes, 0, NULL);
+    vkUpdateDescriptorSets(g->device, num_bindings, writes, 0, NULL);
 }
 
 void gpu_pipeline_destroy(gpu *g, gpu_pipeline *p)

@@ -131,6 +131,10 @@ typedef struct gpu_pipeline {
 
 void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc);
 void gpu_pipeline_destroy(gpu *g, gpu_pipeline *p); /* accepts a zeroed struct */
+/* Points the pipeline's descriptor set at these buffers (the bindings and types it was
+ * created with): a buffer made anew needs no new kernel, whose compilation costs about a
+ * second on lavapipe. Only while no command buffer that uses the set is recording or pending. */
+void gpu_pipeline_bind(gpu *g, gpu_pipeline *p, const gpu_binding *bindings, uint32_t num_bindings);
 
 /* One-shot command buffers: begin, record dispatches and barriers, submit and wait. */
 VkCommandBuffer gpu_begin(gpu *g);

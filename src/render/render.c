@@ -126,9 +126,7 @@ bool renderer_update(renderer *r, const scene *sc)
     } else { /* (more of the stand-ins for emissive meshes than before: a new buffer) */
         gpu_buffer_destroy(r->g, &r->lights);
         gpu_buffer_create_storage(r->g, &r->lights, lights, sizeof(GnLight) * r->num_lights);
-        for (uint32_t i = 0; i < GN_MODE_COUNT; i++) /* their descriptor sets name the old buffer */
-            gpu_pipeline_destroy(r->g, &r->pipelines[i]);
-        gpu_pipeline_destroy(r->g, &r->vertex_pass);
+        renderer_buffers_replaced(r);
     }
     free(lights);
     free(r->emitter_table);
@@ -351,23 +349,31 @@ const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
 {
     gpu_pipeline *p = &r->pipelines[mode];
-    GnFeatures features = kernel_features(r, mode);
-    if (p->pipeline && r->pipeline_features[mode] != features)
+    gpu_binding b[GN_BIND_COUNT];
+    renderer_spec spec;
+    const VkSpecializationInfo *info = renderer_specialize(r, mode, &spec);
+    spec.values[3] = mode_kernel(mode)->batched ? r->loop_cap : 0u;
+    if (p->pipeline && memcmp(r->pipeline_spec[mode], spec.values, sizeof spec.values))
         gpu_pipeline_destroy(r->g, p); /* built for other features: a new kernel */
     if (!p->pipeline) {
-        r->pipeline_features[mode] = features;
-        gpu_binding b[GN_BIND_COUNT];
-        renderer_spec spec;
         gpu_pipeline_desc pd = {
             .name = mode_kernel(mode)->name, .code = mode_kernel(mode)->code,
             .code_size = mode_kernel(mode)->code_size,
             .local_size = {GN_TILE_X, GN_TILE_Y, 1}, .push_size = sizeof(GnPush),
-            .bindings = b, .num_bindings = renderer_bindings(r, b),
-            .specialization = renderer_specialize(r, mode, &spec)};
-        spec.values[3] = mode_kernel(mode)->batched ? r->loop_cap : 0u;
+            .bindings = b, .num_bindings = renderer_bindings(r, b), .specialization = info};
         gpu_pipeline_create(r->g, p, &pd);
+        memcpy(r->pipeline_spec[mode], spec.values, sizeof spec.values);
+        r->pipeline_bound[mode] = r->buffers_replaced;
+    } else if (r->pipeline_bound[mode] != r->buffers_replaced) {
+        gpu_pipeline_bind(r->g, p, b, renderer_bindings(r, b));
+        r->pipeline_bound[mode] = r->buffers_replaced;
     }
     return p;
+}
+
+void renderer_buffers_replaced(renderer *r)
+{
+    r->buffers_replaced++;
 }
 
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,

@@ -120,7 +120,11 @@ typedef struct renderer {
     double setup_seconds;
     GnFeatures material_features; /* GN_FEAT_* the materials need (renderer_create) */
     GnFeatures path_features;     /* ... and the current path render (renderer_begin) */
-    GnFeatures pipeline_features[GN_MODE_COUNT]; /* what each cached kernel was built for */
+    /* A kernel is compiled once for its specialisation (renderer_pipeline); buffers made anew
+     * (a larger image, more lights, another map) are pointed at by its descriptor set, not
+     * compiled again: renderer_buffers_replaced counts them, and each kernel rebinds once. */
+    uint32_t pipeline_spec[GN_MODE_COUNT][6]; /* what each cached kernel was built for */
+    uint32_t pipeline_bound[GN_MODE_COUNT], vertex_bound, buffers_replaced;
     uint32_t path_samples;      /* samples per path dispatch (1..GN_PATH_SAMPLES) */
     bool failed;                /* renderer_create refused the scene: nothing renders */
     VkDeviceSize vcolor_bytes;  /* Gouraud's colours: more than a storage buffer holds when
@@ -165,8 +169,12 @@ typedef struct renderer_spec {
 } renderer_spec;
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec);
 
-/* The kernel of a mode (created on first use, kept until renderer_destroy). */
+/* The kernel of a mode (created on first use, kept until renderer_destroy or until its
+ * specialisation changes), its descriptor set naming the renderer's current buffers. */
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode);
+/* After a buffer the kernels bind is destroyed and made anew: each kernel's descriptor set is
+ * pointed at the new one before its next use. */
+void renderer_buffers_replaced(renderer *r);
 /* Records one sample pass (sample `sample_index` in every pixel) and a barrier. Call
  * renderer_begin first. */
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,

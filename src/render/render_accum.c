@@ -107,11 +107,8 @@ void size_buffers(renderer *r, int w, int h, uint32_t aov)
                 (unsigned long long)r->squares.size);
     r->width = w;
     r->height = h;
-    if (changed) { /* the cached kernels' descriptor sets name the old buffers */
-        for (uint32_t i = 0; i < GN_MODE_COUNT; i++)
-            gpu_pipeline_destroy(r->g, &r->pipelines[i]);
-        gpu_pipeline_destroy(r->g, &r->vertex_pass);
-    }
+    if (changed) /* the cached kernels' descriptor sets name the old buffers */
+        renderer_buffers_replaced(r);
 }
 
 

@@ -94,8 +94,12 @@ bool light_vertices(renderer *r)
                    groups, max_x, max_y);
         return false;
     }
+    gpu_binding b[GN_BIND_COUNT];
+    if (r->vertex_pass.pipeline && r->vertex_bound != r->buffers_replaced) {
+        gpu_pipeline_bind(r->g, &r->vertex_pass, b, renderer_bindings(r, b));
+        r->vertex_bound = r->buffers_replaced;
+    }
     if (!r->vertex_pass.pipeline) {
-        gpu_binding b[GN_BIND_COUNT];
         const uint32_t instances = r->geo.two_levels;
         const VkSpecializationMapEntry entry = {GN_SPEC_INSTANCES, 0, sizeof instances};
         const VkSpecializationInfo spec = {1, &entry, sizeof instances, &instances};
@@ -104,6 +108,7 @@ bool light_vertices(renderer *r)
             .local_size = {64, 1, 1}, .push_size = sizeof(GnPush), .specialization = &spec,
             .bindings = b, .num_bindings = renderer_bindings(r, b)};
         gpu_pipeline_create(r->g, &r->vertex_pass, &pd);
+        r->vertex_bound = r->buffers_replaced;
     }
     cmd = gpu_begin(r->g);
     for (uint32_t side = 0; side < 2; side++) {

@@ -323,8 +323,7 @@ static bool upload_env_map(renderer *r, const image *map)
     } else {
         gpu_buffer_destroy(r->g, &r->env);
         gpu_buffer_create_texels_as(r->g, &r->env, data, words * 4, VK_FORMAT_R32_UINT);
-        for (uint32_t i = 0; i < GN_MODE_COUNT; i++) /* their descriptor sets name the old buffer */
-            gpu_pipeline_destroy(r->g, &r->pipelines[i]);
+        renderer_buffers_replaced(r); /* the kernels' descriptor sets name the old buffer */
     }
     /* mean L over the sphere = sum(L sin dtheta dphi) / 4 pi, dtheta dphi = 2 pi^2 / n */
     r->env_weight = scene_radius2(r->sc) * 2 * M_PI * M_PI * total / (double)n;
