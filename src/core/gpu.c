@@ -274,10 +274,13 @@ bool gpu_create(gpu *g, const gpu_desc *desc)
     return true;
 }
 
+static void gpu_kernels_destroy(gpu *g);
+
 void gpu_destroy(gpu *g)
 {
     if (g->device) {
         vkDeviceWaitIdle(g->device);
+        gpu_kernels_destroy(g);
         if (g->pool)
             vkDestroyCommandPool(g->device, g->pool, NULL);
         vkDestroyDevice(g->device, NULL);
@@ -582,20 +585,155 @@ void gpu_buffer_create_storage(gpu *g, gpu_buffer *b, const void *data, VkDevice
 
 /* ---- pipelines ---------------------------------------------------------------------- */
 
-void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc)
+/* The device's kernels: each (SPIR-V, specialisation, bindings, push constants) is compiled
+ * once and shared by every pipeline that asks for it, while each gpu_pipeline has a
+ * descriptor set of its own. Compiling a kernel is what a render's setup costs most on
+ * lavapipe (about a second for the path kernel, more when LLVM compiles it anew): renderers
+ * made again for the same scene kind (an animation's frames, a probe, a test's scenes) find
+ * it here. Kernels no pipeline uses stay until GPU_KERNELS_KEPT are kept, then the least
+ * recently used goes. */
+#define GPU_KERNELS_KEPT 64
+#define GPU_SPEC_BYTES 64
+#define GPU_SPEC_ENTRIES 16
+struct gpu_kernel {
+    const uint32_t *code;
+    size_t code_size;
+    uint32_t push_size, num_bindings;
+    VkDescriptorSetLayoutBinding bindings[32];
+    uint32_t num_entries, spec_size;
+    VkSpecializationMapEntry entries[GPU_SPEC_ENTRIES];
+    unsigned char spec[GPU_SPEC_BYTES];
+    VkDescriptorSetLayout set_layout;
+    VkPipelineLayout layout;
+    VkPipeline pipeline;
+    uint32_t users;
+    uint64_t used; /* the cache's clock at its last use */
+};
+struct gpu_kernels {
+    gpu_kernel **items;
+    uint32_t count, cap;
+    uint64_t clock;
+};
+
+static void kernel_destroy(gpu *g, gpu_kernel *k)
 {
-    VkDescriptorSetLayoutBinding lb[32];
+    vkDestroyPipeline(g->device, k->pipeline, NULL);
+    vkDestroyPipelineLayout(g->device, k->layout, NULL);
+    vkDestroyDescriptorSetLayout(g->device, k->set_layout, NULL);
+    free(k);
+}
+
+static void gpu_kernels_destroy(gpu *g)
+{
+    if (!g->kernels)
+        return;
+    for (uint32_t i = 0; i < g->kernels->count; i++)
+        kernel_destroy(g, g->kernels->items[i]);
+    free(g->kernels->items);
+    free(g->kernels);
+    g->kernels = NULL;
+}
+
+uint32_t gpu_kernel_count(const gpu *g) { return g->kernels ? g->kernels->count : 0; }
+
+/* The key of desc's kernel in k (all but the Vulkan objects). */
+static void kernel_key(gpu_kernel *k, const gpu_pipeline_desc *desc)
+{
+    const VkSpecializationInfo *si = desc->specialization;
+    memset(k, 0, sizeof *k);
+    k->code = desc->code;
+    k->code_size = desc->code_size;
+    k->push_size = desc->push_size;
+    k->num_bindings = desc->num_bindings;
+    for (uint32_t i = 0; i < desc->num_bindings; i++)
+        k->bindings[i] = (VkDescriptorSetLayoutBinding){desc->bindings[i].binding, desc->bindings[i].type, 1,
+                                                        VK_SHADER_STAGE_COMPUTE_BIT, NULL};
+    if (si) {
+        assert(si->mapEntryCount <= GPU_SPEC_ENTRIES && si->dataSize <= GPU_SPEC_BYTES);
+        k->num_entries = si->mapEntryCount;
+        k->spec_size = (uint32_t)si->dataSize;
+        memcpy(k->entries, si->pMapEntries, sizeof *si->pMapEntries * si->mapEntryCount);
+        memcpy(k->spec, si->pData, si->dataSize);
+    }
+}
+
+static bool kernel_same(const gpu_kernel *a, const gpu_kernel *b)
+{
+    return a->code == b->code && a->code_size == b->code_size && a->push_size == b->push_size &&
+           a->num_bindings == b->num_bindings && a->num_entries == b->num_entries && a->spec_size == b->spec_size &&
+           !memcmp(a->bindings, b->bindings, sizeof *a->bindings * a->num_bindings) &&
+           !memcmp(a->entries, b->entries, sizeof *a->entries * a->num_entries) &&
+           !memcmp(a->spec, b->spec, a->spec_size);
+}
+
+/* desc's kernel: the one kept, or a new one compiled (and an unused one let go if too many
+ * are kept). */
+static gpu_kernel *kernel_get(gpu *g, const gpu_pipeline_desc *desc)
+{
+    gpu_kernel key, *k;
+    struct gpu_kernels *c;
+    kernel_key(&key, desc);
+    if (!g->kernels)
+        g->kernels = util_calloc(1, sizeof *g->kernels);
+    c = g->kernels;
+    c->clock++;
+    for (uint32_t i = 0; i < c->count; i++)
+        if (kernel_same(c->items[i], &key)) {
+            c->items[i]->used = c->clock;
+            return c->items[i];
+        }
+    if (c->count >= GPU_KERNELS_KEPT) { /* let the least recently used idle kernel go */
+        uint32_t oldest = c->count;
+        for (uint32_t i = 0; i < c->count; i++)
+            if (!c->items[i]->users && (oldest == c->count || c->items[i]->used < c->items[oldest]->used))
+                oldest = i;
+        if (oldest < c->count) {
+            kernel_destroy(g, c->items[oldest]);
+            c->items[oldest] = c->items[--c->count];
+        }
+    }
+    if (c->count == c->cap) {
+        c->cap = c->cap ? 2 * c->cap : 16;
+        c->items = util_realloc(c->items, sizeof *c->items * c->cap);
+    }
+    k = util_malloc(sizeof *k);
+    *k = key;
+    k->used = c->clock;
+
     VkDescriptorSetLayoutCreateInfo dlci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
     VkPushConstantRange push = {VK_SHADER_STAGE_COMPUTE_BIT, 0, desc->push_size};
     VkPipelineLayoutCreateInfo plci = {.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
     VkShaderModuleCreateInfo smci = {.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
     VkComputePipelineCreateInfo cpci = {.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    VkShaderModule module;
+    dlci.bindingCount = k->num_bindings;
+    dlci.pBindings = k->bindings;
+    GPU_CHECK(vkCreateDescriptorSetLayout(g->device, &dlci, NULL, &k->set_layout));
+    plci.setLayoutCount = 1;
+    plci.pSetLayouts = &k->set_layout;
+    plci.pushConstantRangeCount = desc->push_size ? 1 : 0;
+    plci.pPushConstantRanges = &push;
+    GPU_CHECK(vkCreatePipelineLayout(g->device, &plci, NULL, &k->layout));
+    smci.codeSize = desc->code_size;
+    smci.pCode = desc->code;
+    GPU_CHECK(vkCreateShaderModule(g->device, &smci, NULL, &module));
+    cpci.stage = (VkPipelineShaderStageCreateInfo){VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                                                   NULL, 0, VK_SHADER_STAGE_COMPUTE_BIT, module,
+                                                   "main", desc->specialization};
+    cpci.layout = k->layout;
+    GPU_CHECK(vkCreateComputePipelines(g->device, VK_NULL_HANDLE, 1, &cpci, NULL, &k->pipeline));
+    vkDestroyShaderModule(g->device, module, NULL);
+    c->items[c->count++] = k;
+    return k;
+}
+
+void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc)
+{
     VkDescriptorPoolSize sizes[3] = {{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 0},
                                      {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 0},
                                      {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 0}};
     VkDescriptorPoolCreateInfo dpci = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     VkDescriptorSetAllocateInfo dsai = {.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-    VkShaderModule module;
 
     assert(desc->num_bindings <= 32);
     memset(p, 0, sizeof *p);
@@ -604,34 +742,17 @@ void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc)
         if (!p->local_size[i])
             p->local_size[i] = 1;
     p->push_size = desc->push_size;
-
-    for (uint32_t i = 0; i < desc->num_bindings; i++) {
-        lb[i] = (VkDescriptorSetLayoutBinding){desc->bindings[i].binding, desc->bindings[i].type,
-                                               1, VK_SHADER_STAGE_COMPUTE_BIT, NULL};
-        for (int k = 0; k < 3; k++)
-            sizes[k].descriptorCount += sizes[k].type == desc->bindings[i].type;
-    }
-    dlci.bindingCount = desc->num_bindings;
-    dlci.pBindings = lb;
-    GPU_CHECK(vkCreateDescriptorSetLayout(g->device, &dlci, NULL, &p->set_layout));
-    plci.setLayoutCount = 1;
-    plci.pSetLayouts = &p->set_layout;
-    plci.pushConstantRangeCount = desc->push_size ? 1 : 0;
-    plci.pPushConstantRanges = &push;
-    GPU_CHECK(vkCreatePipelineLayout(g->device, &plci, NULL, &p->layout));
-
-    smci.codeSize = desc->code_size;
-    smci.pCode = desc->code;
-    GPU_CHECK(vkCreateShaderModule(g->device, &smci, NULL, &module));
-    cpci.stage = (VkPipelineShaderStageCreateInfo){VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                                                   NULL, 0, VK_SHADER_STAGE_COMPUTE_BIT, module,
-                                                   "main", desc->specialization};
-    cpci.layout = p->layout;
-    GPU_CHECK(vkCreateComputePipelines(g->device, VK_NULL_HANDLE, 1, &cpci, NULL, &p->pipeline));
-    vkDestroyShaderModule(g->device, module, NULL);
+    p->kernel = kernel_get(g, desc);
+    p->kernel->users++;
+    p->set_layout = p->kernel->set_layout;
+    p->layout = p->kernel->layout;
+    p->pipeline = p->kernel->pipeline;
 
     if (!desc->num_bindings)
         return;
+    for (uint32_t i = 0; i < desc->num_bindings; i++)
+        for (int k = 0; k < 3; k++)
+            sizes[k].descriptorCount += sizes[k].type == desc->bindings[i].type;
     dpci.maxSets = 1;
     dpci.poolSizeCount = 0;
     {
@@ -667,14 +788,10 @@ void gpu_pipeline_bind(gpu *g, gpu_pipeline *p, const gpu_binding *bindings, uin
 
 void gpu_pipeline_destroy(gpu *g, gpu_pipeline *p)
 {
-    if (p->pipeline)
-        vkDestroyPipeline(g->device, p->pipeline, NULL);
-    if (p->layout)
-        vkDestroyPipelineLayout(g->device, p->layout, NULL);
     if (p->descriptor_pool)
         vkDestroyDescriptorPool(g->device, p->descriptor_pool, NULL);
-    if (p->set_layout)
-        vkDestroyDescriptorSetLayout(g->device, p->set_layout, NULL);
+    if (p->kernel)
+        p->kernel->users--; /* (kept for the next pipeline that asks: kernel_get) */
     memset(p, 0, sizeof *p);
 }
 

@@ -24,6 +24,7 @@ typedef struct gpu_desc {
     bool swapchain;                     /* enable VK_KHR_swapchain on the device */
 } gpu_desc;
 
+typedef struct gpu_kernel gpu_kernel;
 typedef struct gpu {
     VkInstance instance;
     VkDebugUtilsMessengerEXT messenger;
@@ -37,6 +38,7 @@ typedef struct gpu {
     bool validate;
     bool unified_memory;                /* one heap that is device-local and host-visible */
     VkDeviceSize max_allocation;        /* maxMemoryAllocationSize (Vulkan 1.1) */
+    struct gpu_kernels *kernels;        /* the compiled kernels (gpu_pipeline_create) */
 } gpu;
 
 /* Creates instance and device; false with an error message when no usable device exists,
@@ -119,8 +121,12 @@ typedef struct gpu_pipeline_desc {
     const VkSpecializationInfo *specialization;
 } gpu_pipeline_desc;
 
+/* A kernel with a descriptor set of its own. The kernel (set layout, layout and pipeline) is
+ * the device's, shared by every pipeline made with the same SPIR-V, specialisation, bindings
+ * and push constants, and compiled once (gpu.c: the kernel cache). */
 typedef struct gpu_pipeline {
-    VkDescriptorSetLayout set_layout;
+    gpu_kernel *kernel;
+    VkDescriptorSetLayout set_layout; /* the kernel's */
     VkPipelineLayout layout;
     VkPipeline pipeline;
     VkDescriptorPool descriptor_pool;
@@ -130,7 +136,9 @@ typedef struct gpu_pipeline {
 } gpu_pipeline;
 
 void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc);
-void gpu_pipeline_destroy(gpu *g, gpu_pipeline *p); /* accepts a zeroed struct */
+void gpu_pipeline_destroy(gpu *g, gpu_pipeline *p); /* accepts a zeroed struct; keeps the kernel */
+/* The kernels the device keeps compiled (those in use, and up to 64 in all). */
+uint32_t gpu_kernel_count(const gpu *g);
 /* Points the pipeline's descriptor set at these buffers (the bindings and types it was
  * created with): a buffer made anew needs no new kernel, whose compilation costs about a
  * second on lavapipe. Only while no command buffer that uses the set is recording or pending. */

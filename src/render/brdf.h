@@ -89,8 +89,9 @@ void brdf_format_title(char *out, size_t cap, const brdf_setting *s);
 GnFeatures brdf_query_features(const BrdfQuery *q);
 
 /* Batches BrdfQuery records through brdf_test.comp, a kernel specialised on the features of
- * each batch's queries (one pipeline kept per feature set, BRDF_RUNNER_KERNELS at most), or
- * the unspecialised kernel where all_features is set (GONIO_ALL_FEATURES, or a test). */
+ * each batch's queries (one pipeline kept per feature set, BRDF_RUNNER_KERNELS at most; the
+ * device keeps the kernels compiled beyond that: gpu.h), or the unspecialised kernel where
+ * all_features is set (GONIO_ALL_FEATURES, or a test). */
 #define BRDF_RUNNER_KERNELS 32
 typedef struct brdf_runner {
     gpu *g;

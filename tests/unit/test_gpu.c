@@ -622,3 +622,84 @@ TEST(gpu, texture_wrap)
     gpu_buffer_destroy(&g, &q);
     gpu_destroy(&g);
 }
+
+/* The device compiles a kernel once (gpu.c: the kernel cache): two pipelines of the same
+ * SPIR-V, specialisation and bindings share it, each with its own descriptor set, and each
+ * computes over its own buffers, also once repointed at others (gpu_pipeline_bind); another
+ * specialisation is another kernel; idle kernels are kept, up to a bound. */
+TEST(gpu, kernels_shared)
+{
+    enum { N = 256 };
+    gpu g = {0};
+    gpu_buffer q[2], out[3];
+    gpu_pipeline p[2];
+    if (!test_open_gpu(&g))
+        return;
+    for (int b = 0; b < 2; b++) {
+        gpu_buffer_create(&g, &q[b], 16 * N, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+        int32_t *qs = q[b].mapped;
+        for (int i = 0; i < N; i++) { /* wrap mode 0 (repeat) of i - 100 + 37 b into 7 + b */
+            qs[4 * i] = i - 100 + 37 * b;
+            qs[4 * i + 1] = 7 + b;
+            qs[4 * i + 2] = 0;
+            qs[4 * i + 3] = 0;
+        }
+    }
+    for (int b = 0; b < 3; b++)
+        gpu_buffer_create(&g, &out[b], 4 * N, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+    const uint32_t before = gpu_kernel_count(&g);
+    for (int b = 0; b < 2; b++) {
+        const gpu_binding bind[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &q[b]},
+                                    {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &out[b]}};
+        gpu_pipeline_desc pd = {.name = "wrap_test", .code = spv_wrap_test, .code_size = sizeof spv_wrap_test,
+                                .local_size = {64, 1, 1}, .push_size = 4, .bindings = bind, .num_bindings = 2};
+        gpu_pipeline_create(&g, &p[b], &pd);
+    }
+    CHECKF(gpu_kernel_count(&g) == before + 1, "%u kernels for one kernel twice", gpu_kernel_count(&g) - before);
+    CHECK(p[0].pipeline == p[1].pipeline && p[0].set != p[1].set);
+    /* p[0] over q[0] into out[0], p[1] over q[1] into out[1]; then p[0] repointed: q[1] into out[2] */
+    uint32_t n = N;
+    VkCommandBuffer cmd = gpu_begin(&g);
+    gpu_dispatch(cmd, &p[0], &n, n, 1, 1);
+    gpu_dispatch(cmd, &p[1], &n, n, 1, 1);
+    gpu_submit_wait(&g, cmd);
+    const gpu_binding rebind[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &q[1]},
+                                  {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &out[2]}};
+    gpu_pipeline_bind(&g, &p[0], rebind, 2);
+    cmd = gpu_begin(&g);
+    gpu_dispatch(cmd, &p[0], &n, n, 1, 1);
+    gpu_submit_wait(&g, cmd);
+    int bad = 0;
+    for (int b = 0; b < 3; b++) {
+        const int32_t *qs = q[b == 0 ? 0 : 1].mapped, *o = out[b].mapped;
+        for (int i = 0; i < N; i++)
+            bad += o[i] != wrap_reference(qs[4 * i], qs[4 * i + 1], qs[4 * i + 2]);
+    }
+    CHECKF(bad == 0, "%d of %d wraps wrong through the shared kernel", bad, 3 * N);
+    for (int b = 0; b < 2; b++)
+        gpu_pipeline_destroy(&g, &p[b]);
+    CHECK(gpu_kernel_count(&g) == before + 1); /* kept while idle */
+    /* Other specialisations (of a constant the kernel does not read): other kernels, kept
+     * up to the bound, the idle ones beyond it let go. */
+    for (uint32_t v = 0; v < 80; v++) {
+        const gpu_binding bind[] = {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &q[0]},
+                                    {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &out[0]}};
+        const VkSpecializationMapEntry entry = {99, 0, sizeof v};
+        const VkSpecializationInfo spec = {1, &entry, sizeof v, &v};
+        gpu_pipeline_desc pd = {.name = "wrap_test", .code = spv_wrap_test, .code_size = sizeof spv_wrap_test,
+                                .local_size = {64, 1, 1}, .push_size = 4, .bindings = bind, .num_bindings = 2,
+                                .specialization = &spec};
+        gpu_pipeline q0;
+        gpu_pipeline_create(&g, &q0, &pd);
+        if (v == 0)
+            CHECKF(gpu_kernel_count(&g) == before + 2, "%u kernels", gpu_kernel_count(&g) - before);
+        gpu_pipeline_destroy(&g, &q0);
+    }
+    CHECKF(gpu_kernel_count(&g) == 64, "%u idle kernels kept (64 expected)", gpu_kernel_count(&g));
+    for (int b = 0; b < 3; b++)
+        gpu_buffer_destroy(&g, &out[b]);
+    for (int b = 0; b < 2; b++)
+        gpu_buffer_destroy(&g, &q[b]);
+    CHECK(gpu_validation_message_count() == 0);
+    gpu_destroy(&g);
+}
