@@ -15,6 +15,7 @@ if in_tier slow; then
     check "compare --sweep, elsewhere" sh -c \
         "cd '$tmp/elsewhere-slow' && exec '$G' compare --sweep 1,2 teapot -o sweep --size 16x16 --quiet"
     # ...and while the image is being written (a large one): the temporary file is removed.
+    rm -f "$tmp/b.err"
     "$G" render $C -o "$tmp/big.exr" --size 6000x6000 --mode depth --time 60 2>"$tmp/b.err" &
     pid=$!
     wait_for "$tmp/b.err" 'spp'
@@ -230,7 +231,7 @@ fi
 # SIGINT (or SIGTERM) once: the render ends after its pass, writes what it has, exits 128 + N.
 for sig in INT TERM; do
     want=$((128 + $(kill -l $sig)))
-    rm -f "$tmp/i.exr"
+    rm -f "$tmp/i.exr" "$tmp/i.err" # (wait_for must not read the render before's messages)
     "$G" render $C -o "$tmp/i.exr" --png "$tmp/i.png" --size 32x32 --time 60 2>"$tmp/i.err" &
     pid=$!
     wait_for "$tmp/i.err" 'ETA'
@@ -245,7 +246,7 @@ for sig in INT TERM; do
     check "SIG$sig: no temporary file left" sh -c "! ls -a '$tmp' | grep -q tmp-"
 done
 # Twice: at once, status 130, no output at all.
-rm -f "$tmp/i.exr"
+rm -f "$tmp/i.exr" "$tmp/i.err"
 "$G" render $C -o "$tmp/i.exr" --size 512x512 --time 60 2>"$tmp/i.err" &
 pid=$!
 wait_for "$tmp/i.err" 'ETA'
