@@ -112,7 +112,8 @@ typedef struct gpu_binding {
 
 typedef struct gpu_pipeline_desc {
     const char *name;                 /* for messages */
-    const uint32_t *code;             /* SPIR-V */
+    const uint32_t *code;             /* SPIR-V, valid as long as the device (the kernel
+                                       * cache knows a kernel by this address) */
     size_t code_size;                 /* bytes */
     uint32_t local_size[3];           /* the kernel's work-group size, to round dispatches up */
     uint32_t push_size;               /* bytes of push constants (0: none) */
