@@ -744,7 +744,6 @@ void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc)
     p->push_size = desc->push_size;
     p->kernel = kernel_get(g, desc);
     p->kernel->users++;
-    p->set_layout = p->kernel->set_layout;
     p->layout = p->kernel->layout;
     p->pipeline = p->kernel->pipeline;
 
@@ -765,7 +764,7 @@ void gpu_pipeline_create(gpu *g, gpu_pipeline *p, const gpu_pipeline_desc *desc)
     }
     dsai.descriptorPool = p->descriptor_pool;
     dsai.descriptorSetCount = 1;
-    dsai.pSetLayouts = &p->set_layout;
+    dsai.pSetLayouts = &p->kernel->set_layout;
     GPU_CHECK(vkAllocateDescriptorSets(g->device, &dsai, &p->set));
     gpu_pipeline_bind(g, p, desc->bindings, desc->num_bindings);
 }

@@ -127,8 +127,7 @@ typedef struct gpu_pipeline_desc {
  * and push constants, and compiled once (gpu.c: the kernel cache). */
 typedef struct gpu_pipeline {
     gpu_kernel *kernel;
-    VkDescriptorSetLayout set_layout; /* the kernel's */
-    VkPipelineLayout layout;
+    VkPipelineLayout layout; /* the kernel's, as its pipeline (read by gpu_dispatch) */
     VkPipeline pipeline;
     VkDescriptorPool descriptor_pool;
     VkDescriptorSet set;

@@ -349,13 +349,13 @@ const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
 {
     gpu_pipeline *p = &r->pipelines[mode];
-    gpu_binding b[GN_BIND_COUNT];
     renderer_spec spec;
     const VkSpecializationInfo *info = renderer_specialize(r, mode, &spec);
     spec.values[3] = mode_kernel(mode)->batched ? r->loop_cap : 0u;
     if (p->pipeline && memcmp(r->pipeline_spec[mode], spec.values, sizeof spec.values))
         gpu_pipeline_destroy(r->g, p); /* built for other features: a new kernel */
     if (!p->pipeline) {
+        gpu_binding b[GN_BIND_COUNT];
         gpu_pipeline_desc pd = {
             .name = mode_kernel(mode)->name, .code = mode_kernel(mode)->code,
             .code_size = mode_kernel(mode)->code_size,
@@ -364,9 +364,8 @@ gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
         gpu_pipeline_create(r->g, p, &pd);
         memcpy(r->pipeline_spec[mode], spec.values, sizeof spec.values);
         r->pipeline_bound[mode] = r->buffers_replaced;
-    } else if (r->pipeline_bound[mode] != r->buffers_replaced) {
-        gpu_pipeline_bind(r->g, p, b, renderer_bindings(r, b));
-        r->pipeline_bound[mode] = r->buffers_replaced;
+    } else {
+        renderer_rebind(r, p, &r->pipeline_bound[mode]);
     }
     return p;
 }
@@ -374,6 +373,15 @@ gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
 void renderer_buffers_replaced(renderer *r)
 {
     r->buffers_replaced++;
+}
+
+void renderer_rebind(renderer *r, gpu_pipeline *p, uint32_t *bound)
+{
+    gpu_binding b[GN_BIND_COUNT];
+    if (*bound == r->buffers_replaced)
+        return;
+    gpu_pipeline_bind(r->g, p, b, renderer_bindings(r, b));
+    *bound = r->buffers_replaced;
 }
 
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,

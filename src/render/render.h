@@ -175,6 +175,8 @@ gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode);
 /* After a buffer the kernels bind is destroyed and made anew: each kernel's descriptor set is
  * pointed at the new one before its next use. */
 void renderer_buffers_replaced(renderer *r);
+/* Points p's descriptor set at the renderer's buffers if any was made anew since *bound. */
+void renderer_rebind(renderer *r, gpu_pipeline *p, uint32_t *bound);
 /* Records one sample pass (sample `sample_index` in every pixel) and a barrier. Call
  * renderer_begin first. */
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,

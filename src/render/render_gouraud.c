@@ -94,12 +94,10 @@ bool light_vertices(renderer *r)
                    groups, max_x, max_y);
         return false;
     }
-    gpu_binding b[GN_BIND_COUNT];
-    if (r->vertex_pass.pipeline && r->vertex_bound != r->buffers_replaced) {
-        gpu_pipeline_bind(r->g, &r->vertex_pass, b, renderer_bindings(r, b));
-        r->vertex_bound = r->buffers_replaced;
-    }
-    if (!r->vertex_pass.pipeline) {
+    if (r->vertex_pass.pipeline) {
+        renderer_rebind(r, &r->vertex_pass, &r->vertex_bound);
+    } else {
+        gpu_binding b[GN_BIND_COUNT];
         const uint32_t instances = r->geo.two_levels;
         const VkSpecializationMapEntry entry = {GN_SPEC_INSTANCES, 0, sizeof instances};
         const VkSpecializationInfo spec = {1, &entry, sizeof instances, &instances};
