@@ -233,7 +233,9 @@ bool select_variant(Ctx &c);
  * else its clearcoat normal map's, else (anisotropy, whose direction is in the tangent frame)
  * its anisotropy texture's or 0; -1 when it needs none. */
 int material_tangent_set(const Ctx &c, uint32_t material);
-void load_images_and_textures(Ctx &c, scene *out);
+/* Decodes the images into out->images and the textures into out->textures; false (an error
+ * naming the image and the problem) when a texture's image cannot be read. */
+bool load_images_and_textures(Ctx &c, scene *out);
 
 /* ---- gltf_environment.cpp: the file's image-based light (EXT_lights_image_based) ---------- */
 struct Doc;

@@ -450,15 +450,16 @@ int texture_source(Ctx &c, size_t i)
                  t.source);
             return t.source;
         }
-        return s; /* unusable and no fallback: ignored, as the image's warning says */
+        return s; /* unusable and no fallback: load_images_and_textures's error */
     }
     return t.source;
 }
 
-void load_images_and_textures(Ctx &c, scene *out)
+bool load_images_and_textures(Ctx &c, scene *out)
 {
     const auto &m = c.m;
     decode_view_images(c);
+    std::map<int, std::string> unusable; /* image -> what it is and why it cannot be read */
     out->images = static_cast<scene_image *>(util_calloc(m.images.size(), sizeof(scene_image)));
     c.image_map.assign(m.images.size(), GN_INVALID);
     for (size_t i = 0; i < m.images.size(); i++) {
@@ -469,8 +470,8 @@ void load_images_and_textures(Ctx &c, scene *out)
             std::string why = c.image_errors.count(int(i)) ? c.image_errors[int(i)] : "file missing or unreadable";
             while (!why.empty() && why.back() == '\n')
                 why.pop_back();
-            warn(c, "%s%s%s: %s; textures using it are ignored", label("image", int(i), img.name).c_str(),
-                 img.uri.empty() ? "" : " ", img.uri.substr(0, 200).c_str(), why.c_str());
+            unusable[int(i)] = label("image", int(i), img.name) + (img.uri.empty() ? "" : " ") +
+                               img.uri.substr(0, 200) + ": " + why;
             continue;
         }
         out->images[out->num_images].format = uint32_t(c.image_formats[int(i)]);
@@ -484,6 +485,7 @@ void load_images_and_textures(Ctx &c, scene *out)
     out->textures = static_cast<scene_texture *>(util_calloc(c.textures_room, sizeof(scene_texture)));
     c.textures_out = out;
     c.texture_map.assign(m.textures.size(), GN_INVALID);
+    std::vector<bool> used(m.images.size(), false);
     for (size_t i = 0; i < m.textures.size(); i++) {
         const auto &t = m.textures[i];
         int source = texture_source(c, i);
@@ -491,8 +493,15 @@ void load_images_and_textures(Ctx &c, scene *out)
             warn(c, "texture %zu has no image source (ignored)", i);
             continue;
         }
-        if (c.image_map[size_t(source)] == GN_INVALID)
+        if (c.image_map[size_t(source)] == GN_INVALID) {
+            /* A texture that cannot be read is an error, not a white or missing slot: the
+             * image would silently be another picture than the file's. */
+            int original = c.image_alias.count(source) ? c.image_alias[source] : source;
+            auto u = unusable.find(original);
+            fail(c, "%s; texture %zu uses it", u != unusable.end() ? u->second.c_str() : "an unusable image", i);
+            used[size_t(original)] = true;
             continue;
+        }
         uint32_t flags = 0;
         if (t.sampler >= 0) {
             const auto &s = m.samplers[size_t(t.sampler)];
@@ -502,6 +511,11 @@ void load_images_and_textures(Ctx &c, scene *out)
         out->textures[out->num_textures] = scene_texture{c.image_map[size_t(source)], flags, {1, 0, 0, 0, 1, 0}};
         c.texture_map[i] = out->num_textures++;
     }
+    /* An image no texture draws (or a fallback's other half) is only worth a warning. */
+    for (const auto &u : unusable)
+        if (!used[size_t(u.first)])
+            warn(c, "%s; no texture draws it", u.second.c_str());
+    return !c.failed;
 }
 
 /* ---- materials: the table's rows read from the JSON document -------------------------------- */

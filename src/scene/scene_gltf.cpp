@@ -282,7 +282,8 @@ bool load(scene *out, const char *path, int scene_index)
     std::vector<Instance> inst, cams, lights;
     if (!collect_instances(c, inst, cams, lights) || !joint_matrices(c) || !bake_geometry(c, inst, out))
         return false;
-    load_images_and_textures(c, out);
+    if (!load_images_and_textures(c, out))
+        return false;
     if (!c.limit_error.empty()) /* images in buffer views are decoded only now */
         return fail(c, "%s", c.limit_error.c_str());
     load_materials(c, out);
