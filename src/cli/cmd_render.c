@@ -701,7 +701,7 @@ static int render_run(const render_job *job)
     }
     scene *scp = cache ? &cache->sc : &sc; /* (a frame's scene moves into the cache) */
     if (env_probe_applies(&env, scp)) { /* the file's own light: is the view dark? */
-        float lit = env_probe_lit_fraction(rp, &s);
+        float lit = env_probe_lit_fraction(rp, &s, false);
         if (env_probe_is_dark(lit)) {
             env_add_studio(&env, scp, quiet, lit, job->s.ambient_set, &env_map, &s);
             studio = true;
@@ -711,7 +711,12 @@ static int render_run(const render_job *job)
             }
         }
     }
-    s.env_label = studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none";
+    bool headlight = studio && !env.given && env_add_headlight(rp, scp, &s, quiet);
+    if (headlight) { /* a camera the studio cannot reach: the headlight joined the scene's lights */
+        renderer_destroy(rp);
+        renderer_create(rp, gp, scp);
+    }
+    s.env_label = headlight ? "headlight" : studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none";
     if ((!resume_path || check_resume(resume_path, rp, &s, brdf, &prev)) && renderer_render(rp, &s, &img, &st)) {
         char seconds[32];
         render_header h;

@@ -15,6 +15,7 @@
 #include "image.h"
 #include "render.h"
 #include "util.h"
+#include "vec.h"
 
 /* ---- shared values ---------------------------------------------------------------------- */
 
@@ -303,7 +304,7 @@ bool env_probe_applies(const env_option *e, const scene *sc)
     return !e->given && !sc->environment.num_channels && env_scene_has_light(sc);
 }
 
-float env_probe_lit_fraction(renderer *r, const render_settings *s)
+float env_probe_lit_fraction(renderer *r, const render_settings *s, bool with_env)
 {
     render_settings p = *s;
     p.mode = GN_MODE_PATH;
@@ -319,8 +320,10 @@ float env_probe_lit_fraction(renderer *r, const render_settings *s)
     p.aov = 0;
     p.progress = NULL;
     p.stop = NULL;
-    p.env_map = NULL;
-    p.env[0] = p.env[1] = p.env[2] = 0;
+    if (!with_env) {
+        p.env_map = NULL;
+        p.env[0] = p.env[1] = p.env[2] = 0;
+    }
     p.strategy = 0;
     p.crop_x0 = p.crop_y0 = p.crop_x1 = p.crop_y1 = 0;
     p.resume = NULL;
@@ -361,4 +364,96 @@ void env_add_studio(const env_option *e, scene *sc, bool quiet, float lit, bool 
     if (!ambient_given)
         for (int k = 0; k < 3; k++)
             s->ambient[k] += mean[k];
+}
+
+/* ---- a camera inside a closed model ------------------------------------------------------
+ * The rule's second step (docs/path-tracing.md, "Light when the scene has none"): where the
+ * studio lights the view by default, a camera inside a closed model (a sky dome around a
+ * city, a room without a window) keeps it out. Of ENV_ENCLOSED_RAYS rays from the camera,
+ * spread evenly over the sphere (a spherical Fibonacci set) and traced on the host through
+ * the render's own trees, at least ENV_ENCLOSED meet the scene: the camera is enclosed, and
+ * the probe is rendered again with the studio. Still dark, a headlight replaces the studio
+ * (which would only take light samples from it): a point light at the camera, which lights
+ * everything the camera sees (nothing stands between them), as bright as the studio makes a
+ * white surface (luminance 0.8, 40 ENV_PROBE_LEVEL) at the median distance of what the
+ * view's rays (ENV_VIEW_RAYS^2 through the image) meet. */
+#define ENV_ENCLOSED_RAYS 1024
+#define ENV_ENCLOSED 0.99f
+#define ENV_VIEW_RAYS 32
+#define ENV_HEADLIGHT_WHITE (40 * ENV_PROBE_LEVEL)
+
+static int cmp_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+static float trace_distance(const renderer *r, const float org[3], const float dir[3])
+{
+    bvh_hit h = r->geo.two_levels ? bvh_top_intersect(&r->geo.top, org, dir, 0, INFINITY, NULL)
+                                  : bvh_intersect(&r->geo.world, org, dir, 0, INFINITY, NULL);
+    return h.tri == GN_INVALID ? -1 : h.t;
+}
+
+bool env_add_headlight(renderer *r, scene *sc, render_settings *s, bool quiet)
+{
+    GnCamera cam;
+    if (r->failed || !renderer_camera(r, s, &cam))
+        return false;
+    const float org[3] = {cam.position.x, cam.position.y, cam.position.z};
+    int hits = 0;
+    const double golden = M_PI * (3 - sqrt(5.0));
+    for (int i = 0; i < ENV_ENCLOSED_RAYS; i++) {
+        float z = 1 - (2 * i + 1) / (float)ENV_ENCLOSED_RAYS, rho = sqrtf(fmaxf(0, 1 - z * z));
+        float dir[3] = {rho * (float)cos(golden * i), rho * (float)sin(golden * i), z};
+        hits += trace_distance(r, org, dir) >= 0;
+    }
+    float enclosed = (float)hits / ENV_ENCLOSED_RAYS;
+    if (enclosed < ENV_ENCLOSED)
+        return false;
+    float seen[ENV_VIEW_RAYS * ENV_VIEW_RAYS];
+    int num_seen = 0;
+    for (int y = 0; y < ENV_VIEW_RAYS; y++)
+        for (int x = 0; x < ENV_VIEW_RAYS; x++) { /* GnCamera's mapping (glsl/lib/shared.h) */
+            float sx = 2 * (x + 0.5f) / ENV_VIEW_RAYS - 1, sy = 1 - 2 * (y + 0.5f) / ENV_VIEW_RAYS;
+            const float right[3] = {cam.right.x, cam.right.y, cam.right.z}, up[3] = {cam.up.x, cam.up.y, cam.up.z};
+            float ro[3] = {org[0], org[1], org[2]}, rd[3] = {cam.forward.x, cam.forward.y, cam.forward.z};
+            float h = cam.ortho_half_height > 0 ? cam.ortho_half_height : cam.tan_half_fovy;
+            for (int k = 0; k < 3; k++) { /* orthographic: the origin moves; perspective: the direction */
+                float off = h * (sx * cam.aspect * right[k] + sy * up[k]);
+                if (cam.ortho_half_height > 0)
+                    ro[k] += off;
+                else
+                    rd[k] += off;
+            }
+            vec_normalize(rd);
+            float t = trace_distance(r, ro, rd);
+            if (t >= 0)
+                seen[num_seen++] = t;
+        }
+    if (num_seen == 0)
+        return false;
+    float lit = env_probe_lit_fraction(r, s, true);
+    if (!env_probe_is_dark(lit))
+        return false;
+    qsort(seen, (size_t)num_seen, sizeof *seen, cmp_float);
+    float d = seen[num_seen / 2];
+    /* A white Lambertian surface facing the light at distance d: radiance I / d^2 / pi in the
+     * path tracer; the local modes' Phong diffuse term has no 1 / pi (environment_studio_key). */
+    float intensity = ENV_HEADLIGHT_WHITE * d * d * (s->mode == GN_MODE_PATH ? (float)M_PI : 1.0f);
+    GnLight head;
+    memset(&head, 0, sizeof head);
+    head.type = GN_LIGHT_POINT;
+    head.position = cam.position;
+    head.direction = cam.forward;
+    head.color = (vec3){intensity, intensity, intensity};
+    sc->lights = util_realloc(sc->lights, (sc->num_lights + 1) * sizeof *sc->lights);
+    sc->lights[sc->num_lights++] = head;
+    s->env_map = NULL; /* (the local modes keep the studio's ambient term) */
+    s->env[0] = s->env[1] = s->env[2] = 0;
+    if (!quiet)
+        util_info("%s: the camera is inside a closed model (%.0f %% of the rays from it meet the scene) that keeps "
+                  "the studio out (%.0f %% of the model lit): a headlight, a point light at the camera, replaces "
+                  "the studio (--env 0 for the file's light alone)", sc->path, 100 * enclosed, 100 * fmaxf(lit, 0));
+    return true;
 }

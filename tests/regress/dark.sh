@@ -111,6 +111,77 @@ else
     echo "  note: no IridescenceSuzanne / LightsPunctualLamp in GONIO_ASSETS: those checks skipped"
 fi
 
+# ---- a camera inside a closed model: the headlight ----------------------------------------
+# Three white boxes on a grey ground inside a closed, double-sided sky box, the camera among
+# them, no light: the studio cannot reach the boxes. "open" is the same without the sky;
+# "lamp" has a point light inside the sky that lights the view (deliberate: unchanged).
+python3 - "$tmp" <<'PY'
+import base64, json, struct, sys
+out = sys.argv[1]
+def box(lo, hi):
+    p, n, i = [], [], []
+    for ax in range(3):
+        for sg in (-1, 1):
+            u, v = (ax + 1) % 3, (ax + 2) % 3
+            b = len(p) // 3
+            for a, c in ((0, 0), (1, 0), (1, 1), (0, 1)):
+                q = [0, 0, 0]; q[ax] = hi[ax] if sg > 0 else lo[ax]
+                q[u] = (lo[u], hi[u])[a]; q[v] = (lo[v], hi[v])[c]
+                p += q; nn = [0, 0, 0]; nn[ax] = sg; n += nn
+            i += [b, b + 1, b + 2, b, b + 2, b + 3] if sg > 0 else [b, b + 2, b + 1, b, b + 3, b + 2]
+    return p, n, i
+def write(name, sky, lamp):
+    parts = [(box([-20, -1, -20], [20, 0, 20]), 0)]
+    parts += [(box([x - 0.5, 0, z - 0.5], [x + 0.5, h, z + 0.5]), 1) for x, z, h in ((-1.5, -2, 1), (0.5, -4, 2), (2, -1.5, 0.8))]
+    if sky:
+        parts.append((box([-25, -5, -25], [25, 25, 25]), 2))
+    blob, views, accs, prims = b"", [], [], []
+    for (P, N, I), mat in parts:
+        nv = len(P) // 3
+        for data, fmt, typ, comp in ((P, "f", "VEC3", 5126), (N, "f", "VEC3", 5126), (I, "I", "SCALAR", 5125)):
+            views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": 4 * len(data)})
+            a = {"bufferView": len(views) - 1, "componentType": comp, "count": len(data) // (3 if typ == "VEC3" else 1), "type": typ}
+            if data is P:
+                a["min"] = [min(P[k::3]) for k in range(3)]; a["max"] = [max(P[k::3]) for k in range(3)]
+            accs.append(a)
+            blob += struct.pack("<%d%s" % (len(data), fmt), *data)
+        k = len(accs)
+        prims.append({"attributes": {"POSITION": k - 3, "NORMAL": k - 2}, "indices": k - 1, "material": mat})
+    mats = [{"pbrMetallicRoughness": {"baseColorFactor": c + [1], "metallicFactor": 0, "roughnessFactor": 1}} for c in ([0.5, 0.5, 0.5], [0.9, 0.9, 0.9], [0.4, 0.6, 0.9])]
+    mats[2]["doubleSided"] = True
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+           "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+           "bufferViews": views, "accessors": accs, "materials": mats, "meshes": [{"primitives": prims}],
+           "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.05}}],
+           "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 1.5, 4], "rotation": [-0.13, 0, 0, 0.9915]}]}
+    if lamp:
+        doc["extensionsUsed"] = ["KHR_lights_punctual"]
+        doc["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 400}]}}
+        doc["nodes"].append({"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [1, 6, 3]})
+        doc["scenes"][0]["nodes"].append(2)
+    json.dump(doc, open(f"{out}/{name}.gltf", "w"))
+write("sky", True, False)
+write("open", False, False)
+write("lamp", True, True)
+PY
+HEAD="a headlight, a point light at the camera, replaces the studio"
+check "a camera inside a closed sky, no light: renders" R "$tmp/sky.gltf" -o "$tmp/sky.exr" --size 48x32
+cp "$tmp/out" "$tmp/msg"
+check "... a headlight added, saying why" grep -qF "the camera is inside a closed model (100 % of the rays from it meet the scene)" "$tmp/msg"
+check "... in one line" test "$(grep -c "$HEAD" "$tmp/msg")" = 1
+check "... and the header says so" test "$(exrheader "$tmp/sky.exr" 2>/dev/null | grep -a -c 'gonio:environment.*headlight')" = 1
+got=$(lit "$tmp/sky.exr")
+check "... and the view is lit (lit fraction $got >= 0.6)" python3 -c "assert $got >= 0.6"
+check "the studio alone (--env studio: no rule)" R "$tmp/sky.gltf" -o "$tmp/sky-s.exr" --size 48x32 --env studio
+got=$(lit "$tmp/sky-s.exr")
+check "... leaves the boxes in the closed sky dark (lit fraction $got < 0.6)" python3 -c "assert $got < 0.6"
+check "the same boxes with no sky render" R "$tmp/open.gltf" -o "$tmp/open.exr" --size 48x32
+grep -qF "$HEAD" "$tmp/out" && fail "no sky: a headlight was added" || pass
+check "a lamp inside the closed sky renders" R "$tmp/lamp.gltf" -o "$tmp/lamp.exr" --size 48x32
+grep -q "$HEAD\|$ADDED" "$tmp/out" && fail "a lamp that lights the closed sky: light was added" || pass
+check "the lamp in the closed sky with --env 0" R "$tmp/lamp.gltf" -o "$tmp/lamp-0.exr" --size 48x32 --env 0
+check "... the same pixels, bit for bit" "$TESTTOOL" same "$tmp/lamp.exr" "$tmp/lamp-0.exr"
+
 # ---- the framing view fills the frame ----------------------------------------------------
 # A red cube under a constant environment: its projected box (testtool's red box) spans at
 # least 85 % of the frame along its limiting axis, whatever its size and position.
