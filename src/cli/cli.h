@@ -251,8 +251,9 @@ void env_add_studio(const env_option *e, struct scene *sc, bool quiet, float lit
                     struct image *map, struct render_settings *s);
 /* The rule's second step, where the studio lights s's view by default: a camera inside a
  * closed model that keeps the studio out, the view still dark, gets a headlight (a point
- * light at the camera) added to sc's lights in place of s's environment, said unless quiet.
- * True when added: the caller makes its renderer again. */
+ * light at the camera) added to sc's lights in place of s's environment map (the local
+ * modes keep its ambient term), said unless quiet. True when added: the caller makes its
+ * renderer again. */
 bool env_add_headlight(struct renderer *r, struct scene *sc, struct render_settings *s, bool quiet);
 
 /* "gonio CMD: MESSAGE" and the hint to use --help; returns 2. */

@@ -372,11 +372,14 @@ void env_add_studio(const env_option *e, scene *sc, bool quiet, float lit, bool 
  * city, a room without a window) keeps it out. Of ENV_ENCLOSED_RAYS rays from the camera,
  * spread evenly over the sphere (a spherical Fibonacci set) and traced on the host through
  * the render's own trees, at least ENV_ENCLOSED meet the scene: the camera is enclosed, and
- * the probe is rendered again with the studio. Still dark, a headlight replaces the studio
- * (which would only take light samples from it): a point light at the camera, which lights
- * everything the camera sees (nothing stands between them), as bright as the studio makes a
- * white surface (luminance 0.8, 40 ENV_PROBE_LEVEL) at the median distance of what the
- * view's rays (ENV_VIEW_RAYS^2 through the image) meet. */
+ * the probe is rendered again with the studio. Still dark, a headlight replaces the studio:
+ * a point light at the camera, which lights everything the camera sees (nothing stands
+ * between them), as bright as the studio makes a white surface (luminance 0.8, 40
+ * ENV_PROBE_LEVEL) at the median distance of what the view's rays (ENV_VIEW_RAYS^2 through
+ * the image) meet. The studio goes: what it reaches through an opening or glass is little
+ * (the view stayed dark), and kept it would take most light samples (the image noisy). Both
+ * kinds of ray start at the camera's znear, as its own rays do (a cutaway camera sees
+ * through what its near plane clips). */
 #define ENV_ENCLOSED_RAYS 1024
 #define ENV_ENCLOSED 0.99f
 #define ENV_VIEW_RAYS 32
@@ -388,10 +391,10 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static float trace_distance(const renderer *r, const float org[3], const float dir[3])
+static float trace_distance(const renderer *r, const float org[3], const float dir[3], float tmin)
 {
-    bvh_hit h = r->geo.two_levels ? bvh_top_intersect(&r->geo.top, org, dir, 0, INFINITY, NULL)
-                                  : bvh_intersect(&r->geo.world, org, dir, 0, INFINITY, NULL);
+    bvh_hit h = r->geo.two_levels ? bvh_top_intersect(&r->geo.top, org, dir, tmin, INFINITY, NULL)
+                                  : bvh_intersect(&r->geo.world, org, dir, tmin, INFINITY, NULL);
     return h.tri == GN_INVALID ? -1 : h.t;
 }
 
@@ -406,7 +409,7 @@ bool env_add_headlight(renderer *r, scene *sc, render_settings *s, bool quiet)
     for (int i = 0; i < ENV_ENCLOSED_RAYS; i++) {
         float z = 1 - (2 * i + 1) / (float)ENV_ENCLOSED_RAYS, rho = sqrtf(fmaxf(0, 1 - z * z));
         float dir[3] = {rho * (float)cos(golden * i), rho * (float)sin(golden * i), z};
-        hits += trace_distance(r, org, dir) >= 0;
+        hits += trace_distance(r, org, dir, cam.znear) >= 0;
     }
     float enclosed = (float)hits / ENV_ENCLOSED_RAYS;
     if (enclosed < ENV_ENCLOSED)
@@ -427,7 +430,7 @@ bool env_add_headlight(renderer *r, scene *sc, render_settings *s, bool quiet)
                     rd[k] += off;
             }
             vec_normalize(rd);
-            float t = trace_distance(r, ro, rd);
+            float t = trace_distance(r, ro, rd, cam.znear);
             if (t >= 0)
                 seen[num_seen++] = t;
         }
@@ -454,6 +457,6 @@ bool env_add_headlight(renderer *r, scene *sc, render_settings *s, bool quiet)
     if (!quiet)
         util_info("%s: the camera is inside a closed model (%.0f %% of the rays from it meet the scene) that keeps "
                   "the studio out (%.0f %% of the model lit): a headlight, a point light at the camera, replaces "
-                  "the studio (--env 0 for the file's light alone)", sc->path, 100 * enclosed, 100 * fmaxf(lit, 0));
+                  "the studio (any --env decides instead)", sc->path, 100 * enclosed, 100 * fmaxf(lit, 0));
     return true;
 }

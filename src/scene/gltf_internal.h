@@ -17,6 +17,7 @@
 #include <cstdarg>
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -118,6 +119,9 @@ struct Ctx {
     std::vector<bool> camera_ok, light_ok;   /* per glTF camera / light: values usable */
     std::vector<std::vector<Prim>> meshes;   /* per glTF mesh */
     std::vector<uint32_t> image_map, texture_map; /* glTF index -> scene index or GN_INVALID */
+    std::map<int, std::string> texture_errors; /* texture -> its image that cannot be read, and why */
+    std::set<int> texture_errors_said;       /* of those, the ones a material's error named */
+    bool material_drawn = true;              /* load_materials: the scene draws the material read now */
     scene *textures_out = nullptr;           /* where texture_slot adds transformed textures */
     size_t textures_room = 0;                /* textures_out->textures' allocated entries */
     std::map<std::pair<uint32_t, size_t>, int> decoded; /* (crc32, size) of image bytes -> first image */
@@ -233,9 +237,10 @@ bool select_variant(Ctx &c);
  * else its clearcoat normal map's, else (anisotropy, whose direction is in the tangent frame)
  * its anisotropy texture's or 0; -1 when it needs none. */
 int material_tangent_set(const Ctx &c, uint32_t material);
-/* Decodes the images into out->images and the textures into out->textures; false (an error
- * naming the image and the problem) when a texture's image cannot be read. */
-bool load_images_and_textures(Ctx &c, scene *out);
+/* Decodes the images into out->images and the textures into out->textures. A texture whose
+ * image cannot be read goes into c.texture_errors: texture_slot's error when a material uses
+ * it (load_materials), else a warning; an unreadable image no texture uses is a warning. */
+void load_images_and_textures(Ctx &c, scene *out);
 
 /* ---- gltf_environment.cpp: the file's image-based light (EXT_lights_image_based) ---------- */
 struct Doc;
@@ -244,7 +249,9 @@ void check_ibl(Doc &d);
 /* Bakes the drawn scene's image-based light into out->environment (after
  * load_images_and_textures: its faces are out->images); false on a bad face. */
 bool bake_environment(Ctx &c, scene *out);
-void load_materials(Ctx &c, scene *out);
+/* The scene's materials; false (with an error naming the material, the slot and the image)
+ * when a material uses a texture whose image cannot be read. */
+bool load_materials(Ctx &c, scene *out);
 
 } // namespace gltf
 

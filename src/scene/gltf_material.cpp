@@ -264,7 +264,7 @@ std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned c
 
 /* tinygltf image callback. Images in buffer views arrive before any buffer view is checked, so
  * they are decoded later (decode_view_images); a file that fails to decode is recorded rather
- * than failing the whole load, and its textures are dropped with a warning. */
+ * than failing the whole load: an error only where a drawn material uses it (texture_slot). */
 bool image_callback(tinygltf::Image *img, const int idx, std::string *, std::string *, int, int,
                     const unsigned char *bytes, int size, void *user)
 {
@@ -429,13 +429,15 @@ uint32_t filter_mode(Ctx &c, size_t sampler, int mag, int min)
     return mag == TINYGLTF_TEXTURE_FILTER_NEAREST ? GN_TEX_NEAREST : 0u;
 }
 
-/* KHR_texture_basisu, EXT_texture_webp: the extension's source (a KTX2 or WebP image; the
- * JSON checks made it an index into images) where its image decoded; else the core source,
- * the optional fallback (a file that requires the extension may omit it); -1 when there is
- * neither. */
+/* KHR_texture_basisu, EXT_texture_webp: the first extension source (a KTX2 or WebP image;
+ * the JSON checks made it an index into images) whose image decoded; else the core source,
+ * the optional fallback (a file that requires the extension may omit it); else the first
+ * extension source, unusable (load_images_and_textures says why); -1 when there is none. */
 int texture_source(Ctx &c, size_t i)
 {
     const auto &t = c.m.textures[i];
+    int first = -1;
+    const char *first_name = "";
     for (const char *name : {"KHR_texture_basisu", "EXT_texture_webp"}) {
         auto e = t.extensions.find(name);
         if (e == t.extensions.end() || !e->second.IsObject() || !e->second.Has("source"))
@@ -445,17 +447,20 @@ int texture_source(Ctx &c, size_t i)
             continue;
         if (c.image_map[size_t(s)] != GN_INVALID)
             return s;
-        if (t.source >= 0 && c.image_map[size_t(t.source)] != GN_INVALID) {
-            warn(c, "texture %zu: its %s image %d is unusable; its fallback, image %d, is used instead", i, name, s,
-                 t.source);
-            return t.source;
+        if (first < 0) {
+            first = s;
+            first_name = name;
         }
-        return s; /* unusable and no fallback: load_images_and_textures's error */
     }
-    return t.source;
+    if (first >= 0 && t.source >= 0 && c.image_map[size_t(t.source)] != GN_INVALID) {
+        warn(c, "texture %zu: its %s image %d is unusable; its fallback, image %d, is used instead", i, first_name,
+             first, t.source);
+        return t.source;
+    }
+    return first >= 0 ? first : t.source;
 }
 
-bool load_images_and_textures(Ctx &c, scene *out)
+void load_images_and_textures(Ctx &c, scene *out)
 {
     const auto &m = c.m;
     decode_view_images(c);
@@ -493,12 +498,10 @@ bool load_images_and_textures(Ctx &c, scene *out)
             warn(c, "texture %zu has no image source (ignored)", i);
             continue;
         }
-        if (c.image_map[size_t(source)] == GN_INVALID) {
-            /* A texture that cannot be read is an error, not a white or missing slot: the
-             * image would silently be another picture than the file's. */
+        if (c.image_map[size_t(source)] == GN_INVALID) { /* an error where a material uses it */
             int original = c.image_alias.count(source) ? c.image_alias[source] : source;
             auto u = unusable.find(original);
-            fail(c, "%s; texture %zu uses it", u != unusable.end() ? u->second.c_str() : "an unusable image", i);
+            c.texture_errors[int(i)] = u != unusable.end() ? u->second : "an unusable image";
             used[size_t(original)] = true;
             continue;
         }
@@ -515,7 +518,6 @@ bool load_images_and_textures(Ctx &c, scene *out)
     for (const auto &u : unusable)
         if (!used[size_t(u.first)])
             warn(c, "%s; no texture draws it", u.second.c_str());
-    return !c.failed;
 }
 
 /* ---- materials: the table's rows read from the JSON document -------------------------------- */
@@ -752,6 +754,16 @@ int material_tangent_set(const Ctx &c, uint32_t material)
  * transform (GnTexture), so each slot stays one index. */
 uint32_t texture_slot(Ctx &c, const TextureRef &ref, const std::string &what, const char *slot)
 {
+    auto bad = c.texture_errors.find(ref.index);
+    if (bad != c.texture_errors.end()) {
+        /* Drawn, an error, not a white or missing slot: the render would silently be another
+         * picture than the file's. (Not drawn: load_materials's warning.) */
+        if (c.material_drawn) {
+            fail(c, "%s: %s: texture %d: %s", what.c_str(), slot, ref.index, bad->second.c_str());
+            c.texture_errors_said.insert(ref.index);
+        }
+        return GN_INVALID;
+    }
     if (ref.index < 0 || c.texture_map[size_t(ref.index)] == GN_INVALID)
         return GN_INVALID;
     if (ref.tex_coord > 1) {
@@ -838,15 +850,16 @@ void read_gonio_extras(Ctx &c, const Json &extras, const std::string &what, GnMa
     }
 }
 
-void load_materials(Ctx &c, scene *out)
+bool load_materials(Ctx &c, scene *out)
 {
     size_t n = c.materials.size();
-    bool need_default = false;
+    std::vector<bool> drawn(n + 1, false); /* the materials the scene's triangles use */
     for (uint32_t t = 0; t < out->num_triangles; t++)
-        need_default |= out->tri_material[t] == n;
+        drawn[std::min(size_t(out->tri_material[t]), n)] = true;
     for (uint32_t m = 0; m < out->num_instanced_meshes; m++)
         for (uint32_t t = 0; t < out->instanced_meshes[m].num_triangles; t++)
-            need_default |= out->instanced_meshes[m].tri_material[t] == n;
+            drawn[std::min(size_t(out->instanced_meshes[m].tri_material[t]), n)] = true;
+    bool need_default = drawn[n];
     out->num_materials = uint32_t(n + (need_default ? 1 : 0));
     out->materials = static_cast<GnMaterial *>(util_calloc(out->num_materials, sizeof(GnMaterial)));
     out->material_extras = static_cast<scene_material_extras *>(util_calloc(out->num_materials, sizeof(scene_material_extras)));
@@ -855,6 +868,7 @@ void load_materials(Ctx &c, scene *out)
         const MaterialDraft &d = c.materials[i];
         GnMaterial &g = out->materials[i];
         g = d.g;
+        c.material_drawn = drawn[i];
 #define RESOLVE_TEX(name, word, ext, json, space, gate, uses) g.name = texture_slot(c, d.tex[word], d.what, shown(json));
         GN_MATERIAL(GN_MAT_NO_PARAM, RESOLVE_TEX, GN_MAT_NO_FIELD)
 #undef RESOLVE_TEX
@@ -866,6 +880,10 @@ void load_materials(Ctx &c, scene *out)
         scene_material_default(&out->materials[n]);
         snprintf(out->material_names[n], 64, "default");
     }
+    for (const auto &t : c.texture_errors)
+        if (!c.texture_errors_said.count(t.first))
+            warn(c, "texture %d: %s; no material the scene draws uses it", t.first, t.second.c_str());
+    return !c.failed;
 }
 
 } // namespace gltf

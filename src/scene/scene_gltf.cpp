@@ -282,12 +282,10 @@ bool load(scene *out, const char *path, int scene_index)
     std::vector<Instance> inst, cams, lights;
     if (!collect_instances(c, inst, cams, lights) || !joint_matrices(c) || !bake_geometry(c, inst, out))
         return false;
-    if (!load_images_and_textures(c, out))
-        return false;
+    load_images_and_textures(c, out);
     if (!c.limit_error.empty()) /* images in buffer views are decoded only now */
         return fail(c, "%s", c.limit_error.c_str());
-    load_materials(c, out);
-    if (!bake_environment(c, out))
+    if (!load_materials(c, out) || !bake_environment(c, out))
         return false;
     bake_cameras(c, cams, out);
     list_extensions(c, out);

@@ -114,7 +114,9 @@ fi
 # ---- a camera inside a closed model: the headlight ----------------------------------------
 # Three white boxes on a grey ground inside a closed, double-sided sky box, the camera among
 # them, no light: the studio cannot reach the boxes. "open" is the same without the sky;
-# "lamp" has a point light inside the sky that lights the view (deliberate: unchanged).
+# "black" is black boxes on a black ground in the open (a dark view, but the studio reaches
+# it: a black metal reflects nothing); "lamp" has a point light inside the sky that lights the view (deliberate: unchanged),
+# "dimlamp" one 400 times dimmer (dark: the studio added, kept out, then the headlight).
 python3 - "$tmp" <<'PY'
 import base64, json, struct, sys
 out = sys.argv[1]
@@ -130,7 +132,7 @@ def box(lo, hi):
                 p += q; nn = [0, 0, 0]; nn[ax] = sg; n += nn
             i += [b, b + 1, b + 2, b, b + 2, b + 3] if sg > 0 else [b, b + 2, b + 1, b, b + 3, b + 2]
     return p, n, i
-def write(name, sky, lamp):
+def write(name, sky, lamp, dark=False):
     parts = [(box([-20, -1, -20], [20, 0, 20]), 0)]
     parts += [(box([x - 0.5, 0, z - 0.5], [x + 0.5, h, z + 0.5]), 1) for x, z, h in ((-1.5, -2, 1), (0.5, -4, 2), (2, -1.5, 0.8))]
     if sky:
@@ -147,7 +149,8 @@ def write(name, sky, lamp):
             blob += struct.pack("<%d%s" % (len(data), fmt), *data)
         k = len(accs)
         prims.append({"attributes": {"POSITION": k - 3, "NORMAL": k - 2}, "indices": k - 1, "material": mat})
-    mats = [{"pbrMetallicRoughness": {"baseColorFactor": c + [1], "metallicFactor": 0, "roughnessFactor": 1}} for c in ([0.5, 0.5, 0.5], [0.9, 0.9, 0.9], [0.4, 0.6, 0.9])]
+    colours = ([0.0] * 3, [0.0] * 3) if dark else ([0.5, 0.5, 0.5], [0.9, 0.9, 0.9])
+    mats = [{"pbrMetallicRoughness": {"baseColorFactor": c + [1], "metallicFactor": 1 if dark else 0, "roughnessFactor": 1}} for c in colours + ([0.4, 0.6, 0.9],)]
     mats[2]["doubleSided"] = True
     doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
            "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
@@ -156,13 +159,15 @@ def write(name, sky, lamp):
            "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 1.5, 4], "rotation": [-0.13, 0, 0, 0.9915]}]}
     if lamp:
         doc["extensionsUsed"] = ["KHR_lights_punctual"]
-        doc["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 400}]}}
+        doc["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": lamp}]}}
         doc["nodes"].append({"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [1, 6, 3]})
         doc["scenes"][0]["nodes"].append(2)
     json.dump(doc, open(f"{out}/{name}.gltf", "w"))
-write("sky", True, False)
-write("open", False, False)
-write("lamp", True, True)
+write("sky", True, 0)
+write("open", False, 0)
+write("black", False, 0, dark=True)
+write("lamp", True, 400)
+write("dimlamp", True, 1)
 PY
 HEAD="a headlight, a point light at the camera, replaces the studio"
 check "a camera inside a closed sky, no light: renders" R "$tmp/sky.gltf" -o "$tmp/sky.exr" --size 48x32
@@ -177,6 +182,15 @@ got=$(lit "$tmp/sky-s.exr")
 check "... leaves the boxes in the closed sky dark (lit fraction $got < 0.6)" python3 -c "assert $got < 0.6"
 check "the same boxes with no sky render" R "$tmp/open.gltf" -o "$tmp/open.exr" --size 48x32
 grep -qF "$HEAD" "$tmp/out" && fail "no sky: a headlight was added" || pass
+check "black boxes in the open render" R "$tmp/black.gltf" -o "$tmp/black.exr" --size 48x32
+grep -qF "$HEAD" "$tmp/out" && fail "a dark model in the open: a headlight was added" || pass
+got=$(lit "$tmp/black.exr")
+check "... though the view is dark (lit fraction $got < 0.6): the camera is not enclosed" python3 -c "assert $got < 0.6"
+check "a dim lamp inside the closed sky renders" R "$tmp/dimlamp.gltf" -o "$tmp/dimlamp.exr" --size 48x32
+cp "$tmp/out" "$tmp/msg"
+check "... the studio added, then the headlight" sh -c "grep -qF \"$ADDED\" '$tmp/msg' && grep -qF '$HEAD' '$tmp/msg'"
+got=$(lit "$tmp/dimlamp.exr")
+check "... and the view is lit (lit fraction $got >= 0.6)" python3 -c "assert $got >= 0.6"
 check "a lamp inside the closed sky renders" R "$tmp/lamp.gltf" -o "$tmp/lamp.exr" --size 48x32
 grep -q "$HEAD\|$ADDED" "$tmp/out" && fail "a lamp that lights the closed sky: light was added" || pass
 check "the lamp in the closed sky with --env 0" R "$tmp/lamp.gltf" -o "$tmp/lamp-0.exr" --size 48x32 --env 0

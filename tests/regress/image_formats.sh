@@ -205,20 +205,37 @@ check "... saying which image of which file, and why" grep -q "trunc_fallback.gl
 check "... and that the fallback is used" grep -q "texture 0: its KHR_texture_basisu image 1 is unusable; its fallback, image 0, is used" "$tmp/trunc_fallback.txt"
 scene trunc_webp "{\"images\": [\"trunc.webp\"], \"texture\": {\"extensions\": {\"EXT_texture_webp\": {\"source\": 0}}}, \"used\": $WEBP, \"required\": $WEBP}"
 check_fails "truncated WebP a texture uses: an error" 1 "$G" render "$tmp/trunc_webp.gltf" --spp 1 --size 8x8 --quiet -o "$tmp/trunc_webp.exr"
-check "... naming the file, the image, the problem and the texture" grep -q "error: .*trunc_webp.gltf: image 0 trunc.webp: WebP: libwebp cannot decode the 64x64 image (corrupt or truncated data); texture 0 uses it" "$tmp/last"
+check "... naming the file, the material, the texture, the image and the problem" grep -q "error: .*trunc_webp.gltf: material 0: baseColorTexture: texture 0: image 0 trunc.webp: WebP: libwebp cannot decode the 64x64 image (corrupt or truncated data)" "$tmp/last"
 check "... and no output" test ! -e "$tmp/trunc_webp.exr"
 printf 'RIFF\x20\0\0\0WEBPVP8 ' >"$tmp/junk.webp"
 scene junk_webp "{\"images\": [\"junk.webp\"], \"texture\": {\"extensions\": {\"EXT_texture_webp\": {\"source\": 0}}}, \"used\": $WEBP}"
 check_fails "a WebP header and no image: an error" 1 "$G" info "$tmp/junk_webp.gltf"
-check "... the problem named" grep -q "error: .*junk_webp.gltf: image 0 junk.webp: WebP: .*; texture 0 uses it" "$tmp/last"
+check "... the problem named" grep -q "error: .*junk_webp.gltf: material 0: baseColorTexture: texture 0: image 0 junk.webp: WebP: .*" "$tmp/last"
 # The core formats alike: a PNG a texture uses that is missing is an error; an image no
 # texture uses is only a warning, and the file renders.
 scene missing_png '{"images": ["nowhere.png"], "texture": {"source": 0}}'
 check_fails "a missing PNG a texture uses: an error" 1 "$G" info "$tmp/missing_png.gltf"
-check "... naming the image and the texture" grep -q "error: .*missing_png.gltf: image 0 nowhere.png: file missing or unreadable; texture 0 uses it" "$tmp/last"
+check "... naming the material, the texture and the image" grep -q "error: .*missing_png.gltf: material 0: baseColorTexture: texture 0: image 0 nowhere.png: file missing or unreadable" "$tmp/last"
 scene unused_png '{"images": ["fallback.png", "nowhere.png"], "texture": {"source": 0}}'
 check "an unreadable image no texture uses: renders" sh -c "'$G' render '$tmp/unused_png.gltf' --spp 1 --size 8x8 --quiet -o '$tmp/unused_png.exr' 2>'$tmp/unused_png.txt'"
 check "... with a warning saying so" grep -q "warning: .*unused_png.gltf: image 1 nowhere.png: file missing or unreadable; no texture draws it" "$tmp/unused_png.txt"
+# A texture only a material the scene does not draw uses: a warning too.
+python3 - "$tmp/missing_png.gltf" "$tmp/undrawn_png.gltf" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["images"] = [{"uri": "fallback.png"}, {"uri": "nowhere.png"}]
+d["textures"].append({"source": 1})
+d["materials"].append({"pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}})
+json.dump(d, open(sys.argv[2], "w"))
+PY
+check "a broken texture only an undrawn material uses: renders" sh -c "'$G' render '$tmp/undrawn_png.gltf' --spp 1 --size 8x8 --quiet -o '$tmp/undrawn_png.exr' 2>'$tmp/undrawn_png.txt'"
+check "... with a warning saying so" grep -q "warning: .*undrawn_png.gltf: texture 1: image 1 nowhere.png: file missing or unreadable; no material the scene draws uses it" "$tmp/undrawn_png.txt"
+if [ $KTX2 = 1 ]; then
+    # Both extensions, the KTX2 image damaged and no core image: the WebP one is drawn.
+    scene both_ext "{\"images\": [\"blocks.webp\", \"trunc.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 1}, \"EXT_texture_webp\": {\"source\": 0}}}, \"used\": [\"KHR_texture_basisu\", \"EXT_texture_webp\"]}"
+    check "a damaged KTX2 beside a WebP, no core image: renders" R both_ext
+    check "... the WebP's texels" python3 "$tmp/probe.py" "$tmp/both_ext.exr" 0 "$(dirname "$0")/../tool" $N
+fi
 if [ $KTX2 = 1 ]; then
     # Every kind of damage the KTX2 checks name, each in a copy of a good file.
     python3 - "$tmp" <<'PY'
@@ -246,7 +263,7 @@ PY
         k=${f%%:*} want=${f#*:}
         scene "bad_$k" "{\"images\": [\"$k.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU, \"required\": $BASISU}"
         check_fails "KTX2 $k: an error" 1 "$G" info "$tmp/bad_$k.gltf"
-        check "... '$want' named, with the file and image" grep -q "error: .*bad_$k.gltf: image 0 $k.ktx2: KTX2: .*$want.*; texture 0 uses it" "$tmp/last"
+        check "... '$want' named, with the file and image" grep -q "error: .*bad_$k.gltf: material 0: baseColorTexture: texture 0: image 0 $k.ktx2: KTX2: .*$want.*" "$tmp/last"
     done
     # A huge declared size is refused by the texel limit before anything is allocated (a
     # 65536x65536 RGBA8 buffer would be 16 GiB).

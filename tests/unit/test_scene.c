@@ -1191,7 +1191,7 @@ TEST(scene, materials_lights_cameras)
              "\"materials\":[{\"name\":\"M\",\"doubleSided\":true,\"alphaMode\":\"MASK\",\"alphaCutoff\":0.25,"
              "\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5,0.5,1],\"metallicFactor\":0,\"roughnessFactor\":0.5,"
              "\"baseColorTexture\":{\"index\":0},\"metallicRoughnessTexture\":{\"index\":1,\"texCoord\":1}},"
-             "\"normalTexture\":{\"index\":1,\"scale\":0.5},\"occlusionTexture\":{\"index\":2,\"strength\":0.75},"
+             "\"normalTexture\":{\"index\":1,\"scale\":0.5},\"occlusionTexture\":{\"index\":1,\"strength\":0.75},"
              "\"extensions\":{\"KHR_materials_unlit\":{},\"KHR_materials_specular\":{\"specularFactor\":0.5,"
              "\"specularColorFactor\":[1,0,0]},\"KHR_materials_transmission\":{\"transmissionFactor\":0.25}},"
              "\"extras\":{\"gonio\":{\"brdf\":\"ward\",\"alpha_x\":0.1,\"alpha_y\":0.3,"
@@ -1208,8 +1208,8 @@ TEST(scene, materials_lights_cameras)
     scene s;
     int w0 = util_warning_count();
     CHECKF(load_tri_scene(&s, body), "%s", load_log);
-    /* Expected warnings: EXT_unknown, image 2 not a PNG (its buffer view holds floats),
-     * camera 1 yfov, light 1 intensity. */
+    /* Expected warnings: EXT_unknown, image 2 not a PNG (its buffer view holds floats; only
+     * texture 2 uses it, which no material does), camera 1 yfov, light 1 intensity. */
     CHECKF(util_warning_count() - w0 == 4, "%d warnings:\n%s", util_warning_count() - w0, load_log);
     CHECK(strstr(load_log, "EXT_unknown") && !strstr(load_log, "MASK") && !strstr(load_log, "TEXCOORD_1") &&
           strstr(load_log, "image 2") && strstr(load_log, "camera 1") && strstr(load_log, "light 1"));
@@ -1226,7 +1226,7 @@ TEST(scene, materials_lights_cameras)
     }
     CHECK(s.num_materials == 1);
     const GnMaterial *m = &s.materials[0];
-    CHECK(m->tex_base == 0 && m->tex_mr == 2 && m->tex_normal == 1 && m->tex_occlusion == GN_INVALID);
+    CHECK(m->tex_base == 0 && m->tex_mr == 2 && m->tex_normal == 1 && m->tex_occlusion == 1);
     CHECK(m->flags == (GN_MAT_DOUBLE_SIDED | GN_MAT_UNLIT | GN_MAT_MASK) && m->alpha_cutoff == 0.25f);
     CHECK(m->normal_scale == 0.5f && m->occlusion_strength == 0.75f && m->transmission == 0.25f);
     CHECK(m->specular == 0.5f && near3(m->specular_color, 1, 0, 0, 0) && m->ior == 1.5f);
@@ -1253,14 +1253,13 @@ TEST(scene, materials_lights_cameras)
         CHECK(near(l->inner_cos, cosf(0.2f), 1e-6f) && near(l->outer_cos, cosf(0.5f), 1e-6f));
     }
     scene_destroy(&s);
-    /* A missing image file: one warning, the texture slot left empty. */
-    w0 = util_warning_count();
-    CHECKF(load_tri_scene(&s, "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
+    /* A missing image file a drawn material uses: an error naming the material's slot, the
+     * texture and the image. */
+    CHECK(!load_tri_scene(&s, "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
                               "\"nodes\":[{\"mesh\":0}],\"images\":[{\"uri\":\"no_such_image.png\"}],\"textures\":[{\"source\":0}],"
-                              "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}]"), "%s", load_log);
-    CHECK(util_warning_count() == w0 + 1 && strstr(load_log, "no_such_image.png"));
-    CHECK(s.num_images == 0 && s.num_textures == 0 && s.num_materials == 1 && s.materials[0].tex_base == GN_INVALID);
-    scene_destroy(&s);
+                              "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}]"));
+    CHECKF(strstr(load_log, "material 0: baseColorTexture: texture 0: image 0 no_such_image.png: file missing or unreadable"),
+           "%s", load_log);
     /* KHR_texture_transform: the rows of T R S (spec: R = [cos sin; -sin cos]); rotation
      * pi/2, scale (2, 3), offset (0.5, 0.25) -> (0, 3, 0.5), (-2, 0, 0.25). */
     snprintf(body, sizeof body, "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
