@@ -42,6 +42,43 @@ finish() {
     [ "$n_fail" = 0 ]
 }
 
+# Renders that share a kernel, run in one process (gonio batch: one device, each kernel
+# compiled once; on lavapipe most of a small render's time is its kernel's compilation):
+# queue ID [NAME=value...] COMMAND ARGS... adds a gonio command line (the words as given; no
+# single quotes in them); run_queue runs what is queued, then queued ID gives that line's
+# exit status and leaves its output (stdout and stderr) in $tmp/last, and check_queued
+# DESCRIPTION STATUS ID checks the status as check_fails does. A line's result is exactly
+# the same command's in a process of its own (tests/regress/batch.sh).
+queue_ids=()
+queue() {
+    local id=$1 w line=""; shift
+    for w in "$@"; do line+="'$w' "; done
+    queue_ids+=("$id")
+    printf '%s\n' "$line" >>"$tmp/queue.txt"
+}
+run_queue() {
+    local n=0 id
+    rm -rf "$tmp/queue"
+    mkdir -p "$tmp/queue"
+    "$GONIO" batch "$tmp/queue.txt" --logs "$tmp/queue" >"$tmp/queue/batch.log" 2>&1
+    for id in "${queue_ids[@]}"; do
+        n=$((n + 1))
+        mv "$tmp/queue/$n.status" "$tmp/queue/$id.status" 2>/dev/null
+        mv "$tmp/queue/$n.log" "$tmp/queue/$id.log" 2>/dev/null
+    done
+    queue_ids=()
+    rm -f "$tmp/queue.txt"
+}
+queued() {
+    cp "$tmp/queue/$1.log" "$tmp/last" 2>/dev/null || echo "no line $1 in the batch" >"$tmp/last"
+    cat "$tmp/queue/$1.status" 2>/dev/null || echo missing
+}
+check_queued() {
+    local got
+    got=$(queued "$3")
+    if [ "$got" = "$2" ]; then pass; else fail "$1 (exit $got, expected $2)"; sed 's/^/    /' "$tmp/last" | tail -n 20; fi
+}
+
 # fixture NAME COMMAND...: the path of a file that several scripts use, made once a run.
 # COMMAND makes it, with the first {} in its arguments standing for the file it writes
 # (a name with NAME's extension); it runs in

@@ -281,21 +281,58 @@ int cli_usage_error(const char *cmd, const char *fmt, ...)
     return 2;
 }
 
+/* gonio batch's device, kept between commands (cli_gpu_share). */
+static struct {
+    bool on, kept;
+    gpu g;
+    int device_index;
+} shared;
+static int messages_before; /* validation messages when the command's device was made or lent */
+
 bool cli_gpu_create(gpu *g, int device_index, bool validate)
 {
     const char *env = getenv("GONIO_VALIDATE");
     gpu_desc d = {.device_index = device_index};
     d.validate = validate || (env && strcmp(env, "1") == 0);
+    messages_before = gpu_validation_message_count();
+    if (shared.kept && shared.device_index == device_index && shared.g.validate == d.validate) {
+        *g = shared.g;
+        shared.kept = false;
+        return true;
+    }
+    if (shared.kept) { /* another device or validation setting: made anew */
+        gpu_destroy(&shared.g);
+        shared.kept = false;
+    }
+    shared.device_index = device_index;
     return gpu_create(g, &d);
 }
 
 bool cli_gpu_finish(gpu *g)
 {
     bool validate = g->validate;
-    gpu_destroy(g);
-    if (validate && gpu_validation_message_count() > 0) {
-        util_error("%d Vulkan validation message(s) (see above)", gpu_validation_message_count());
+    if (shared.on && g->device && !shared.kept) {
+        shared.g = *g;
+        shared.kept = true;
+        memset(g, 0, sizeof *g);
+    } else {
+        gpu_destroy(g);
+    }
+    int seen = gpu_validation_message_count() - messages_before;
+    if (validate && seen > 0) {
+        util_error("%d Vulkan validation message(s) (see above)", seen);
         return false;
     }
     return true;
+}
+
+bool cli_gpu_share(bool on)
+{
+    shared.on = on;
+    if (on || !shared.kept)
+        return true;
+    gpu g = shared.g;
+    shared.kept = false;
+    messages_before = gpu_validation_message_count();
+    return cli_gpu_finish(&g);
 }

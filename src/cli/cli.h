@@ -24,6 +24,11 @@ int cmd_merge(int argc, char **argv);
 int cmd_compare(int argc, char **argv);
 int cmd_preview(int argc, char **argv);
 int cmd_denoise(int argc, char **argv);
+int cmd_batch(int argc, char **argv);
+/* How `gonio batch` runs a line: the program's dispatcher (argv[0] = the command's name),
+ * which main sets. */
+typedef int cli_command_fn(int argc, char **argv);
+extern cli_command_fn *cli_dispatch;
 
 /* One of `gonio scene`'s scenes ("cornell", "teapot") loaded as from its glTF (written to a
  * temporary directory and removed), so a default scene needs no file in the working
@@ -259,10 +264,16 @@ bool env_add_headlight(struct renderer *r, struct scene *sc, struct render_setti
 /* "gonio CMD: MESSAGE" and the hint to use --help; returns 2. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);
 /* The Vulkan device for a command: --device, --validate (or GONIO_VALIDATE=1 in the
- * environment). */
+ * environment). While devices are shared (cli_gpu_share), the device the command before
+ * handed back, when it has the same index and validation, with its compiled kernels. */
 bool cli_gpu_create(gpu *g, int device_index, bool validate);
-/* After work under validation: false (with an error) if any validation message was seen. */
+/* After work under validation: false (with an error) if any validation message was seen
+ * since cli_gpu_create. While devices are shared, the device is kept for the next command
+ * (and *g zeroed) instead of destroyed. */
 bool cli_gpu_finish(gpu *g);
+/* on: from now on cli_gpu_finish keeps the device for the next cli_gpu_create (gonio batch).
+ * off: the kept device is destroyed; false when that fails validation. */
+bool cli_gpu_share(bool on);
 /* The command line, space-joined, for output headers. */
 void cli_set_command_line(int argc, char **argv);
 const char *cli_command_line(void);

@@ -24,7 +24,21 @@ static const struct {
     {"brdf", cmd_brdf, "virtual goniophotometer: BRDF lobe plots, albedo, material balls"},
     {"scene", cmd_scene, "write a built-in scene (cornell, teapot) as glTF"},
     {"teapot", cmd_teapot, "write the Utah teapot at a tessellation level as glTF"},
+    {"batch", cmd_batch, "run many gonio command lines in one process, on one device"},
 };
+
+static void usage(FILE *f);
+
+/* argv[0] the command's name: its exit status (also gonio batch's way to run a line). */
+static int dispatch(int argc, char **argv)
+{
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
+        if (!strcmp(argv[0], commands[i].name))
+            return commands[i].fn(argc, argv);
+    fprintf(stderr, "gonio: unknown command '%s'\n\n", argv[0]);
+    usage(stderr);
+    return 2;
+}
 
 static void usage(FILE *f)
 {
@@ -71,10 +85,6 @@ int main(int argc, char **argv)
         printf("gonio %s\nimage decoders: %s\n", GONIO_VERSION, image_decode_versions());
         return 0;
     }
-    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
-        if (!strcmp(argv[1], commands[i].name))
-            return commands[i].fn(argc - 1, argv + 1);
-    fprintf(stderr, "gonio: unknown command '%s'\n\n", argv[1]);
-    usage(stderr);
-    return 2;
+    cli_dispatch = dispatch;
+    return dispatch(argc - 1, argv + 1);
 }

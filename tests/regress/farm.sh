@@ -14,15 +14,29 @@ same() { check "$3" "$T" same "$1" "$2"; }
 has() { if grep -qF -- "$2" "$1"; then pass; else fail "$1 lacks '$2': $(head -c 600 "$1")"; fi; }
 
 # ---- tiles ---------------------------------------------------------------------------------
+# The whole renders in processes of their own; the tiles, crops and seeds in one batch.
 "$G" render $S "${common[@]}" --spp 5 --aov variance,depth -o "$tmp/whole.exr"
 # A 3x3 tiling with uneven tiles (66 = 22 + 22 + 22, 48 = 16 + 17 + 15).
 xs=(0 22 44 66) ys=(0 16 33 48) tiles=()
 for j in 0 1 2; do for i in 0 1 2; do
     t="$tmp/tile_$i$j.exr"
-    check "tile $i,$j renders" "$G" render $S "${common[@]}" --spp 5 --aov variance,depth \
+    queue "tile$i$j" render $S "${common[@]}" --spp 5 --aov variance,depth \
         --crop "${xs[i]},${ys[j]},${xs[i + 1]},${ys[j + 1]}" -o "$t"
     tiles+=("$t")
 done; done
+# Fractions as pbrt's cropwindow: ceil(0.5 * 66) = 33, ceil(0.25 * 48) = 12.
+queue frac render $S "${common[@]}" --spp 5 --aov variance,depth --crop 0.5,0.25,1.0,1.0 -o "$tmp/frac.exr"
+# A local mode too (one sample a dispatch, another kernel).
+"$G" render $S "${common[@]}" --mode phong --spp 3 -o "$tmp/phong.exr"
+queue phong_crop render $S "${common[@]}" --mode phong --spp 3 --crop 5,7,40,30 -o "$tmp/phong_crop.exr"
+# Tiles x seeds: 2 tiles x 2 seeds merged = 2 whole renders of those seeds merged.
+for s in 1 2; do
+    queue "w$s" render $S "${common[@]}" --spp 4 --seed $s --aov variance -o "$tmp/w$s.exr"
+    queue "a$s" render $S "${common[@]}" --spp 4 --seed $s --aov variance --crop 0,0,66,20 -o "$tmp/a$s.exr"
+    queue "b$s" render $S "${common[@]}" --spp 4 --seed $s --aov variance --crop 0,20,66,48 -o "$tmp/b$s.exr"
+done
+run_queue
+for j in 0 1 2; do for i in 0 1 2; do check_queued "tile $i,$j renders" 0 "tile$i$j"; done; done
 exrheader "$tmp/tile_21.exr" >"$tmp/h21"
 has "$tmp/h21" "dataWindow (type box2i): (44 16) - (65 32)"
 has "$tmp/h21" "displayWindow (type box2i): (0 0) - (65 47)"
@@ -32,23 +46,11 @@ exrheader "$tmp/tiled.exr" >"$tmp/ht"
 has "$tmp/ht" "dataWindow (type box2i): (0 0) - (65 47)"
 same "$tmp/whole.exr" "$tmp/tiled.exr" "the merged 3x3 tiling equals the whole render"
 same "$tmp/tiled.exr" "$tmp/whole.exr" "... and covers all of it"
-# Fractions as pbrt's cropwindow: ceil(0.5 * 66) = 33, ceil(0.25 * 48) = 12.
-check "a crop in fractions" "$G" render $S "${common[@]}" --spp 5 --aov variance,depth \
-    --crop 0.5,0.25,1.0,1.0 -o "$tmp/frac.exr"
+check_queued "a crop in fractions" 0 frac
 exrheader "$tmp/frac.exr" >"$tmp/hf"
 has "$tmp/hf" "dataWindow (type box2i): (33 12) - (65 47)"
 same "$tmp/whole.exr" "$tmp/frac.exr" "a fractional crop's pixels are the whole render's"
-# A local mode too (one sample a dispatch, another kernel).
-"$G" render $S "${common[@]}" --mode phong --spp 3 -o "$tmp/phong.exr"
-"$G" render $S "${common[@]}" --mode phong --spp 3 --crop 5,7,40,30 -o "$tmp/phong_crop.exr"
 same "$tmp/phong.exr" "$tmp/phong_crop.exr" "a phong crop's pixels are the whole render's"
-
-# Tiles x seeds: 2 tiles x 2 seeds merged = 2 whole renders of those seeds merged.
-for s in 1 2; do
-    "$G" render $S "${common[@]}" --spp 4 --seed $s --aov variance -o "$tmp/w$s.exr"
-    "$G" render $S "${common[@]}" --spp 4 --seed $s --aov variance --crop 0,0,66,20 -o "$tmp/a$s.exr"
-    "$G" render $S "${common[@]}" --spp 4 --seed $s --aov variance --crop 0,20,66,48 -o "$tmp/b$s.exr"
-done
 "$G" merge "$tmp/w1.exr" "$tmp/w2.exr" -o "$tmp/wm.exr"
 check "tiles x seeds merge" "$G" merge "$tmp/a1.exr" "$tmp/b2.exr" "$tmp/b1.exr" "$tmp/a2.exr" -o "$tmp/tm.exr"
 same "$tmp/wm.exr" "$tmp/tm.exr" "tiles x seeds merged equal the seeds' whole renders merged"
@@ -68,30 +70,43 @@ check_fails "a malformed crop is a usage error" 2 "$G" render $S "${common[@]}" 
 # 64 + 64 = 128, with AOVs and the variance: every channel bit for bit.
 r=(--size 40x30 --quiet --aov normal,depth,variance --seed 7)
 "$G" render $S "${r[@]}" --spp 128 -o "$tmp/r128.exr"
-check "64 spp, resumable" "$G" render $S "${r[@]}" --spp 64 --resumable -o "$tmp/r64.exr"
+"$G" render $S "${r[@]}" --spp 40 --crop 8,4,31,25 -o "$tmp/c40.exr"
+# (the renders that resume, and those refused, in one batch)
+queue r64 render $S "${r[@]}" --spp 64 --resumable -o "$tmp/r64.exr"
+queue r64_128 render $S "${r[@]}" --spp 128 --resume "$tmp/r64.exr" -o "$tmp/r64_128.exr"
+# A crop resumes too, and in an odd split (13 + 27), even with --half for the means.
+queue c13 render $S "${r[@]}" --spp 13 --crop 8,4,31,25 --resumable --half -o "$tmp/c13.exr"
+queue c13_40 render $S "${r[@]}" --spp 40 --crop 8,4,31,25 --resume "$tmp/c13.exr" -o "$tmp/c13_40.exr"
+queue seed render $S "${r[@]/7/8}" --spp 128 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
+queue depth render $S "${r[@]}" --max-depth 3 --spp 128 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
+queue camera render $S "${r[@]}" --fov 30 --spp 128 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
+queue region render $S "${r[@]}" --crop 0,0,10,10 --spp 128 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
+queue nosums render $S "${r[@]}" --spp 256 --resume "$tmp/r128.exr" -o "$tmp/x.exr"
+queue fewer render $S "${r[@]}" --spp 64 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
+queue missing render $S "${r[@]}" --spp 64 --resume "$tmp/none.exr" -o "$tmp/x.exr"
+run_queue
+check_queued "64 spp, resumable" 0 r64
 exrheader "$tmp/r64.exr" >"$tmp/h64"
 has "$tmp/h64" "sum.R, 32-bit floating-point"
-check "resumed to 128" "$G" render $S "${r[@]}" --spp 128 --resume "$tmp/r64.exr" -o "$tmp/r64_128.exr"
+check_queued "resumed to 128" 0 r64_128
 same "$tmp/r128.exr" "$tmp/r64_128.exr" "64 + 64 resumed equals 128 in one run"
 exrheader "$tmp/r64_128.exr" >"$tmp/hr"
 has "$tmp/hr" "gonio:spp (type int): 128"
-# A crop resumes too, and in an odd split (13 + 27), even with --half for the means.
-"$G" render $S "${r[@]}" --spp 40 --crop 8,4,31,25 -o "$tmp/c40.exr"
-"$G" render $S "${r[@]}" --spp 13 --crop 8,4,31,25 --resumable --half -o "$tmp/c13.exr"
-check "a crop resumed" "$G" render $S "${r[@]}" --spp 40 --crop 8,4,31,25 --resume "$tmp/c13.exr" -o "$tmp/c13_40.exr"
+check_queued "a crop, resumable" 0 c13
+check_queued "a crop resumed" 0 c13_40
 same "$tmp/c40.exr" "$tmp/c13_40.exr" "a crop's 13 + 27 resumed equals its 40 in one run"
-check_fails "resume: another seed is refused" 1 "$G" render $S "${r[@]/7/8}" --spp 128 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
+check_queued "resume: another seed is refused" 1 seed
 has "$tmp/last" "seed"
-check_fails "resume: another max depth is refused" 1 "$G" render $S "${r[@]}" --max-depth 3 --spp 128 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
+check_queued "resume: another max depth is refused" 1 depth
 has "$tmp/last" "gonio:max-depth differs"
-check_fails "resume: another camera is refused" 1 "$G" render $S "${r[@]}" --fov 30 --spp 128 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
+check_queued "resume: another camera is refused" 1 camera
 has "$tmp/last" "gonio:camera differs"
-check_fails "resume: another region is refused" 1 "$G" render $S "${r[@]}" --crop 0,0,10,10 --spp 128 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
+check_queued "resume: another region is refused" 1 region
 has "$tmp/last" "region"
-check_fails "resume: a file without sums is refused" 1 "$G" render $S "${r[@]}" --spp 256 --resume "$tmp/r128.exr" -o "$tmp/x.exr"
+check_queued "resume: a file without sums is refused" 1 nosums
 has "$tmp/last" "no channel 'sum.R'"
-check_fails "resume: no more samples than the file is refused" 1 "$G" render $S "${r[@]}" --spp 64 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
-check_fails "resume: a missing file" 1 "$G" render $S "${r[@]}" --spp 64 --resume "$tmp/none.exr" -o "$tmp/x.exr"
+check_queued "resume: no more samples than the file is refused" 1 fewer
+check_queued "resume: a missing file" 1 missing
 has "$tmp/last" "none.exr"
 [ ! -e "$tmp/x.exr" ] && pass || fail "a refused resume left an output"
 
@@ -167,7 +182,9 @@ at "$tmp/lin_08.exr" 1      # the last frame, t = 2
 exrheader "$tmp/lin_03.exr" >"$tmp/hl"
 has "$tmp/hl" "gonio:frame (type int): 3"
 has "$tmp/hl" "gonio:time (type double): 0.75"
-at_time() { "$G" render "$1" "${a[@]}" --at "$2" -o "$tmp/at.exr" && at "$tmp/at.exr" "$3"; }
+# at_time FILE T X: FILE rendered at time T shows the square at X (the renders in one batch).
+at_n=0 at_checks=()
+at_time() { at_n=$((at_n + 1)); queue "at$at_n" render "$1" "${a[@]}" --at "$2" -o "$tmp/at$at_n.exr"; at_checks+=("$at_n $3"); }
 at_time "$tmp/linear.gltf" 5 1  # after the last key: its value
 anim "$tmp/step.gltf" 0 STEP "0 1 2" "-1 0.5 1"
 at_time "$tmp/step.gltf" 0.99 -1
@@ -181,6 +198,12 @@ at_time "$tmp/cubic.gltf" 0.5 "$want"
 # The camera animates: it moves to x = 1 over a second; at 0.5 s the square is 0.5 left.
 anim "$tmp/camera.gltf" 1 LINEAR "0 1" "0 1"
 at_time "$tmp/camera.gltf" 0.5 -0.5
+run_queue
+for c in "${at_checks[@]}"; do
+    set -- $c
+    check_queued "--at: render $1" 0 "at$1"
+    at "$tmp/at$1.exr" "$2"
+done
 check_fails "--frames needs a pattern" 2 "$G" render "$tmp/linear.gltf" "${a[@]}" --frames 0-2 -o "$tmp/x.exr"
 check_fails "--frames A-B with B < A" 2 "$G" render "$tmp/linear.gltf" "${a[@]}" --frames 3-2 -o "$tmp/x%d.exr"
 check_fails "--frame and --at" 2 "$G" render "$tmp/linear.gltf" "${a[@]}" --frame 1 --at 2 -o "$tmp/x.exr"

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# batch.sh: `gonio batch`: its lines render what the same command lines give run one process
+# each (bit for bit, the references made by separate processes); per-line logs and exit
+# statuses; a failing line neither stops the others nor hides its status; NAME=value applies
+# to its line only; quoting, comments, and its own errors.
+. "$(dirname "$0")/../lib.sh"
+G=$GONIO
+C=scenes/cornell.gltf
+R="--spp 3 --size 24x24 --quiet"
+
+# The references: one process each.
+"$G" render $C -o "$tmp/ref-1.exr" $R --seed 1 &&
+    "$G" render $C -o "$tmp/ref-2.exr" $R --seed 2 --aov albedo,normal &&
+    "$G" render scenes/teapot.gltf -o "$tmp/ref-3.exr" $R --mode phong &&
+    GONIO_ALL_FEATURES=1 "$G" render $C -o "$tmp/ref-4.exr" $R --brdf ggx || fail "the reference renders"
+
+mkdir -p "$tmp/logs"
+cat >"$tmp/jobs.txt" <<EOF
+# the same renders, in one process
+render $C -o '$tmp/b-1.exr' $R --seed 1
+render $C -o "$tmp/b-2.exr" $R --seed 2 --aov albedo,normal
+
+render scenes/teapot.gltf -o $tmp/b-3.exr $R --mode phong   # a comment after a line
+GONIO_ALL_FEATURES=1 render $C -o $tmp/b-4.exr $R --brdf ggx
+render $C -o $tmp/b-5.exr $R --brdf nosuch
+render $tmp/none.gltf -o $tmp/b-6.exr $R
+sh -c 'exit 0'
+preview $C
+render $C -o '$tmp/b-9.exr $R
+info $C
+EOF
+check_fails "a batch with failing lines exits 1" 1 "$G" batch "$tmp/jobs.txt" --logs "$tmp/logs"
+for k in 1 2 3 4; do
+    check "line $((k + 1)): the pixels of its own process" "$TESTTOOL" same "$tmp/ref-$k.exr" "$tmp/b-$k.exr"
+done
+check "... its own header (the line's command)" sh -c "exrheader '$tmp/b-4.exr' | grep -a 'gonio:command' | grep -q 'gonio render $C -o $tmp/b-4.exr'"
+status() { cat "$tmp/logs/$1.status" 2>/dev/null; }
+check "each line's status: 0 for the renders" test "$(status 2)$(status 3)$(status 5)$(status 6)" = 0000
+check "... 2 for a usage error (line 7)" test "$(status 7)" = 2
+check "... 1 for a missing scene (line 8)" test "$(status 8)" = 1
+check "... 2 for an unknown command, preview and a broken quote (lines 9-11)" test "$(status 9)$(status 10)$(status 11)" = 222
+check "... and the lines after them ran (line 12)" test "$(status 12)" = 0
+check "no log or status for comments and blank lines" test ! -e "$tmp/logs/1.log" -a ! -e "$tmp/logs/4.status"
+check "each line's messages in its own log" grep -q "unknown BRDF model 'nosuch'" "$tmp/logs/7.log"
+check "... naming the file" grep -q "none.gltf" "$tmp/logs/8.log"
+check "... stdout too" grep -q "^triangles" "$tmp/logs/12.log"
+check "... and the batch's own stderr says which lines failed" sh -c \
+    "grep -q 'jobs.txt:7 gave exit status 2' '$tmp/last' && grep -q 'jobs.txt:8 gave exit status 1' '$tmp/last'"
+check "the broken quote named" grep -q "jobs.txt:11: an unterminated quote" "$tmp/logs/11.log"
+check "preview refused" grep -q "'preview' cannot run in a batch" "$tmp/logs/10.log"
+
+# NAME=value holds for its line only: the loop cap's debug line is in the first line's log,
+# not in the second's.
+cat >"$tmp/env.txt" <<EOF
+GONIO_LOOP_CAP=3000 GONIO_DEBUG_RESUMES=1 render $C -o $tmp/e-1.exr $R --seed 1
+render $C -o $tmp/e-2.exr $R --seed 1
+EOF
+mkdir -p "$tmp/envlogs"
+check "a batch of two lines" "$G" batch "$tmp/env.txt" --logs "$tmp/envlogs"
+check "... the first with its variables" grep -q "gonio: debug: .*dispatch" "$tmp/envlogs/1.log"
+check "... the second without them" sh -c "! grep -q 'debug' '$tmp/envlogs/2.log'"
+check "... both the pixels of one process" sh -c "'$TESTTOOL' same '$tmp/ref-1.exr' '$tmp/e-1.exr' && '$TESTTOOL' same '$tmp/ref-1.exr' '$tmp/e-2.exr'"
+check "a batch from standard input" sh -c "echo 'render $C -o $tmp/s-1.exr $R --seed 1' | '$G' batch -"
+check "... renders" "$TESTTOOL" same "$tmp/ref-1.exr" "$tmp/s-1.exr"
+check_fails "no batch file: a usage error" 2 "$G" batch
+check_fails "a missing batch file" 1 "$G" batch "$tmp/none.txt"
+check "... named" grep -q "none.txt: cannot read" "$tmp/last"
+check "batch --help" sh -c "'$G' batch --help | grep -q 'usage: gonio batch'"
+finish
