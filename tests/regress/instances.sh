@@ -25,23 +25,34 @@ check "info: the instances place the flattened scene's triangles ($placed, $flat
 check "info: a top tree over them" grep -q 'top tree over 20 instances' "$tmp/info"
 check "info: the scene's memory" grep -q '^scene memory .* instances 0.00' "$tmp/info"
 
+# (the renders below, up to the animation, in one batch: lib.sh, queue)
+for m in normal depth albedo phong flat gouraud; do
+    queue "i-$m" render "$I" -o "$tmp/i-$m.exr" --mode $m --size 48x48 --spp 1 $V
+    queue "f-$m" render "$F" -o "$tmp/f-$m.exr" --mode $m --size 48x48 --spp 1 $V
+done
+queue s-phong render "$tmp/inst-short.gltf" -o "$tmp/s-phong.exr" --mode phong --size 48x48 --spp 1 $V
+P="--size 40x40 --spp 128 --env 0,0,0 $V"
+queue pi render "$I" -o "$tmp/pi.exr" $P --seed 1
+queue pf render "$F" -o "$tmp/pf.exr" $P --seed 2
+queue pf3 render "$F" -o "$tmp/pf3.exr" $P --seed 3
+queue one render "$I" -o "$tmp/one.exr" --spp 3 --size 24x24 --env 0.3 --aov albedo,normal,depth $V
+queue two GONIO_LOOP_CAP=3000 GONIO_DEBUG_RESUMES=1 render "$I" -o "$tmp/two.exr" --spp 3 --size 24x24 \
+    --env 0.3 --aov albedo,normal,depth $V
+run_queue
+
 # The local modes: the same pixels up to the transforms' rounding
 for m in normal depth albedo phong flat gouraud; do
-    "$G" render "$I" -o "$tmp/i-$m.exr" --mode $m --size 48x48 --spp 1 $V &&
-        "$G" render "$F" -o "$tmp/f-$m.exr" --mode $m --size 48x48 --spp 1 $V ||
-        { fail "--mode $m renders"; continue; }
+    if [ "$(queued "i-$m")$(queued "f-$m")" != 00 ]; then fail "--mode $m renders"; continue; fi
     check "--mode $m: instances = flattened" "$G" diff "$tmp/i-$m.exr" "$tmp/f-$m.exr" --max-rmse 1e-3 --quiet
 done
 # ROTATION as normalized shorts: the quantized quaternions are a little off the floats
-"$G" render "$tmp/inst-short.gltf" -o "$tmp/s-phong.exr" --mode phong --size 48x48 --spp 1 $V
+check_queued "ROTATION as normalized shorts renders" 0 s-phong
 check "ROTATION as normalized shorts = floats" "$G" diff "$tmp/s-phong.exr" "$tmp/f-phong.exr" --max-rmse 3e-3 --quiet
 
 # The path tracer, lit only by the instanced emitters (their world areas differ from the
 # mesh's): instances against the flattened scene, on other seeds than a second flattened
 # render, so that the two differences are both noise and must be alike
-P="--size 40x40 --spp 128 --env 0,0,0 $V"
-"$G" render "$I" -o "$tmp/pi.exr" $P --seed 1 && "$G" render "$F" -o "$tmp/pf.exr" $P --seed 2 &&
-    "$G" render "$F" -o "$tmp/pf3.exr" $P --seed 3 || fail "path renders"
+[ "$(queued pi)$(queued pf)$(queued pf3)" = 000 ] || fail "path renders"
 rmse() { "$G" diff "$1" "$2" | awk '$1 == "rmse" {print $2}'; }
 bias() { "$G" diff "$1" "$2" | awk '$1 == "rel_bias" {print $2}'; }
 a=$(rmse "$tmp/pi.exr" "$tmp/pf.exr") b=$(rmse "$tmp/pf3.exr" "$tmp/pf.exr") rb=$(bias "$tmp/pi.exr" "$tmp/pf.exr")
@@ -50,14 +61,12 @@ check "path: instances differ from flattened as two seeds do (rmse $a vs $b)" \
 check "path: no bias (rel_bias $rb)" python3 -c "import sys; sys.exit(0 if abs($rb) <= 0.02 else 1)"
 
 # The loop cap: paths interrupted in their walks, inside instances too, resume bit for bit
-if "$G" render "$I" -o "$tmp/one.exr" --spp 3 --size 24x24 --env 0.3 --aov albedo,normal,depth $V 2>"$tmp/cap.err" &&
-    env GONIO_LOOP_CAP=3000 GONIO_DEBUG_RESUMES=1 "$G" render "$I" -o "$tmp/two.exr" --spp 3 --size 24x24 \
-        --env 0.3 --aov albedo,normal,depth $V 2>>"$tmp/cap.err"; then
+if [ "$(queued one)$(queued two)" = 00 ]; then
     check "interrupted paths = whole paths" "$TESTTOOL" same "$tmp/one.exr" "$tmp/two.exr"
-    n=$(sed -n 's/^gonio: debug: \([0-9]*\) dispatch.*/\1/p' "$tmp/cap.err")
+    n=$(sed -n 's/^gonio: debug: \([0-9]*\) dispatch.*/\1/p' "$tmp/queue/two.log")
     check "... and some were interrupted (${n:-no} resuming dispatches)" test "${n:-0}" -gt 0
 else
-    fail "interrupted paths (render failed)"; sed 's/^/    /' "$tmp/cap.err"
+    fail "interrupted paths (render failed)"; sed 's/^/    /' "$tmp/queue/one.log" "$tmp/queue/two.log"
 fi
 
 # An animation (--frames): a frame that only moves instances keeps the trees and kernels of the

@@ -23,26 +23,60 @@ fi
 # (an environment map for the checks below, in the slow tier alone too)
 [ -e "$tmp/d.exr" ] || "$G" render $C -o "$tmp/d.exr" --spp 2 --size 32x32 --quiet
 
-# base SCENE FLAGS...: the path of SCENE's render as it is (3 spp, 24x24, FLAGS), made once
-# in this script (with GONIO_WALK_ARRAY as set now): the checks below compare several
-# variants of a render against it.
+# The pairs of renders below are compared pixel for pixel. They are queued (lib.sh: queue)
+# and rendered in one batch per block, so that a kernel variant is compiled once for all the
+# pairs that use it; check_pairs renders what is queued and makes each pair's checks.
+# base SCENE FLAGS...: queues SCENE's render as it is (3 spp, 24x24, FLAGS, GONIO_WALK_ARRAY as
+# set now) once a script; its path is $tmp/base-$base_key.exr.
+declare -A base_queued=()
 base() {
-    local f=$tmp/base-$(printf '%s\n' "${GONIO_WALK_ARRAY:-}" "$@" | md5sum | cut -c1-16).exr
-    [ -e "$f" ] || "$G" render "$1" -o "$f" --spp 3 --size 24x24 --quiet "${@:2}" || return 1
-    echo "$f"
+    base_key=$(printf '%s\n' "${GONIO_WALK_ARRAY:-}" "$@" | md5sum | cut -c1-16)
+    if [ -z "${base_queued[$base_key]:-}" ]; then
+        base_queued[$base_key]=1
+        queue "base-$base_key" ${GONIO_WALK_ARRAY:+GONIO_WALK_ARRAY=$GONIO_WALK_ARRAY} \
+            render "$1" -o "$tmp/base-$base_key.exr" --spp 3 --size 24x24 --quiet "${@:2}"
+    fi
+}
+pairs=() pair_n=0
+# pair KIND NAME ENV... -- SCENE FLAGS...: queues SCENE's render as it is and one with the
+# environment assignments ENV, for check_pairs to compare (KIND: same or interrupted).
+pair() {
+    local kind=$1 name=$2 env=(); shift 2
+    while [ "$1" != -- ]; do env+=("$1"); shift; done
+    shift
+    pair_n=$((pair_n + 1))
+    base "$@"
+    queue "two-$pair_n" "${env[@]}" ${GONIO_WALK_ARRAY:+GONIO_WALK_ARRAY=$GONIO_WALK_ARRAY} \
+        render "$1" -o "$tmp/two-$pair_n.exr" --spp 3 --size 24x24 --quiet "${@:2}"
+    pairs+=("$kind|$name|$base_key|$pair_n")
+}
+check_pairs() {
+    local p kind name key n one two
+    run_queue
+    for p in "${pairs[@]}"; do
+        IFS='|' read -r kind name key n <<<"$p"
+        one=$tmp/base-$key.exr two=$tmp/two-$n.exr
+        if [ "$(queued "base-$key")" != 0 ] || [ "$(queued "two-$n")" != 0 ]; then
+            fail "$name (render failed)"; cat "$tmp/queue/base-$key.log" "$tmp/queue/two-$n.log" | sed 's/^/    /' | tail -n 20
+        elif [ "$kind" = same ]; then
+            check_fails "$name" 0 "$G" diff "$one" "$two" --max-error 0
+        else
+            check "interrupted paths = whole paths: $name" "$TESTTOOL" same "$one" "$two"
+            # the last line: the render's own (a file with lights of its own has a probe render first)
+            local dispatches
+            dispatches=$(sed -n 's/^gonio: debug: \([0-9]*\) dispatch.*/\1/p' "$tmp/queue/two-$n.log" | tail -n 1)
+            check "... and some were interrupted ($name: ${dispatches:-no} resuming dispatches)" test "${dispatches:-0}" -gt 0
+            check "... none cut short ($name)" sh -c "! grep -q 'internal error\|cut short' '$tmp/queue/two-$n.log'"
+        fi
+    done
+    pairs=()
 }
 
 # same_pixels WHAT ENV NAME SCENE FLAGS...: a render as it is and one with the environment
 # assignment ENV must give identical pixels; the check is named "WHAT: NAME".
 same_pixels() {
-    local what=$1 env=$2 name=$3 scene=$4 one; shift 4
-    if one=$(base "$scene" "$@" 2>"$tmp/spec.err") &&
-        env "$env" "$G" render "$scene" -o "$tmp/two.exr" --spp 3 --size 24x24 --quiet "$@" \
-            2>>"$tmp/spec.err"; then
-        check_fails "$what: $name" 0 "$G" diff "$one" "$tmp/two.exr" --max-error 0
-    else
-        fail "$what: $name (render failed)"; sed 's/^/    /' "$tmp/spec.err"
-    fi
+    local what=$1 env=$2 name=$3; shift 3
+    pair same "$what: $name" "$env" -- "$@"
 }
 
 # The path kernel is specialised on what the scene needs (GN_FEAT_* in glsl/lib/shared.h):
@@ -125,18 +159,8 @@ fi
 # every pixel and AOV must be what the render at the normal cap gives, and resuming must
 # really have happened (GONIO_DEBUG_RESUMES).
 same_interrupted() {
-    local name=$1 scene=$2 one; shift 2
-    if one=$(base "$scene" "$@" 2>"$tmp/cap.err") &&
-        env GONIO_LOOP_CAP=3000 GONIO_DEBUG_RESUMES=1 "$G" render "$scene" -o "$tmp/two.exr" \
-            --spp 3 --size 24x24 --quiet "$@" 2>>"$tmp/cap.err"; then
-        check "interrupted paths = whole paths: $name" "$TESTTOOL" same "$one" "$tmp/two.exr"
-        # the last line: the render's own (a file with lights of its own has a probe render first)
-        n=$(sed -n 's/^gonio: debug: \([0-9]*\) dispatch.*/\1/p' "$tmp/cap.err" | tail -n 1)
-        check "... and some were interrupted ($name: ${n:-no} resuming dispatches)" test "${n:-0}" -gt 0
-        check "... none cut short ($name)" sh -c "! grep -q 'internal error\|cut short' '$tmp/cap.err'"
-    else
-        fail "interrupted paths: $name (render failed)"; sed 's/^/    /' "$tmp/cap.err"
-    fi
+    local name=$1; shift
+    pair interrupted "$name" GONIO_LOOP_CAP=3000 GONIO_DEBUG_RESUMES=1 -- "$@"
 }
 if in_tier fast; then
     same_interrupted "Cornell box" $C
@@ -159,6 +183,7 @@ if in_tier slow; then
         --size 128x128 -o "$tmp/teapot.exr"
     check "... warns of nothing" sh -c "! grep -q warning '$tmp/last'"
 fi
+check_pairs # every pair above, in one batch
 in_tier fast || { finish; exit; }
 
 # Ctrl-C: the render stops after the current pass, writes what it has and exits 130.
@@ -172,41 +197,53 @@ exrheader "$tmp/int.exr" >"$tmp/hdr.txt" 2>&1
 check "the interrupted EXR is readable and has its spp" grep -Eq 'gonio:spp \(type int\): [1-9]' "$tmp/hdr.txt"
 
 # merge: 4 + 12 spp with two seeds; the result weights them 1:3.
-check "render seed 1" "$G" render $C -o "$tmp/a.exr" --spp 4 --size 32x32 --seed 1 --aov variance --quiet
-check "render seed 2" "$G" render $C -o "$tmp/b.exr" --spp 12 --size 32x32 --seed 2 --aov variance --quiet
+# (the renders of the merge checks in one batch)
+T=scenes/teapot.gltf
+r32() { queue "$1" render "${@:2}" --spp 4 --size 32x32 --aov variance --quiet; }
+queue a render $C -o "$tmp/a.exr" --spp 4 --size 32x32 --seed 1 --aov variance --quiet
+queue b render $C -o "$tmp/b.exr" --spp 12 --size 32x32 --seed 2 --aov variance --quiet
+# merge refuses what cannot be one render: exit 1, a message naming both files and the
+# field, no output. Each input below differs from a.exr in one thing only.
+r32 scene $T -o "$tmp/i-scene.exr" --seed 3
+r32 mode $C -o "$tmp/i-mode.exr" --seed 3 --mode phong
+r32 camera $C -o "$tmp/i-camera.exr" --seed 3 --camera frame # 0 is the default
+r32 max-depth $C -o "$tmp/i-max-depth.exr" --seed 3 --max-depth 2
+r32 env $C -o "$tmp/i-env.exr" --seed 3 --env 0.5
+r32 estimator $C -o "$tmp/i-estimator.exr" --seed 3 --estimator light
+r32 brdf $C -o "$tmp/i-brdf.exr" --seed 3 --brdf lambert
+queue p1 render $C -o "$tmp/p1.exr" --mode phong --spp 2 --size 32x32 --seed 1 --quiet
+queue p2 render $C -o "$tmp/p2.exr" --mode phong --spp 2 --size 32x32 --seed 2 --no-shadows --quiet
+queue p3 render $C -o "$tmp/p3.exr" --mode phong --spp 2 --size 32x32 --seed 3 --max-depth 2 --quiet
+# The same scene from another file (a copy elsewhere, or as .glb) is the same render.
+mkdir -p "$tmp/elsewhere" && cp $C "$tmp/elsewhere/box.gltf"
+r32 copy "$tmp/elsewhere/box.gltf" -o "$tmp/copy.exr" --seed 3
+r32 a2 $C -o "$tmp/a2.exr" --seed 1
+run_queue
+check_queued "render seed 1" 0 a
+check_queued "render seed 2" 0 b
 check "merge" "$G" merge "$tmp/a.exr" "$tmp/b.exr" -o "$tmp/m.exr"
 exrheader "$tmp/m.exr" >"$tmp/hdr.txt" 2>&1
 check "merged spp is the sum" grep -q 'gonio:spp (type int): 16' "$tmp/hdr.txt"
 check_fails "merging different sizes fails" 1 "$G" merge "$tmp/a.exr" "$tmp/d.exr" -o "$tmp/x.exr"
-# merge refuses what cannot be one render: exit 1, a message naming both files and the
-# field, no output. Each input below differs from a.exr in one thing only.
-T=scenes/teapot.gltf
-r32() { "$G" render "$@" --spp 4 --size 32x32 --aov variance --quiet; }
-check "other scene" r32 $T -o "$tmp/i-scene.exr" --seed 3
-check "other mode" r32 $C -o "$tmp/i-mode.exr" --seed 3 --mode phong
-check "other camera" r32 $C -o "$tmp/i-camera.exr" --seed 3 --camera frame # 0 is the default
-check "other max-depth" r32 $C -o "$tmp/i-max-depth.exr" --seed 3 --max-depth 2
-check "other env" r32 $C -o "$tmp/i-env.exr" --seed 3 --env 0.5
-check "other estimator" r32 $C -o "$tmp/i-estimator.exr" --seed 3 --estimator light
-check "other brdf" r32 $C -o "$tmp/i-brdf.exr" --seed 3 --brdf lambert
+for f in scene mode camera max-depth env estimator brdf; do
+    check_queued "other $f" 0 $f
+done
 for f in scene mode camera max-depth env estimator brdf; do
     field=$f; [ $f = brdf ] && field=scene # --brdf changes the materials: another scene
     check_fails "merge refuses another $f" 1 "$G" merge "$tmp/a.exr" "$tmp/i-$f.exr" -o "$tmp/x.exr"
     check "... naming both files and gonio:$field" sh -c "grep 'a.exr' '$tmp/last' | grep 'i-$f.exr' | grep -q 'gonio:$field differs'"
 done
 check "no output after a refusal" test ! -e "$tmp/x.exr"
-check "phong: seed 1" "$G" render $C -o "$tmp/p1.exr" --mode phong --spp 2 --size 32x32 --seed 1 --quiet
-check "phong: seed 2, no shadows" "$G" render $C -o "$tmp/p2.exr" --mode phong --spp 2 --size 32x32 --seed 2 --no-shadows --quiet
-check "phong: seed 3, --max-depth (unused by phong)" "$G" render $C -o "$tmp/p3.exr" --mode phong --spp 2 --size 32x32 --seed 3 --max-depth 2 --quiet
+check_queued "phong: seed 1" 0 p1
+check_queued "phong: seed 2, no shadows" 0 p2
+check_queued "phong: seed 3, --max-depth (unused by phong)" 0 p3
 check_fails "merge refuses phong with and without shadows" 1 "$G" merge "$tmp/p1.exr" "$tmp/p2.exr" -o "$tmp/x.exr"
 check "... naming gonio:shadows" grep -q 'gonio:shadows differs' "$tmp/last"
 check "an option the mode ignores does not keep renders apart" "$G" merge "$tmp/p1.exr" "$tmp/p3.exr" -o "$tmp/p13.exr"
-# The same scene from another file (a copy elsewhere, or as .glb) is the same render.
-mkdir -p "$tmp/elsewhere" && cp $C "$tmp/elsewhere/box.gltf"
-check "render a copy of the scene" r32 "$tmp/elsewhere/box.gltf" -o "$tmp/copy.exr" --seed 3
+check_queued "render a copy of the scene" 0 copy
 check "merge takes the copy" "$G" merge "$tmp/a.exr" "$tmp/copy.exr" -o "$tmp/ac.exr"
 # Seeds: a repeated one is an error unless --force; merged files carry their seeds on.
-check "render seed 1 again" r32 $C -o "$tmp/a2.exr" --seed 1
+check_queued "render seed 1 again" 0 a2
 check_fails "merge refuses a repeated seed" 1 "$G" merge "$tmp/a.exr" "$tmp/a2.exr" -o "$tmp/x.exr"
 check "... naming both files and the seed" sh -c "grep 'a.exr' '$tmp/last' | grep 'a2.exr' | grep -q 'seed 1'"
 check_fails "merge refuses a seed repeated through a merged file" 1 "$G" merge "$tmp/m.exr" "$tmp/a2.exr" -o "$tmp/x.exr"

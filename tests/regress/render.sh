@@ -11,10 +11,11 @@ for s in plane inside-sphere; do
     check "testtool scene $s" "$TESTTOOL" scene $s "$tmp/$s.gltf"
     for aov in depth normal; do
         check "testtool ref $s $aov" "$TESTTOOL" ref $s $aov 96 96 "$tmp/$s-$aov-ref.exr"
-        check "render $s $aov" "$G" render "$tmp/$s.gltf" -o "$tmp/$s-$aov.exr" --mode $aov \
-            --spp 1 --size 96x96 --camera 0 --quiet
+        queue "$s-$aov" render "$tmp/$s.gltf" -o "$tmp/$s-$aov.exr" --mode $aov --spp 1 --size 96x96 --camera 0 --quiet
     done
 done
+run_queue # (the renders of a block in one batch: lib.sh, queue)
+for s in plane inside-sphere; do for aov in depth normal; do check_queued "render $s $aov" 0 "$s-$aov"; done; done
 # The plane is exact up to float rounding: 1e-4 is far below one pixel's depth step.
 check "plane depth matches the analytic depth" "$G" diff "$tmp/plane-depth.exr" \
     "$tmp/plane-depth-ref.exr" --max-error 1e-4 --quiet
@@ -106,12 +107,31 @@ for set in normal albedo depth variance depth,normal albedo,variance normal,albe
     check "--aov $set: channels $want" test "$(channels "$tmp/aov.exr")" = "$want"
 done
 check_fails "--aov bogus" 2 "$G" render $C -o "$tmp/bad.exr" --aov normal,bogus --quiet
+# (this block's renders first, in one batch)
+queue plane-aov render "$tmp/plane.gltf" -o "$tmp/plane-aov.exr" --mode albedo --aov depth --spp 1 --size 96x96 --camera 0 --quiet
+queue dm render $C -o "$tmp/dm.exr" --mode depth --spp 1 --size 32x32 --quiet
+queue da render $C -o "$tmp/da.exr" --mode albedo --aov depth --spp 1 --size 32x32 --quiet
+for comp in none rle zips zip piz pxr24 b44 b44a; do
+    case $comp in none | zip | piz | b44) in_tier fast || [ $comp = zip ] || continue ;; *) in_tier slow || continue ;; esac
+    queue "z-$comp" render $C -o "$tmp/z-$comp.exr" --mode albedo --spp 1 --size 32x32 --compression $comp --quiet
+done
+queue h render $C -o "$tmp/h.exr" --mode albedo --spp 1 --size 32x32 --half --aov depth --quiet
+queue pd render "$tmp/plane.gltf" --png "$tmp/pd.png" --mode depth --spp 1 --size 96x96 --camera 0 --quiet
+queue pn render "$tmp/plane.gltf" --png "$tmp/pn.png" --mode normal --spp 1 --size 96x96 --camera 0 --quiet
+queue cn render $C -o "$tmp/cn.png" --mode normal --spp 1 --size 64x64 --quiet
+queue cc render $C -o "$tmp/cc.png" --mode cost --spp 1 --size 64x64 --quiet
+for m in normal albedo depth cost phong; do
+    queue "m-$m" render $C -o "$tmp/m-$m.exr" --mode $m --spp 2 --size 32x32 --quiet
+done
+queue c2 render $C -o "$tmp/c2.exr" --spp 4 --size 64x64 --aov normal,albedo,depth --seed 7 --quiet
+queue c3 render $C -o "$tmp/c3.exr" --spp 4 --size 64x64 --seed 8 --quiet
+run_queue
 # The depth AOV is the depth mode's image: 0 (not +inf) where nothing is hit, in both.
-check "depth AOV of the plane" "$G" render "$tmp/plane.gltf" -o "$tmp/plane-aov.exr" --mode albedo --aov depth --spp 1 --size 96x96 --camera 0 --quiet
+check_queued "depth AOV of the plane" 0 plane-aov
 check "pick the plane's depth.Z" "$TESTTOOL" pick "$tmp/plane-aov.exr" depth.Z "$tmp/plane-aov-z.exr"
 check "the depth AOV matches the analytic depth" "$G" diff "$tmp/plane-aov-z.exr" "$tmp/plane-depth-ref.exr" --max-error 1e-4 --quiet
-check "cornell depth mode" "$G" render $C -o "$tmp/dm.exr" --mode depth --spp 1 --size 32x32 --quiet
-check "cornell depth AOV" "$G" render $C -o "$tmp/da.exr" --mode albedo --aov depth --spp 1 --size 32x32 --quiet
+check_queued "cornell depth mode" 0 dm
+check_queued "cornell depth AOV" 0 da
 check "pick depth.Z" "$TESTTOOL" pick "$tmp/da.exr" depth.Z "$tmp/dz.exr"
 check "depth mode = depth AOV, background included" "$G" diff "$tmp/dm.exr" "$tmp/dz.exr" --max-error 0 --quiet
 # Pixel (0, 0) of this view is background (coverage 0); the centre is the back wall.
@@ -124,7 +144,7 @@ check "the back wall has a depth" sh -c "test \"\$('$TESTTOOL' at '$tmp/da.exr' 
 # (the fast tier: none, zip, piz and b44; the slow tier the other four, each as before)
 for comp in none rle zips zip piz pxr24 b44 b44a; do
     case $comp in none | zip | piz | b44) in_tier fast || [ $comp = zip ] || continue ;; *) in_tier slow || continue ;; esac
-    check "--compression $comp" "$G" render $C -o "$tmp/z-$comp.exr" --mode albedo --spp 1 --size 32x32 --compression $comp --quiet
+    check_queued "--compression $comp" 0 "z-$comp"
     case $comp in rle) says=run-length ;; zips) says="zip, individual" ;; zip) says="zip, multi" ;; *) says="$comp\$" ;; esac
     check "--compression $comp recorded" sh -c "exrheader '$tmp/z-$comp.exr' | grep -q '^compression (type compression): $says'"
 done
@@ -133,7 +153,7 @@ for comp in none rle zips piz; do # lossless: the same floats as zip
     case $comp in none | piz) in_tier fast || continue ;; *) in_tier slow || continue ;; esac
     check "--compression $comp is lossless" "$G" diff "$tmp/z-$comp.exr" "$tmp/z-zip.exr" --max-error 0 --quiet
 done
-check "--half" "$G" render $C -o "$tmp/h.exr" --mode albedo --spp 1 --size 32x32 --half --aov depth --quiet
+check_queued "--half" 0 h
 check "--half: half channels" sh -c "exrheader '$tmp/h.exr' | grep -q 'depth.Z, 16-bit floating-point'"
 check "--half: no float channel" sh -c "! exrheader '$tmp/h.exr' | grep -q '32-bit floating'"
 # Half keeps 11 significant bits: albedos in [0, 1] within 2^-11.
@@ -145,24 +165,24 @@ check_fails "--half: but not exactly" 1 "$G" diff "$tmp/h.exr" "$tmp/z-zip.exr" 
 # give 0.5 n + 0.5 exactly; the background of the Cornell box's normal PNG is black.
 px() { convert "$1" -format "%[fx:int(255*p{$2,$3}.r+0.5)],%[fx:int(255*p{$2,$3}.g+0.5)],%[fx:int(255*p{$2,$3}.b+0.5)]" info:; }
 range() { convert "$1" -colorspace gray -format "%[fx:int(255*minima+0.5)] %[fx:int(255*maxima+0.5)]" info:; }
-check "plane depth PNG" "$G" render "$tmp/plane.gltf" --png "$tmp/pd.png" --mode depth --spp 1 --size 96x96 --camera 0 --quiet
+check_queued "plane depth PNG" 0 pd
 check "depth PNG spans 51..255 (20% grey to white)" test "$(range "$tmp/pd.png")" = "51 255"
 check "depth PNG is the analytic depth, near white" "$TESTTOOL" png depth "$tmp/pd.png" "$tmp/plane-depth-ref.exr"
-check "plane normal PNG" "$G" render "$tmp/plane.gltf" --png "$tmp/pn.png" --mode normal --spp 1 --size 96x96 --camera 0 --quiet
+check_queued "plane normal PNG" 0 pn
 check "normal PNG is 0.5 n + 0.5 of the analytic normals" "$TESTTOOL" png normal "$tmp/pn.png" "$tmp/plane-normal-ref.exr"
-check "cornell normal PNG" "$G" render $C -o "$tmp/cn.png" --mode normal --spp 1 --size 64x64 --quiet
+check_queued "cornell normal PNG" 0 cn
 check "normal PNG background is black" test "$(px "$tmp/cn.png" 0 0)" = "0,0,0"
-check "cornell cost PNG" "$G" render $C -o "$tmp/cc.png" --mode cost --spp 1 --size 64x64 --quiet
+check_queued "cornell cost PNG" 0 cc
 check "cost PNG is a heat map: not grey" sh -c "test \"\$(convert '$tmp/cc.png' -colorspace HSL -channel G -separate -format '%[fx:maxima>0.3]' info:)\" = 1"
 check "cost PNG reaches the map's top (yellow)" sh -c "convert '$tmp/cc.png' -format '%[fx:maxima.r>0.9]' info: | grep -q 1"
 check "no temporary files left" sh -c "! ls -a '$tmp' | grep -q tmp-"
 for m in normal albedo depth cost phong; do
-    check "mode $m renders" "$G" render $C -o "$tmp/m-$m.exr" --mode $m --spp 2 --size 32x32 --quiet
+    check_queued "mode $m renders" 0 "m-$m"
 done
 # Same command, same image, bit for bit.
-check "render again" "$G" render $C -o "$tmp/c2.exr" --spp 4 --size 64x64 --aov normal,albedo,depth --seed 7 --quiet
+check_queued "render again (in a batch)" 0 c2
 check "deterministic: identical pixels" "$G" diff "$tmp/c.exr" "$tmp/c2.exr" --max-error 0 --quiet
-check "render with another seed" "$G" render $C -o "$tmp/c3.exr" --spp 4 --size 64x64 --seed 8 --quiet
+check_queued "render with another seed" 0 c3
 check_fails "another seed gives other pixels" 1 "$G" diff "$tmp/c.exr" "$tmp/c3.exr" --max-error 0 --quiet
 # The summary line: seconds, spp and Mrays/s.
 "$G" render $C -o "$tmp/s.exr" --mode phong --spp 2 --size 32x32 2>"$tmp/summary.txt"
@@ -264,9 +284,10 @@ col_gltf "$tmp/col_u8.gltf" "1,1,1" ',"COLOR_0":1' \
 for mode in albedo phong gouraud flat path; do
     case $mode in albedo | path) in_tier fast || continue ;; *) in_tier slow || continue ;; esac
     for f in col_base col_f col_u8; do
-        check "COLOR_0: $f renders in $mode" "$G" render "$tmp/$f.gltf" -o "$tmp/$f-$mode.exr" --mode $mode \
-            --size 24x24 --spp 2 --env 1 --ambient 1 --quiet
+        queue "$f-$mode" render "$tmp/$f.gltf" -o "$tmp/$f-$mode.exr" --mode $mode --size 24x24 --spp 2 --env 1 --ambient 1 --quiet
     done
+    run_queue
+    for f in col_base col_f col_u8; do check_queued "COLOR_0: $f renders in $mode" 0 "$f-$mode"; done
     check "COLOR_0 float RGB = base colour ($mode)" "$G" diff "$tmp/col_f-$mode.exr" "$tmp/col_base-$mode.exr" --max-error 1e-6
     check "COLOR_0 unorm8 RGBA = base colour ($mode)" "$G" diff "$tmp/col_u8-$mode.exr" "$tmp/col_base-$mode.exr" --max-error 1e-6
 done
