@@ -20,19 +20,24 @@ for f in "$A"/asset-generator/*/*.gltf; do files+=("$f"); done
 
 # Every fourth model (in the order above, so each set has models in both tiers) is in the
 # fast tier, the rest in the slow tier: the same check on each model, in one tier or the
-# other. (A render of a sample model costs about 2.5 s of CPU: its kernel's compile, its
-# textures, its tree.)
-k=0
+# other. (A render of a sample model costs about 2.5 s of CPU alone: its kernel's compile,
+# its textures, its tree; in a batch, models with the same features share the kernel.)
+# (the renders in one batch: lib.sh, queue; models that need the same kernel share it)
+k=0 models=()
 for f in "${files[@]}"; do
     k=$((k + 1))
     if [ $((k % 4)) = 1 ]; then in_tier fast || continue; else in_tier slow || continue; fi
     m=$(basename "$f" | sed 's/\.[^.]*$//')
+    queue "$m" render "$f" -o "$tmp/$m.exr" --size 32x32 --spp 4 --quiet
+    models+=("$m")
+done
+run_queue
+for m in "${models[@]}"; do
     out="$tmp/$m.exr"
-    "$G" render "$f" -o "$out" --size 32x32 --spp 4 --quiet >"$tmp/out" 2>&1
-    rc=$?
-    if [ $rc != 0 ]; then
+    rc=$(queued "$m")
+    if [ "$rc" != 0 ]; then
         fail "$m renders with default flags (exit $rc)"
-        sed 's/^/    /' "$tmp/out" | tail -n 5
+        sed 's/^/    /' "$tmp/last" | tail -n 5
         continue
     fi
     pass

@@ -135,25 +135,37 @@ check "  attenuationDistance" grep -q "bad.gltf: material 0: attenuationDistance
 check "  attenuationColor" grep -q "bad.gltf: material 0: attenuationColor must be 3 numbers in \[0, 1\]" "$tmp/last"
 
 F="--env 1 --quiet"
+P="--env 0 --quiet --spp 64 --size 96x96"
+# (every render below in one batch: lib.sh, queue; the references are computed here)
+queue slab1 render "$tmp/slab1.gltf" -o "$tmp/slab1.exr" $F --spp 2 --size 16x16
+queue slab15 render "$tmp/slab15.gltf" -o "$tmp/slab15.exr" $F --spp 64 --size 64x64
+queue nested15 render "$tmp/nested15.gltf" -o "$tmp/nested15.exr" $F --spp 64 --size 64x64
+for s in nested touching; do queue "$s" render "$tmp/$s.gltf" -o "$tmp/$s.exr" $F --spp 64 --size 64x64; done
+for s in disp1 disp0 nodisp thin0 plain iorR iorB; do queue "$s" render "$tmp/$s.gltf" -o "$tmp/$s.exr" $P; done
+for s in nested disp1; do
+    queue "$s-a" render "$tmp/$s.gltf" -o "$tmp/$s-a.exr" --env 1 --quiet --spp 3 --size 24x24
+    queue "$s-b" GONIO_ALL_FEATURES=1 render "$tmp/$s.gltf" -o "$tmp/$s-b.exr" --env 1 --quiet --spp 3 --size 24x24
+done
+run_queue
+
 # Index 1: no Fresnel, no roulette before depth 3: the same number in every pixel, to float precision.
-check "slab, index 1: render" "$G" render "$tmp/slab1.gltf" -o "$tmp/slab1.exr" $F --spp 2 --size 16x16
+check_queued "slab, index 1: render" 0 slab1
 check_means "slab, index 1: exp(-sigma d)" "$tmp/slab1.exr" "$tmp/slab1.ref" 1e-5
 # Index 1.5: Fresnel at both faces and every internal reflection (a Monte Carlo estimate:
 # 262144 paths, standard error about 1e-4 relative).
-check "slab, index 1.5: render" "$G" render "$tmp/slab15.gltf" -o "$tmp/slab15.exr" $F --spp 64 --size 64x64
+check_queued "slab, index 1.5: render" 0 slab15
 check_means "slab, index 1.5: R + T^2 tau / (1 - R tau)" "$tmp/slab15.exr" "$tmp/slab15.ref" 2e-3
 check_fails "  (the single pass alone is not it)" 1 near "$(means "$tmp/slab15.exr" | awk '{print $1}')" "$(awk '{print $1}' "$tmp/slab15-single.ref")" 2e-3
-check "glass around a medium of its index: render" "$G" render "$tmp/nested15.gltf" -o "$tmp/nested15.exr" $F --spp 64 --size 64x64
+check_queued "glass around a medium of its index: render" 0 nested15
 check_means "glass around a medium of its index: no inner interface" "$tmp/nested15.exr" "$tmp/slab15.ref" 2e-3
 for s in nested touching; do
-    check "$s media: render" "$G" render "$tmp/$s.gltf" -o "$tmp/$s.exr" $F --spp 64 --size 64x64
+    check_queued "$s media: render" 0 "$s"
     check_means "$s media: exp(-sigma_g d_g - sigma_l d_l)" "$tmp/$s.exr" "$tmp/$s.ref" 3e-3
 done
 
 # Dispersion: a white bar seen through a sphere of index 1.5.
-P="--env 0 --quiet --spp 64 --size 96x96"
 for s in disp1 disp0 nodisp thin0 plain iorR iorB; do
-    "$G" render "$tmp/$s.gltf" -o "$tmp/$s.exr" $P 2>"$tmp/$s.err" || fail "render $s"
+    [ "$(queued "$s")" = 0 ] || { fail "render $s"; sed 's/^/    /' "$tmp/last"; }
 done
 check "dispersion 0 is the file without the extension" "$T" same "$tmp/nodisp.exr" "$tmp/disp0.exr"
 check "  (without a volume too)" "$T" same "$tmp/plain.exr" "$tmp/thin0.exr"
@@ -167,9 +179,7 @@ check "blue's brightness is n_B's" near "$(means "$tmp/disp1.exr" | awk '{print 
 
 # The kernel specialised on the scene's features (GN_FEAT_VOLUME) gives the unspecialised pixels.
 for s in nested disp1; do
-    "$G" render "$tmp/$s.gltf" -o "$tmp/$s-a.exr" --env 1 --quiet --spp 3 --size 24x24 &&
-        GONIO_ALL_FEATURES=1 "$G" render "$tmp/$s.gltf" -o "$tmp/$s-b.exr" --env 1 --quiet --spp 3 --size 24x24 ||
-        fail "$s: renders"
+    [ "$(queued "$s-a")$(queued "$s-b")" = 00 ] || fail "$s: renders"
     check "$s: specialised = unspecialised" "$T" same "$tmp/$s-a.exr" "$tmp/$s-b.exr"
 done
 finish
