@@ -52,7 +52,10 @@ finish() {
 queue_ids=()
 queue() {
     local id=$1 w line=""; shift
-    for w in "$@"; do line+="'$w' "; done
+    for w in "$@"; do
+        case $w in *"'"* | *$'\n'*) fail "queue $id: a word with a quote or a newline: '$w'"; return 1 ;; esac
+        line+="'$w' "
+    done
     queue_ids+=("$id")
     printf '%s\n' "$line" >>"$tmp/queue.txt"
 }
@@ -61,6 +64,13 @@ run_queue() {
     rm -rf "$tmp/queue"
     mkdir -p "$tmp/queue"
     "$GONIO" batch "$tmp/queue.txt" --logs "$tmp/queue" >"$tmp/queue/batch.log" 2>&1
+    local rc=$?
+    # The batch's own failures, which no line's status shows: 0 or 1 (a line failed) only,
+    # and nothing said at its end by the validation layer or a sanitizer (of the device
+    # it kept, or of memory it leaked).
+    if [ $rc -gt 1 ] || grep -q 'validation\|Sanitizer\|runtime error' "$tmp/queue/batch.log"; then
+        fail "the batch itself (exit $rc)"; sed 's/^/    /' "$tmp/queue/batch.log" | tail -n 20
+    fi
     for id in "${queue_ids[@]}"; do
         n=$((n + 1))
         mv "$tmp/queue/$n.status" "$tmp/queue/$id.status" 2>/dev/null

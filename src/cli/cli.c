@@ -294,16 +294,15 @@ bool cli_gpu_create(gpu *g, int device_index, bool validate)
     const char *env = getenv("GONIO_VALIDATE");
     gpu_desc d = {.device_index = device_index};
     d.validate = validate || (env && strcmp(env, "1") == 0);
-    messages_before = gpu_validation_message_count();
     if (shared.kept && shared.device_index == device_index && shared.g.validate == d.validate) {
         *g = shared.g;
         shared.kept = false;
+        messages_before = gpu_validation_message_count();
         return true;
     }
-    if (shared.kept) { /* another device or validation setting: made anew */
-        gpu_destroy(&shared.g);
-        shared.kept = false;
-    }
+    if (shared.kept && !cli_gpu_share(true)) /* another device or validation setting: made anew */
+        return false;
+    messages_before = gpu_validation_message_count();
     shared.device_index = device_index;
     return gpu_create(g, &d);
 }
@@ -329,10 +328,16 @@ bool cli_gpu_finish(gpu *g)
 bool cli_gpu_share(bool on)
 {
     shared.on = on;
-    if (on || !shared.kept)
+    if (!shared.kept)
         return true;
+    /* The kept device destroyed (on: to make another): what validation says of its
+     * destruction (objects left behind) is an error here. */
     gpu g = shared.g;
+    bool keep = shared.on;
     shared.kept = false;
+    shared.on = false;
     messages_before = gpu_validation_message_count();
-    return cli_gpu_finish(&g);
+    bool ok = cli_gpu_finish(&g);
+    shared.on = keep;
+    return ok;
 }

@@ -271,8 +271,9 @@ bool cli_gpu_create(gpu *g, int device_index, bool validate);
  * since cli_gpu_create. While devices are shared, the device is kept for the next command
  * (and *g zeroed) instead of destroyed. */
 bool cli_gpu_finish(gpu *g);
-/* on: from now on cli_gpu_finish keeps the device for the next cli_gpu_create (gonio batch).
- * off: the kept device is destroyed; false when that fails validation. */
+/* on: from now on cli_gpu_finish keeps the device for the next cli_gpu_create (gonio batch);
+ * a device kept before is destroyed. off: the kept device is destroyed. False when that
+ * destruction fails validation. */
 bool cli_gpu_share(bool on);
 /* The command line, space-joined, for output headers. */
 void cli_set_command_line(int argc, char **argv);

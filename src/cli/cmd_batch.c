@@ -5,12 +5,14 @@
  * time). */
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "cli.h"
+#include "scene.h"
 #include "util.h"
 
 cli_command_fn *cli_dispatch;
@@ -115,11 +117,19 @@ static int run_line(char **words, int n)
         util_error("batch: '%s' cannot run in a batch", words[first]);
         rc = 2;
     } else {
-        char *line[BATCH_MAX_WORDS + 1] = {"gonio"}; /* the headers' command line, as the program's */
+        char *line[BATCH_MAX_WORDS + 1] = {"gonio"}; /* the headers' command line */
         memcpy(line + 1, words + first, sizeof *words * (size_t)(n - first));
         cli_set_command_line(n - first + 1, line);
+        /* What a process starts with, whatever the line before set: the settings that
+         * options put in globals, and the signals' default actions. */
         util_set_quiet(false);
+        scene_allow_outside_files(false);
+        scene_select_variant(NULL);
+        scene_animation_time(-1);
+        scene_instance_animated(false);
         rc = cli_dispatch(n - first, words + first);
+        signal(SIGINT, SIG_DFL); /* (render catches them while it works) */
+        signal(SIGTERM, SIG_DFL);
     }
     for (int k = first - 1; k >= 0; k--) {
         if (had[k])
