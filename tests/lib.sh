@@ -47,9 +47,13 @@ finish() {
 # queue ID [NAME=value...] COMMAND ARGS... adds a gonio command line (the words as given; no
 # single quotes in them); run_queue runs what is queued, then queued ID gives that line's
 # exit status and leaves its output (stdout and stderr) in $tmp/last, and check_queued
-# DESCRIPTION STATUS ID checks the status as check_fails does. A line's result is exactly
+# DESCRIPTION STATUS ID checks the status as check_fails does; after_queue (below) defers a
+# check until the queue has run. A line's result is exactly
 # the same command's in a process of its own (tests/regress/batch.sh).
-queue_ids=()
+# after_queue COMMAND ARGS... runs COMMAND ARGS (the checks on a queued line's results) after
+# the next run_queue, in the order they were given.
+queue_ids=() queue_after=()
+after_queue() { queue_after+=("$(printf '%q ' "$@")"); }
 queue() {
     local id=$1 w line=""; shift
     for w in "$@"; do
@@ -78,6 +82,9 @@ run_queue() {
     done
     queue_ids=()
     rm -f "$tmp/queue.txt"
+    local after=("${queue_after[@]}") a
+    queue_after=()
+    for a in "${after[@]}"; do eval "$a"; done
 }
 queued() {
     cp "$tmp/queue/$1.log" "$tmp/last" 2>/dev/null || echo "no line $1 in the batch" >"$tmp/last"

@@ -242,24 +242,17 @@ bool cli_take_env(const char *cmd, const char *opt, const char *val, void *dest)
  * map. */
 bool env_setup(const env_option *e, struct scene *sc, bool quiet, struct image *map, struct render_settings *s,
                bool *studio);
-/* The dark-view rule (options.c): whether it applies (no --env, no image-based light, and
- * the file has light of its own), the lit fraction of a probe render of s's view with the
- * file's lights (with_env: and s's environment; -1 when no pixel sees the model), whether
- * that is dark, and the studio added to the file's lights, saying so unless quiet (ambient_given: --ambient was given,
- * the local modes' ambient stays). In the local modes the studio's key light is added to
- * sc's lights: a renderer made before must be made again. */
+/* The dark-view rule (options.c; docs/path-tracing.md, "Light when the scene has none"),
+ * whole, after env_setup: with no --env and light of its own, a probe render of s's view; a
+ * dark view gets the studio added (said unless quiet; ambient_given: --ambient was given, the
+ * local modes' ambient stays); where the studio lights the view by default and a closed model
+ * keeps it out, a headlight (a point light at the camera) in its place. *studio: in, the
+ * studio lights the view already; out, whether it does now; *headlight: whether one was
+ * added. True when sc's lights changed (the local modes' studio key light, the headlight):
+ * the caller makes its renderer again. */
 struct renderer;
-bool env_probe_applies(const env_option *e, const struct scene *sc);
-float env_probe_lit_fraction(struct renderer *r, const struct render_settings *s, bool with_env);
-bool env_probe_is_dark(float lit);
-void env_add_studio(const env_option *e, struct scene *sc, bool quiet, float lit, bool ambient_given,
-                    struct image *map, struct render_settings *s);
-/* The rule's second step, where the studio lights s's view by default: a camera inside a
- * closed model that keeps the studio out, the view still dark, gets a headlight (a point
- * light at the camera) added to sc's lights in place of s's environment map (the local
- * modes keep its ambient term), said unless quiet. True when added: the caller makes its
- * renderer again. */
-bool env_add_headlight(struct renderer *r, struct scene *sc, struct render_settings *s, bool quiet);
+bool env_light_rule(const env_option *e, struct scene *sc, struct renderer *r, struct render_settings *s,
+                    struct image *map, bool quiet, bool ambient_given, bool *studio, bool *headlight);
 
 /* "gonio CMD: MESSAGE" and the hint to use --help; returns 2. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);

@@ -700,20 +700,9 @@ static int render_run(const render_job *job)
         renderer_create(rp, gp, &sc);
     }
     scene *scp = cache ? &cache->sc : &sc; /* (a frame's scene moves into the cache) */
-    if (env_probe_applies(&env, scp)) { /* the file's own light: is the view dark? */
-        float lit = env_probe_lit_fraction(rp, &s, false);
-        if (env_probe_is_dark(lit)) {
-            env_add_studio(&env, scp, quiet, lit, job->s.ambient_set, &env_map, &s);
-            studio = true;
-            if (s.mode != GN_MODE_PATH) { /* the studio's key light joined the scene's lights */
-                renderer_destroy(rp);
-                renderer_create(rp, gp, scp);
-            }
-        }
-    }
-    bool headlight = studio && !env.given && env_add_headlight(rp, scp, &s, quiet);
-    if (headlight) { /* a camera the studio cannot reach: the headlight joined the scene's lights */
-        renderer_destroy(rp);
+    bool headlight;
+    if (env_light_rule(&env, scp, rp, &s, &env_map, quiet, job->s.ambient_set, &studio, &headlight)) {
+        renderer_destroy(rp); /* the studio's key light or the headlight joined the scene's lights */
         renderer_create(rp, gp, scp);
     }
     s.env_label = headlight ? "headlight" : studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none";

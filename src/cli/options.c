@@ -299,12 +299,12 @@ bool env_setup(const env_option *e, scene *sc, bool quiet, image *map, render_se
 #define ENV_PROBE_LEVEL 0.02f
 #define ENV_PROBE_LIT 0.6f
 
-bool env_probe_applies(const env_option *e, const scene *sc)
+static bool env_probe_applies(const env_option *e, const scene *sc)
 {
     return !e->given && !sc->environment.num_channels && env_scene_has_light(sc);
 }
 
-float env_probe_lit_fraction(renderer *r, const render_settings *s, bool with_env)
+static float env_probe_lit_fraction(renderer *r, const render_settings *s, bool with_env)
 {
     render_settings p = *s;
     p.mode = GN_MODE_PATH;
@@ -345,13 +345,13 @@ float env_probe_lit_fraction(renderer *r, const render_settings *s, bool with_en
     return seen ? (float)lit / (float)seen : -1;
 }
 
-bool env_probe_is_dark(float lit)
+static bool env_probe_is_dark(float lit)
 {
     return lit >= 0 && lit < ENV_PROBE_LIT;
 }
 
-void env_add_studio(const env_option *e, scene *sc, bool quiet, float lit, bool ambient_given, image *map,
-                    render_settings *s)
+static void env_add_studio(const env_option *e, scene *sc, bool quiet, float lit, bool ambient_given,
+                           image *map, render_settings *s)
 {
     float scale = e->intensity > 0 ? e->intensity : 1, mean[3];
     if (!quiet)
@@ -398,7 +398,7 @@ static float trace_distance(const renderer *r, const float org[3], const float d
     return h.tri == GN_INVALID ? -1 : h.t;
 }
 
-bool env_add_headlight(renderer *r, scene *sc, render_settings *s, bool quiet)
+static bool env_add_headlight(renderer *r, scene *sc, render_settings *s, bool quiet)
 {
     GnCamera cam;
     if (r->failed || !renderer_camera(r, s, &cam))
@@ -459,4 +459,22 @@ bool env_add_headlight(renderer *r, scene *sc, render_settings *s, bool quiet)
                   "the studio out (%.0f %% of the model lit): a headlight, a point light at the camera, replaces "
                   "the studio (any --env decides instead)", sc->path, 100 * enclosed, 100 * fmaxf(lit, 0));
     return true;
+}
+
+bool env_light_rule(const env_option *e, scene *sc, renderer *r, render_settings *s, image *map, bool quiet,
+                    bool ambient_given, bool *studio, bool *headlight)
+{
+    bool changed = false;
+    *headlight = false;
+    if (env_probe_applies(e, sc)) { /* the file's own light: is the view dark? */
+        float lit = env_probe_lit_fraction(r, s, false);
+        if (env_probe_is_dark(lit)) {
+            env_add_studio(e, sc, quiet, lit, ambient_given, map, s);
+            *studio = true;
+            changed = s->mode != GN_MODE_PATH; /* the studio's key light joined the scene's lights */
+        }
+    }
+    if (*studio && !e->given && env_add_headlight(r, sc, s, quiet)) /* a camera the studio cannot reach */
+        *headlight = changed = true;
+    return changed;
 }

@@ -934,23 +934,13 @@ int cmd_preview(int argc, char **argv)
         p->s.aov |= RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL;
     }
     const bool started = setup(p, device, validate, width, height);
-    if (started && env_probe_applies(&env, &p->sc)) {
-        float lit = env_probe_lit_fraction(&p->r, &p->s, false); /* the file's own light: a dark view? */
-        if (env_probe_is_dark(lit)) {
-            env_add_studio(&env, &p->sc, false, lit, ambient_given, &env_map, &p->s);
-            studio = true;
-            if (p->s.mode != GN_MODE_PATH) { /* the studio's key light joined the scene's lights */
-                renderer_destroy(&p->r);
-                renderer_create(&p->r, &p->g, &p->sc);
-            }
-            p->restart = true;
-        }
-    }
-    if (started && studio && !env.given && env_add_headlight(&p->r, &p->sc, &p->s, false)) { /* the studio kept out */
-        renderer_destroy(&p->r);
+    bool had_studio = studio, headlight = false;
+    if (started && env_light_rule(&env, &p->sc, &p->r, &p->s, &env_map, false, ambient_given, &studio, &headlight)) {
+        renderer_destroy(&p->r); /* the studio's key light or the headlight joined the scene's lights */
         renderer_create(&p->r, &p->g, &p->sc);
-        p->restart = true;
     }
+    if (studio != had_studio || headlight)
+        p->restart = true;
     if (started) {
         util_info("preview: %s on %s; press H in the window for the keys", scene_path,
                   p->g.props.deviceName);

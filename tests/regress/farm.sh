@@ -183,8 +183,9 @@ exrheader "$tmp/lin_03.exr" >"$tmp/hl"
 has "$tmp/hl" "gonio:frame (type int): 3"
 has "$tmp/hl" "gonio:time (type double): 0.75"
 # at_time FILE T X: FILE rendered at time T shows the square at X (the renders in one batch).
-at_n=0 at_checks=()
-at_time() { at_n=$((at_n + 1)); queue "at$at_n" render "$1" "${a[@]}" --at "$2" -o "$tmp/at$at_n.exr"; at_checks+=("$at_n $3"); }
+at_n=0
+at_time() { at_n=$((at_n + 1)); queue "at$at_n" render "$1" "${a[@]}" --at "$2" -o "$tmp/at$at_n.exr"; after_queue at_checks $at_n "$3"; }
+at_checks() { check_queued "--at: render $1" 0 "at$1"; at "$tmp/at$1.exr" "$2"; }
 at_time "$tmp/linear.gltf" 5 1  # after the last key: its value
 anim "$tmp/step.gltf" 0 STEP "0 1 2" "-1 0.5 1"
 at_time "$tmp/step.gltf" 0.99 -1
@@ -199,11 +200,6 @@ at_time "$tmp/cubic.gltf" 0.5 "$want"
 anim "$tmp/camera.gltf" 1 LINEAR "0 1" "0 1"
 at_time "$tmp/camera.gltf" 0.5 -0.5
 run_queue
-for c in "${at_checks[@]}"; do
-    set -- $c
-    check_queued "--at: render $1" 0 "at$1"
-    at "$tmp/at$1.exr" "$2"
-done
 check_fails "--frames needs a pattern" 2 "$G" render "$tmp/linear.gltf" "${a[@]}" --frames 0-2 -o "$tmp/x.exr"
 check_fails "--frames A-B with B < A" 2 "$G" render "$tmp/linear.gltf" "${a[@]}" --frames 3-2 -o "$tmp/x%d.exr"
 check_fails "--frame and --at" 2 "$G" render "$tmp/linear.gltf" "${a[@]}" --frame 1 --at 2 -o "$tmp/x.exr"

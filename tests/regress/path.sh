@@ -24,8 +24,8 @@ fi
 [ -e "$tmp/d.exr" ] || "$G" render $C -o "$tmp/d.exr" --spp 2 --size 32x32 --quiet
 
 # The pairs of renders below are compared pixel for pixel. They are queued (lib.sh: queue)
-# and rendered in one batch per block, so that a kernel variant is compiled once for all the
-# pairs that use it; check_pairs renders what is queued and makes each pair's checks.
+# and rendered in one batch, so that a kernel variant is compiled once for all the pairs that
+# use it; each pair's checks run once the queue has.
 # base SCENE FLAGS...: queues SCENE's render as it is (3 spp, 24x24, FLAGS, GONIO_WALK_ARRAY as
 # set now) once a script; its path is $tmp/base-$base_key.exr.
 declare -A base_queued=()
@@ -37,9 +37,9 @@ base() {
             render "$1" -o "$tmp/base-$base_key.exr" --spp 3 --size 24x24 --quiet "${@:2}"
     fi
 }
-pairs=() pair_n=0
+pair_n=0
 # pair KIND NAME ENV... -- SCENE FLAGS...: queues SCENE's render as it is and one with the
-# environment assignments ENV, for check_pairs to compare (KIND: same or interrupted).
+# environment assignments ENV, compared once the queue has run (KIND: same or interrupted).
 pair() {
     local kind=$1 name=$2 env=(); shift 2
     while [ "$1" != -- ]; do env+=("$1"); shift; done
@@ -48,28 +48,21 @@ pair() {
     base "$@"
     queue "two-$pair_n" "${env[@]}" ${GONIO_WALK_ARRAY:+GONIO_WALK_ARRAY=$GONIO_WALK_ARRAY} \
         render "$1" -o "$tmp/two-$pair_n.exr" --spp 3 --size 24x24 --quiet "${@:2}"
-    pairs+=("$kind|$name|$base_key|$pair_n")
+    after_queue pair_checks "$kind" "$name" "$base_key" "$pair_n"
 }
-check_pairs() {
-    local p kind name key n one two
-    run_queue
-    for p in "${pairs[@]}"; do
-        IFS='|' read -r kind name key n <<<"$p"
-        one=$tmp/base-$key.exr two=$tmp/two-$n.exr
-        if [ "$(queued "base-$key")" != 0 ] || [ "$(queued "two-$n")" != 0 ]; then
-            fail "$name (render failed)"; cat "$tmp/queue/base-$key.log" "$tmp/queue/two-$n.log" | sed 's/^/    /' | tail -n 20
-        elif [ "$kind" = same ]; then
-            check_fails "$name" 0 "$G" diff "$one" "$two" --max-error 0
-        else
-            check "interrupted paths = whole paths: $name" "$TESTTOOL" same "$one" "$two"
-            # the last line: the render's own (a file with lights of its own has a probe render first)
-            local dispatches
-            dispatches=$(sed -n 's/^gonio: debug: \([0-9]*\) dispatch.*/\1/p' "$tmp/queue/two-$n.log" | tail -n 1)
-            check "... and some were interrupted ($name: ${dispatches:-no} resuming dispatches)" test "${dispatches:-0}" -gt 0
-            check "... none cut short ($name)" sh -c "! grep -q 'internal error\|cut short' '$tmp/queue/two-$n.log'"
-        fi
-    done
-    pairs=()
+pair_checks() {
+    local kind=$1 name=$2 key=$3 n=$4 one=$tmp/base-$3.exr two=$tmp/two-$4.exr dispatches
+    if [ "$(queued "base-$key")" != 0 ] || [ "$(queued "two-$n")" != 0 ]; then
+        fail "$name (render failed)"; cat "$tmp/queue/base-$key.log" "$tmp/queue/two-$n.log" | sed 's/^/    /' | tail -n 20
+    elif [ "$kind" = same ]; then
+        check_fails "$name" 0 "$G" diff "$one" "$two" --max-error 0
+    else
+        check "interrupted paths = whole paths: $name" "$TESTTOOL" same "$one" "$two"
+        # the last line: the render's own (a file with lights of its own has a probe render first)
+        dispatches=$(sed -n 's/^gonio: debug: \([0-9]*\) dispatch.*/\1/p' "$tmp/queue/two-$n.log" | tail -n 1)
+        check "... and some were interrupted ($name: ${dispatches:-no} resuming dispatches)" test "${dispatches:-0}" -gt 0
+        check "... none cut short ($name)" sh -c "! grep -q 'internal error\|cut short' '$tmp/queue/two-$n.log'"
+    fi
 }
 
 # same_pixels WHAT ENV NAME SCENE FLAGS...: a render as it is and one with the environment
@@ -183,7 +176,7 @@ if in_tier slow; then
         --size 128x128 -o "$tmp/teapot.exr"
     check "... warns of nothing" sh -c "! grep -q warning '$tmp/last'"
 fi
-check_pairs # every pair above, in one batch
+run_queue # every pair above, in one batch
 in_tier fast || { finish; exit; }
 
 # Ctrl-C: the render stops after the current pass, writes what it has and exits 130.

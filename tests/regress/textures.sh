@@ -134,23 +134,16 @@ PY
 
 scene() { python3 "$tmp/gen.py" "$tmp/$1.gltf" "$2"; }
 R() { "$G" render "$tmp/$1.gltf" --mode albedo --spp 1 --size ${N}x$N --quiet -o "$tmp/$1.exr" "${@:2}"; }
-# case NAME OPTIONS DESCRIPTION: write the scene and queue its render (lib.sh, queue);
-# run_cases renders the cases in one batch and probes each.
-cases=()
+# case NAME OPTIONS DESCRIPTION: write the scene and queue its render (lib.sh, queue); once
+# the queue has run, probe it.
 case_() {
     scene "$1" "$2" || { fail "$3: the scene"; return; }
     queue "$1" render "$tmp/$1.gltf" --mode albedo --spp 1 --size ${N}x$N --quiet -o "$tmp/$1.exr"
-    cases+=("$1"$'\t'"$2"$'\t'"$3")
+    after_queue case_checks "$@"
 }
-run_cases() {
-    local c name opts what
-    run_queue
-    for c in "${cases[@]}"; do
-        IFS=$'\t' read -r name opts what <<<"$c"
-        check_queued "$what: renders" 0 "$name" &&
-            check "$what: texels where the spec puts them" python3 "$tmp/probe.py" "$tmp/$name.exr" "$opts" "$TESTTOOL" $N
-    done
-    cases=()
+case_checks() {
+    check_queued "$3: renders" 0 "$1" &&
+        check "$3: texels where the spec puts them" python3 "$tmp/probe.py" "$tmp/$1.exr" "$2" "$TESTTOOL" $N
 }
 
 UV='"uv0": [[0, 0], [1, 1]]'
@@ -170,7 +163,7 @@ UV01='"uv0": [[0.01, 0.01], [0.02, 0.02]], "uv1": [[0, 0], [1, 1]]'
 case_ uv1 "{$UV01, \"texcoord\": 1}" "texCoord 1 reads TEXCOORD_1"
 case_ uv1tt "{$UV01, \"texcoord\": 0, \"tt\": {\"texCoord\": 1, \"offset\": [0.5, 0]}}" \
     "KHR_texture_transform's texCoord overrides the reference's"
-run_cases
+run_queue
 scene uv1none "{\"uv0\": [[0, 0], [1, 1]], \"texcoord\": 2}"
 "$G" render "$tmp/uv1none.gltf" --mode albedo --spp 1 --size 8x8 --quiet -o "$tmp/uv1none.exr" 2>"$tmp/uv1none.txt"
 check "texCoord 2 is dropped with a warning" grep -q "uses TEXCOORD_2, only TEXCOORD_0 and TEXCOORD_1" "$tmp/uv1none.txt"

@@ -75,22 +75,15 @@ check "... through exrtool's own writer too (it reads and writes the file faithf
      '$G' render $S -o '$P/full2.exr' $R --spp 8 --resume '$P/copy.exr' --aov depth,variance && \
      '$G' diff '$P/full2.exr' '$P/one.exr' --max-error 0"
 # refused NAME DESCRIPTION GREP: --resume $P/NAME.exr fails naming the problem, writes
-# nothing (queued: lib.sh, queue; check_refused renders them in one batch and checks)
-refusals=()
+# nothing (queued: lib.sh, queue; checked once the queue has run)
 refused() {
     queue "$1" render $S -o "$P/$1-out.exr" $R --spp 8 --resume "$P/$1.exr" --aov depth,variance
-    refusals+=("$1"$'\t'"$2"$'\t'"$3")
+    after_queue refused_checks "$@"
 }
-check_refused() {
-    local c name what says
-    run_queue
-    for c in "${refusals[@]}"; do
-        IFS=$'\t' read -r name what says <<<"$c"
-        check_queued "$what" 1 "$name"
-        check "... saying: $says" grep -q -- "$says" "$tmp/last"
-        check "... writing nothing" test ! -e "$P/$name-out.exr"
-    done
-    refusals=()
+refused_checks() {
+    check_queued "$2" 1 "$1"
+    check "... saying: $3" grep -q -- "$3" "$tmp/last"
+    check "... writing nothing" test ! -e "$P/$1-out.exr"
 }
 for v in nan inf -inf; do
     $X poke "$P/part.exr" "$P/$v.exr" sum.R 3 4 $v
@@ -114,7 +107,7 @@ $X poke "$P/part.exr" "$P/depth.exr" sum.depth.Z 1 1 -3
 refused depth "a negative depth sum" "'sum.depth.Z' at pixel (1, 1) is -3: negative"
 $X window "$P/part.exr" "$P/moved.exr" 8 0
 refused moved "a partial whose data window is not the render's" "are not this render's region"
-check_refused
+run_queue
 
 # ---- merge: only tiles of one render --------------------------------------------------------
 M=$tmp/merge
