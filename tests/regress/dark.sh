@@ -8,7 +8,9 @@
 . "$(dirname "$0")/../lib.sh"
 G=$GONIO
 command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
-R() { "$G" render --spp 4 --compression none "$@"; }
+# Q ID ARGS...: queues a render (lib.sh: queue); the script's renders run in one batch,
+# then the checks read each one's status, output ($tmp/last) and image.
+Q() { local id=$1; shift; queue "$id" render --spp 4 --compression none "$@"; }
 ADDED="added gonio's studio environment (--env 0 for the file's light alone)"
 # The lit fraction of a render, as the rule defines it, computed here from the EXR by an
 # independent reader: of the pixels with A > 0.5, the share with luminance above 0.02.
@@ -21,12 +23,6 @@ L = [0.2126 * r + 0.7152 * g + 0.0722 * b for r, g, b, al in zip(R, G, B, A) if 
 print('%.3f' % (sum(x > 0.02 for x in L) / max(1, len(L))))"
 }
 env_of() { grep -a -o 'studio\|none' <<<"$(exrheader "$1" 2>/dev/null | grep 'gonio:environment')" | head -n 1; }
-
-# ---- deliberate light: unchanged --------------------------------------------------------
-check "Cornell box renders" R scenes/cornell.gltf -o "$tmp/cornell.exr" --size 48x48
-grep -q "$ADDED" "$tmp/out" && fail "Cornell box: the studio was added" || pass
-check "Cornell box with --env 0" R scenes/cornell.gltf -o "$tmp/cornell-0.exr" --size 48x48 --env 0
-check "Cornell box: the same pixels as --env 0, bit for bit" "$TESTTOOL" same "$tmp/cornell.exr" "$tmp/cornell-0.exr"
 
 # A white floor and a grey cube under a point light above the front: deliberate light that
 # lights the view (no camera: the framing view).
@@ -74,42 +70,6 @@ write("dim", 1.0, [0, 0, 0], True, 0.05, [0.8, 0.8, 0.8])
 write("tiny", 1e-3, [5e-3, -2e-3, 1e-3], False, 0, [1, 0, 0])
 write("huge", 1e4, [3e4, 1e4, -2e4], False, 0, [1, 0, 0])
 PY
-check "a point light over a floor renders" R "$tmp/lit.gltf" -o "$tmp/lit.exr" --size 48x48
-grep -q "$ADDED" "$tmp/out" && fail "a deliberate point light: the studio was added" || pass
-got=$(lit "$tmp/lit.exr")
-check "the point light lights the view itself (lit fraction $got >= 0.6)" python3 -c "assert $got >= 0.6"
-check "the point light with --env 0" R "$tmp/lit.gltf" -o "$tmp/lit-0.exr" --size 48x48 --env 0
-check "a deliberate point light: the same pixels as --env 0, bit for bit" "$TESTTOOL" same "$tmp/lit.exr" "$tmp/lit-0.exr"
-
-# ---- a dark view: the studio added, with the message; --env 0 keeps it dark ---------------
-check "a dim point light renders" R "$tmp/dim.gltf" -o "$tmp/dim.exr" --size 48x48
-cp "$tmp/out" "$tmp/msg" # check writes each command's output to $tmp/out
-check "a dim point light: the studio added, saying so" grep -qF "$ADDED" "$tmp/msg"
-check "the message is one line" test "$(grep -c "studio" "$tmp/msg")" = 1
-check "the header says studio" test "$(env_of "$tmp/dim.exr")" = studio
-got=$(lit "$tmp/dim.exr")
-check "with the studio the view is lit (lit fraction $got >= 0.6)" python3 -c "assert $got >= 0.6"
-check "a dim point light, --env 0" R "$tmp/dim.gltf" -o "$tmp/dim-0.exr" --size 48x48 --env 0
-grep -q "studio" "$tmp/out" && fail "--env 0: the studio was added" || pass
-got=$(lit "$tmp/dim-0.exr")
-check "--env 0 keeps the dark file dark (lit fraction $got < 0.6)" python3 -c "assert $got < 0.6"
-check "--env studio given: no message of the rule" R "$tmp/dim.gltf" -o "$tmp/dim-s.exr" --size 48x48 --env studio
-grep -q "$ADDED" "$tmp/out" && fail "an explicit --env studio printed the rule's message" || pass
-
-A=${GONIO_ASSETS:-}
-if [ -n "$A" ] && [ -d "$A/gltf/IridescenceSuzanne" ] && [ -d "$A/gltf/LightsPunctualLamp" ]; then
-    for m in IridescenceSuzanne LightsPunctualLamp; do
-        check "$m renders" R "$A/gltf/$m/glTF/$m.gltf" -o "$tmp/$m.exr" --size 64x32
-        cp "$tmp/out" "$tmp/msg"
-        check "$m: the studio added, saying so" grep -qF "$ADDED" "$tmp/msg"
-        check "$m: the header says studio" test "$(env_of "$tmp/$m.exr")" = studio
-        check "$m, --env 0" R "$A/gltf/$m/glTF/$m.gltf" -o "$tmp/$m-0.exr" --size 64x32 --env 0
-        got=$(lit "$tmp/$m-0.exr")
-        check "$m: its own light leaves it dark (lit fraction $got < 0.6)" python3 -c "assert $got < 0.6"
-    done
-else
-    echo "  note: no IridescenceSuzanne / LightsPunctualLamp in GONIO_ASSETS: those checks skipped"
-fi
 
 # ---- a camera inside a closed model: the headlight ----------------------------------------
 # Three white boxes on a grey ground inside a closed, double-sided sky box, the camera among
@@ -169,38 +129,104 @@ write("black", False, 0, dark=True)
 write("lamp", True, 400)
 write("dimlamp", True, 1)
 PY
+
+# ---- the renders, queued ------------------------------------------------------------------
+Q cornell scenes/cornell.gltf -o "$tmp/cornell.exr" --size 48x48
+Q cornell-0 scenes/cornell.gltf -o "$tmp/cornell-0.exr" --size 48x48 --env 0
+Q lit "$tmp/lit.gltf" -o "$tmp/lit.exr" --size 48x48
+Q lit-0 "$tmp/lit.gltf" -o "$tmp/lit-0.exr" --size 48x48 --env 0
+Q dim "$tmp/dim.gltf" -o "$tmp/dim.exr" --size 48x48
+Q dim-0 "$tmp/dim.gltf" -o "$tmp/dim-0.exr" --size 48x48 --env 0
+Q dim-s "$tmp/dim.gltf" -o "$tmp/dim-s.exr" --size 48x48 --env studio
+A=${GONIO_ASSETS:-}
+assets=0
+if [ -n "$A" ] && [ -d "$A/gltf/IridescenceSuzanne" ] && [ -d "$A/gltf/LightsPunctualLamp" ]; then
+    assets=1
+    for m in IridescenceSuzanne LightsPunctualLamp; do
+        Q "$m" "$A/gltf/$m/glTF/$m.gltf" -o "$tmp/$m.exr" --size 64x32
+        Q "$m-0" "$A/gltf/$m/glTF/$m.gltf" -o "$tmp/$m-0.exr" --size 64x32 --env 0
+    done
+fi
+for m in sky open black dimlamp lamp; do Q "$m" "$tmp/$m.gltf" -o "$tmp/$m.exr" --size 48x32; done
+Q sky-s "$tmp/sky.gltf" -o "$tmp/sky-s.exr" --size 48x32 --env studio
+Q lamp-0 "$tmp/lamp.gltf" -o "$tmp/lamp-0.exr" --size 48x32 --env 0
+for m in tiny huge; do Q "$m" "$tmp/$m.gltf" -o "$tmp/$m.exr" --size 64x64 --env 1; done
+run_queue
+
+# ---- deliberate light: unchanged --------------------------------------------------------
+check_queued "Cornell box renders" 0 "cornell"
+grep -q "$ADDED" "$tmp/last" && fail "Cornell box: the studio was added" || pass
+check_queued "Cornell box with --env 0" 0 "cornell-0"
+check "Cornell box: the same pixels as --env 0, bit for bit" "$TESTTOOL" same "$tmp/cornell.exr" "$tmp/cornell-0.exr"
+
+check_queued "a point light over a floor renders" 0 "lit"
+grep -q "$ADDED" "$tmp/last" && fail "a deliberate point light: the studio was added" || pass
+got=$(lit "$tmp/lit.exr")
+check "the point light lights the view itself (lit fraction $got >= 0.6)" python3 -c "assert $got >= 0.6"
+check_queued "the point light with --env 0" 0 "lit-0"
+check "a deliberate point light: the same pixels as --env 0, bit for bit" "$TESTTOOL" same "$tmp/lit.exr" "$tmp/lit-0.exr"
+
+# ---- a dark view: the studio added, with the message; --env 0 keeps it dark ---------------
+check_queued "a dim point light renders" 0 "dim"
+cp "$tmp/last" "$tmp/msg"
+check "a dim point light: the studio added, saying so" grep -qF "$ADDED" "$tmp/msg"
+check "the message is one line" test "$(grep -c "studio" "$tmp/msg")" = 1
+check "the header says studio" test "$(env_of "$tmp/dim.exr")" = studio
+got=$(lit "$tmp/dim.exr")
+check "with the studio the view is lit (lit fraction $got >= 0.6)" python3 -c "assert $got >= 0.6"
+check_queued "a dim point light, --env 0" 0 "dim-0"
+grep -q "studio" "$tmp/last" && fail "--env 0: the studio was added" || pass
+got=$(lit "$tmp/dim-0.exr")
+check "--env 0 keeps the dark file dark (lit fraction $got < 0.6)" python3 -c "assert $got < 0.6"
+check_queued "--env studio given: no message of the rule" 0 "dim-s"
+grep -q "$ADDED" "$tmp/last" && fail "an explicit --env studio printed the rule's message" || pass
+
+if [ $assets = 1 ]; then
+    for m in IridescenceSuzanne LightsPunctualLamp; do
+        check_queued "$m renders" 0 "$m"
+        cp "$tmp/last" "$tmp/msg"
+        check "$m: the studio added, saying so" grep -qF "$ADDED" "$tmp/msg"
+        check "$m: the header says studio" test "$(env_of "$tmp/$m.exr")" = studio
+        check_queued "$m, --env 0" 0 "$m-0"
+        got=$(lit "$tmp/$m-0.exr")
+        check "$m: its own light leaves it dark (lit fraction $got < 0.6)" python3 -c "assert $got < 0.6"
+    done
+else
+    echo "  note: no IridescenceSuzanne / LightsPunctualLamp in GONIO_ASSETS: those checks skipped"
+fi
+
 HEAD="a headlight, a point light at the camera, replaces the studio"
-check "a camera inside a closed sky, no light: renders" R "$tmp/sky.gltf" -o "$tmp/sky.exr" --size 48x32
-cp "$tmp/out" "$tmp/msg"
+check_queued "a camera inside a closed sky, no light: renders" 0 "sky"
+cp "$tmp/last" "$tmp/msg"
 check "... a headlight added, saying why" grep -qF "the camera is inside a closed model (100 % of the rays from it meet the scene)" "$tmp/msg"
 check "... in one line" test "$(grep -c "$HEAD" "$tmp/msg")" = 1
 check "... and the header says so" test "$(exrheader "$tmp/sky.exr" 2>/dev/null | grep -a -c 'gonio:environment.*headlight')" = 1
 got=$(lit "$tmp/sky.exr")
 check "... and the view is lit (lit fraction $got >= 0.6)" python3 -c "assert $got >= 0.6"
-check "the studio alone (--env studio: no rule)" R "$tmp/sky.gltf" -o "$tmp/sky-s.exr" --size 48x32 --env studio
+check_queued "the studio alone (--env studio: no rule)" 0 "sky-s"
 got=$(lit "$tmp/sky-s.exr")
 check "... leaves the boxes in the closed sky dark (lit fraction $got < 0.6)" python3 -c "assert $got < 0.6"
-check "the same boxes with no sky render" R "$tmp/open.gltf" -o "$tmp/open.exr" --size 48x32
-grep -qF "$HEAD" "$tmp/out" && fail "no sky: a headlight was added" || pass
-check "black boxes in the open render" R "$tmp/black.gltf" -o "$tmp/black.exr" --size 48x32
-grep -qF "$HEAD" "$tmp/out" && fail "a dark model in the open: a headlight was added" || pass
+check_queued "the same boxes with no sky render" 0 "open"
+grep -qF "$HEAD" "$tmp/last" && fail "no sky: a headlight was added" || pass
+check_queued "black boxes in the open render" 0 "black"
+grep -qF "$HEAD" "$tmp/last" && fail "a dark model in the open: a headlight was added" || pass
 got=$(lit "$tmp/black.exr")
 check "... though the view is dark (lit fraction $got < 0.6): the camera is not enclosed" python3 -c "assert $got < 0.6"
-check "a dim lamp inside the closed sky renders" R "$tmp/dimlamp.gltf" -o "$tmp/dimlamp.exr" --size 48x32
-cp "$tmp/out" "$tmp/msg"
+check_queued "a dim lamp inside the closed sky renders" 0 "dimlamp"
+cp "$tmp/last" "$tmp/msg"
 check "... the studio added, then the headlight" sh -c "grep -qF \"$ADDED\" '$tmp/msg' && grep -qF '$HEAD' '$tmp/msg'"
 got=$(lit "$tmp/dimlamp.exr")
 check "... and the view is lit (lit fraction $got >= 0.6)" python3 -c "assert $got >= 0.6"
-check "a lamp inside the closed sky renders" R "$tmp/lamp.gltf" -o "$tmp/lamp.exr" --size 48x32
-grep -q "$HEAD\|$ADDED" "$tmp/out" && fail "a lamp that lights the closed sky: light was added" || pass
-check "the lamp in the closed sky with --env 0" R "$tmp/lamp.gltf" -o "$tmp/lamp-0.exr" --size 48x32 --env 0
+check_queued "a lamp inside the closed sky renders" 0 "lamp"
+grep -q "$HEAD\|$ADDED" "$tmp/last" && fail "a lamp that lights the closed sky: light was added" || pass
+check_queued "the lamp in the closed sky with --env 0" 0 "lamp-0"
 check "... the same pixels, bit for bit" "$TESTTOOL" same "$tmp/lamp.exr" "$tmp/lamp-0.exr"
 
 # ---- the framing view fills the frame ----------------------------------------------------
 # A red cube under a constant environment: its projected box (testtool's red box) spans at
 # least 85 % of the frame along its limiting axis, whatever its size and position.
 for m in tiny huge; do
-    check "$m cube renders" R "$tmp/$m.gltf" -o "$tmp/$m.exr" --size 64x64 --env 1
+    check_queued "$m cube renders" 0 "$m"
     box=$("$TESTTOOL" stats "$tmp/$m.exr" | awk '{print $8, $9, $10, $11}')
     check "$m cube fills the frame (red box $box in 64x64)" sh -c \
         "echo $box | awk '{w = \$3 - \$1 + 1; h = \$4 - \$2 + 1; exit !(\$1 >= 0 && (w >= 0.85 * 64 || h >= 0.85 * 64) && w <= 64 && h <= 64)}'"

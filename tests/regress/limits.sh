@@ -31,86 +31,100 @@ fi
 
 in_tier fast || { finish; exit; }
 
-# ---- bands forced on a small image: path, every AOV and the sums, several rounds ----------
+# The renders below run in one batch (lib.sh: queue), each with its limits as NAME=value
+# words of its own line; a line's log is $tmp/queue/ID.log.
+L() { echo "$tmp/queue/$1.log"; }
 l=(--spp 40 --size 96x80 --aov normal,albedo,depth,variance --resumable)
 p=("${l[@]}" --quiet)
-check "whole" "$G" render $S "${p[@]}" -o "$tmp/whole.exr"
-GONIO_MAX_BUFFER_BYTES=20000 "$G" render $S "${l[@]}" -o "$tmp/banded.exr" 2>"$tmp/banded.log"
-check "in bands" test $? = 0
-has "$tmp/banded.log" "96x80 rendered in 20 bands of 4 rows: its 368640-byte AOV buffer exceeds the device's GONIO_MAX_BUFFER_BYTES (20000 bytes)"
+c=(--crop 10,7,90,61)
+gr=(--mode gouraud --spp 1 --size 64x64 --quiet)
+queue whole render $S "${p[@]}" -o "$tmp/whole.exr"
+queue banded GONIO_MAX_BUFFER_BYTES=20000 render $S "${l[@]}" -o "$tmp/banded.exr"
+queue cw render $S "${p[@]}" "${c[@]}" -o "$tmp/cw.exr"
+queue cb GONIO_MAX_BUFFER_BYTES=9000 render $S "${p[@]}" "${c[@]}" -o "$tmp/cb.exr"
+queue part render $S "${p[@]/40/16}" -o "$tmp/part.exr"
+queue resumed GONIO_MAX_BUFFER_BYTES=20000 render $S "${p[@]}" --resume "$tmp/part.exr" -o "$tmp/resumed.exr"
+queue timed GONIO_MAX_BUFFER_BYTES=20000 render $S --time 0.5 --size 96x80 --quiet -o "$tmp/timed.exr"
+queue plain GONIO_DEBUG_BUFFERS=1 render $S --spp 1 --size 64x48 -o "$tmp/plain.exr"
+queue depth GONIO_DEBUG_BUFFERS=1 render $S --spp 1 --size 64x48 --aov depth -o "$tmp/depth.exr"
+queue var GONIO_DEBUG_BUFFERS=1 render $S --spp 2 --size 64x48 --aov variance -o "$tmp/var.exr"
+queue novar render $S --spp 2 --size 64x48 --quiet -o "$tmp/novar.exr"
+queue teapot teapot --level 8 -o "$tmp/teapot.gltf" # 2081 vertices: 33 groups of 64
+queue g1 render "$tmp/teapot.gltf" "${gr[@]}" -o "$tmp/g1.exr"
+# 8 groups a row: 5 rows of groups (and the image's 8x8 groups of 8x8 pixels still fit).
+queue g8 GONIO_MAX_WORKGROUPS=8 render "$tmp/teapot.gltf" "${gr[@]}" -o "$tmp/g8.exr"
+queue g5 GONIO_MAX_WORKGROUPS=5 render "$tmp/teapot.gltf" --mode gouraud --spp 1 --size 40x40 --quiet -o "$tmp/g5.exr"
+queue gbig GONIO_MAX_BUFFER_BYTES=60000 render "$tmp/teapot.gltf" "${gr[@]}" -o "$tmp/gbig.exr"
+queue pbig GONIO_MAX_BUFFER_BYTES=60000 render "$tmp/teapot.gltf" --mode phong --spp 1 --size 64x64 --quiet -o "$tmp/pbig.exr"
+queue row GONIO_MAX_BUFFER_BYTES=1000 render $S --spp 1 --size 96x80 --quiet -o "$tmp/row.exr"
+queue wide GONIO_MAX_WORKGROUPS=4 render $S --spp 1 --size 40x8 --quiet -o "$tmp/wide.exr"
+queue texels GONIO_MAX_TEXELS=100 render $S --spp 1 --size 16x16 --quiet -o "$tmp/texels.exr"
+A=${GONIO_ASSETS:-}/gltf/BoxTextured/glTF/BoxTextured.gltf
+if [ -f "$A" ]; then
+    # its one image is 256x256: 65,537 texels with the buffer's trailing zero
+    queue box GONIO_MAX_TEXELS=65536 render "$A" --spp 1 --size 16x16 --quiet -o "$tmp/box.exr"
+    queue box-fits GONIO_MAX_TEXELS=65537 render "$A" --spp 1 --size 16x16 --env 0 --quiet -o "$tmp/box-fits.exr"
+fi
+run_queue
+
+# ---- bands forced on a small image: path, every AOV and the sums, several rounds ----------
+check_queued "whole" 0 whole
+check_queued "in bands" 0 banded
+has "$(L banded)" "96x80 rendered in 20 bands of 4 rows: its 368640-byte AOV buffer exceeds the device's GONIO_MAX_BUFFER_BYTES (20000 bytes)"
 same "$tmp/whole.exr" "$tmp/banded.exr" "bands give the whole render's pixels and AOVs"
 for c in sum.R sum.A sum.normal.Y sum.depth.Z sum2.B; do
     "$T" pick "$tmp/whole.exr" $c "$tmp/w_$c.exr" && "$T" pick "$tmp/banded.exr" $c "$tmp/b_$c.exr"
     same "$tmp/w_$c.exr" "$tmp/b_$c.exr" "bands keep the exact sums ($c)"
 done
 # A crop in bands, and a banded render resumed from a render in one piece.
-c=(--crop 10,7,90,61)
-check "crop whole" "$G" render $S "${p[@]}" "${c[@]}" -o "$tmp/cw.exr"
-check "crop in bands" env GONIO_MAX_BUFFER_BYTES=9000 "$G" render $S "${p[@]}" "${c[@]}" -o "$tmp/cb.exr"
+check_queued "crop whole" 0 cw
+check_queued "crop in bands" 0 cb
 same "$tmp/cw.exr" "$tmp/cb.exr" "a crop in bands is the crop in one piece"
-check "16 spp in one piece" "$G" render $S "${p[@]/40/16}" -o "$tmp/part.exr"
-check "resumed in bands" env GONIO_MAX_BUFFER_BYTES=20000 "$G" render $S "${p[@]}" \
-    --resume "$tmp/part.exr" -o "$tmp/resumed.exr"
+check_queued "16 spp in one piece" 0 part
+check_queued "resumed in bands" 0 resumed
 same "$tmp/whole.exr" "$tmp/resumed.exr" "a render resumed in bands is the whole render"
 # --time: every round goes through all bands, so the header's spp is every pixel's.
-check "--time in bands" env GONIO_MAX_BUFFER_BYTES=20000 "$G" render $S --time 0.5 --size 96x80 \
-    --quiet -o "$tmp/timed.exr"
+check_queued "--time in bands" 0 timed
 spp=$(exrheader "$tmp/timed.exr" 2>/dev/null | sed -n 's/^gonio:spp (type int): //p')
 check "--time in bands took samples" test "${spp:-0}" -ge 1
 check "the same spp in one piece" "$G" render $S --spp "${spp:-1}" --size 96x80 --quiet -o "$tmp/untimed.exr"
 same "$tmp/untimed.exr" "$tmp/timed.exr" "--time in bands: every pixel has the header's spp"
 
 # ---- the AOV and squares buffers only when asked for -------------------------------------
-GONIO_DEBUG_BUFFERS=1 "$G" render $S --spp 1 --size 64x48 -o "$tmp/plain.exr" 2>"$tmp/plain.log"
-has "$tmp/plain.log" "buffers for 64x48: accum 49152, aov 16, squares 16 bytes"
-GONIO_DEBUG_BUFFERS=1 "$G" render $S --spp 1 --size 64x48 --aov depth -o "$tmp/depth.exr" 2>"$tmp/depth.log"
-has "$tmp/depth.log" "buffers for 64x48: accum 49152, aov 147456, squares 16 bytes"
-GONIO_DEBUG_BUFFERS=1 "$G" render $S --spp 2 --size 64x48 --aov variance -o "$tmp/var.exr" 2>"$tmp/var.log"
-has "$tmp/var.log" "buffers for 64x48: accum 49152, aov 16, squares 49152 bytes"
+has "$(L plain)" "buffers for 64x48: accum 49152, aov 16, squares 16 bytes"
+has "$(L depth)" "buffers for 64x48: accum 49152, aov 147456, squares 16 bytes"
+has "$(L var)" "buffers for 64x48: accum 49152, aov 16, squares 49152 bytes"
 v=$("$T" at "$tmp/var.exr" variance.R 32 24)
 check "the squares are summed (variance.R at 32,24 is $v)" awk -v v="$v" 'BEGIN { exit !(v > 0) }'
 # Without the squares the colours are the same bits.
-check "render with variance" "$G" render $S --spp 2 --size 64x48 --quiet -o "$tmp/novar.exr"
+check_queued "render with variance" 0 novar
 "$T" pick "$tmp/var.exr" R "$tmp/var_R.exr" && "$T" pick "$tmp/novar.exr" R "$tmp/novar_R.exr"
 same "$tmp/var_R.exr" "$tmp/novar_R.exr" "the variance AOV changes no colour"
 
 # ---- Gouraud's vertex pass in rows of work groups ------------------------------------------
-check "teapot" "$G" teapot --level 8 -o "$tmp/teapot.gltf" # 2081 vertices: 33 groups of 64
-gr=(--mode gouraud --spp 1 --size 64x64 --quiet)
-check "gouraud" "$G" render "$tmp/teapot.gltf" "${gr[@]}" -o "$tmp/g1.exr"
-# 8 groups a row: 5 rows of groups (and the image's 8x8 groups of 8x8 pixels still fit).
-check "gouraud, 8 work groups a row" env GONIO_MAX_WORKGROUPS=8 "$G" render "$tmp/teapot.gltf" \
-    "${gr[@]}" -o "$tmp/g8.exr"
+check_queued "teapot" 0 teapot
+check_queued "gouraud" 0 g1
+check_queued "gouraud, 8 work groups a row" 0 g8
 same "$tmp/g1.exr" "$tmp/g8.exr" "the vertex pass in rows of groups lights every vertex"
-check_fails "more vertex groups than rows x columns is refused" 1 env GONIO_MAX_WORKGROUPS=5 \
-    "$G" render "$tmp/teapot.gltf" --mode gouraud --spp 1 --size 40x40 --quiet -o "$tmp/g5.exr"
+check_queued "more vertex groups than rows x columns is refused" 1 g5
 has "$tmp/last" "the 2081 vertices need 33 work groups, more than this device dispatches (maxComputeWorkGroupCount 5 x 5)"
-check_fails "vertex colours beyond a storage buffer: gouraud refused" 1 env GONIO_MAX_BUFFER_BYTES=60000 \
-    "$G" render "$tmp/teapot.gltf" "${gr[@]}" -o "$tmp/gbig.exr"
+check_queued "vertex colours beyond a storage buffer: gouraud refused" 1 gbig
 has "$tmp/last" "--mode gouraud: the 2081 vertices' colours need 66592 bytes, more than one storage buffer may hold on this device (GONIO_MAX_BUFFER_BYTES: 60000)"
-check "...while phong renders" env GONIO_MAX_BUFFER_BYTES=60000 "$G" render "$tmp/teapot.gltf" \
-    --mode phong --spp 1 --size 64x64 --quiet -o "$tmp/pbig.exr"
+check_queued "...while phong renders" 0 pbig
 
 # ---- what cannot be done at all -------------------------------------------------------------
-check_fails "a row beyond a storage buffer is refused" 1 env GONIO_MAX_BUFFER_BYTES=1000 \
-    "$G" render $S --spp 1 --size 96x80 --quiet -o "$tmp/row.exr"
+check_queued "a row beyond a storage buffer is refused" 1 row
 has "$tmp/last" "a row of 96 pixels needs 1536 bytes of accumulation buffers, more than this device allows (GONIO_MAX_BUFFER_BYTES: 1000 bytes"
 check "no output" test ! -e "$tmp/row.exr"
-check_fails "a row wider than the work groups is refused" 1 env GONIO_MAX_WORKGROUPS=4 \
-    "$G" render $S --spp 1 --size 40x8 --quiet -o "$tmp/wide.exr"
+check_queued "a row wider than the work groups is refused" 1 wide
 has "$tmp/last" "a row of 40 pixels needs 5 work groups, more than the 4 this device dispatches (maxComputeWorkGroupCount[0])"
-check_fails "a scene beyond a texel buffer is refused" 1 env GONIO_MAX_TEXELS=100 \
-    "$G" render $S --spp 1 --size 16x16 --quiet -o "$tmp/texels.exr"
+check_queued "a scene beyond a texel buffer is refused" 1 texels
 has "$tmp/last" "scenes/cornell.gltf: the vertices need"
 has "$tmp/last" "more than the 100 of one texel buffer on this device (GONIO_MAX_TEXELS)"
-A=${GONIO_ASSETS:-}/gltf/BoxTextured/glTF/BoxTextured.gltf
 if [ -f "$A" ]; then
-    # its one image is 256x256: 65,537 texels with the buffer's trailing zero
-    check_fails "textures beyond a texel buffer are refused" 1 env GONIO_MAX_TEXELS=65536 \
-        "$G" render "$A" --spp 1 --size 16x16 --quiet -o "$tmp/box.exr"
+    check_queued "textures beyond a texel buffer are refused" 1 box
     has "$tmp/last" "the 1 texture image(s) hold 65537 texels (the largest, image 0, is 256x256), more than the 65536"
-    check "...and fit at the limit" env GONIO_MAX_TEXELS=65537 "$G" render "$A" --spp 1 --size 16x16 \
-        --env 0 --quiet -o "$tmp/box.exr"
+    check_queued "...and fit at the limit" 0 box-fits
 else
     echo "  skipped: BoxTextured (no \$GONIO_ASSETS)"
 fi
