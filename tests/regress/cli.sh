@@ -35,12 +35,51 @@ if in_tier slow; then
 fi
 in_tier fast || { finish; exit; }
 
+# The commands that open a device run in one batch (lib.sh: queue); the checks read each
+# line's status and output ($tmp/last) once it has run.
+queue sp render $C -o "$tmp/sp.exr" --mode phong --spp 2 --size 24x16 --seed 3 --quiet
+queue eq render $C --output="$tmp/eq.exr" --mode=phong --spp=2 --size=24x16 --seed=3 --quiet
+queue other render $C -o "$tmp/other.exr" --mode phong --spp 2 --size 24x16 --seed 4 --quiet
+queue bench bench --generate=2000 --size=16x16 --seconds=0.05
+queue cmp compare $C --modes=flat,phong --spp=1 --size=16x16 --output="$tmp/cmp" --quiet
+# warns MODE-AND-OPTIONS... -- WARNING: queues a render that must succeed with WARNING on
+# stderr (an option the mode or outputs do not use is a warning, not silence); its check
+# runs after the batch.
+nw=0
+warns() {
+    local args=() want
+    while [ "$1" != -- ]; do args+=("$1"); shift; done
+    want=$2
+    nw=$((nw + 1))
+    queue "w$nw" render $C -o "$tmp/w$nw.exr" --size 8x8 --spp 1 --quiet "${args[@]}"
+    after_queue warns_check "w$nw" "$want" "${args[*]}"
+}
+warns_check() {
+    if [ "$(queued "$1")" = 0 ] && grep -q "warning: $2" "$tmp/last"; then pass
+    else fail "render $3: expected a warning '$2', got: $(cat "$tmp/last")"; fi
+}
+for o in "--max-depth 3" "--estimator light"; do
+    warns --mode phong $o -- "${o% *} applies to --mode path only; ignored with --mode phong"
+done
+warns --mode flat --brdf lambert -- "--brdf applies to --mode path (and albedo"
+warns --ambient 0.5 -- "--ambient applies to the local modes only"
+warns --no-shadows -- "--no-shadows applies to the local modes only"
+warns --exposure 1 -- "--exposure applies to the PNG only"
+warns --tonemap=aces -- "--tonemap applies to the PNG only"
+warns --time 0.1 --spp 4 -- "--spp is ignored with --time"
+queue apply render $C -o "$tmp/w.exr" --png "$tmp/w.png" --size 8x8 --spp 1 --max-depth 2 --brdf lambert \
+    --estimator bsdf --exposure 1 --tonemap aces --quiet
+queue albedo render $C -o "$tmp/w.exr" --size 8x8 --spp 1 --mode albedo --brdf lambert --ambient 1 --no-shadows --quiet
+run_queue # the warnings' checks run here (after_queue)
+check "options that apply: no warning" sh -c "[ \"\$(cat '$tmp/queue/apply.status')\" = 0 ] && test ! -s '$tmp/queue/apply.log'"
+check "albedo with --brdf, --ambient, --no-shadows: no warning about --brdf" sh -c "! grep -q brdf '$tmp/queue/albedo.log'"
+
 # ---- --opt=value --------------------------------------------------------------------------
 # The same command in both forms gives the same bits.
-check "render --opt value" "$G" render $C -o "$tmp/sp.exr" --mode phong --spp 2 --size 24x16 --seed 3 --quiet
-check "render --opt=value" "$G" render $C --output="$tmp/eq.exr" --mode=phong --spp=2 --size=24x16 --seed=3 --quiet
+check_queued "render --opt value" 0 sp
+check_queued "render --opt=value" 0 eq
 check "render: both forms, identical pixels" "$G" diff "$tmp/sp.exr" "$tmp/eq.exr" --max-error=0 --quiet
-check "render another seed" "$G" render $C -o "$tmp/other.exr" --mode phong --spp 2 --size 24x16 --seed 4 --quiet
+check_queued "render another seed" 0 other
 check_fails "diff --max-error=0 on other pixels fails" 1 "$G" diff "$tmp/sp.exr" "$tmp/other.exr" --max-error=0 --quiet
 check "teapot --level=2 --output=" "$G" teapot --level=2 --output="$tmp/t-eq.gltf"
 check "teapot --level 2 -o" "$G" teapot --level 2 -o "$tmp/t-sp.gltf"
@@ -48,10 +87,9 @@ check "teapot: both forms, the same file" cmp "$tmp/t-eq.gltf" "$tmp/t-sp.gltf"
 check "scene cornell --output=" "$G" scene cornell --output="$tmp/c.gltf"
 check "merge --output=" "$G" merge "$tmp/sp.exr" "$tmp/eq.exr" --force --output="$tmp/m.exr" # one seed twice
 check "merged: 4 spp" sh -c "exrheader '$tmp/m.exr' | grep -q 'gonio:spp (type int): 4'"
-check "bench --generate=N --size= --seconds=" "$G" bench --generate=2000 --size=16x16 --seconds=0.05
+check_queued "bench --generate=N --size= --seconds=" 0 bench
 check "brdf MODEL --PARAM=V --theta=" "$G" brdf phong --exponent=8 --theta=45 --output="$tmp/lobe.png" --size=240x240
-check "compare --modes= --spp= --size= --output=" "$G" compare $C --modes=flat,phong --spp=1 --size=16x16 \
-    --output="$tmp/cmp" --quiet
+check_queued "compare --modes= --spp= --size= --output=" 0 cmp
 check "compare wrote flat.exr" test -s "$tmp/cmp/flat.exr"
 # Each option's own parser sees the value: its own message, naming the value.
 for c in "render $C -o $tmp/x.exr --spp" "preview $C --frames" "bench --seconds" "brdf phong --theta" \
@@ -86,29 +124,7 @@ for c in "render $C -o $tmp/x.exr" "preview $C" "info $C" devices "compare $C -o
     done
 done
 # ---- render: an option the mode or outputs do not use is a warning, not silence --------
-# warns MODE-AND-OPTIONS... -- WARNING: the render succeeds and stderr says WARNING.
-warns() {
-    local args=() want
-    while [ "$1" != -- ]; do args+=("$1"); shift; done
-    want=$2
-    "$G" render $C -o "$tmp/w.exr" --size 8x8 --spp 1 --quiet "${args[@]}" 2>"$tmp/w.err"
-    if [ $? = 0 ] && grep -q "warning: $want" "$tmp/w.err"; then pass
-    else fail "render ${args[*]}: expected a warning '$want', got: $(cat "$tmp/w.err")"; fi
-}
-for o in "--max-depth 3" "--estimator light"; do
-    warns --mode phong $o -- "${o% *} applies to --mode path only; ignored with --mode phong"
-done
-warns --mode flat --brdf lambert -- "--brdf applies to --mode path (and albedo"
-warns --ambient 0.5 -- "--ambient applies to the local modes only"
-warns --no-shadows -- "--no-shadows applies to the local modes only"
-warns --exposure 1 -- "--exposure applies to the PNG only"
-warns --tonemap=aces -- "--tonemap applies to the PNG only"
-warns --time 0.1 --spp 4 -- "--spp is ignored with --time"
-"$G" render $C -o "$tmp/w.exr" --png "$tmp/w.png" --size 8x8 --spp 1 --max-depth 2 --brdf lambert \
-    --estimator bsdf --exposure 1 --tonemap aces --quiet 2>"$tmp/w.err"
-check "options that apply: no warning" test ! -s "$tmp/w.err"
-"$G" render $C -o "$tmp/w.exr" --size 8x8 --spp 1 --mode albedo --brdf lambert --ambient 1 --no-shadows --quiet 2>"$tmp/w.err"
-check "albedo with --brdf, --ambient, --no-shadows: no warning about --brdf" sh -c "! grep -q brdf '$tmp/w.err'"
+# (queued with the renders above: warns)
 
 # ---- gonio info: emitters and cameras ---------------------------------------------------
 # The Cornell box's light is one quad (src/cli/cmd_scene.c); its camera stands at (0, 0.273,
@@ -132,23 +148,35 @@ fi
 
 # ---- every command from any directory: no path into the source tree ----------------------
 mkdir -p "$tmp/elsewhere"
+# (one batch, run from there: relative paths are the batch's working directory's)
 cd "$tmp/elsewhere" && {
-    check "bench without a scene, elsewhere" "$G" bench --size 16x16 --seconds 0.05
-    cp "$tmp/out" bench.txt
+    queue bench bench --size 16x16 --seconds 0.05
+    queue paths bench --paths --size 16x16 --seconds 0.1 --reference 16x16:8
+    queue scene scene cornell -o c.gltf
+    queue teapot teapot --level 1 -o t.gltf
+    queue render render c.gltf -o r.exr --png r.png --size 16x16 --spp 2 --quiet
+    queue render2 render c.gltf -o r2.exr --size 16x16 --spp 2 --seed 1 --quiet
+    queue merge merge r.exr r2.exr -o m.exr
+    queue devices devices
+    queue brdf brdf lambert --sphere -o b.exr --size 16x16 --spp 1
+    queue compare compare c.gltf -o cmp --size 16x16 --spp 1 --modes flat,phong --quiet
+    run_queue
+    check_queued "bench without a scene, elsewhere" 0 bench
+    cp "$tmp/last" bench.txt
     check "... is the built-in Cornell box (32 triangles)" sh -c \
         "grep -q '^scene  *cornell (built in)' bench.txt && grep -q '^triangles  *32$' bench.txt"
-    check "bench --paths without a scene, elsewhere" "$G" bench --paths --size 16x16 --seconds 0.1 --reference 16x16:8
-    check "scene cornell, elsewhere" "$G" scene cornell -o c.gltf
+    check_queued "bench --paths without a scene, elsewhere" 0 paths
+    check_queued "scene cornell, elsewhere" 0 scene
     check "... the same file as scenes/cornell.gltf" cmp c.gltf "$C"
-    check "teapot, elsewhere" "$G" teapot --level 1 -o t.gltf
-    check "render, elsewhere" "$G" render c.gltf -o r.exr --png r.png --size 16x16 --spp 2 --quiet
-    check "render another seed, elsewhere" "$G" render c.gltf -o r2.exr --size 16x16 --spp 2 --seed 1 --quiet
-    check "merge, elsewhere" "$G" merge r.exr r2.exr -o m.exr
+    check_queued "teapot, elsewhere" 0 teapot
+    check_queued "render, elsewhere" 0 render
+    check_queued "render another seed, elsewhere" 0 render2
+    check_queued "merge, elsewhere" 0 merge
     check "diff, elsewhere" "$G" diff r.exr m.exr --quiet
     check "info, elsewhere" "$G" info t.gltf
-    check "devices, elsewhere" "$G" devices
-    check "brdf --sphere, elsewhere" "$G" brdf lambert --sphere -o b.exr --size 16x16 --spp 1
-    check "compare, elsewhere" "$G" compare c.gltf -o cmp --size 16x16 --spp 1 --modes flat,phong --quiet
+    check_queued "devices, elsewhere" 0 devices
+    check_queued "brdf --sphere, elsewhere" 0 brdf
+    check_queued "compare, elsewhere" 0 compare
     cd - >/dev/null
 }
 
