@@ -52,13 +52,33 @@ check "spp recorded" grep -q 'gonio:spp (type int): 4' "$tmp/hdr.txt"
 magic() { head -c 4 "$1" | od -An -tx1 | tr -d ' \n'; } # first 4 bytes, hex
 is_exr() { [ "$(magic "$1")" = 762f3101 ]; }
 is_png() { [ "$(magic "$1")" = 89504e47 ]; }
-check "render -o x.png" "$G" render $C -o "$tmp/o.png" --spp 1 --size 16x16 --quiet
+# (this block's and the next two's renders in one batch)
+queue o render $C -o "$tmp/o.png" --spp 1 --size 16x16 --quiet
+queue O render $C -o "$tmp/o.EXR" --spp 1 --size 16x16 --quiet
+queue o2 render $C --png "$tmp/o2.png" --spp 1 --size 16x16 --quiet
+queue ball-png brdf lambert --sphere -o "$tmp/ball.png" --size 16x16 --spp 2
+queue ball-exr brdf lambert --sphere -o "$tmp/ball.exr" --size 16x16 --spp 2
+le32() { od -An -tu4 -j "$2" -N4 "$1" | tr -d ' '; }
+for sc in teapot cornell; do
+    check "scene $sc -o x.glb" "$G" scene $sc -o "$tmp/$sc.glb"
+    check "scene $sc -o x.gltf" "$G" scene $sc -o "$tmp/$sc.gltf"
+    queue "$sc-glb" render "$tmp/$sc.glb" -o "$tmp/$sc-glb.exr" --mode phong --spp 2 --size 32x32 --quiet
+    queue "$sc-gltf" render "$tmp/$sc.gltf" -o "$tmp/$sc-gltf.exr" --mode phong --spp 2 --size 32x32 --quiet
+done
+aov_sets=()
+for set in normal albedo depth variance depth,normal albedo,variance normal,albedo,depth,variance; do
+    if [ "${set#*,}" != "$set" ] && [ "$set" != normal,albedo,depth,variance ]; then in_tier slow || continue; else in_tier fast || continue; fi
+    aov_sets+=("$set")
+    queue "aov-$set" render $C -o "$tmp/aov-$set.exr" --mode phong --spp 2 --size 16x16 --aov $set --quiet
+done
+run_queue
+check_queued "render -o x.png" 0 o
 check "render -o x.png writes a PNG" is_png "$tmp/o.png"
 check "render -o x.exr writes an EXR" is_exr "$tmp/c.exr"
 check "render --png writes a PNG" is_png "$tmp/c.png"
-check "render -o X.EXR" "$G" render $C -o "$tmp/o.EXR" --spp 1 --size 16x16 --quiet
+check_queued "render -o X.EXR" 0 O
 check "render -o X.EXR writes an EXR" is_exr "$tmp/o.EXR"
-check "render --png alone" "$G" render $C --png "$tmp/o2.png" --spp 1 --size 16x16 --quiet
+check_queued "render --png alone" 0 o2
 check "render -o x.png is the --png PNG" cmp "$tmp/o.png" "$tmp/o2.png"
 for bad in "-o $tmp/bad.jpg" "-o $tmp/bad" "--png $tmp/bad.exr" "-o $tmp/bad.exr --png $tmp/bad.tif"; do
     check_fails "render $bad: a usage error" 2 "$G" render $C $bad --spp 1 --size 16x16 --quiet
@@ -68,25 +88,23 @@ check_fails "--half without an EXR output" 2 "$G" render $C --png "$tmp/bad.png"
 check_fails "an unknown --compression" 2 "$G" render $C -o "$tmp/bad.exr" --compression dwaa --quiet
 check_fails "brdf: the lobe plot is no EXR" 2 "$G" brdf lambert -o "$tmp/bad.exr"
 check_fails "brdf --sphere -o x.jpg" 2 "$G" brdf lambert --sphere -o "$tmp/bad.jpg"
-check "brdf --sphere -o x.png" "$G" brdf lambert --sphere -o "$tmp/ball.png" --size 16x16 --spp 2
+check_queued "brdf --sphere -o x.png" 0 ball-png
 check "brdf --sphere -o x.png writes a PNG" is_png "$tmp/ball.png"
-check "brdf --sphere -o x.exr" "$G" brdf lambert --sphere -o "$tmp/ball.exr" --size 16x16 --spp 2
+check_queued "brdf --sphere -o x.exr" 0 ball-exr
 check "brdf --sphere -o x.exr writes an EXR" is_exr "$tmp/ball.exr"
 check "brdf lobe -o x.png" "$G" brdf lambert -o "$tmp/lobe.png"
 check "brdf lobe writes a PNG" is_png "$tmp/lobe.png"
 check_fails "teapot -o x.obj" 2 "$G" teapot -o "$tmp/bad.obj"
 # .glb is binary glTF (magic, version 2, total length = file size) that info and render read,
 # and the same scene as the .gltf: identical pixels and the same gonio:scene hash.
-le32() { od -An -tu4 -j "$2" -N4 "$1" | tr -d ' '; }
+# (the files are written and rendered above, in the batch)
 for sc in teapot cornell; do
-    check "scene $sc -o x.glb" "$G" scene $sc -o "$tmp/$sc.glb"
-    check "scene $sc -o x.gltf" "$G" scene $sc -o "$tmp/$sc.gltf"
     check "$sc.glb: GLB magic" test "$(magic "$tmp/$sc.glb")" = 676c5446
     check "$sc.glb: version 2 and its length" test "$(le32 "$tmp/$sc.glb" 4) $(le32 "$tmp/$sc.glb" 8)" = "2 $(stat -c %s "$tmp/$sc.glb")"
     check "$sc.gltf is JSON" grep -q '"asset"' "$tmp/$sc.gltf"
     check "info reads $sc.glb" "$G" info "$tmp/$sc.glb"
-    check "render $sc.glb" "$G" render "$tmp/$sc.glb" -o "$tmp/$sc-glb.exr" --mode phong --spp 2 --size 32x32 --quiet
-    check "render $sc.gltf" "$G" render "$tmp/$sc.gltf" -o "$tmp/$sc-gltf.exr" --mode phong --spp 2 --size 32x32 --quiet
+    check_queued "render $sc.glb" 0 "$sc-glb"
+    check_queued "render $sc.gltf" 0 "$sc-gltf"
     check "$sc: .glb and .gltf render the same pixels" "$G" diff "$tmp/$sc-glb.exr" "$tmp/$sc-gltf.exr" --max-error 0 --quiet
     check "$sc: .glb and .gltf are the same gonio:scene" test \
         "$(exrheader "$tmp/$sc-glb.exr" | grep 'gonio:scene ')" = "$(exrheader "$tmp/$sc-gltf.exr" | grep 'gonio:scene ')"
@@ -95,16 +113,15 @@ done
 # ---- --aov writes exactly the AOVs listed ------------------------------------------------
 channels() { exrheader "$1" | sed -n 's/^    \([^,]*\), .*/\1/p' | sort | tr '\n' ' '; }
 # (the fast tier: every AOV alone and all together; the slow tier: the pairs)
-for set in normal albedo depth variance depth,normal albedo,variance normal,albedo,depth,variance; do
-    if [ "${set#*,}" != "$set" ] && [ "$set" != normal,albedo,depth,variance ]; then in_tier slow || continue; else in_tier fast || continue; fi
-    check "--aov $set" "$G" render $C -o "$tmp/aov.exr" --mode phong --spp 2 --size 16x16 --aov $set --quiet
+for set in "${aov_sets[@]}"; do
+    check_queued "--aov $set" 0 "aov-$set"
     want="A B G R"
     case ,$set, in *,albedo,*) want="$want albedo.B albedo.G albedo.R" ;; esac
     case ,$set, in *,depth,*) want="$want depth.Z" ;; esac
     case ,$set, in *,normal,*) want="$want normal.X normal.Y normal.Z" ;; esac
     case ,$set, in *,variance,*) want="$want variance.B variance.G variance.R" ;; esac
     want=$(echo $want | tr ' ' '\n' | sort | tr '\n' ' ')
-    check "--aov $set: channels $want" test "$(channels "$tmp/aov.exr")" = "$want"
+    check "--aov $set: channels $want" test "$(channels "$tmp/aov-$set.exr")" = "$want"
 done
 check_fails "--aov bogus" 2 "$G" render $C -o "$tmp/bad.exr" --aov normal,bogus --quiet
 # (this block's renders first, in one batch)
@@ -184,11 +201,7 @@ check_queued "render again (in a batch)" 0 c2
 check "deterministic: identical pixels" "$G" diff "$tmp/c.exr" "$tmp/c2.exr" --max-error 0 --quiet
 check_queued "render with another seed" 0 c3
 check_fails "another seed gives other pixels" 1 "$G" diff "$tmp/c.exr" "$tmp/c3.exr" --max-error 0 --quiet
-# The summary line: seconds, spp and Mrays/s.
-"$G" render $C -o "$tmp/s.exr" --mode phong --spp 2 --size 32x32 2>"$tmp/summary.txt"
-check "summary line" grep -Eq 'phong, 2 spp in [0-9.]+ s \([0-9.]+ Mrays/s' "$tmp/summary.txt"
-"$G" render $C -o "$tmp/s.exr" --spp 2 --size 32x32 2>"$tmp/summary.txt"
-check "summary line of the path tracer" grep -Eq 'path, 2 spp in [0-9.]+ s \([0-9.]+ M paths/s' "$tmp/summary.txt"
+# (the summary lines are checked below, with the last batch's renders)
 
 check "gonio info" sh -c "'$G' info $C >'$tmp/info.txt'"
 for f in triangles meshes materials lights 'bvh nodes' 'bvh depth' 'sah cost' 'bvh build'; do
@@ -243,24 +256,6 @@ tri_gltf "$tmp/ok.gltf" "$zero$zero$zero$one$zero$zero$zero$one$zero"
 tri_gltf "$tmp/nan.gltf" "$nan$zero$zero$one$zero$zero$zero$one$zero"
 tri_gltf "$tmp/huge.gltf" "$huge$zero$zero$one$zero$zero$zero$one$zero"
 echo '{"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],"scene":0}' >"$tmp/empty.gltf"
-check "a one-triangle file renders" "$G" render "$tmp/ok.gltf" -o "$tmp/ok.exr" --size 16x16 --spp 1 --quiet
-for bad in nan huge empty; do
-    "$G" render "$tmp/$bad.gltf" -o "$tmp/$bad.exr" --size 16x16 --spp 1 --quiet >"$tmp/out" 2>&1
-    rc=$?
-    if [ $rc = 1 ] && grep -q "$bad.gltf" "$tmp/out" && [ ! -e "$tmp/$bad.exr" ]; then pass
-    else fail "$bad.gltf: expected exit 1, a message naming the file, no output (got $rc)"; cat "$tmp/out"; fi
-done
-
-# --ambient: the Phong model's global ambient light A adds A * ka to every lit pixel. The
-# teapot's material says ka = 0.2 (its extras), so A = 0.2 adds exactly 0.04 where the
-# teapot covers a pixel: the largest difference is 0.04, not more, not less.
-T=scenes/teapot.gltf
-check "phong without ambient" "$G" render $T --mode phong -o "$tmp/amb0.exr" --spp 4 --size 48x48 --quiet
-check "phong with --ambient 0.2" "$G" render $T --mode phong --ambient 0.2 -o "$tmp/amb2.exr" --spp 4 --size 48x48 --quiet
-check "ambient adds at most A ka = 0.04" "$G" diff "$tmp/amb0.exr" "$tmp/amb2.exr" --max-error 0.0401
-check_fails "ambient adds A ka = 0.04 somewhere" 1 "$G" diff "$tmp/amb0.exr" "$tmp/amb2.exr" --max-error 0.0399
-check "gouraud with --ambient" "$G" render $T --mode gouraud --ambient 0.2,0.2,0.2 -o "$tmp/amb3.exr" --spp 1 --size 48x48 --quiet
-check_fails "a negative --ambient is a usage error" 2 "$G" render $T --mode phong --ambient -1 -o "$tmp/x.exr" --quiet
 # Vertex colours (glTF COLOR_0) multiply the base colour: a triangle painted red through
 # COLOR_0 (float RGB, or normalised unsigned-byte RGBA) under a white material renders
 # exactly like the same triangle with a red base colour, in every mode that shows it.
@@ -280,13 +275,48 @@ col_gltf "$tmp/col_f.gltf" "1,1,1" ',"COLOR_0":1' \
     ',{"bufferView":1,"componentType":5126,"count":3,"type":"VEC3"}' "$red_f$red_f$red_f" 36
 col_gltf "$tmp/col_u8.gltf" "1,1,1" ',"COLOR_0":1' \
     ',{"bufferView":1,"componentType":5121,"normalized":true,"count":3,"type":"VEC4"}' "$red_u8$red_u8$red_u8" 12
-# (the fast tier: albedo and path; the slow tier: phong, gouraud and flat)
+# (the renders of the rest of this script, in one batch)
+col_modes=()
 for mode in albedo phong gouraud flat path; do
     case $mode in albedo | path) in_tier fast || continue ;; *) in_tier slow || continue ;; esac
+    col_modes+=("$mode")
     for f in col_base col_f col_u8; do
         queue "$f-$mode" render "$tmp/$f.gltf" -o "$tmp/$f-$mode.exr" --mode $mode --size 24x24 --spp 2 --env 1 --ambient 1 --quiet
     done
-    run_queue
+done
+T=scenes/teapot.gltf
+queue s1 render $C -o "$tmp/s1.exr" --mode phong --spp 2 --size 32x32
+queue s2 render $C -o "$tmp/s2.exr" --spp 2 --size 32x32
+queue ok render "$tmp/ok.gltf" -o "$tmp/ok.exr" --size 16x16 --spp 1 --quiet
+for bad in nan huge empty; do queue "$bad" render "$tmp/$bad.gltf" -o "$tmp/$bad.exr" --size 16x16 --spp 1 --quiet; done
+queue amb0 render $T --mode phong -o "$tmp/amb0.exr" --spp 4 --size 48x48 --quiet
+queue amb2 render $T --mode phong --ambient 0.2 -o "$tmp/amb2.exr" --spp 4 --size 48x48 --quiet
+queue amb3 render $T --mode gouraud --ambient 0.2,0.2,0.2 -o "$tmp/amb3.exr" --spp 1 --size 48x48 --quiet
+run_queue
+# The summary line: seconds, spp and Mrays/s.
+queued s1 >/dev/null
+check "summary line" grep -Eq 'phong, 2 spp in [0-9.]+ s \([0-9.]+ Mrays/s' "$tmp/last"
+queued s2 >/dev/null
+check "summary line of the path tracer" grep -Eq 'path, 2 spp in [0-9.]+ s \([0-9.]+ M paths/s' "$tmp/last"
+check_queued "a one-triangle file renders" 0 ok
+for bad in nan huge empty; do
+    rc=$(queued "$bad")
+    if [ "$rc" = 1 ] && grep -q "$bad.gltf" "$tmp/last" && [ ! -e "$tmp/$bad.exr" ]; then pass
+    else fail "$bad.gltf: expected exit 1, a message naming the file, no output (got $rc)"; cat "$tmp/last"; fi
+done
+
+# --ambient: the Phong model's global ambient light A adds A * ka to every lit pixel. The
+# teapot's material says ka = 0.2 (its extras), so A = 0.2 adds exactly 0.04 where the
+# teapot covers a pixel: the largest difference is 0.04, not more, not less.
+check_queued "phong without ambient" 0 amb0
+check_queued "phong with --ambient 0.2" 0 amb2
+check "ambient adds at most A ka = 0.04" "$G" diff "$tmp/amb0.exr" "$tmp/amb2.exr" --max-error 0.0401
+check_fails "ambient adds A ka = 0.04 somewhere" 1 "$G" diff "$tmp/amb0.exr" "$tmp/amb2.exr" --max-error 0.0399
+check_queued "gouraud with --ambient" 0 amb3
+check_fails "a negative --ambient is a usage error" 2 "$G" render $T --mode phong --ambient -1 -o "$tmp/x.exr" --quiet
+# (the fast tier: albedo and path; the slow tier: phong, gouraud and flat; rendered in the
+# batch above)
+for mode in "${col_modes[@]}"; do
     for f in col_base col_f col_u8; do check_queued "COLOR_0: $f renders in $mode" 0 "$f-$mode"; done
     check "COLOR_0 float RGB = base colour ($mode)" "$G" diff "$tmp/col_f-$mode.exr" "$tmp/col_base-$mode.exr" --max-error 1e-6
     check "COLOR_0 unorm8 RGBA = base colour ($mode)" "$G" diff "$tmp/col_u8-$mode.exr" "$tmp/col_base-$mode.exr" --max-error 1e-6
