@@ -79,6 +79,9 @@ run_queue() {
         n=$((n + 1))
         mv "$tmp/queue/$n.status" "$tmp/queue/$id.status" 2>/dev/null
         mv "$tmp/queue/$n.log" "$tmp/queue/$id.log" 2>/dev/null
+        # a queued line over the budget of a test gets the note a check would
+        awk -v lim=$TEST_BUDGET_S -v id="$id" '$1 > lim { printf "  note: queued line \"%s\" took %.1f s, over the %d s budget of a test (tests/README.md)\n", id, $1, lim }' \
+            "$tmp/queue/$n.time" 2>/dev/null
     done
     queue_ids=()
     rm -f "$tmp/queue.txt"

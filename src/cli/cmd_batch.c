@@ -145,8 +145,9 @@ int cmd_batch(int argc, char **argv)
 {
     const char *logs = NULL;
     const cli_option options[] = {
-        {"--logs", "DIR", "each line's output (stdout and stderr) in DIR/N.log and its exit status in\n"
-                          "DIR/N.status, N its line number; else both go to the batch's own",
+        {"--logs", "DIR", "each line's output (stdout and stderr) in DIR/N.log, its exit status in\n"
+                          "DIR/N.status and its wall time in seconds in DIR/N.time, N its line\n"
+                          "number; else the output goes to the batch's own",
          CLI_STRING, CLI_AS(const char *, &logs), 0, 0, NULL, NULL, "/"},
     };
     const cli_command cmd = {
@@ -191,6 +192,7 @@ int cmd_batch(int argc, char **argv)
         int saved[2], status;
         char name[4096];
         bool logged = false;
+        double t0 = util_now();
         if (logs) {
             snprintf(name, sizeof name, "%s/%d.log", logs, number);
             if (!redirect_output(name, saved)) {
@@ -208,11 +210,15 @@ int cmd_batch(int argc, char **argv)
         if (logged)
             restore_output(saved);
         if (logs) {
-            snprintf(name, sizeof name, "%s/%d.status", logs, number);
-            FILE *s = fopen(name, "w");
-            if (!s || fprintf(s, "%d\n", status) < 0 || fclose(s) != 0) {
-                util_error("%s: cannot write", name);
-                failed++;
+            const char *what[2] = {"status", "time"};
+            for (int k = 0; k < 2; k++) {
+                snprintf(name, sizeof name, "%s/%d.%s", logs, number, what[k]);
+                FILE *s = fopen(name, "w");
+                int w = !s ? -1 : k == 0 ? fprintf(s, "%d\n", status) : fprintf(s, "%.3f\n", util_now() - t0);
+                if (!s || w < 0 || fclose(s) != 0) {
+                    util_error("%s: cannot write", name);
+                    failed++;
+                }
             }
         }
         if (status != 0) {

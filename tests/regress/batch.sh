@@ -41,6 +41,9 @@ check "... 1 for a missing scene (line 8)" test "$(status 8)" = 1
 check "... 2 for an unknown command, preview and a broken quote (lines 9-11)" test "$(status 9)$(status 10)$(status 11)" = 222
 check "... and the lines after them ran (line 12)" test "$(status 12)" = 0
 check "no log or status for comments and blank lines" test ! -e "$tmp/logs/1.log" -a ! -e "$tmp/logs/4.status"
+check "each line's wall time: seconds, a render's more than an info's" awk \
+    'FNR == 1 { t[FILENAME] = $1 + 0; if ($0 !~ /^[0-9]+\.[0-9][0-9][0-9]$/) bad = 1 }
+     END { exit bad || !(t[ARGV[1]] > t[ARGV[2]]) }' "$tmp/logs/2.time" "$tmp/logs/12.time"
 check "each line's messages in its own log" grep -q "unknown BRDF model 'nosuch'" "$tmp/logs/7.log"
 check "... naming the file" grep -q "none.gltf" "$tmp/logs/8.log"
 check "... stdout too" grep -q "^triangles" "$tmp/logs/12.log"
