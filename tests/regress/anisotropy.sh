@@ -61,11 +61,24 @@ moments() { m=$("$T" moments "$tmp/$1.exr") || m="0 0 0"; }
 # ratio EXPR: awk on the moments ($1 sxx, $2 syy, $3 sxy) must be true
 holds() { echo "$m" | awk "{ exit !($1) }"; }
 
+# The renders (these and the Khronos models' below) run in one batch (lib.sh: queue); the
+# checks read each line's status and image.
+made=()
 for c in "iso 0 0" "rot0 1 0" "rot90 1 1.5707963" "rot45 1 0.78539816" "tex 1 0 128,255,255" "texb0 1 0 128,255,0"; do
     set -- $c
     scene "$2" "$3" "$tmp/$1.gltf" ${4:-} || { fail "$1: scene"; continue; }
-    check "$1: render" "$G" render "$tmp/$1.gltf" -o "$tmp/$1.exr" $R
+    made+=("$1")
+    queue "$1" render "$tmp/$1.gltf" -o "$tmp/$1.exr" $R
 done
+models=()
+for f in AnisotropyBarnLamp AnisotropyDiscTest AnisotropyRotationTest AnisotropyStrengthTest; do
+    g=${GONIO_ASSETS:-/nonexistent}/gltf/$f/glTF/$f.gltf
+    [ -f "$g" ] || continue
+    models+=("$f")
+    queue "$f" render "$g" -o "$tmp/$f.exr" --spp 4 --size 96x96 --quiet
+done
+run_queue
+for c in "${made[@]}"; do check_queued "$c: render" 0 "$c"; done
 moments iso
 echo "  moments (sxx syy sxy): strength 0: $m"
 check "strength 0: the highlight is round (sxx/syy within 10%)" holds '$1 < 1.1 * $2 && $2 < 1.1 * $1'
@@ -95,11 +108,9 @@ check "the warning names the file and the field" grep -q "bad.gltf: .*anisotropy
 
 # The Khronos anisotropy models (glTF-Sample-Assets), where the assets have them.
 found=0
-for f in AnisotropyBarnLamp AnisotropyDiscTest AnisotropyRotationTest AnisotropyStrengthTest; do
-    g=${GONIO_ASSETS:-/nonexistent}/gltf/$f/glTF/$f.gltf
-    [ -f "$g" ] || continue
+for f in "${models[@]}"; do
     found=1
-    check "$f: renders" "$G" render "$g" -o "$tmp/$f.exr" --spp 4 --size 96x96 --quiet
+    check_queued "$f: renders" 0 "$f"
     check "$f: finite pixels" sh -c "'$T' stats '$tmp/$f.exr' | grep -q 'nonfinite 0$'"
 done
 [ $found = 1 ] || echo "  note: no Khronos anisotropy models in \$GONIO_ASSETS: their renders are skipped"

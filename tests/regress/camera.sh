@@ -62,22 +62,48 @@ centre_is() { # centre_is FILE.exr red|white: the centre pixel's colour (odd siz
     if [ "$want" = red ]; then [ $inside = 1 ]; else [ $inside = 0 ]; fi
 }
 R() { "$G" render "$S" --mode albedo --spp 1 --quiet "$@"; }
+# Q ID ARGS...: queues R's render (lib.sh: queue); the renders run in one batch, then the
+# checks read each one's status, output ($tmp/last) and image. Usage errors (exit 2) stay
+# processes of their own (cheap: no device).
+Q() { local id=$1; shift; queue "$id" render "$S" --mode albedo --spp 1 --quiet "$@"; }
+
+# ---- the renders, queued (in order: --camera FILE.exr reads an earlier line's EXR) -------
+Q default -o "$tmp/default.exr" --size 33x33
+queue d2 render "$S" --mode albedo --spp 1 --size 33x33 -o "$tmp/d2.exr"
+Q b -o "$tmp/b.exr" --size 33x33 --camera 1
+Q a -o "$tmp/a.exr" --size 33x33 --camera 0
+Q cam3 -o "$tmp/x.exr" --size 33x33 --camera 3
+Q a65 -o "$tmp/a65.exr" --size 65x65
+Q ortho -o "$tmp/ortho.exr" --size 64x32 --camera 2
+Q ortho-size -o "$tmp/ortho-size.exr" --camera 2
+Q frame -o "$tmp/frame.exr" --size 33x33 --camera frame
+Q look -o "$tmp/look.exr" --size 33x33 --look-at 1.3,0.4,3,1.3,0.4,0 --fov 20
+Q look2 -o "$tmp/look2.exr" --size 33x33 --look-at 0,0,3,0,0,0,0,1,0
+Q again -o "$tmp/again.exr" --size 33x33 --camera "$tmp/look.exr"
+Q again-a -o "$tmp/again-a.exr" --size 65x65 --camera "$tmp/a65.exr"
+Q again-o -o "$tmp/again-o.exr" --camera "$tmp/ortho.exr"
+Q scene1 -o "$tmp/scene1.exr" --size 33x33 --scene 1
+queue s1 render "$S" --mode albedo --spp 1 --size 33x33 --scene 1 -o "$tmp/s1.exr"
+Q scene2 -o "$tmp/x.exr" --scene 2
+queue cmp compare "$S" -o "$tmp/cmp" --spp 1 --size 33x33 --quiet
+run_queue
 
 # ---- the default: the first camera of the default scene in depth-first node order (A) ----
-check "default camera renders" R -o "$tmp/default.exr" --size 33x33
+check_queued "default camera renders" 0 default
 check "default camera is A (looks at the red square)" centre_is red "$tmp/default.exr"
-"$G" render "$S" --mode albedo --spp 1 --size 33x33 -o "$tmp/d2.exr" 2>"$tmp/summary.txt"
+queued d2 >/dev/null
+cp "$tmp/last" "$tmp/summary.txt"
 check "summary line names the camera" grep -q "camera 0 'A'" "$tmp/summary.txt"
-check "--camera 1 is B" R -o "$tmp/b.exr" --size 33x33 --camera 1
+check_queued "--camera 1 is B" 0 b
 check "B looks at the white quad" centre_is white "$tmp/b.exr"
-check "--camera=0 is A" R -o "$tmp/a.exr" --size 33x33 --camera 0
+check_queued "--camera=0 is A" 0 a
 check "A and the default agree" "$G" diff "$tmp/a.exr" "$tmp/default.exr" --max-error 0 --quiet
-check_fails "--camera 3 does not exist" 1 R -o "$tmp/x.exr" --size 33x33 --camera 3
+check_queued "--camera 3 does not exist" 1 cam3
 check "error names the scene and the count" grep -q "cameras.gltf: --camera 3: the scene has 3 camera" "$tmp/last"
 check_fails "--camera bogus is a usage error" 2 R -o "$tmp/x.exr" --camera bogus
 
 # Perspective geometry: A's red box from the pinhole model, computed here.
-check "A at 65x65" R -o "$tmp/a65.exr" --size 65x65
+check_queued "A at 65x65" 0 a65
 want=$(python3 -c '
 import math
 H = 65; th = math.tan(0.25); d = 5 - 0.01
@@ -88,19 +114,19 @@ check "perspective: the red square spans the pixels the pinhole model says ($wan
 
 # ---- orthographic: xmag 2, ymag 1 -> the 1 x 1 square is a quarter of the width and half
 # of the height, whatever the distance --------------------------------------------------
-check "--camera 2 (orthographic) renders" R -o "$tmp/ortho.exr" --size 64x32 --camera 2
+check_queued "--camera 2 (orthographic) renders" 0 ortho
 got=$(stats "$tmp/ortho.exr" | awk '{print $8, $9, $10, $11}')
 check "orthographic: the square covers columns 24-39 and rows 8-23 (got $got)" test "$got" = "24 8 39 23"
-check "orthographic default size follows xmag/ymag" R -o "$tmp/ortho-size.exr" --camera 2
+check_queued "orthographic default size follows xmag/ymag" 0 ortho-size
 check "512x256" sh -c "exrheader '$tmp/ortho-size.exr' | grep -q 'dataWindow.*(0 0) - (511 255)'"
 
 # ---- framing, look-at, --fov ----------------------------------------------------------------
-check "--camera frame renders" R -o "$tmp/frame.exr" --size 33x33 --camera frame
+check_queued "--camera frame renders" 0 frame
 check "the framing view sees both the quad and the square" sh -c \
     "'$TESTTOOL' stats '$tmp/frame.exr' | awk '{exit !(\$2 > 200 && \$8 >= 0)}'"
-check "--look-at at the square" R -o "$tmp/look.exr" --size 33x33 --look-at 1.3,0.4,3,1.3,0.4,0 --fov 20
+check_queued "--look-at at the square" 0 look
 check "look-at centre is red" centre_is red "$tmp/look.exr"
-check "--look-at=... at the origin" R -o "$tmp/look2.exr" --size 33x33 --look-at 0,0,3,0,0,0,0,1,0
+check_queued "--look-at=... at the origin" 0 look2
 check "look-at origin centre is white" centre_is white "$tmp/look2.exr"
 # --fov 20 at distance 3: tan(10 deg) * 3 = 0.529 half-height, so the 0.5 square nearly fills it.
 got=$(stats "$tmp/look.exr" | awk '{print $9, $11}')
@@ -121,13 +147,13 @@ import sys
 got = [float(v) for v in sys.argv[1].split()]
 want = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -1, 0, 0, 0, 3, 1]
 sys.exit(not (len(got) == 16 and all(abs(a - b) < 1e-6 for a, b in zip(got, want))))' "$m44"
-check "--camera FILE.exr takes the recorded view" R -o "$tmp/again.exr" --size 33x33 --camera "$tmp/look.exr"
+check_queued "--camera FILE.exr takes the recorded view" 0 again
 check "... and gives the same pixels" "$G" diff "$tmp/again.exr" "$tmp/look.exr" --max-error 0 --quiet
-check "--camera FILE.exr of a file camera" R -o "$tmp/again-a.exr" --size 65x65 --camera "$tmp/a65.exr"
+check_queued "--camera FILE.exr of a file camera" 0 again-a
 check "... the same pixels as that camera" "$G" diff "$tmp/again-a.exr" "$tmp/a65.exr" --max-error 0 --quiet
 # Without --size, the file's own size (a 64x32 orthographic render), and the same identity,
 # so the two renders are one image to gonio merge.
-check "--camera FILE.exr without --size" R -o "$tmp/again-o.exr" --camera "$tmp/ortho.exr"
+check_queued "--camera FILE.exr without --size" 0 again-o
 check "... renders the file's 64x32" sh -c "exrheader '$tmp/again-o.exr' | grep -q 'dataWindow.*(0 0) - (63 31)'"
 check "... the same pixels" "$G" diff "$tmp/again-o.exr" "$tmp/ortho.exr" --max-error 0 --quiet
 cam_id() { exrheader "$1" | grep 'gonio:camera (type string)'; }
@@ -138,14 +164,15 @@ check "... says so" grep -q "not an EXR with a gonio:look-at header" "$tmp/last"
 check_fails "--camera of a missing EXR" 2 R -o "$tmp/x.exr" --camera "$tmp/nonexistent.exr"
 
 # ---- --scene ---------------------------------------------------------------------------
-check "--scene 1 renders" R -o "$tmp/scene1.exr" --size 33x33 --scene 1
-"$G" render "$S" --mode albedo --spp 1 --size 33x33 --scene 1 -o "$tmp/s1.exr" 2>"$tmp/s1.txt"
+check_queued "--scene 1 renders" 0 scene1
+queued s1 >/dev/null
+cp "$tmp/last" "$tmp/s1.txt"
 check "scene 1's first camera is B" grep -q "camera 0 'B'" "$tmp/s1.txt"
 check "scene 1 has no quad: the centre is background" sh -c \
     "'$TESTTOOL' stats '$tmp/scene1.exr' | awk '{exit !(\$2 < 33 * 33)}'"
-check_fails "--scene 2 does not exist" 1 R -o "$tmp/x.exr" --scene 2
+check_queued "--scene 2 does not exist" 1 scene2
 check "error names the scene count" grep -q "the file has 2 scene" "$tmp/last"
 
 # ---- the other commands follow the same rule ------------------------------------------------
-check "compare uses the default camera" "$G" compare "$S" -o "$tmp/cmp" --spp 1 --size 33x33 --quiet
+check_queued "compare uses the default camera" 0 cmp
 finish

@@ -123,6 +123,22 @@ if in_tier slow; then
 fi
 in_tier fast || { finish; exit; }
 
+# The fast tier's renders run in one batch (lib.sh: queue); the checks below read each
+# line's status, output ($tmp/last) and image.
+P="--env 0 --quiet --spp 64 --size 32x32"
+queue dt render "$tmp/dt.gltf" -o "$tmp/dt.exr" $P
+for st in light bsdf; do queue "dt-$st" render "$tmp/dt.gltf" -o "$tmp/dt-$st.exr" $P --estimator $st; done
+for st in light bsdf; do
+    queue "dtvol-$st" render "$tmp/dtvol.gltf" -o "$tmp/dtvol-$st.exr" --env 0 --quiet --spp 512 --size 16x16 --estimator $st
+done
+queue dtnovol render "$tmp/dtnovol.gltf" -o "$tmp/dtnovol.exr" --env 0 --quiet --spp 64 --size 16x16
+for s in dt0 nodt irid0 noirid; do queue "$s" render "$tmp/$s.gltf" -o "$tmp/$s.exr" $P; done
+queue irid render "$tmp/irid.gltf" -o "$tmp/irid.exr" $P
+S=${GONIO_ASSETS:-}/gltf/IridescenceSuzanne/glTF/IridescenceSuzanne.gltf
+[ -f "$S" ] && queue suzanne render "$S" -o "$tmp/suzanne.exr" \
+    --look-at 0,0.3,7,0,0,0 --fov 40 --env 0.6,0.6,0.6 --spp 8 --size 96x32 --quiet
+run_queue
+
 check "info shows the diffuse transmission" sh -c "'$G' info '$tmp/dt.gltf' | grep -q 'diffuse transmission 0 .* factor 0.6, colour (1, 0.5, 0.25)'"
 check "info shows the film" sh -c "'$G' info '$tmp/irid.gltf' | grep -q 'iridescence 0 .* factor 1, film ior 1.3, thickness 350 nm'"
 for s in dt irid; do
@@ -130,15 +146,14 @@ for s in dt irid; do
     check "  (none printed)" sh -c "! grep -q 'unsupported extension' '$tmp/last'"
 done
 
-P="--env 0 --quiet --spp 64 --size 32x32"
-check "sheet: render" "$G" render "$tmp/dt.gltf" -o "$tmp/dt.exr" $P
+check_queued "sheet: render" 0 dt
 got=($(means "$tmp/dt.exr")) ref=($(cat "$tmp/dt.ref"))
 for k in 0 1 2; do
     check "sheet: far side's radiance k c Le F, channel $k: ${got[$k]} vs ${ref[$k]}" near "${got[$k]}" "${ref[$k]}" 5e-3
 done
 # each strategy alone: light sampling of the light behind the surface, BSDF samples through it
 for st in light bsdf; do
-    check "sheet, $st sampling alone: render" "$G" render "$tmp/dt.gltf" -o "$tmp/dt-$st.exr" $P --estimator $st
+    check_queued "sheet, $st sampling alone: render" 0 "dt-$st"
     got=($(means "$tmp/dt-$st.exr"))
     check "  channel 0: ${got[0]} vs ${ref[0]}" near "${got[0]}" "${ref[0]}" 1e-2
 done
@@ -147,10 +162,9 @@ done
 # sample's side, light sampling alone is brighter), and the medium darkens the cube.
 check "info: the cube of diffuse transmission bounds a medium" sh -c "'$G' info '$tmp/dtvol.gltf' | grep -q 'medium 0'"
 for st in light bsdf; do
-    check "cube with a medium, $st sampling alone: render" "$G" render "$tmp/dtvol.gltf" -o "$tmp/dtvol-$st.exr" \
-        --env 0 --quiet --spp 512 --size 16x16 --estimator $st
+    check_queued "cube with a medium, $st sampling alone: render" 0 "dtvol-$st"
 done
-check "cube without the medium: render" "$G" render "$tmp/dtnovol.gltf" -o "$tmp/dtnovol.exr" --env 0 --quiet --spp 64 --size 16x16
+check_queued "cube without the medium: render" 0 dtnovol
 gl=($(means "$tmp/dtvol-light.exr")) gb=($(means "$tmp/dtvol-bsdf.exr")) gn=($(means "$tmp/dtnovol.exr"))
 for k in 0 1 2; do
     check "  channel $k: light sampling ${gl[$k]} = BSDF sampling ${gb[$k]}" near "${gl[$k]}" "${gb[$k]}" 0.03
@@ -158,17 +172,15 @@ done
 check "  the medium darkens red (${gb[0]}) below half of no medium's (${gn[0]})" \
     python3 -c "import sys; sys.exit(0 if ${gb[0]} < 0.5 * ${gn[0]} else 1)"
 for s in dt0 nodt irid0 noirid; do
-    "$G" render "$tmp/$s.gltf" -o "$tmp/$s.exr" $P || fail "render $s"
+    [ "$(queued "$s")" = 0 ] || fail "render $s"
 done
 check "diffuse transmission 0 is the file without the extension" "$T" same "$tmp/nodt.exr" "$tmp/dt0.exr"
 check "iridescence 0 is the file without the extension" "$T" same "$tmp/noirid.exr" "$tmp/irid0.exr"
-check "iridescence: render" "$G" render "$tmp/irid.gltf" -o "$tmp/irid.exr" $P
+check_queued "iridescence: render" 0 irid
 check_fails "  (the film changes the reflection)" 1 "$T" same "$tmp/noirid.exr" "$tmp/irid.exr"
 
-S=${GONIO_ASSETS:-}/gltf/IridescenceSuzanne/glTF/IridescenceSuzanne.gltf
 if [ -f "$S" ]; then
-    check_fails "IridescenceSuzanne: renders without warnings" 0 "$G" render "$S" -o "$tmp/suzanne.exr" \
-        --look-at 0,0.3,7,0,0,0 --fov 40 --env 0.6,0.6,0.6 --spp 8 --size 96x32 --quiet
+    check_queued "IridescenceSuzanne: renders without warnings" 0 suzanne
     check "  (no warning)" sh -c "! grep -q 'warning' '$tmp/last'"
     check "IridescenceSuzanne: info shows its thickness texture's range" sh -c \
         "'$G' info '$S' | grep -q 'iridescence 2 .* film ior 1.8, thickness 200 - 600 nm (texture G)'"

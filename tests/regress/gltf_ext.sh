@@ -13,13 +13,14 @@ command -v python3 >/dev/null || skip_all "python3 is needed to edit the test sc
 R="--spp 4 --size 96x72 --quiet"
 
 "$G" scene cornell -o "$tmp/cornell.gltf" && "$G" teapot --level 4 -o "$tmp/teapot.gltf" || { fail "scenes"; finish; exit; }
+# Q ID SCENE ARGS...: queues a render (lib.sh: queue); the script's renders run in one batch,
+# after the compressed and edited scenes are written, then the checks read each one's status,
+# output ($tmp/last) and image.
+Q() { local id=$1 f=$2; shift 2; queue "$id" render "$f" -o "$tmp/$id.exr" $R "$@"; }
 for s in cornell teapot; do
-    check "$s: render" "$G" render "$tmp/$s.gltf" -o "$tmp/$s.exr" $R
     for k in draco meshopt; do
         check "$s: $k encode" "$T" compress $k "$tmp/$s.gltf" "$tmp/$s-$k.gltf"
         check "$s: $k file uses the extension" grep -q "$([ $k = draco ] && echo KHR_draco_mesh_compression || echo EXT_meshopt_compression)" "$tmp/$s-$k.gltf"
-        check "$s: $k render" "$G" render "$tmp/$s-$k.gltf" -o "$tmp/$s-$k.exr" $R
-        check "$s: $k decodes to the same image" "$T" same "$tmp/$s.exr" "$tmp/$s-$k.exr"
     done
 done
 
@@ -35,11 +36,6 @@ for i in range(0, len(raw), 7):
 d["buffers"][-1]["uri"] = head + "," + base64.b64encode(bytes(raw)).decode()
 json.dump(d, open(sys.argv[2], "w"))
 PY
-    check_fails "$k: corrupt data is an error" 1 "$G" render "$tmp/bad-$k.gltf" -o "$tmp/bad-$k.exr" $R
-    what=$([ $k = draco ] && echo "primitives\[0\].extensions.KHR_draco_mesh_compression: Draco cannot decode" ||
-        echo "(EXT_meshopt_compression): meshoptimizer cannot decode")
-    check "$k: the error names the file and the part" grep -q "bad-$k.gltf: .*$what" "$tmp/last"
-    check "$k: no output" test ! -e "$tmp/bad-$k.exr"
 done
 
 # Variants: "green_left" maps the red wall (mesh 3) to the green material (2).
@@ -56,14 +52,43 @@ del p["extensions"]
 p["material"] = 2
 json.dump(d, open(sys.argv[3], "w"))
 PY
+
+# ---- the renders, queued ------------------------------------------------------------------
+for s in cornell teapot; do
+    Q $s "$tmp/$s.gltf"
+    for k in draco meshopt; do Q $s-$k "$tmp/$s-$k.gltf"; done
+done
+for k in draco meshopt; do Q bad-$k "$tmp/bad-$k.gltf"; done
+Q v-default "$tmp/variants.gltf"
+Q v-green "$tmp/variants.gltf" --variant green_left
+Q green "$tmp/green.gltf"
+Q v-x "$tmp/variants.gltf" --variant nosuch
+run_queue
+
+for s in cornell teapot; do
+    check_queued "$s: render" 0 $s
+    for k in draco meshopt; do
+        check_queued "$s: $k render" 0 $s-$k
+        check "$s: $k decodes to the same image" "$T" same "$tmp/$s.exr" "$tmp/$s-$k.exr"
+    done
+done
+
+for k in draco meshopt; do
+    check_queued "$k: corrupt data is an error" 1 bad-$k
+    what=$([ $k = draco ] && echo "primitives\[0\].extensions.KHR_draco_mesh_compression: Draco cannot decode" ||
+        echo "(EXT_meshopt_compression): meshoptimizer cannot decode")
+    check "$k: the error names the file and the part" grep -q "bad-$k.gltf: .*$what" "$tmp/last"
+    check "$k: no output" test ! -e "$tmp/bad-$k.exr"
+done
+
 check "variants: info lists them" sh -c "'$G' info '$tmp/variants.gltf' | grep -q 'variant 1 .*\"green_left\"'"
-check "variants: default render" "$G" render "$tmp/variants.gltf" -o "$tmp/v-default.exr" $R
+check_queued "variants: default render" 0 v-default
 check "variants: default is the file's own materials" "$T" same "$tmp/cornell.exr" "$tmp/v-default.exr"
-check "variants: --variant green_left" "$G" render "$tmp/variants.gltf" --variant green_left -o "$tmp/v-green.exr" $R
-check "variants: reference" "$G" render "$tmp/green.gltf" -o "$tmp/green.exr" $R
+check_queued "variants: --variant green_left" 0 v-green
+check_queued "variants: reference" 0 green
 check "variants: green_left has its material" "$T" same "$tmp/green.exr" "$tmp/v-green.exr"
 check_fails "variants: green_left differs from the default" 1 "$T" same "$tmp/cornell.exr" "$tmp/v-green.exr"
-check_fails "variants: unknown name" 1 "$G" render "$tmp/variants.gltf" --variant nosuch -o "$tmp/v-x.exr" $R
+check_queued "variants: unknown name" 1 v-x
 check "variants: the error lists the variants" grep -q "no material variant 'nosuch' (variants: 'as_is', 'green_left')" "$tmp/last"
 
 # Extension rules.

@@ -30,6 +30,65 @@ for name, uri in cases.items():
 PY
 ln -sf "$tmp/secret.bin" "$D/a/b/link.bin"
 B=$D/a/b
+# A camera aspect ratio from the file (0.004), for the render of the longer side's 512 below.
+python3 - "$B/ok.gltf" "$B/thin.gltf" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 0.004, "znear": 0.1}}]
+d["nodes"].append({"camera": 0, "translation": [0.3, 0.3, 3]})
+d["scenes"][0]["nodes"].append(1)
+json.dump(d, open(sys.argv[2], "w"))
+PY
+# A light and an emitter of 1e39, for the renders of finite pixels below.
+python3 - "$B/ok.gltf" "$B/bright.gltf" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["extensionsUsed"] = ["KHR_lights_punctual", "KHR_materials_emissive_strength"]
+d["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1e39}]}}
+d["materials"] = [{"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e39}}}]
+d["meshes"][0]["primitives"][0]["material"] = 0
+d["nodes"].append({"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0.2, 0.2, 1]})
+d["scenes"][0]["nodes"].append(1)
+json.dump(d, open(sys.argv[2], "w"))
+PY
+# Outputs (the checks below): an existing file of mode 640, and one of another owner (when
+# root), that a render replaces; stale temporary files of a gonio killed while writing.
+O=$tmp/outputs
+mkdir -p "$O"
+R="--size 8x8 --spp 1 --quiet"
+echo old > "$O/mode.exr"
+chmod 640 "$O/mode.exr"
+owner=0
+if [ "$(id -u)" = 0 ] && id nobody >/dev/null 2>&1; then
+    owner=1
+    echo old > "$O/owner.exr"
+    chmod 640 "$O/owner.exr"
+    chown nobody "$O/owner.exr"
+fi
+dead=$(sh -c 'echo $$')
+echo half > "$O/.out.exr.tmp-$dead-a1b2c3"
+echo live > "$O/.out.exr.tmp-$$-a1b2c3"
+echo other > "$O/.other.exr.tmp-$dead-a1b2c3"
+
+# ---- the renders, queued (lib.sh: queue): the script's renders run in one batch, whose
+# results the checks below read; commands refused before any work, `gonio info` and
+# `gonio merge` stay processes of their own (cheap: no device).
+queue up render "$B/up.gltf" --allow-outside-files -o "$tmp/up.exr" --size 8x8 --spp 1 --quiet
+queue thin render "$B/thin.gltf" -o "$tmp/thin.exr" --spp 1 --quiet
+for sd in 3000000000 3000000001; do
+    queue seed-$sd render "$B/ok.gltf" -o "$tmp/seed-$sd.exr" --size 8x8 --spp 1 --seed $sd --quiet
+done
+for m in path phong; do
+    queue bright-$m render "$B/bright.gltf" -o "$tmp/bright-$m.exr" --mode $m --size 16x16 --spp 2 --quiet
+done
+queue v render "$B/ok.gltf" -o "$tmp/v.exr" --size 16x16 --spp 1 --fov 30 --env 0.5,1,0 --quiet
+queue v-brdf render "$B/ok.gltf" -o "$tmp/v.exr" --size 8x8 --spp 1 --brdf ggx:alpha=0.3:diffuse=0.2,0.4,0.6 --quiet
+queue mode render "$B/ok.gltf" -o "$O/mode.exr" $R
+[ $owner = 1 ] && queue owner render "$B/ok.gltf" -o "$O/owner.exr" $R
+queue stale render "$B/ok.gltf" -o "$O/out.exr" $R
+queue a render "$B/ok.gltf" -o "$O/a.exr" $R --seed 1
+queue b render "$B/ok.gltf" -o "$O/b.exr" $R --seed 2
+run_queue
 
 check "a buffer beside the scene loads" "$G" info "$B/ok.gltf"
 for c in up pct abs link; do
@@ -46,23 +105,14 @@ check_fails "cwd: a file only in the working directory is not read" 1 sh -c "cd 
 check_fails "size: a wrong byteLength on an outside file is refused" 1 "$G" info "$B/size.gltf"
 check "... without telling the file's size" sh -c "! grep -q 2520 '$tmp/last'"
 check "--allow-outside-files reads it" "$G" info "$B/up.gltf" --allow-outside-files
-check "render --allow-outside-files too" "$G" render "$B/up.gltf" --allow-outside-files -o "$tmp/up.exr" \
-    --size 8x8 --spp 1 --quiet
+check_queued "render --allow-outside-files too" 0 up
 check_fails "render refuses it by default" 1 "$G" render "$B/up.gltf" -o "$tmp/up2.exr" --size 8x8 --spp 1 --quiet
 check "... and writes nothing" test ! -e "$tmp/up2.exr"
 check_fails "a directory as the scene is an error" 1 "$G" info "$tmp"
 check "... naming it, not 'out of memory'" sh -c "grep -q 'is a directory; gonio reads only regular files' '$tmp/last' && ! grep -q 'out of memory' '$tmp/last'"
 
 # A camera aspect ratio from the file suggests the size, within the longer side's 512.
-python3 - "$B/ok.gltf" "$B/thin.gltf" <<'PY'
-import json, sys
-d = json.load(open(sys.argv[1]))
-d["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 0.004, "znear": 0.1}}]
-d["nodes"].append({"camera": 0, "translation": [0.3, 0.3, 3]})
-d["scenes"][0]["nodes"].append(1)
-json.dump(d, open(sys.argv[2], "w"))
-PY
-check "a camera aspect of 0.004 renders" "$G" render "$B/thin.gltf" -o "$tmp/thin.exr" --spp 1 --quiet
+check_queued "a camera aspect of 0.004 renders" 0 thin
 check "... at most 512 pixels on its longer side" sh -c "exrheader '$tmp/thin.exr' | grep -q 'dataWindow.*(0 0) - (1 511)'"
 
 # Amplification: a few hundred bytes of JSON must not decode into gigabytes. One accessor of
@@ -141,7 +191,7 @@ check "... with the numbers" grep -q "images too large: 335544320 texels" "$tmp/
 
 # Seeds of 2^31 and above survive the EXR header's signed int: merge still sees a repeat.
 for sd in 3000000000 3000000001; do
-    check "render --seed $sd" "$G" render "$B/ok.gltf" -o "$tmp/seed-$sd.exr" --size 8x8 --spp 1 --seed $sd --quiet
+    check_queued "render --seed $sd" 0 seed-$sd
 done
 check "the same seed twice" cp "$tmp/seed-3000000000.exr" "$tmp/seed-again.exr"
 check_fails "merge refuses seed 3000000000 twice" 1 "$G" merge "$tmp/seed-3000000000.exr" "$tmp/seed-again.exr" -o "$tmp/sm.exr"
@@ -154,20 +204,8 @@ check "... naming the range" grep -q "1000..50000000" "$tmp/last"
 
 # Huge radiance: clamped or refused, never NaN or Inf pixels.
 check_fails "--env 1e38 is refused" 2 "$G" render "$B/ok.gltf" -o "$tmp/x.exr" --env 1e38 --quiet
-python3 - "$B/ok.gltf" "$B/bright.gltf" <<'PY'
-import json, sys
-d = json.load(open(sys.argv[1]))
-d["extensionsUsed"] = ["KHR_lights_punctual", "KHR_materials_emissive_strength"]
-d["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1e39}]}}
-d["materials"] = [{"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e39}}}]
-d["meshes"][0]["primitives"][0]["material"] = 0
-d["nodes"].append({"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0.2, 0.2, 1]})
-d["scenes"][0]["nodes"].append(1)
-json.dump(d, open(sys.argv[2], "w"))
-PY
 for m in path phong; do
-    check "a light and an emitter of 1e39 render ($m)" "$G" render "$B/bright.gltf" -o "$tmp/bright-$m.exr" \
-        --mode $m --size 16x16 --spp 2 --quiet
+    check_queued "a light and an emitter of 1e39 render ($m)" 0 bright-$m
     check "... with finite pixels ($m)" sh -c "'$TESTTOOL' stats '$tmp/bright-$m.exr' | grep -q 'nonfinite 0\$'"
 done
 check "the clamp is a warning naming the value" sh -c "'$G' info '$B/bright.gltf' 2>&1 | grep -q 'intensity 1e+39 is above 1e+09 (clamped)'"
@@ -180,8 +218,7 @@ check_fails "--spp ' 4' is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr"
 check_fails "--fov +30 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --fov +30 --quiet
 check_fails "--env ' 1' is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --env " 1" --quiet
 check_fails "--env 0x1p1 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --env 0x1p1 --quiet
-check "--size 16x16 --spp 1 --fov 30 --env 0.5,1,0 still render" "$G" render "$B/ok.gltf" -o "$tmp/v.exr" \
-    --size 16x16 --spp 1 --fov 30 --env 0.5,1,0 --quiet
+check_queued "--size 16x16 --spp 1 --fov 30 --env 0.5,1,0 still render" 0 v
 for v in "ggx:::" "ggx:" "ggx:alpha=0.3:" ":alpha=0.3" "ggx:=1"; do
     check_fails "--brdf '$v' is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --brdf "$v" --quiet
 done
@@ -190,8 +227,7 @@ check "... naming the parameter as it was given" sh -c "grep -q 'parameter alpha
 check_fails "--brdf ggx:shininess=5 is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --brdf ggx:shininess=5 --quiet
 check "... listing the parameters in the spec's form" sh -c "grep -q 'no parameter shininess; it accepts .*alpha=X' '$tmp/last' && ! grep -q -- '--alpha' '$tmp/last'"
 check_fails "--brdf nosuch is bad usage" 2 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --brdf nosuch --quiet
-check "--brdf ggx:alpha=0.3:diffuse=0.2,0.4,0.6 renders" "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --size 8x8 --spp 1 \
-    --brdf ggx:alpha=0.3:diffuse=0.2,0.4,0.6 --quiet
+check_queued "--brdf ggx:alpha=0.3:diffuse=0.2,0.4,0.6 renders" 0 v-brdf
 check_fails "gonio brdf's own option still says --alpha" 2 "$G" brdf ggx --alpha 5 -o "$tmp/lobe.png"
 check "... (--alpha)" grep -q -- "--alpha 5 is out of range" "$tmp/last"
 # Under the sanitizers a refused device index must not leak (the driver was unloaded
@@ -199,9 +235,7 @@ check "... (--alpha)" grep -q -- "--alpha 5 is out of range" "$tmp/last"
 check_fails "--device 63 is refused cleanly" 1 "$G" render "$B/ok.gltf" -o "$tmp/v.exr" --device 63 --quiet
 check "... naming the devices" grep -q "only .* device(s)" "$tmp/last"
 # ---- Outputs: a new name or a writable regular file, nothing else (src/core/util.h) ------------
-O=$tmp/outputs
-mkdir -p "$O"
-R="--size 8x8 --spp 1 --quiet"
+# ($O, mode.exr, owner.exr and the stale temporary files are made above, before the renders)
 echo secret > "$O/target.exr"
 ln -s target.exr "$O/link.exr"
 mkfifo "$O/fifo.exr"
@@ -229,25 +263,19 @@ echo keep > "$O/ro.exr"
 chmod 444 "$O/ro.exr"
 check_fails "-o a read-only file is refused (for root too)" 1 "$G" render "$B/ok.gltf" -o "$O/ro.exr" $R
 check "... saying so, and it stays" sh -c "grep -q 'ro.exr: is read-only' '$tmp/last' && grep -q keep '$O/ro.exr'"
-echo old > "$O/mode.exr"
-chmod 640 "$O/mode.exr"
-check "-o an existing file replaces it" "$G" render "$B/ok.gltf" -o "$O/mode.exr" $R
+check_queued "-o an existing file replaces it" 0 mode
 check "... keeping its mode" test "$(stat -c %a "$O/mode.exr")" = 640
-if [ "$(id -u)" = 0 ] && id nobody >/dev/null 2>&1; then
-    chown nobody "$O/mode.exr"
-    check "... and its owner (root writing)" sh -c "'$G' render '$B/ok.gltf' -o '$O/mode.exr' $R && test \"\$(stat -c %U '$O/mode.exr')\" = nobody"
+if [ $owner = 1 ]; then
+    # owner.exr: another existing file of mode 640, owned by nobody, replaced by root
+    owner_kept() { [ "$(queued owner)" = 0 ] || { cat "$tmp/last"; return 1; }; test "$(stat -c %U "$O/owner.exr")" = nobody; }
+    check "... and its owner (root writing)" owner_kept
 fi
 # A gonio killed while writing leaves .NAME.tmp-PID-XXXXXX: the next write of NAME removes it
 # when that process is gone, and leaves other names and live processes' files alone.
-dead=$(sh -c 'echo $$')
-echo half > "$O/.out.exr.tmp-$dead-a1b2c3"
-echo live > "$O/.out.exr.tmp-$$-a1b2c3"
-echo other > "$O/.other.exr.tmp-$dead-a1b2c3"
-check "a stale temporary file is cleaned up" "$G" render "$B/ok.gltf" -o "$O/out.exr" $R
+check_queued "a stale temporary file is cleaned up" 0 stale
 check "... the dead process's one is gone" test ! -e "$O/.out.exr.tmp-$dead-a1b2c3"
 check "... a live process's and another name's stay" test -e "$O/.out.exr.tmp-$$-a1b2c3" -a -e "$O/.other.exr.tmp-$dead-a1b2c3"
-# Every command that writes checks the same way, before any work.
-"$G" render "$B/ok.gltf" -o "$O/a.exr" $R --seed 1 && "$G" render "$B/ok.gltf" -o "$O/b.exr" $R --seed 2
+# Every command that writes checks the same way, before any work (a.exr and b.exr: rendered above).
 check_fails "merge -o a symbolic link is refused" 1 "$G" merge "$O/a.exr" "$O/b.exr" -o "$O/link.exr"
 check "... saying so" grep -q "link.exr: is a symbolic link" "$tmp/last"
 ln -s target.gltf "$O/link.gltf"

@@ -150,11 +150,18 @@ PY
 
 scene() { python3 "$tmp/gen.py" "$tmp/$1.gltf" "$2"; }
 R() { "$G" render "$tmp/$1.gltf" --mode albedo --spp 1 --size ${N}x$N --quiet --compression none -o "$tmp/$1.exr"; }
-# case NAME TOL DESCRIPTION JSON: write, render (no warning), probe
+# The script's renders are queued (lib.sh: queue) and run in one batch (below); the checks of
+# each read its status, output ($tmp/last) and image. QR NAME [FILE]: queues R's render.
+QR() { queue "$1" render "${2:-$tmp/$1.gltf}" --mode albedo --spp 1 --size ${N}x$N --quiet --compression none -o "$tmp/$1.exr"; }
+# case NAME TOL DESCRIPTION JSON: write, queue; once the queue has run: renders (no warning), probe
 case_() {
     scene "$1" "$4"
-    check "$3: renders" R "$1"
-    check "$3: no warning" test ! -s "$tmp/out"
+    QR "$1"
+    after_queue render_checks "$@"
+}
+render_checks() {
+    check_queued "$3: renders" 0 "$1"
+    check "$3: no warning" test ! -s "$tmp/last"
     check "$3: the image's texels" python3 "$tmp/probe.py" "$tmp/$1.exr" "$2" "$(dirname "$0")/../tool" $N
 }
 WEBP='["EXT_texture_webp"]'
@@ -170,7 +177,7 @@ if [ $KTX2 = 1 ]; then
         "{\"images\": [\"blocks-uastc.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU, \"required\": $BASISU}"
     case_ zstd_required 1 "KTX2 UASTC + Zstandard without a fallback, extension required" \
         "{\"images\": [\"blocks-uastc-zstd.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU, \"required\": $BASISU}"
-    check "gonio info: the images' formats" sh -c "'$G' info '$tmp/etc1s_fallback.gltf' | grep -q '^image formats  1 PNG, 1 KTX2$'"
+    after_queue check "gonio info: the images' formats" sh -c "'$G' info '$tmp/etc1s_fallback.gltf' | grep -q '^image formats  1 PNG, 1 KTX2$'"
 else
     scene needs_basisu "{\"images\": [\"fallback.png\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU, \"required\": $BASISU}"
     check_fails "without Basis Universal, a file requiring KHR_texture_basisu is refused" 1 R needs_basisu
@@ -179,19 +186,17 @@ fi
 
 # Images in a GLB's binary chunk, with their mimeType (decoded once the buffer views are
 # checked, where files named by a uri are decoded as tinygltf reads them).
-glb_case() { # glb_case NAME TOL DESCRIPTION IMAGE [FALLBACK]
+glb_case() { # glb_case NAME TOL DESCRIPTION IMAGE [FALLBACK]: write, queue, then case_'s checks
     python3 "$(dirname "$0")/../tool/texture_glb.py" "$tmp/$1.glb" "${@:4}"
-    check "$3: renders" "$G" render "$tmp/$1.glb" --mode albedo --spp 1 --size ${N}x$N --quiet --compression none -o "$tmp/$1.exr"
-    check "$3: no warning" test ! -s "$tmp/out"
-    check "$3: the image's texels" python3 "$tmp/probe.py" "$tmp/$1.exr" "$2" "$(dirname "$0")/../tool" $N
+    QR "$1" "$tmp/$1.glb"
+    after_queue render_checks "$@"
 }
 glb_case glb_webp 0 "GLB: WebP in the binary chunk, extension required" "$tmp/blocks.webp"
 if [ $KTX2 = 1 ]; then
     glb_case glb_ktx2 1 "GLB: KTX2 UASTC + Zstandard in the binary chunk, a PNG fallback" "$tmp/blocks-uastc-zstd.ktx2" "$tmp/fallback.png"
 fi
 
-# ---- damaged images: a clear message naming the file, the image and the problem ------------
-# (gonio info loads a scene as render does, and says the same, without a device)
+# ---- the damaged images' renders' scenes (their checks below), and the batch ---------------
 head -c $(($(wc -c <"$tmp/grad.webp") / 2)) "$tmp/grad.webp" >"$tmp/trunc.webp"
 if [ $KTX2 = 1 ]; then
     head -c 150 "$tmp/blocks-uastc-zstd.ktx2" >"$tmp/trunc.ktx2"
@@ -199,7 +204,32 @@ else
     python3 -c "import sys; sys.stdout.buffer.write(b'\xabKTX 20\xbb\r\n\x1a\n' + bytes(100))" >"$tmp/trunc.ktx2"
 fi
 scene trunc_fallback "{\"images\": [\"blocks.png\", \"trunc.ktx2\"], \"texture\": {\"source\": 0, \"extensions\": {\"KHR_texture_basisu\": {\"source\": 1}}}, \"used\": $BASISU}"
-"$G" render "$tmp/trunc_fallback.gltf" --mode albedo --spp 1 --size ${N}x$N --quiet --compression none -o "$tmp/trunc_fallback.exr" 2>"$tmp/trunc_fallback.txt"
+QR trunc_fallback
+# a missing PNG a texture uses (gonio info, below); one no texture uses; one only a material
+# the scene does not draw uses
+scene missing_png '{"images": ["nowhere.png"], "texture": {"source": 0}}'
+scene unused_png '{"images": ["fallback.png", "nowhere.png"], "texture": {"source": 0}}'
+python3 - "$tmp/missing_png.gltf" "$tmp/undrawn_png.gltf" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+d["images"] = [{"uri": "fallback.png"}, {"uri": "nowhere.png"}]
+d["textures"].append({"source": 1})
+d["materials"].append({"pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}})
+json.dump(d, open(sys.argv[2], "w"))
+PY
+for f in unused_png undrawn_png; do
+    queue $f render "$tmp/$f.gltf" --spp 1 --size 8x8 --quiet -o "$tmp/$f.exr"
+done
+if [ $KTX2 = 1 ]; then # both extensions, the KTX2 image damaged, no core image
+    scene both_ext "{\"images\": [\"blocks.webp\", \"trunc.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 1}, \"EXT_texture_webp\": {\"source\": 0}}}, \"used\": [\"KHR_texture_basisu\", \"EXT_texture_webp\"]}"
+    QR both_ext
+fi
+run_queue
+
+# ---- damaged images: a clear message naming the file, the image and the problem ------------
+# (gonio info loads a scene as render does, and says the same, without a device)
+queued trunc_fallback >/dev/null # (its status unchecked, as ever: what it says, in its log)
+cp "$tmp/last" "$tmp/trunc_fallback.txt"
 check "truncated KTX2 with a fallback: renders the fallback" python3 "$tmp/probe.py" "$tmp/trunc_fallback.exr" 0 "$(dirname "$0")/../tool" $N
 check "... saying which image of which file, and why" grep -q "trunc_fallback.gltf: image 1 trunc.ktx2: KTX2: " "$tmp/trunc_fallback.txt"
 check "... and that the fallback is used" grep -q "texture 0: its KHR_texture_basisu image 1 is unusable; its fallback, image 0, is used" "$tmp/trunc_fallback.txt"
@@ -213,27 +243,18 @@ check_fails "a WebP header and no image: an error" 1 "$G" info "$tmp/junk_webp.g
 check "... the problem named" grep -q "error: .*junk_webp.gltf: material 0: baseColorTexture: texture 0: image 0 junk.webp: WebP: .*" "$tmp/last"
 # The core formats alike: a PNG a texture uses that is missing is an error; an image no
 # texture uses is only a warning, and the file renders.
-scene missing_png '{"images": ["nowhere.png"], "texture": {"source": 0}}'
 check_fails "a missing PNG a texture uses: an error" 1 "$G" info "$tmp/missing_png.gltf"
 check "... naming the material, the texture and the image" grep -q "error: .*missing_png.gltf: material 0: baseColorTexture: texture 0: image 0 nowhere.png: file missing or unreadable" "$tmp/last"
-scene unused_png '{"images": ["fallback.png", "nowhere.png"], "texture": {"source": 0}}'
-check "an unreadable image no texture uses: renders" sh -c "'$G' render '$tmp/unused_png.gltf' --spp 1 --size 8x8 --quiet -o '$tmp/unused_png.exr' 2>'$tmp/unused_png.txt'"
+check_queued "an unreadable image no texture uses: renders" 0 unused_png
+cp "$tmp/last" "$tmp/unused_png.txt"
 check "... with a warning saying so" grep -q "warning: .*unused_png.gltf: image 1 nowhere.png: file missing or unreadable; no texture draws it" "$tmp/unused_png.txt"
 # A texture only a material the scene does not draw uses: a warning too.
-python3 - "$tmp/missing_png.gltf" "$tmp/undrawn_png.gltf" <<'PY'
-import json, sys
-d = json.load(open(sys.argv[1]))
-d["images"] = [{"uri": "fallback.png"}, {"uri": "nowhere.png"}]
-d["textures"].append({"source": 1})
-d["materials"].append({"pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}})
-json.dump(d, open(sys.argv[2], "w"))
-PY
-check "a broken texture only an undrawn material uses: renders" sh -c "'$G' render '$tmp/undrawn_png.gltf' --spp 1 --size 8x8 --quiet -o '$tmp/undrawn_png.exr' 2>'$tmp/undrawn_png.txt'"
+check_queued "a broken texture only an undrawn material uses: renders" 0 undrawn_png
+cp "$tmp/last" "$tmp/undrawn_png.txt"
 check "... with a warning saying so" grep -q "warning: .*undrawn_png.gltf: texture 1: image 1 nowhere.png: file missing or unreadable; no material the scene draws uses it" "$tmp/undrawn_png.txt"
 if [ $KTX2 = 1 ]; then
     # Both extensions, the KTX2 image damaged and no core image: the WebP one is drawn.
-    scene both_ext "{\"images\": [\"blocks.webp\", \"trunc.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 1}, \"EXT_texture_webp\": {\"source\": 0}}}, \"used\": [\"KHR_texture_basisu\", \"EXT_texture_webp\"]}"
-    check "a damaged KTX2 beside a WebP, no core image: renders" R both_ext
+    check_queued "a damaged KTX2 beside a WebP, no core image: renders" 0 both_ext
     check "... the WebP's texels" python3 "$tmp/probe.py" "$tmp/both_ext.exr" 0 "$(dirname "$0")/../tool" $N
 fi
 if [ $KTX2 = 1 ]; then

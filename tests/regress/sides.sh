@@ -65,20 +65,6 @@ python3 "$tmp/gen.py" "$tmp/away.gltf" $GREEN $RED_AWAY &&
     python3 "$tmp/gen.py" "$tmp/open.gltf" $GREEN &&
     python3 "$tmp/gen.py" "$tmp/roof.gltf" $GREEN 6,20,0.5,0.5,0.5,0,1 || fail "scenes"
 
-# colour SCENE MODE: "green" or "red", the colour at the centre
-colour() {
-    "$G" render "$tmp/$1.gltf" --mode $2 --spp 8 --size 16x16 --env 1 --compression none --quiet -o "$tmp/$1-$2.exr" ||
-        return 1
-    python3 "$tmp/centre.py" "$tmp/$1-$2.exr" "$T" | awk '{print ($2 > 2 * $1 ? "green" : $1 > 2 * $2 ? "red" : "neither")}'
-}
-for mode in path albedo phong; do
-    got=$(colour away $mode)
-    [ "$got" = green ] && pass || fail "$mode: a single-sided quad turned away hides what is behind it ($got at the centre)"
-    got=$(colour double $mode)
-    [ "$got" = red ] && pass || fail "$mode: the same quad double-sided is not seen ($got at the centre)"
-    got=$(colour toward $mode)
-    [ "$got" = red ] && pass || fail "$mode: a single-sided quad turned toward the camera is not seen ($got at the centre)"
-done
 # instances (a mesh two nodes use is kept once and placed twice: docs/architecture.md): the
 # red quad's mesh used by a second node out of view, and the red quad's node as is (0),
 # mirrored in z (1: a negative determinant, whose front glTF defines as the authored side,
@@ -95,6 +81,37 @@ json.dump(d, open(sys.argv[2], "w"))' "$1" "$2" "$3"
 }
 for m in 0 1 2; do
     inst "$tmp/away.gltf" "$tmp/away-inst$m.gltf" $m && inst "$tmp/toward.gltf" "$tmp/toward-inst$m.gltf" $m || fail "instanced scenes"
+done
+
+# The renders run in one batch (lib.sh: queue); the checks below read each line's status
+# and image.
+# queue_colour SCENE MODE: queues the render that colour reads
+queue_colour() {
+    queue "$1-$2" render "$tmp/$1.gltf" --mode $2 --spp 8 --size 16x16 --env 1 --compression none --quiet -o "$tmp/$1-$2.exr"
+}
+# colour SCENE MODE: "green" or "red", the colour at the centre (of the queued render)
+colour() {
+    [ "$(queued "$1-$2")" = 0 ] || return 1
+    python3 "$tmp/centre.py" "$tmp/$1-$2.exr" "$T" | awk '{print ($2 > 2 * $1 ? "green" : $1 > 2 * $2 ? "red" : "neither")}'
+}
+for mode in path albedo phong; do
+    for sc in away double toward; do queue_colour $sc $mode; done
+done
+for m in 0 1 2; do queue_colour away-inst$m path; queue_colour toward-inst$m path; done
+for sc in open roof; do
+    queue "$sc" render "$tmp/$sc.gltf" --spp 64 --size 16x16 --env 1 --compression none --quiet -o "$tmp/$sc.exr"
+done
+run_queue
+
+for mode in path albedo phong; do
+    got=$(colour away $mode)
+    [ "$got" = green ] && pass || fail "$mode: a single-sided quad turned away hides what is behind it ($got at the centre)"
+    got=$(colour double $mode)
+    [ "$got" = red ] && pass || fail "$mode: the same quad double-sided is not seen ($got at the centre)"
+    got=$(colour toward $mode)
+    [ "$got" = red ] && pass || fail "$mode: a single-sided quad turned toward the camera is not seen ($got at the centre)"
+done
+for m in 0 1 2; do
     "$G" info "$tmp/away-inst$m.gltf" | grep -q "^instances *[1-9]" && pass || fail "the instanced scene has instances"
     what=("an instance" "a mirrored instance" "a turned instance")
     want_away=green want_toward=red
@@ -108,7 +125,7 @@ done
 # bounce rays see a back face: the roof behind the camera (its back to the scene) shades the
 # green quad from the environment above it
 lum() {
-    "$G" render "$tmp/$1.gltf" --spp 64 --size 16x16 --env 1 --compression none --quiet -o "$tmp/$1.exr" &&
+    [ "$(queued "$1")" = 0 ] &&
         python3 "$tmp/centre.py" "$tmp/$1.exr" "$T" | awk '{print 0.2126 * $1 + 0.7152 * $2 + 0.0722 * $3}'
 }
 open=$(lum open) roof=$(lum roof)

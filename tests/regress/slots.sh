@@ -76,17 +76,31 @@ print("%d values wrong, %d differ between factor 0 and 1" % (bad, differ))
 sys.exit(1 if bad or differ == 0 else 0)
 PY
 
-R() { "$G" render "$tmp/$1.gltf" --spp 4 --size ${W}x$H --env 1 --compression none --quiet -o "$tmp/$1.exr"; }
-# slot NAME EXT FACTOR-KEY FACTOR-AT-1 FACTOR-AT-0 TEXTURE-KEY
+# slot NAME EXT FACTOR-KEY FACTOR-AT-1 FACTOR-AT-0 TEXTURE-KEY: writes the three scenes and
+# queues their renders (lib.sh: queue; the script's renders run in one batch); once the queue
+# has run, the checks.
 slot() {
     python3 "$tmp/gen.py" "$tmp/$1-tex.gltf" "$2" "$3" "$4" "$6" &&
         python3 "$tmp/gen.py" "$tmp/$1-one.gltf" "$2" "$3" "$4" - &&
         python3 "$tmp/gen.py" "$tmp/$1-zero.gltf" "$2" "$3" "$5" - || { fail "$1: scenes"; return; }
-    check "$1: renders" sh -c "$(declare -f R); G='$G' W=$W H=$H tmp='$tmp'; R $1-tex && R $1-one && R $1-zero"
+    local v
+    for v in tex one zero; do
+        queue "$1-$v" render "$tmp/$1-$v.gltf" --spp 4 --size ${W}x$H --env 1 --compression none --quiet -o "$tmp/$1-$v.exr"
+    done
+    after_queue slot_checks "$@"
+}
+# all_ok ID...: every queued line gave 0 (the first that did not: its output)
+all_ok() {
+    local id
+    for id; do [ "$(queued "$id")" = 0 ] || { echo "$id:"; cat "$tmp/last"; return 1; }; done
+}
+slot_checks() {
+    check "$1: renders" all_ok $1-tex $1-one $1-zero
     check "$1: $6 scales $3 texel by texel" python3 "$tmp/halves.py" "$tmp/$1-tex.exr" "$tmp/$1-zero.exr" \
         "$tmp/$1-one.exr" "$(dirname "$0")/../tool" $W
 }
 slot specular KHR_materials_specular specularFactor 1 0 specularTexture
 slot specular-color KHR_materials_specular specularColorFactor "[1, 1, 1]" "[0, 0, 0]" specularColorTexture
 slot transmission KHR_materials_transmission transmissionFactor 1 0 transmissionTexture
+run_queue
 finish

@@ -72,9 +72,25 @@ gen sg-tex '{"extensions": {"KHR_materials_pbrSpecularGlossiness": {"diffuseFact
 gen mr-white "$(mr "$D" "$S" 0.75)" "$MR_EXT"  # the left texel: specular x 1, glossiness x 1
 gen mr-black "$(mr "$D" '[0, 0, 0]' 0)" "$MR_EXT" # the right one: specular x 0, glossiness x 0
 
-R() { "$G" render "$tmp/$1.gltf" --spp 4 --size ${W}x$H --env 1 --compression none --quiet -o "$tmp/$1.exr"; }
+# a bad value (checked below)
+gen bad '{"extensions": {"KHR_materials_pbrSpecularGlossiness": {"specularFactor": [0.5, "x", 0.5]}}}' "$SG_EXT"
+f=$A/gltf/SpecGlossVsMetalRough/glTF/SpecGlossVsMetalRough.gltf
+assets=0
+[ -n "$A" ] && [ -f "$f" ] && assets=1
+
+# ---- the renders, queued (lib.sh: queue), run in one batch --------------------------------
 for s in sg-factors mr-factors sg-tex mr-white mr-black; do
-    check "$s renders" R $s
+    queue $s render "$tmp/$s.gltf" --spp 4 --size ${W}x$H --env 1 --compression none --quiet -o "$tmp/$s.exr"
+done
+queue bad render "$tmp/bad.gltf" --spp 1 --size 8x8 -o "$tmp/bad.exr"
+# From 5 m away with a 3.665 degree view the image is 0.32 m wide: the bottles (at x = -0.08
+# and +0.08, the same turn) fill a half each, nearly as a translated copy.
+[ $assets = 1 ] && queue sgmr render "$f" --size 64x64 --spp 16 --look-at 0,0.03,5,0,0.03,0 \
+    --fov 3.665 --compression none --quiet -o "$tmp/sgmr.exr"
+run_queue
+
+for s in sg-factors mr-factors sg-tex mr-white mr-black; do
+    check_queued "$s renders" 0 $s
 done
 
 # halves.py A.exr LEFT.exr RIGHT.exr TOOLDIR W: A's left half is LEFT's, its right half
@@ -110,21 +126,16 @@ check "specularGlossinessTexture: RGB scales the specular colour, A the glossine
     python3 "$tmp/halves.py" "$tmp/sg-tex.exr" "$tmp/mr-white.exr" "$tmp/mr-black.exr" "$T" $W
 
 # a bad value: an error naming the JSON path, exit 1
-gen bad '{"extensions": {"KHR_materials_pbrSpecularGlossiness": {"specularFactor": [0.5, "x", 0.5]}}}' "$SG_EXT"
-check_fails "a specularFactor of the wrong type is refused" 1 "$G" render "$tmp/bad.gltf" --spp 1 --size 8x8 -o "$tmp/bad.exr"
+check_queued "a specularFactor of the wrong type is refused" 1 bad
 check "... naming its JSON path" grep -q "materials\[0\].extensions.KHR_materials_pbrSpecularGlossiness.specularFactor" "$tmp/last"
 
-[ -n "$A" ] && [ -f "$A/gltf/SpecGlossVsMetalRough/glTF/SpecGlossVsMetalRough.gltf" ] || {
+[ $assets = 1 ] || {
     echo "  (SpecGlossVsMetalRough skipped: no test assets)"
     finish
     exit
 }
-f=$A/gltf/SpecGlossVsMetalRough/glTF/SpecGlossVsMetalRough.gltf
 check "gonio info lists the extension as supported" sh -c "'$G' info '$f' | grep -q 'KHR_materials_pbrSpecularGlossiness (required): supported'"
-# From 5 m away with a 3.665 degree view the image is 0.32 m wide: the bottles (at x = -0.08
-# and +0.08, the same turn) fill a half each, nearly as a translated copy.
-check "SpecGlossVsMetalRough renders straight on" "$G" render "$f" --size 64x64 --spp 16 --look-at 0,0.03,5,0,0.03,0 \
-    --fov 3.665 --compression none --quiet -o "$tmp/sgmr.exr"
+check_queued "SpecGlossVsMetalRough renders straight on" 0 sgmr
 cat >"$tmp/means.py" <<'PY'
 import sys
 sys.path.insert(0, sys.argv[2])
