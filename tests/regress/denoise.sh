@@ -42,32 +42,48 @@ if [ ! -e "$lib" ] && [ -z "${GONIO_OIDN_LIB:-}" ]; then
     skip_all "no Open Image Denoise at $lib (make denoiser fetches it): the checks that denoise did not run"
 fi
 
+# The renders and the bench below run in one batch (lib.sh: queue), the checks after it; the
+# lines run in order, so --resume finds its 8 spp file. (The commands that set GONIO_OIDN_LIB,
+# the usage errors and gonio denoise stay processes of their own.)
+V="--look-at 0,0.15,0.8,0,0.12,0 --fov 30 --size 64x64 --quiet"
+queue d render $C -o "$tmp/d.exr" --png "$tmp/d.png" --spp 16 --denoise $R
+queue n render $C -o "$tmp/n.exr" --png "$tmp/n.png" --spp 16 $R
+queue da render $C -o "$tmp/da.exr" --spp 16 --denoise --aov albedo,normal,depth $R
+queue dt render $C -o "$tmp/dt.exr" --time 0.5 --denoise $R
+queue ds render $C -o "$tmp/ds.exr" --spp 4 --size 32x32 --denoise
+queue bench bench $C --paths --denoise --size 16x16 --seconds 0.2 --reference 16x16:32
+queue r8 render $C -o "$tmp/r8.exr" --spp 8 --resumable --denoise $R
+queue r16 render $C -o "$tmp/r16.exr" --spp 16 --resume "$tmp/r8.exr" --denoise $R
+queue g render $C -o "$tmp/g.exr" --spp 16 --aov albedo,normal $R
+queue small render $C -o "$tmp/small.exr" --spp 1 --aov albedo --size 32x32 --quiet
+queue q-ref render $C -o "$tmp/q-ref.exr" --spp 512 --seed 1 $V
+queue q render $C -o "$tmp/q.exr" --spp 16 --denoise $V
+run_queue
+
 # ---- render --denoise: layers, header, the noisy layer is the render ---------------------------
 channels() { exrheader "$1" | sed -n 's/^ *\([A-Za-z.]*\), 32-bit floating-point.*/\1/p' | sort | tr '\n' ' '; }
-check "render --denoise" "$G" render $C -o "$tmp/d.exr" --png "$tmp/d.png" --spp 16 --denoise $R
+check_queued "render --denoise" 0 d
 check "... channels R, G, B, A and the noisy layer, nothing else (no --aov)" \
     test "$(channels "$tmp/d.exr")" = "A B G R noisy.B noisy.G noisy.R "
 check "... the header names the denoiser, its version and what it did" \
     sh -c "exrheader '$tmp/d.exr' | grep -Eq 'gonio:denoiser .*OpenImageDenoise 2\.[0-9]+\.[0-9]+ RT \(hdr, albedo\+normal prefiltered, cleanAux'"
 check "... and its time" sh -c "exrheader '$tmp/d.exr' | grep -q 'gonio:denoise-seconds (type double)'"
-check "render the same without --denoise" "$G" render $C -o "$tmp/n.exr" --png "$tmp/n.png" --spp 16 $R
+check_queued "render the same without --denoise" 0 n
 check "the noisy layer as R, G, B" "$T" rename "$tmp/d.exr" "$tmp/d-noisy.exr" R=,G=,B=,noisy.R=R,noisy.G=G,noisy.B=B
 check "... is the render without --denoise, bit for bit" "$T" same "$tmp/n.exr" "$tmp/d-noisy.exr"
 check "the denoised R, G, B differ from it" sh -c "! '$T' same '$tmp/n.exr' '$tmp/d.exr'"
 check "the PNG is the denoised one: it differs from the noisy render's" \
     sh -c "[ \"\$(compare -metric AE '$tmp/d.png' '$tmp/n.png' null: 2>&1)\" -gt 1000 ]"
-check "render --denoise --aov albedo,normal,depth keeps what --aov asks" \
-    "$G" render $C -o "$tmp/da.exr" --spp 16 --denoise --aov albedo,normal,depth $R
+check_queued "render --denoise --aov albedo,normal,depth keeps what --aov asks" 0 da
 check "... the guides and depth beside the layers" test "$(channels "$tmp/da.exr")" = \
     "A B G R albedo.B albedo.G albedo.R depth.Z noisy.B noisy.G noisy.R normal.X normal.Y normal.Z "
-check "render --denoise --time" "$G" render $C -o "$tmp/dt.exr" --time 0.5 --denoise $R
+check_queued "render --denoise --time" 0 dt
 check "... is denoised" sh -c "exrheader '$tmp/dt.exr' | grep -q 'gonio:denoiser'"
-check "the summary line reports the denoise time apart" \
-    sh -c "'$G' render $C -o '$tmp/ds.exr' --spp 4 --size 32x32 --denoise 2>&1 | grep -q 'denoised in [0-9.]* s'"
+check "the summary line reports the denoise time apart" grep -q 'denoised in [0-9.]* s' "$tmp/queue/ds.log"
 
 # ---- bench --paths --denoise: the equal-quality speed-up (docs/performance.md) ----------------
-check "bench --paths --denoise" "$G" bench $C --paths --denoise --size 16x16 --seconds 0.2 --reference 16x16:32
-cp "$tmp/out" "$tmp/bench.txt"
+check_queued "bench --paths --denoise" 0 bench
+cp "$tmp/last" "$tmp/bench.txt"
 for line in "rmse < 0.05 " "rmse < 0.02 " "denoised rmse < 0.05 " "denoised rmse < 0.02 " \
     "denoise speed-up .* at rmse 0.05" "denoise speed-up .* at rmse 0.02"; do
     check "... prints '$line'" grep -Eq "^$line" "$tmp/bench.txt"
@@ -77,15 +93,15 @@ check_fails "bench --denoise without --paths is bad usage" 2 "$G" bench $C --den
 # ---- merge and resume -------------------------------------------------------------------------
 check_fails "gonio merge refuses a denoised file" 1 "$G" merge "$tmp/d.exr" "$tmp/n.exr" -o "$tmp/m.exr"
 check "... saying why and what to do instead" sh -c "grep -q 'is denoised' '$tmp/last' && grep -q 'gonio denoise' '$tmp/last'"
-check "--resumable --denoise at 8 spp" "$G" render $C -o "$tmp/r8.exr" --spp 8 --resumable --denoise $R
-check "--resume it to 16 spp, --denoise" "$G" render $C -o "$tmp/r16.exr" --spp 16 --resume "$tmp/r8.exr" --denoise $R
+check_queued "--resumable --denoise at 8 spp" 0 r8
+check_queued "--resume it to 16 spp, --denoise" 0 r16
 check "... its noisy layer" "$T" rename "$tmp/r16.exr" "$tmp/r16-noisy.exr" R=,G=,B=,noisy.R=R,noisy.G=G,noisy.B=B
 check "... is the 16 spp render, bit for bit (the sums stayed the noisy ones)" "$T" same "$tmp/n.exr" "$tmp/r16-noisy.exr"
 check "... and its denoised image that of render --denoise at 16 spp" \
     "$G" diff "$tmp/r16.exr" "$tmp/d.exr" --max-error 1e-4 --quiet
 
 # ---- gonio denoise ----------------------------------------------------------------------------
-check "render the guides (--aov albedo,normal)" "$G" render $C -o "$tmp/g.exr" --spp 16 --aov albedo,normal $R
+check_queued "render the guides (--aov albedo,normal)" 0 g
 check "gonio denoise it" "$G" denoise "$tmp/g.exr" -o "$tmp/gd.exr" --png "$tmp/gd.png" --quiet
 check "... equals render --denoise of the same samples" "$G" diff "$tmp/gd.exr" "$tmp/d.exr" --max-error 1e-4 --quiet
 check "... keeps the guides and the noisy layer" test "$(channels "$tmp/gd.exr")" = \
@@ -121,7 +137,7 @@ check "a NaN in the beauty" "$T" poke "$tmp/g.exr" G 5 7 nan "$tmp/nan.exr"
 bad "a NaN pixel" "nan.exr: 1 value(s) of the beauty (R, G, B) are NaN or infinite, the first at pixel (5, 7)" "$tmp/nan.exr"
 check "an infinity in the albedo" "$T" poke "$tmp/g.exr" albedo.R 0 3 inf "$tmp/inf.exr"
 bad "an infinite guide" "inf.exr: 1 value(s) of the albedo" "$tmp/inf.exr"
-check "a guide of another size" "$G" render $C -o "$tmp/small.exr" --spp 1 --aov albedo --size 32x32 --quiet
+check_queued "a guide of another size" 0 small
 bad "an albedo file of another size" "small.exr: its 32x32 pixels .* are not those of .*n.exr, 64x64" "$tmp/n.exr" --albedo "$tmp/small.exr"
 bad "--beauty naming no layer" "no channels nope.R" "$tmp/g.exr" --beauty nope
 mkfifo "$tmp/fifo.exr"
@@ -142,9 +158,9 @@ check_fails "gonio denoise -o a name it cannot write is bad usage" 2 "$G" denois
 # reference's own noise, 0.0026, is in both); the denoised mean within 0.11% of the noisy
 # image's own (whose mean is within 0.7% of the reference's: the noise of a 64x64 mean).
 # Required: at least 2.2 times lower, and the mean within 0.5% of the noisy one's.
-V="--look-at 0,0.15,0.8,0,0.12,0 --fov 30 --size 64x64 --quiet"
-check "reference: 512 spp" "$G" render $C -o "$tmp/q-ref.exr" --spp 512 --seed 1 $V
-check "16 spp, --denoise" "$G" render $C -o "$tmp/q.exr" --spp 16 --denoise $V
+# (V and the renders: the batch above)
+check_queued "reference: 512 spp" 0 q-ref
+check_queued "16 spp, --denoise" 0 q
 check "... its noisy layer" "$T" rename "$tmp/q.exr" "$tmp/q-noisy.exr" R=,G=,B=,noisy.R=R,noisy.G=G,noisy.B=B
 rmse() { "$G" diff "$1" "$tmp/q-ref.exr" | sed -n 's/^rmse //p'; }
 noisy=$(rmse "$tmp/q-noisy.exr")

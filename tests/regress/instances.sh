@@ -25,7 +25,7 @@ check "info: the instances place the flattened scene's triangles ($placed, $flat
 check "info: a top tree over them" grep -q 'top tree over 20 instances' "$tmp/info"
 check "info: the scene's memory" grep -q '^scene memory .* instances 0.00' "$tmp/info"
 
-# (the renders below, up to the animation, in one batch: lib.sh, queue)
+# (the renders below in one batch: lib.sh, queue; the checks read them after it)
 for m in normal depth albedo phong flat gouraud; do
     queue "i-$m" render "$I" -o "$tmp/i-$m.exr" --mode $m --size 48x48 --spp 1 $V
     queue "f-$m" render "$F" -o "$tmp/f-$m.exr" --mode $m --size 48x48 --spp 1 $V
@@ -38,6 +38,22 @@ queue pf3 render "$F" -o "$tmp/pf3.exr" $P --seed 3
 queue one render "$I" -o "$tmp/one.exr" --spp 3 --size 24x24 --env 0.3 --aov albedo,normal,depth $V
 queue two GONIO_LOOP_CAP=3000 GONIO_DEBUG_RESUMES=1 render "$I" -o "$tmp/two.exr" --spp 3 --size 24x24 \
     --env 0.3 --aov albedo,normal,depth $V
+queue frames render "$tmp/inst-anim.gltf" --camera 0 --size 32x32 --spp 1 --mode phong --fps 1 \
+    --frames 0-2 -o "$tmp/fr_%d.exr"
+for k in 0 2; do
+    queue "frame-$k" render "$tmp/inst-anim.gltf" --camera 0 --size 32x32 --spp 1 --mode phong --fps 1 --frame $k \
+        -o "$tmp/one_$k.exr" --quiet
+done
+S=$A/SimpleInstancing/glTF/SimpleInstancing.gltf
+if [ -f "$S" ]; then
+    python3 "$(dirname "$0")/../tool/instances.py" flatten "$S" "$tmp/si-flat.gltf"
+    queue si render "$S" -o "$tmp/si.exr" --mode phong --size 64x64 --spp 1 --quiet
+    queue si-flat render "$tmp/si-flat.gltf" -o "$tmp/si-flat.exr" --mode phong --size 64x64 --spp 1 --quiet
+    queue si-png render "$S" -o "$tmp/si.png" --size 32x32 --spp 1
+fi
+while read -r bad path; do
+    queue "bad-$bad" render "$tmp/bad-$bad.gltf" -o "$tmp/bad.exr" --quiet
+done <"$tmp/bad.txt"
 run_queue
 
 # The local modes: the same pixels up to the transforms' rounding
@@ -72,31 +88,25 @@ fi
 # An animation (--frames): a frame that only moves instances keeps the trees and kernels of the
 # frame before and rebuilds only the top tree (a mesh used once that the animation moves is
 # an instance for --frames); each frame is the one --frame renders alone
-check "--frames renders" "$G" render "$tmp/inst-anim.gltf" --camera 0 --size 32x32 --spp 1 --mode phong --fps 1 \
-    --frames 0-2 -o "$tmp/fr_%d.exr"
+check_queued "--frames renders" 0 frames
 check "... frames 1 and 2 rebuild only the top tree" \
-    test "$(grep -c 'frame [12]: the same geometry, moved: the top tree over 20 instances rebuilt' "$tmp/out")" = 2
+    test "$(grep -c 'frame [12]: the same geometry, moved: the top tree over 20 instances rebuilt' "$tmp/queue/frames.log")" = 2
 for k in 0 2; do
-    "$G" render "$tmp/inst-anim.gltf" --camera 0 --size 32x32 --spp 1 --mode phong --fps 1 --frame $k -o "$tmp/one_$k.exr" --quiet
     check "... frame $k = --frame $k" "$G" diff "$tmp/fr_$k.exr" "$tmp/one_$k.exr" --max-rmse 1e-3 --quiet
 done
 check "... and the frames differ" sh -c "! '$G' diff '$tmp/fr_0.exr' '$tmp/fr_2.exr' --max-rmse 1e-2 --quiet"
 
-# A Khronos sample: 125 instances of a cube, like its flattened self
-S=$A/SimpleInstancing/glTF/SimpleInstancing.gltf
+# A Khronos sample: 125 instances of a cube, like its flattened self (S: the batch above)
 if [ -f "$S" ]; then
-    python3 "$(dirname "$0")/../tool/instances.py" flatten "$S" "$tmp/si-flat.gltf"
     check "SimpleInstancing: 125 instances" sh -c "'$G' info '$S' | grep -q '^instances *125 '"
-    "$G" render "$S" -o "$tmp/si.exr" --mode phong --size 64x64 --spp 1 --quiet &&
-        "$G" render "$tmp/si-flat.gltf" -o "$tmp/si-flat.exr" --mode phong --size 64x64 --spp 1 --quiet
     check "SimpleInstancing = flattened" "$G" diff "$tmp/si.exr" "$tmp/si-flat.exr" --max-rmse 1e-3 --quiet
-    check_fails "SimpleInstancing: no warning" 0 "$G" render "$S" -o "$tmp/si.png" --size 32x32 --spp 1
+    check_queued "SimpleInstancing: no warning" 0 si-png
     check "... about the extension" sh -c "! grep -q 'warning' '$tmp/last'"
 fi
 
 # A wrong attribute: an error naming the file and the JSON path, no output
 while read -r bad path; do
-    check_fails "bad $bad: an error" 1 "$G" render "$tmp/bad-$bad.gltf" -o "$tmp/bad.exr" --quiet
+    check_queued "bad $bad: an error" 1 "bad-$bad"
     check "bad $bad: names $path" grep -qF "bad-$bad.gltf: $path" "$tmp/last"
 done <"$tmp/bad.txt"
 check "no output from bad files" test ! -e "$tmp/bad.exr"
