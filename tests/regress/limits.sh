@@ -15,13 +15,13 @@ lacks() { if grep -qF -- "$2" "$1"; then fail "$1 has '$2'"; else pass; fi; }
 
 # ---- above lavapipe's maxStorageBufferRange (128 MiB): 3000x3000 x 16 bytes = 144 MB -----
 # The validation layer is on (tests/run.sh): a buffer bound beyond the range fails the run.
-"$G" render $S --mode phong --spp 1 --size 3000x3000 -o "$tmp/big.exr" 2>"$tmp/big.log"
-check "a 3000x3000 render passes validation" test $? = 0
-has "$tmp/big.log" "3000x3000 rendered in 2 bands of 1504 rows"
-has "$tmp/big.log" "maxStorageBufferRange"
-# (slow: a second 9-megapixel render; the fast tier's bands below compare bands with one
-# piece on small images)
+# (slow: two 9-megapixel renders; the fast tier's bands below take the same path with the
+# limit lowered, on small images)
 if in_tier slow; then
+    "$G" render $S --mode phong --spp 1 --size 3000x3000 -o "$tmp/big.exr" 2>"$tmp/big.log"
+    check "a 3000x3000 render passes validation" test $? = 0
+    has "$tmp/big.log" "3000x3000 rendered in 2 bands of 1504 rows"
+    has "$tmp/big.log" "maxStorageBufferRange"
     GONIO_MAX_BUFFER_BYTES=40000000 "$G" render $S --mode phong --spp 1 --size 3000x3000 \
         -o "$tmp/big7.exr" 2>"$tmp/big7.log"
     check "the same render in smaller bands passes" test $? = 0
