@@ -91,16 +91,16 @@ if in_tier fast; then
         same_as_unspecialised "--brdf $model" $C --brdf "$model" --env 0.2
     done
     same_as_unspecialised "AOVs" $C --aov albedo,normal,depth,variance
-    same_as_unspecialised "an environment map" scenes/teapot.gltf --env "$tmp/d.exr"
     # textures and normal maps; punctual lights
     for m in DamagedHelmet LightsPunctualLamp; do
         f=$A/$m/glTF/$m.gltf
         [ -f "$f" ] && same_as_unspecialised "$m" "$f" --env 0.5
     done
-    f=${GONIO_ASSETS:-}/asset-generator/Material_MetallicRoughness/Material_MetallicRoughness_01.gltf
-    [ -f "$f" ] && same_as_unspecialised "vertex colours (Asset Generator)" "$f" --env 0.5
 fi
 if in_tier slow; then
+    same_as_unspecialised "an environment map" scenes/teapot.gltf --env "$tmp/d.exr"
+    f=${GONIO_ASSETS:-}/asset-generator/Material_MetallicRoughness/Material_MetallicRoughness_01.gltf
+    [ -f "$f" ] && same_as_unspecialised "vertex colours (Asset Generator)" "$f" --env 0.5
     same_as_unspecialised "light sampling only" $C --estimator light
     same_as_unspecialised "BSDF sampling only" $C --estimator bsdf
     for model in $models conductor:alpha=0 dielectric:alpha=0.3 \
