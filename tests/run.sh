@@ -127,12 +127,15 @@ trap cleanup EXIT
 trap 'exit 130' INT TERM
 
 # Start order: longest first, by the times the last run in this build tree took (kept
-# beside the unit-test binary); a job not timed yet goes first. The printed order is fixed.
+# beside the unit-test binary), else by tests/job-times (typical times on 2 cores, so that a
+# fresh clone's first run starts its long jobs first too); a job timed in neither goes
+# first. The printed order is fixed.
 times_file=$(dirname "$UNIT")/test-times
 declare -A last_time=()
-if [ -r "$times_file" ]; then
-    while read -r name secs; do last_time[$name]=$secs; done <"$times_file"
-fi
+for f in "$here/job-times" "$times_file"; do
+    [ -r "$f" ] || continue
+    while read -r name secs; do [ -n "$name" ] && [ "${name#\#}" = "$name" ] && last_time[$name]=$secs; done <"$f"
+done
 order=$(for ((i = 0; i < n; i++)); do echo "${last_time[${job_name[i]}]:-9999} $i"; done | sort -k1,1nr -k2,2n | cut -d' ' -f2)
 order=($order)
 
