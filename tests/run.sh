@@ -131,12 +131,14 @@ trap 'exit 130' INT TERM
 # fresh clone's first run starts its long jobs first too); a job timed in neither goes
 # first. The printed order is fixed.
 times_file=$(dirname "$UNIT")/test-times
-declare -A last_time=()
-for f in "$here/job-times" "$times_file"; do
-    [ -r "$f" ] || continue
-    while read -r name secs; do [ -n "$name" ] && [ "${name#\#}" = "$name" ] && last_time[$name]=$secs; done <"$f"
-done
-order=$(for ((i = 0; i < n; i++)); do echo "${last_time[${job_name[i]}]:-9999} $i"; done | sort -k1,1nr -k2,2n | cut -d' ' -f2)
+declare -A last_time=() typical_time=()
+if [ -r "$here/job-times" ]; then
+    while read -r name secs; do [ -n "$name" ] && [ "${name#\#}" = "$name" ] && typical_time[$name]=$secs; done <"$here/job-times"
+fi
+if [ -r "$times_file" ]; then
+    while read -r name secs; do last_time[$name]=$secs; done <"$times_file"
+fi
+order=$(for ((i = 0; i < n; i++)); do echo "${last_time[${job_name[i]}]:-${typical_time[${job_name[i]}]:-9999}} $i"; done | sort -k1,1nr -k2,2n | cut -d' ' -f2)
 order=($order)
 
 # run_job I: runs job I with its output in $jobdir/I.out; writes its status and seconds.

@@ -215,7 +215,8 @@ int cmd_batch(int argc, char **argv)
                 snprintf(name, sizeof name, "%s/%d.%s", logs, number, what[k]);
                 FILE *s = fopen(name, "w");
                 int w = !s ? -1 : k == 0 ? fprintf(s, "%d\n", status) : fprintf(s, "%.3f\n", util_now() - t0);
-                if (!s || w < 0 || fclose(s) != 0) {
+                int c = s ? fclose(s) : EOF;
+                if (w < 0 || c != 0) {
                     util_error("%s: cannot write", name);
                     failed++;
                 }

@@ -6,8 +6,8 @@
 G=$GONIO
 C=scenes/cornell.gltf
 
-# The fast tier has one case of each kind below; the slow tier (lib.sh: in_tier) the same
-# checks on more models, scenes and settings.
+# The fast tier has the cases below that tests/README.md names; the slow tier (lib.sh:
+# in_tier) the same checks on more models, estimators, scenes and settings.
 if in_tier fast; then
 check "path is the default mode" "$G" render $C -o "$tmp/d.exr" --spp 2 --size 32x32 --quiet
 exrheader "$tmp/d.exr" >"$tmp/hdr.txt" 2>&1
