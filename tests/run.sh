@@ -64,7 +64,8 @@ export GONIO_TEST_TIER=$tier
 # The fast tier runs lavapipe's kernels without LLVM's optimisation passes (GALLIVM_PERF=nopt):
 # its renders are small, so compiling a kernel variant costs more than running it, and nopt
 # compiles in about half the time and runs about 40 % slower (docs/performance.md). The slow
-# tier keeps the optimised kernels, so CI runs both. GALLIVM_PERF set outside (even empty) wins.
+# tier keeps the optimised kernels (make test-full runs every check so). GALLIVM_PERF set
+# outside (even empty) wins.
 [ "$tier" = fast ] && export GALLIVM_PERF=${GALLIVM_PERF-nopt}
 
 # ---- the jobs ------------------------------------------------------------------------------
