@@ -141,6 +141,20 @@ static int run_line(char **words, int n)
     return rc;
 }
 
+/* Writes text to DIR/N.EXT (a line's status or time), saying so when it cannot. */
+static bool write_line_file(const char *dir, int number, const char *ext, const char *text)
+{
+    char name[4096];
+    snprintf(name, sizeof name, "%s/%d.%s", dir, number, ext);
+    FILE *f = fopen(name, "w");
+    bool ok = f && fputs(text, f) >= 0;
+    if (f && fclose(f) != 0)
+        ok = false;
+    if (!ok)
+        util_error("%s: cannot write", name);
+    return ok;
+}
+
 int cmd_batch(int argc, char **argv)
 {
     const char *logs = NULL;
@@ -210,17 +224,11 @@ int cmd_batch(int argc, char **argv)
         if (logged)
             restore_output(saved);
         if (logs) {
-            const char *what[2] = {"status", "time"};
-            for (int k = 0; k < 2; k++) {
-                snprintf(name, sizeof name, "%s/%d.%s", logs, number, what[k]);
-                FILE *s = fopen(name, "w");
-                int w = !s ? -1 : k == 0 ? fprintf(s, "%d\n", status) : fprintf(s, "%.3f\n", util_now() - t0);
-                int c = s ? fclose(s) : EOF;
-                if (w < 0 || c != 0) {
-                    util_error("%s: cannot write", name);
-                    failed++;
-                }
-            }
+            char text[64];
+            snprintf(text, sizeof text, "%d\n", status);
+            failed += !write_line_file(logs, number, "status", text);
+            snprintf(text, sizeof text, "%.3f\n", util_now() - t0);
+            failed += !write_line_file(logs, number, "time", text);
         }
         if (status != 0) {
             failed++;
