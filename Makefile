@@ -144,15 +144,16 @@ DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools lib
 	libdraco-dev libmeshoptimizer-dev libwebp-dev libzstd-dev
 # man-db: tests/regress/cli.sh renders the installed man page with man -l.
 # webp: cwebp, the tests' encoder of WebP textures (tests/regress/image_formats.sh).
+# python3: the scripts' small helpers (tests/tool/*.py; the standard library only).
 # libmagickcore-6.q16-6-extra: ImageMagick's EXR coder (only a recommendation of imagemagick,
 # which --no-install-recommends leaves out); tests/regress/diff.sh writes EXRs with it.
 DEB_TEST := vulkan-validationlayers openexr xvfb xauth imagemagick libmagickcore-6.q16-6-extra \
-	x11-apps xdotool man-db webp
+	x11-apps xdotool man-db webp python3
 DEPS_CHECK = { command -v glslangValidator && command -v spirv-val && command -v pkg-config \
 	&& command -v help2man && pkg-config --exists $(PKGS) && ls /usr/include/meshoptimizer.h && ls /usr/share/vulkan/icd.d/lvp_icd*.json; } >/dev/null 2>&1
 TEST_DEPS_CHECK = { ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json \
 	&& command -v exrheader && command -v xvfb-run && command -v xauth && command -v import \
-	&& command -v xwd && command -v xdotool && command -v man && command -v cwebp \
+	&& command -v xwd && command -v xdotool && command -v man && command -v cwebp && test -x /usr/bin/python3 \
 	&& convert -list format | grep -q 'EXR.*rw'; } >/dev/null 2>&1
 
 # make fuzz only: clang and its libFuzzer runtime (Debian 12's clang is clang-14).

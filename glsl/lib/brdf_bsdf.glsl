@@ -379,7 +379,7 @@ void brdf_dt_eval_pdf(Bsdf b, vec3 wo, vec3 wi, float px, inout vec3 f, inout fl
 {
     float q = brdf_dt_prob(b, wo), pd = px * abs(wi.z) / BRDF_PI;
     if (wo.z > 0.0 && wi.z > 0.0) {
-        pdf -= q * pd;
+        pdf = max(pdf - q * pd, 0.0); // (all of the diffuse part's: q = 1, and rounding may leave -ulp)
     } else if (wo.z * wi.z < 0.0) {
         f += brdf_coupled(b, b.dt, abs(wo.z), abs(wi.z));
         pdf += q * pd;
