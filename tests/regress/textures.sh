@@ -133,7 +133,6 @@ sys.exit(1 if bad or checked < 50 else 0)
 PY
 
 scene() { python3 "$tmp/gen.py" "$tmp/$1.gltf" "$2"; }
-R() { "$G" render "$tmp/$1.gltf" --mode albedo --spp 1 --size ${N}x$N --quiet -o "$tmp/$1.exr" "${@:2}"; }
 # case NAME OPTIONS DESCRIPTION: write the scene and queue its render (lib.sh, queue); once
 # the queue has run, probe it.
 case_() {
@@ -163,16 +162,33 @@ UV01='"uv0": [[0.01, 0.01], [0.02, 0.02]], "uv1": [[0, 0], [1, 1]]'
 case_ uv1 "{$UV01, \"texcoord\": 1}" "texCoord 1 reads TEXCOORD_1"
 case_ uv1tt "{$UV01, \"texcoord\": 0, \"tt\": {\"texCoord\": 1, \"offset\": [0.5, 0]}}" \
     "KHR_texture_transform's texCoord overrides the reference's"
-run_queue
-scene uv1none "{\"uv0\": [[0, 0], [1, 1]], \"texcoord\": 2}"
-"$G" render "$tmp/uv1none.gltf" --mode albedo --spp 1 --size 8x8 --quiet -o "$tmp/uv1none.exr" 2>"$tmp/uv1none.txt"
-check "texCoord 2 is dropped with a warning" grep -q "uses TEXCOORD_2, only TEXCOORD_0 and TEXCOORD_1" "$tmp/uv1none.txt"
 
+# The scenes below render in the same batch (lib.sh, queue), their checks after it.
+# R NAME [MODE [SIZE]]: queues the render of $tmp/NAME.gltf (--mode albedo, N x N by default).
+R() { queue "$1" render "$tmp/$1.gltf" --mode "${2:-albedo}" --spp 1 --size "${3:-${N}x$N}" --quiet -o "$tmp/$1.exr"; }
+scene uv1none "{\"uv0\": [[0, 0], [1, 1]], \"texcoord\": 2}" && R uv1none albedo 8x8
 # Filters: bilinear (magFilter LINEAR) blends the two nearest texel centres linearly:
 # along row 30, pixel x's centre lies at p = (x + 0.5) / 12 - 0.5 texel centres, so R is
 # (1 - f) texel floor(p) + f the next, f = p - floor(p) (sRGB decoded before blending).
 # Without magFilter, minFilter NEAREST_MIPMAP_LINEAR's NEAREST is used.
 scene linear "{$UV, \"mag\": 9729}" && R linear
+scene minnear "{$UV, \"mag\": null, \"min\": 9986}" && R minnear
+# KHR_mesh_quantization: positions as unsigned shorts (moved by the node), normals as
+# normalized bytes, texture coordinates as signed shorts, which hold the float scene's
+# values exactly: the same image to the bit.
+scene float_q "{$WIDE, \"wrap\": [33648, 10497]}" && R float_q
+scene quant "{$WIDE, \"wrap\": [33648, 10497], \"quant\": true}" && R quant
+# Normals: a byte's step is 1/127, so each component is off by at most 0.5/127 = 0.0039
+# before renormalisation, which changes the direction by at most about 2 x 0.0039.
+NRM='"normal": [0.6, 0.0, 0.8]'
+scene nfloat "{$UV, $NRM}" && R nfloat normal 16x16
+scene nquant "{$UV, $NRM, \"quant\": true}" && R nquant normal 16x16
+scene undeclared "{$UV, \"quant\": true, \"declare_quant\": false}" && R undeclared albedo 8x8
+run_queue
+
+check_queued "texCoord 2: renders" 0 uv1none
+check "texCoord 2 is dropped with a warning" grep -q "uses TEXCOORD_2, only TEXCOORD_0 and TEXCOORD_1" "$tmp/last"
+check_queued "LINEAR: renders" 0 linear
 check "LINEAR: bilinear between texel centres" python3 -c "
 import math, subprocess, sys
 lin = lambda c: (((c/255) + 0.055) / 1.055) ** 2.4
@@ -185,27 +201,16 @@ for x in range(6, 42):
     got = row[x - 6]
     if abs(got - want) > 1e-3 * want + 1e-4: bad += 1; print(x, got, want)
 sys.exit(1 if bad else 0)" "$TESTTOOL" "$tmp/linear.exr"
-scene minnear "{$UV, \"mag\": null, \"min\": 9986}" && R minnear
+check_queued "no magFilter: renders" 0 minnear
 check "no magFilter: minFilter NEAREST_MIPMAP_LINEAR samples nearest" \
     python3 "$tmp/probe.py" "$tmp/minnear.exr" "{$UV}" "$TESTTOOL" $N
-
-# KHR_mesh_quantization: positions as unsigned shorts (moved by the node), normals as
-# normalized bytes, texture coordinates as signed shorts, which hold the float scene's
-# values exactly: the same image to the bit.
-scene float_q "{$WIDE, \"wrap\": [33648, 10497]}" && R float_q
-scene quant "{$WIDE, \"wrap\": [33648, 10497], \"quant\": true}"
-check "quantized mesh renders" R quant
+check_queued "float mesh renders" 0 float_q
+check_queued "quantized mesh renders" 0 quant
 check "quantized mesh: the float original's image exactly" "$G" diff "$tmp/float_q.exr" "$tmp/quant.exr" --max-error 0
-# Normals: a byte's step is 1/127, so each component is off by at most 0.5/127 = 0.0039
-# before renormalisation, which changes the direction by at most about 2 x 0.0039.
-NRM='"normal": [0.6, 0.0, 0.8]'
-scene nfloat "{$UV, $NRM}" && "$G" render "$tmp/nfloat.gltf" --mode normal --spp 1 --size 16x16 --quiet -o "$tmp/nfloat.exr"
-scene nquant "{$UV, $NRM, \"quant\": true}"
-check "quantized normals render" "$G" render "$tmp/nquant.gltf" --mode normal --spp 1 --size 16x16 --quiet -o "$tmp/nquant.exr"
+check_queued "float normals render" 0 nfloat
+check_queued "quantized normals render" 0 nquant
 check "quantized normals within their step" "$G" diff "$tmp/nfloat.exr" "$tmp/nquant.exr" --max-error 0.008
-scene undeclared "{$UV, \"quant\": true, \"declare_quant\": false}"
-check_fails "quantized attributes without KHR_mesh_quantization" 1 \
-    "$G" render "$tmp/undeclared.gltf" --mode albedo --spp 1 --size 8x8 --quiet -o "$tmp/undeclared.exr"
+check_queued "quantized attributes without KHR_mesh_quantization" 1 undeclared
 check "error names the file and the extension" grep -q "undeclared.gltf: .*not allowed for attribute .*needs KHR_mesh_quantization" "$tmp/last"
 check "no output after the error" test ! -e "$tmp/undeclared.exr"
 finish
