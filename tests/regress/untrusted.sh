@@ -35,7 +35,19 @@ check "no temporary file is left behind" sh -c "! ls -A '$O' | grep -q '\.tmp-[0
 F=$tmp/fifo
 mkdir -p "$F"
 mkfifo "$F/scene.gltf" "$F/map.hdr" "$F/map.exr" "$F/part.exr" "$F/view.exr" "$F/tile.exr" "$F/buffer.bin"
-"$G" render $S -o "$F/ok.exr" $R --spp 1 --seed 1
+# The renders the sections below start from, in one batch (lib.sh, queue): a file for the
+# FIFO checks, a resumable partial and its whole render (--resume), halves and a whole (merge).
+P=$tmp/resume
+M=$tmp/merge
+mkdir -p "$P" "$M"
+queue ok render $S -o "$F/ok.exr" $R --spp 1 --seed 1
+queue part render $S -o "$P/part.exr" $R --spp 4 --resumable --compression none --aov depth,variance
+queue one render $S -o "$P/one.exr" $R --spp 8 --aov depth,variance
+queue left render $S -o "$M/left.exr" $R --spp 2 --crop 0,0,8,16 --compression none
+queue right render $S -o "$M/right.exr" $R --spp 2 --crop 8,0,16,16 --compression none
+queue whole render $S -o "$M/whole.exr" $R --spp 2
+run_queue
+for id in ok part one left right whole; do check_queued "the render '$id' the checks start from" 0 $id; done
 fifo_refused() { # fifo_refused DESCRIPTION COMMAND...: exit 1 at once, naming the FIFO
     local what=$1 want=1; shift
     case "$*" in *--camera*) want=2 ;; esac # an option's value: a usage error, as a missing file is
@@ -63,17 +75,19 @@ check "... is not a regular file" grep -q "buffer.bin' is not a regular file" "$
 check "no output was written" test ! -e "$F/x.exr"
 
 # ---- --resume: only what a render writes ----------------------------------------------------
-P=$tmp/resume
-mkdir -p "$P"
-"$G" render $S -o "$P/part.exr" $R --spp 4 --resumable --compression none --aov depth,variance
-"$G" render $S -o "$P/one.exr" $R --spp 8 --aov depth,variance
-check "an untouched partial resumes to the one render, bit for bit" sh -c \
-    "'$G' render $S -o '$P/full.exr' $R --spp 8 --resume '$P/part.exr' --aov depth,variance && \
-     '$G' diff '$P/full.exr' '$P/one.exr' --max-error 0"
-check "... through exrtool's own writer too (it reads and writes the file faithfully)" sh -c \
-    "$X attr '$P/part.exr' '$P/copy.exr' gonio:note string x && \
-     '$G' render $S -o '$P/full2.exr' $R --spp 8 --resume '$P/copy.exr' --aov depth,variance && \
-     '$G' diff '$P/full2.exr' '$P/one.exr' --max-error 0"
+# resumed ID PARTIAL DESCRIPTION: --resume PARTIAL to 8 spp gives the one render's file,
+# bit for bit (queued, checked once the queue has run)
+resumed() {
+    queue "$1" render $S -o "$P/$1.exr" $R --spp 8 --resume "$2" --aov depth,variance
+    after_queue resumed_checks "$1" "$3"
+}
+resumed_checks() {
+    check_queued "$2: renders" 0 "$1"
+    check "$2" "$G" diff "$P/$1.exr" "$P/one.exr" --max-error 0
+}
+resumed full "$P/part.exr" "an untouched partial resumes to the one render, bit for bit"
+check "exrtool copies the partial" $X attr "$P/part.exr" "$P/copy.exr" gonio:note string x
+resumed full2 "$P/copy.exr" "... through exrtool's own writer too (it reads and writes the file faithfully)"
 # refused NAME DESCRIPTION GREP: --resume $P/NAME.exr fails naming the problem, writes
 # nothing (queued: lib.sh, queue; checked once the queue has run)
 refused() {
@@ -110,11 +124,6 @@ refused moved "a partial whose data window is not the render's" "are not this re
 run_queue
 
 # ---- merge: only tiles of one render --------------------------------------------------------
-M=$tmp/merge
-mkdir -p "$M"
-"$G" render $S -o "$M/left.exr" $R --spp 2 --crop 0,0,8,16 --compression none
-"$G" render $S -o "$M/right.exr" $R --spp 2 --crop 8,0,16,16 --compression none
-"$G" render $S -o "$M/whole.exr" $R --spp 2
 check "two halves merge into the whole render" sh -c \
     "'$G' merge '$M/left.exr' '$M/right.exr' -o '$M/m.exr' && '$G' diff '$M/m.exr' '$M/whole.exr' --max-error 0"
 $X window "$M/right.exr" "$M/outside.exr" 8 0
