@@ -97,6 +97,10 @@ queued() {
     cp "$tmp/queue/$1.log" "$tmp/last" 2>/dev/null || echo "no line $1 in the batch" >"$tmp/last"
     cat "$tmp/queue/$1.status" 2>/dev/null || echo missing
 }
+queued_ok() { # queued_ok ID...: whether every line ID exited 0 ($tmp/last: the first failed one's output)
+    local id
+    for id; do [ "$(queued "$id")" = 0 ] || return 1; done
+}
 check_queued() {
     local got
     got=$(queued "$3")

@@ -61,11 +61,12 @@ centre_is() { # centre_is FILE.exr red|white: the centre pixel's colour (odd siz
     [ "$x0" -ge 0 ] && [ "$x0" -le $c ] && [ "$x1" -ge $c ] && [ "$y0" -le $c ] && [ "$y1" -ge $c ] && inside=1
     if [ "$want" = red ]; then [ $inside = 1 ]; else [ $inside = 0 ]; fi
 }
-R() { "$G" render "$S" --mode albedo --spp 1 --quiet "$@"; }
-# Q ID ARGS...: queues R's render (lib.sh: queue); the renders run in one batch, then the
-# checks read each one's status, output ($tmp/last) and image. Usage errors (exit 2) stay
-# processes of their own (cheap: no device).
-Q() { local id=$1; shift; queue "$id" render "$S" --mode albedo --spp 1 --quiet "$@"; }
+# R ARGS...: renders the scene's albedo; Q ID ARGS...: queues the same render (lib.sh: queue).
+# The renders run in one batch, then the checks read each one's status, output ($tmp/last)
+# and image. Usage errors (exit 2) stay processes of their own (cheap: no device).
+albedo=(render "$S" --mode albedo --spp 1 --quiet)
+R() { "$G" "${albedo[@]}" "$@"; }
+Q() { local id=$1; shift; queue "$id" "${albedo[@]}" "$@"; }
 
 # ---- the renders, queued (in order: --camera FILE.exr reads an earlier line's EXR) -------
 Q default -o "$tmp/default.exr" --size 33x33
@@ -91,9 +92,7 @@ run_queue
 # ---- the default: the first camera of the default scene in depth-first node order (A) ----
 check_queued "default camera renders" 0 default
 check "default camera is A (looks at the red square)" centre_is red "$tmp/default.exr"
-queued d2 >/dev/null
-cp "$tmp/last" "$tmp/summary.txt"
-check "summary line names the camera" grep -q "camera 0 'A'" "$tmp/summary.txt"
+check "summary line names the camera" grep -q "camera 0 'A'" "$tmp/queue/d2.log"
 check_queued "--camera 1 is B" 0 b
 check "B looks at the white quad" centre_is white "$tmp/b.exr"
 check_queued "--camera=0 is A" 0 a
@@ -165,9 +164,7 @@ check_fails "--camera of a missing EXR" 2 R -o "$tmp/x.exr" --camera "$tmp/nonex
 
 # ---- --scene ---------------------------------------------------------------------------
 check_queued "--scene 1 renders" 0 scene1
-queued s1 >/dev/null
-cp "$tmp/last" "$tmp/s1.txt"
-check "scene 1's first camera is B" grep -q "camera 0 'B'" "$tmp/s1.txt"
+check "scene 1's first camera is B" grep -q "camera 0 'B'" "$tmp/queue/s1.log"
 check "scene 1 has no quad: the centre is background" sh -c \
     "'$TESTTOOL' stats '$tmp/scene1.exr' | awk '{exit !(\$2 < 33 * 33)}'"
 check_queued "--scene 2 does not exist" 1 scene2

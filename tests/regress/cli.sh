@@ -55,7 +55,7 @@ warns() {
     after_queue warns_check "w$nw" "$want" "${args[*]}"
 }
 warns_check() {
-    if [ "$(queued "$1")" = 0 ] && grep -q "warning: $2" "$tmp/last"; then pass
+    if queued_ok "$1" && grep -q "warning: $2" "$tmp/last"; then pass
     else fail "render $3: expected a warning '$2', got: $(cat "$tmp/last")"; fi
 }
 for o in "--max-depth 3" "--estimator light"; do

@@ -172,7 +172,7 @@ done
 check "  the medium darkens red (${gb[0]}) below half of no medium's (${gn[0]})" \
     python3 -c "import sys; sys.exit(0 if ${gb[0]} < 0.5 * ${gn[0]} else 1)"
 for s in dt0 nodt irid0 noirid; do
-    [ "$(queued "$s")" = 0 ] || fail "render $s"
+    queued_ok "$s" || fail "render $s"
 done
 check "diffuse transmission 0 is the file without the extension" "$T" same "$tmp/nodt.exr" "$tmp/dt0.exr"
 check "iridescence 0 is the file without the extension" "$T" same "$tmp/noirid.exr" "$tmp/irid0.exr"

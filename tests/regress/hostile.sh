@@ -267,7 +267,7 @@ check_queued "-o an existing file replaces it" 0 mode
 check "... keeping its mode" test "$(stat -c %a "$O/mode.exr")" = 640
 if [ $owner = 1 ]; then
     # owner.exr: another existing file of mode 640, owned by nobody, replaced by root
-    owner_kept() { [ "$(queued owner)" = 0 ] || { cat "$tmp/last"; return 1; }; test "$(stat -c %U "$O/owner.exr")" = nobody; }
+    owner_kept() { queued_ok owner || { cat "$tmp/last"; return 1; }; test "$(stat -c %U "$O/owner.exr")" = nobody; }
     check "... and its owner (root writing)" owner_kept
 fi
 # A gonio killed while writing leaves .NAME.tmp-PID-XXXXXX: the next write of NAME removes it

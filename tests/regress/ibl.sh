@@ -113,7 +113,6 @@ render() { # render ID SCENE CAMERA OUT [ARGS...]: queues the render
     local id=$1 s=$2 cam=$3 o=$4; shift 4
     queue "$id" render "$tmp/$s.gltf" --camera "$cam" --size 16x16 --spp 4 --compression none -o "$o" --quiet "$@"
 }
-ok() { [ "$(queued "$1")" = 0 ]; } # ok ID: the queued line succeeded
 
 while read -r what cam axis r g b; do
     case $what in
@@ -130,13 +129,13 @@ while read -r what cam axis r g b; do
     case $what in
     faces | bright)
         o=$tmp/$what-$cam.exr
-        if ok "$what-$cam"; then
+        if queued_ok "$what-$cam"; then
             got=$(pixel "$o" 8 8)
             near "$r $g $b" "$got" && pass || fail "$what: the camera looking along $axis sees $got, not the face's $r $g $b"
         else fail "$what: camera $cam renders"; fi ;;
     turned)
         o=$tmp/turned.exr
-        ok turned && got=$(pixel "$o" 8 8) && near "$r $g $b" "$got" && pass ||
+        queued_ok turned && got=$(pixel "$o" 8 8) && near "$r $g $b" "$got" && pass ||
             fail "turned by 90 degrees about +Y: along -Z the +X face ($r $g $b) is expected, got ${got:-nothing}" ;;
     split-left | split-right)
         o=$tmp/split.exr
@@ -149,7 +148,7 @@ done < "$tmp/expect.txt"
 # the default: the file's light, announced; --env replaces it; gonio info names it
 msg=$(cat "$tmp/queue/msg.log")
 [[ $msg == *"image-based light"*"EXT_lights_image_based light 0"* ]] && pass || fail "the render says what lights it: $msg"
-ok env0 && [ "$(pixel "$tmp/env0.exr" 8 8)" = "0 0 0" ] && pass || fail "--env 0 replaces the file's light"
+queued_ok env0 && [ "$(pixel "$tmp/env0.exr" 8 8)" = "0 0 0" ] && pass || fail "--env 0 replaces the file's light"
 "$G" info "$tmp/faces.gltf" | grep -q "^environment *EXT_lights_image_based light 0, 6 faces of 16x16" && pass || fail "gonio info names the environment"
 
 # bad lights: exit 1, the JSON path or the face named, no output

@@ -149,10 +149,12 @@ sys.exit(1 if bad or checked < 100 else 0)
 PY
 
 scene() { python3 "$tmp/gen.py" "$tmp/$1.gltf" "$2"; }
-R() { "$G" render "$tmp/$1.gltf" --mode albedo --spp 1 --size ${N}x$N --quiet --compression none -o "$tmp/$1.exr"; }
-# The script's renders are queued (lib.sh: queue) and run in one batch (below); the checks of
-# each read its status, output ($tmp/last) and image. QR NAME [FILE]: queues R's render.
-QR() { queue "$1" render "${2:-$tmp/$1.gltf}" --mode albedo --spp 1 --size ${N}x$N --quiet --compression none -o "$tmp/$1.exr"; }
+# R NAME: renders $tmp/NAME.gltf's albedo to $tmp/NAME.exr. The script's renders are queued
+# instead (lib.sh: queue) and run in one batch (below); the checks of each read its status,
+# output ($tmp/last) and image. QR NAME [FILE]: queues R's render (of FILE).
+albedo=(--mode albedo --spp 1 --size ${N}x$N --quiet --compression none)
+R() { "$G" render "$tmp/$1.gltf" "${albedo[@]}" -o "$tmp/$1.exr"; }
+QR() { queue "$1" render "${2:-$tmp/$1.gltf}" "${albedo[@]}" -o "$tmp/$1.exr"; }
 # case NAME TOL DESCRIPTION JSON: write, queue; once the queue has run: renders (no warning), probe
 case_() {
     scene "$1" "$4"
@@ -228,11 +230,10 @@ run_queue
 
 # ---- damaged images: a clear message naming the file, the image and the problem ------------
 # (gonio info loads a scene as render does, and says the same, without a device)
-queued trunc_fallback >/dev/null # (its status unchecked, as ever: what it says, in its log)
-cp "$tmp/last" "$tmp/trunc_fallback.txt"
+# (trunc_fallback's status unchecked, as ever: what it says, in its log)
 check "truncated KTX2 with a fallback: renders the fallback" python3 "$tmp/probe.py" "$tmp/trunc_fallback.exr" 0 "$(dirname "$0")/../tool" $N
-check "... saying which image of which file, and why" grep -q "trunc_fallback.gltf: image 1 trunc.ktx2: KTX2: " "$tmp/trunc_fallback.txt"
-check "... and that the fallback is used" grep -q "texture 0: its KHR_texture_basisu image 1 is unusable; its fallback, image 0, is used" "$tmp/trunc_fallback.txt"
+check "... saying which image of which file, and why" grep -q "trunc_fallback.gltf: image 1 trunc.ktx2: KTX2: " "$tmp/queue/trunc_fallback.log"
+check "... and that the fallback is used" grep -q "texture 0: its KHR_texture_basisu image 1 is unusable; its fallback, image 0, is used" "$tmp/queue/trunc_fallback.log"
 scene trunc_webp "{\"images\": [\"trunc.webp\"], \"texture\": {\"extensions\": {\"EXT_texture_webp\": {\"source\": 0}}}, \"used\": $WEBP, \"required\": $WEBP}"
 check_fails "truncated WebP a texture uses: an error" 1 "$G" render "$tmp/trunc_webp.gltf" --spp 1 --size 8x8 --quiet -o "$tmp/trunc_webp.exr"
 check "... naming the file, the material, the texture, the image and the problem" grep -q "error: .*trunc_webp.gltf: material 0: baseColorTexture: texture 0: image 0 trunc.webp: WebP: libwebp cannot decode the 64x64 image (corrupt or truncated data)" "$tmp/last"
@@ -246,12 +247,10 @@ check "... the problem named" grep -q "error: .*junk_webp.gltf: material 0: base
 check_fails "a missing PNG a texture uses: an error" 1 "$G" info "$tmp/missing_png.gltf"
 check "... naming the material, the texture and the image" grep -q "error: .*missing_png.gltf: material 0: baseColorTexture: texture 0: image 0 nowhere.png: file missing or unreadable" "$tmp/last"
 check_queued "an unreadable image no texture uses: renders" 0 unused_png
-cp "$tmp/last" "$tmp/unused_png.txt"
-check "... with a warning saying so" grep -q "warning: .*unused_png.gltf: image 1 nowhere.png: file missing or unreadable; no texture draws it" "$tmp/unused_png.txt"
+check "... with a warning saying so" grep -q "warning: .*unused_png.gltf: image 1 nowhere.png: file missing or unreadable; no texture draws it" "$tmp/queue/unused_png.log"
 # A texture only a material the scene does not draw uses: a warning too.
 check_queued "a broken texture only an undrawn material uses: renders" 0 undrawn_png
-cp "$tmp/last" "$tmp/undrawn_png.txt"
-check "... with a warning saying so" grep -q "warning: .*undrawn_png.gltf: texture 1: image 1 nowhere.png: file missing or unreadable; no material the scene draws uses it" "$tmp/undrawn_png.txt"
+check "... with a warning saying so" grep -q "warning: .*undrawn_png.gltf: texture 1: image 1 nowhere.png: file missing or unreadable; no material the scene draws uses it" "$tmp/queue/undrawn_png.log"
 if [ $KTX2 = 1 ]; then
     # Both extensions, the KTX2 image damaged and no core image: the WebP one is drawn.
     check_queued "a damaged KTX2 beside a WebP, no core image: renders" 0 both_ext

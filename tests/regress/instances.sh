@@ -58,7 +58,7 @@ run_queue
 
 # The local modes: the same pixels up to the transforms' rounding
 for m in normal depth albedo phong flat gouraud; do
-    if [ "$(queued "i-$m")$(queued "f-$m")" != 00 ]; then fail "--mode $m renders"; continue; fi
+    if ! queued_ok "i-$m" "f-$m"; then fail "--mode $m renders"; continue; fi
     check "--mode $m: instances = flattened" "$G" diff "$tmp/i-$m.exr" "$tmp/f-$m.exr" --max-rmse 1e-3 --quiet
 done
 # ROTATION as normalized shorts: the quantized quaternions are a little off the floats
@@ -68,7 +68,7 @@ check "ROTATION as normalized shorts = floats" "$G" diff "$tmp/s-phong.exr" "$tm
 # The path tracer, lit only by the instanced emitters (their world areas differ from the
 # mesh's): instances against the flattened scene, on other seeds than a second flattened
 # render, so that the two differences are both noise and must be alike
-[ "$(queued pi)$(queued pf)$(queued pf3)" = 000 ] || fail "path renders"
+queued_ok pi pf pf3 || fail "path renders"
 rmse() { "$G" diff "$1" "$2" | awk '$1 == "rmse" {print $2}'; }
 bias() { "$G" diff "$1" "$2" | awk '$1 == "rel_bias" {print $2}'; }
 a=$(rmse "$tmp/pi.exr" "$tmp/pf.exr") b=$(rmse "$tmp/pf3.exr" "$tmp/pf.exr") rb=$(bias "$tmp/pi.exr" "$tmp/pf.exr")
@@ -77,7 +77,7 @@ check "path: instances differ from flattened as two seeds do (rmse $a vs $b)" \
 check "path: no bias (rel_bias $rb)" python3 -c "import sys; sys.exit(0 if abs($rb) <= 0.02 else 1)"
 
 # The loop cap: paths interrupted in their walks, inside instances too, resume bit for bit
-if [ "$(queued one)$(queued two)" = 00 ]; then
+if queued_ok one two; then
     check "interrupted paths = whole paths" "$TESTTOOL" same "$tmp/one.exr" "$tmp/two.exr"
     n=$(sed -n 's/^gonio: debug: \([0-9]*\) dispatch.*/\1/p' "$tmp/queue/two.log")
     check "... and some were interrupted (${n:-no} resuming dispatches)" test "${n:-0}" -gt 0

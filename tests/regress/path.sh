@@ -52,7 +52,7 @@ pair() {
 }
 pair_checks() {
     local kind=$1 name=$2 key=$3 n=$4 one=$tmp/base-$3.exr two=$tmp/two-$4.exr dispatches
-    if [ "$(queued "base-$key")" != 0 ] || [ "$(queued "two-$n")" != 0 ]; then
+    if ! queued_ok "base-$key" "two-$n"; then
         fail "$name (render failed)"; cat "$tmp/queue/base-$key.log" "$tmp/queue/two-$n.log" | sed 's/^/    /' | tail -n 20
     elif [ "$kind" = same ]; then
         check_fails "$name" 0 "$G" diff "$one" "$two" --max-error 0

@@ -91,7 +91,7 @@ queue_colour() {
 }
 # colour SCENE MODE: "green" or "red", the colour at the centre (of the queued render)
 colour() {
-    [ "$(queued "$1-$2")" = 0 ] || return 1
+    queued_ok "$1-$2" || return 1
     python3 "$tmp/centre.py" "$tmp/$1-$2.exr" "$T" | awk '{print ($2 > 2 * $1 ? "green" : $1 > 2 * $2 ? "red" : "neither")}'
 }
 for mode in path albedo phong; do
@@ -125,7 +125,7 @@ done
 # bounce rays see a back face: the roof behind the camera (its back to the scene) shades the
 # green quad from the environment above it
 lum() {
-    [ "$(queued "$1")" = 0 ] &&
+    queued_ok "$1" &&
         python3 "$tmp/centre.py" "$tmp/$1.exr" "$T" | awk '{print 0.2126 * $1 + 0.7152 * $2 + 0.0722 * $3}'
 }
 open=$(lum open) roof=$(lum roof)

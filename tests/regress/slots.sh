@@ -92,7 +92,7 @@ slot() {
 # all_ok ID...: every queued line gave 0 (the first that did not: its output)
 all_ok() {
     local id
-    for id; do [ "$(queued "$id")" = 0 ] || { echo "$id:"; cat "$tmp/last"; return 1; }; done
+    for id; do queued_ok "$id" || { echo "$id:"; cat "$tmp/last"; return 1; }; done
 }
 slot_checks() {
     check "$1: renders" all_ok $1-tex $1-one $1-zero

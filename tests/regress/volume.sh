@@ -137,7 +137,7 @@ if in_tier slow; then
     done
     run_queue
     for s in nested disp1; do
-        [ "$(queued "$s-a")$(queued "$s-b")" = 00 ] || fail "$s: renders"
+        queued_ok "$s-a" "$s-b" || fail "$s: renders"
         check "$s: specialised = unspecialised" "$T" same "$tmp/$s-a.exr" "$tmp/$s-b.exr"
     done
 fi
@@ -177,7 +177,7 @@ done
 
 # Dispersion: a white bar seen through a sphere of index 1.5.
 for s in disp1 disp0 nodisp thin0 plain iorR iorB; do
-    [ "$(queued "$s")" = 0 ] || { fail "render $s"; sed 's/^/    /' "$tmp/last"; }
+    queued_ok "$s" || { fail "render $s"; sed 's/^/    /' "$tmp/last"; }
 done
 check "dispersion 0 is the file without the extension" "$T" same "$tmp/nodisp.exr" "$tmp/disp0.exr"
 check "  (without a volume too)" "$T" same "$tmp/plain.exr" "$tmp/thin0.exr"
