@@ -197,7 +197,7 @@ static bool bench_paths(renderer *r, render_settings *s, double t_start, float s
      * figures estimate the error against the converged image. */
     for (int p = 0; ref_spp > 1 && p < ref_w * ref_h; p++)
         for (int c = 0; c < 3; c++) {
-            double m = ref.planes[c][p], sq = ((const float *)r->squares.mapped)[4 * p + c];
+            double m = ref.planes[c][p], sq = ((const float *)r->accum.squares.mapped)[4 * p + c];
             ref_noise += (sq / ref_spp - m * m) / (ref_spp - 1);
         }
     ref_noise /= 3.0 * ref_w * ref_h;
@@ -394,7 +394,7 @@ int cmd_bench(int argc, char **argv)
     }
     for (uint32_t mode = 0; mode < 2; mode++) {
         gpu_binding b[GN_BIND_COUNT];
-        renderer_spec spec;
+        render_spec spec;
         gpu_pipeline_desc pd = {.name = "bench", .code = spv_bench, .code_size = sizeof spv_bench,
                                 .local_size = {GN_TILE_X, GN_TILE_Y, 1},
                                 .push_size = sizeof(GnPush), .bindings = b,
@@ -420,7 +420,7 @@ int cmd_bench(int argc, char **argv)
             continue;
         }
         {
-            const float *rays = r.aov.mapped;
+            const float *rays = r.accum.aov.mapped;
             for (int p = 0; p < w * h; p++)
                 n_diffuse += rays[8 * p + 7] >= 0.0f;
         }

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "brdf.h"
+#include "brdf_runner.h"
 #include "brdf_sphere.h" /* spv_brdf_sphere, generated from glsl/kernels/brdf_sphere.comp */
 #include "cli.h"
 #include "draw.h"

@@ -308,7 +308,7 @@ static void denoise_step(preview *p)
         if (!ok) {
             p->denoise_view = false;
             p->denoise_unavailable = true;
-        } else if (generation == p->generation && w == p->r.width && h == p->r.height &&
+        } else if (generation == p->generation && w == p->r.accum.width && h == p->r.accum.height &&
                    p->denoised.size >= 16 * (VkDeviceSize)w * (VkDeviceSize)h) {
             memcpy(p->denoised.mapped, rgba, 16 * (size_t)w * (size_t)h);
             p->denoised_spp = spp;
@@ -530,29 +530,29 @@ static bool swapchain_create(preview *p)
  * kernel's descriptors name the renderer's accumulation buffer, reallocated on a resize). */
 static void display_resize(preview *p)
 {
-    gpu_binding b[2] = {{GN_DISPLAY_BIND_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &p->r.accum},
+    gpu_binding b[2] = {{GN_DISPLAY_BIND_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &p->r.accum.accum},
                         {GN_DISPLAY_BIND_OUT, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &p->texels}};
     gpu_pipeline_desc pd = {.name = "display", .code = spv_display, .code_size = sizeof spv_display,
                             .local_size = {GN_TILE_X, GN_TILE_Y, 1},
                             .push_size = sizeof(GnDisplayPush), .bindings = b, .num_bindings = 2};
-    if (p->display_width == p->r.width && p->display_height == p->r.height &&
+    if (p->display_width == p->r.accum.width && p->display_height == p->r.accum.height &&
         (!p->denoiser.started || p->denoised.buffer))
         return;
     gpu_pipeline_destroy(&p->g, &p->display);
     gpu_buffer_destroy(&p->g, &p->texels);
-    gpu_buffer_create(&p->g, &p->texels, 4 * (VkDeviceSize)p->r.width * (VkDeviceSize)p->r.height,
+    gpu_buffer_create(&p->g, &p->texels, 4 * (VkDeviceSize)p->r.accum.width * (VkDeviceSize)p->r.accum.height,
                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
     gpu_pipeline_create(&p->g, &p->display, &pd);
     gpu_pipeline_destroy(&p->g, &p->display_denoised);
     gpu_buffer_destroy(&p->g, &p->denoised);
     if (p->denoiser.started) { /* the denoised view's input: the display kernel on `denoised` */
-        gpu_buffer_create(&p->g, &p->denoised, 16 * (VkDeviceSize)p->r.width * (VkDeviceSize)p->r.height,
+        gpu_buffer_create(&p->g, &p->denoised, 16 * (VkDeviceSize)p->r.accum.width * (VkDeviceSize)p->r.accum.height,
                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
         b[0].buffer = &p->denoised;
         gpu_pipeline_create(&p->g, &p->display_denoised, &pd);
     }
-    p->display_width = p->r.width;
-    p->display_height = p->r.height;
+    p->display_width = p->r.accum.width;
+    p->display_height = p->r.accum.height;
     p->shown = false;
 }
 
@@ -571,8 +571,8 @@ static void record_frame(preview *p, VkImage target, int passes)
 
     GPU_CHECK(vkBeginCommandBuffer(cmd, &bi));
     renderer_record_samples(&p->r, cmd, p->s.mode, (uint32_t)p->spp, (uint32_t)passes);
-    push.width = (uint32_t)p->r.width;
-    push.height = (uint32_t)p->r.height;
+    push.width = (uint32_t)p->r.accum.width;
+    push.height = (uint32_t)p->r.accum.height;
     push.tonemap = (uint32_t)p->tonemap;
     push.flags = bgra ? GN_DISPLAY_BGRA : 0u;
     push.inv_spp = 1.0f / (float)(p->spp + passes > 0 ? p->spp + passes : 1);
@@ -618,7 +618,7 @@ static void update_title(preview *p)
 {
     char t[sizeof p->title];
     snprintf(t, sizeof t, "gonio preview: %s | %dx%d | %d spp | %.2f Mpaths/s | %.1f ms | EV %+.1f %s",
-             render_mode_name(p->s.mode), p->r.width, p->r.height, p->spp, p->paths_per_second * 1e-6,
+             render_mode_name(p->s.mode), p->r.accum.width, p->r.accum.height, p->spp, p->paths_per_second * 1e-6,
              p->frame_seconds * 1e3, p->exposure, image_tonemap_name(p->tonemap));
     if (p->denoise_unavailable)
         snprintf(t + strlen(t), sizeof t - strlen(t), " | denoiser unavailable");
@@ -652,7 +652,7 @@ static bool frame(preview *p, double *submit_time, int *last_passes)
     GPU_CHECK(vkWaitForFences(dev, 1, &p->fence, VK_TRUE, UINT64_MAX));
     if (*last_passes > 0) {
         double gpu_seconds = util_now() - *submit_time;
-        p->paths_per_second = (double)*last_passes * p->r.width * p->r.height / gpu_seconds;
+        p->paths_per_second = (double)*last_passes * p->r.accum.width * p->r.accum.height / gpu_seconds;
         if (gpu_seconds < 0.5 * PREVIEW_FRAME_SECONDS && p->batch < PREVIEW_MAX_BATCH)
             p->batch *= 2;
         else if (gpu_seconds > 1.5 * PREVIEW_FRAME_SECONDS && p->batch > 1)
@@ -975,7 +975,7 @@ int cmd_preview(int argc, char **argv)
         if (screenshot)
             ok = save_screenshot(p, screenshot) && ok;
         util_info("preview: %d frame(s), %s, %d spp, %dx%d", frames, render_mode_name(p->s.mode),
-                  p->spp, p->r.width, p->r.height);
+                  p->spp, p->r.accum.width, p->r.accum.height);
     } else {
         ok = false;
     }

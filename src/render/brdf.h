@@ -1,6 +1,6 @@
 /* brdf.h: the BRDF model table (names, parameters, defaults and ranges of the models in
- * glsl/lib/brdf_models.h) with strict parsing of `--PARAM VALUE` settings, and a runner that
- * batches queries through glsl/kernels/brdf_test.comp, i.e. through the renderer's own brdf_*.glsl. */
+ * glsl/lib/brdf_models.h) with strict parsing of `--PARAM VALUE` settings and `--brdf`
+ * specs. The kernel that evaluates them for tests and gonio brdf: brdf_runner.h. */
 #ifndef GONIO_BRDF_H
 #define GONIO_BRDF_H
 
@@ -9,7 +9,6 @@
 #include <stdint.h>
 
 #include "brdf_models.h"
-#include "gpu.h"
 #include "sheen_albedo.h"
 
 /* Where a setting's values go: the words of a GnMaterial (glsl/lib/material.h), the colour
@@ -82,31 +81,5 @@ void brdf_format_setting(char *out, size_t cap, const brdf_setting *s);
  * lists only those that differ from their defaults, so that the title stays a few lines. */
 #define BRDF_TITLE_PARAMS 8
 void brdf_format_title(char *out, size_t cap, const brdf_setting *s);
-
-/* The GN_FEAT_* the kernel needs for query q (brdf_test.comp is specialised on them, as
- * the renderer's kernels are): its material's (material_features); every feature for the
- * Fresnel queries. */
-GnFeatures brdf_query_features(const BrdfQuery *q);
-
-/* Batches BrdfQuery records through brdf_test.comp, a kernel specialised on the features of
- * each batch's queries (one pipeline kept per feature set, BRDF_RUNNER_KERNELS at most; the
- * device keeps the kernels compiled beyond that: gpu.h), or the unspecialised kernel where
- * all_features is set (GONIO_ALL_FEATURES, or a test). */
-#define BRDF_RUNNER_KERNELS 32
-typedef struct brdf_runner {
-    gpu *g;
-    gpu_buffer queries, results, sheen;
-    gpu_pipeline pipelines[BRDF_RUNNER_KERNELS];
-    GnFeatures features[BRDF_RUNNER_KERNELS]; /* pipelines[i]'s, when its pipeline exists */
-    uint32_t next;                          /* the slot the next new kernel replaces */
-    uint32_t capacity;
-    bool all_features;
-} brdf_runner;
-
-/* capacity: queries per dispatch (buffers of sizeof(BrdfQuery) and sizeof(BrdfResult) bytes per query). */
-void brdf_runner_create(brdf_runner *r, gpu *g, uint32_t capacity);
-void brdf_runner_destroy(brdf_runner *r); /* accepts a zeroed struct */
-/* Runs n queries (in batches of the capacity) and writes their n results. */
-void brdf_runner_run(brdf_runner *r, const BrdfQuery *q, BrdfResult *out, size_t n);
 
 #endif

@@ -1,6 +1,5 @@
-/* render.c: the renderer: the scene's upload, the frame constants of a render, the kernels
- * (created and specialised on first use) and the progressive pass loop. Its other concerns
- * have their own files (render_internal.h lists them). */
+/* render.c: the renderer: the scene's upload, the frame constants of a render, its kernels
+ * and the progressive pass loop. It composes the parts that own the rest (render.h). */
 #include "render.h"
 
 #include <assert.h>
@@ -10,19 +9,89 @@
 #include <string.h>
 
 #include "brdf.h"
-#include "render_internal.h"
+#include "render_limits.h"
 #include "render_material.h"
 #include "util.h"
 #include "vec.h"
 
+/* The GN_FEAT_* the scene's materials and vertex data can need in the kernels. */
+static GnFeatures scene_features(const scene *sc)
+{
+    GnFeatures f = GN_FEAT_NONE;
+    for (uint32_t i = 0; i < sc->num_materials; i++)
+        f |= material_features(&sc->materials[i]);
+    if (sc->vertex_colors)
+        f |= GN_FEAT_VERTEX_COLOR;
+    for (uint32_t i = 0; i < sc->num_textures; i++) {
+        const float *t = sc->textures[i].transform;
+        if (t[0] != 1 || t[1] != 0 || t[2] != 0 || t[3] != 0 || t[4] != 1 || t[5] != 0)
+            f |= GN_FEAT_TEX_TRANSFORM;
+        if (sc->textures[i].flags & GN_TEX_UV1)
+            f |= GN_FEAT_UV1;
+    }
+    return f;
+}
+
+/* Texels of the sheen's albedo table (brdf_sheen_table) at the head of the texel buffer,
+ * where a material has layers (glsl/kernels/path.comp reads it from there); 0 elsewhere, so
+ * other scenes keep their buffer as it was. */
+static uint32_t sheen_texels(GnFeatures features)
+{
+    return features & GN_FEAT_LAYERS ? BRDF_SHEEN_TABLE_SIZE : 0;
+}
+
+/* The texture images packed into one texel buffer after the sheen's table (the total fits:
+ * render_scene_fits), and the table of textures that index it. */
+static void upload_textures(renderer *r)
+{
+    const scene *sc = r->sc;
+    const uint32_t sheen = sheen_texels(r->material_features);
+    uint32_t *image_offset = util_calloc(sc->num_images + 1, sizeof *image_offset), total = sheen;
+    for (uint32_t i = 0; i < sc->num_images; i++) {
+        image_offset[i] = total;
+        total += sc->images[i].width * sc->images[i].height;
+    }
+    uint32_t *texels = util_malloc(sizeof *texels * (total + 1));
+    texels[total] = 0; /* the buffer is never empty */
+    memcpy(texels, brdf_sheen_table, sizeof *texels * sheen);
+    for (uint32_t i = 0; i < sc->num_images; i++)
+        memcpy(texels + image_offset[i], sc->images[i].rgba8, (size_t)sc->images[i].width * sc->images[i].height * 4);
+    GnTexture *tex = util_calloc(sc->num_textures + 1, sizeof *tex);
+    for (uint32_t i = 0; i < sc->num_textures; i++) {
+        const scene_image *im = &sc->images[sc->textures[i].image];
+        const float *t = sc->textures[i].transform;
+        tex[i] = (GnTexture){image_offset[sc->textures[i].image], im->width, im->height,
+                             sc->textures[i].flags, {t[0], t[1], t[2]}, 0, {t[3], t[4], t[5]}, 0};
+    }
+    gpu_buffer_create_texels_as(r->g, &r->texels, texels, sizeof(uint32_t) * (total + 1), VK_FORMAT_R32_UINT);
+    gpu_buffer_create_texels(r->g, &r->textures, tex, sizeof(GnTexture) * (sc->num_textures + 1));
+    free(image_offset);
+    free(texels);
+    free(tex);
+}
+
+/* The renderer's own buffers: the frame, the counters and the scene's arrays. */
+static void upload_scene(renderer *r)
+{
+    gpu *g = r->g;
+    const render_geometry *geo = &r->geo;
+    gpu_buffer_create(g, &r->frame, sizeof(GnFrame), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+    gpu_buffer_create(g, &r->status, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+    gpu_buffer_create_texels(g, &r->nodes, geo->nodes, sizeof(GnBvhNode) * geo->num_nodes);
+    gpu_buffer_create_texels(g, &r->tris, geo->pairs, sizeof(GnTriPair) * geo->num_pairs);
+    gpu_buffer_create_texels(g, &r->prims, geo->prims, sizeof(GnPrim) * geo->num_slots);
+    gpu_buffer_create_texels(g, &r->vertices, geo->vertices, sizeof(GnVertex) * geo->num_vertices);
+    gpu_buffer_create_texels(g, &r->materials, r->sc->materials, sizeof(GnMaterial) * r->sc->num_materials);
+    upload_textures(r);
+    if (geo->two_levels)
+        gpu_buffer_create_texels(g, &r->instances, geo->top.instances, sizeof(GnInstance) * geo->top.num_instances);
+    else
+        gpu_buffer_create_texels(g, &r->instances, NULL, 16);
+}
+
 bool renderer_create(renderer *r, gpu *g, const scene *sc)
 {
     double t0 = util_now();
-    GnPrim *prims;
-    GnTexture *tex;
-    uint32_t *texels, total_texels = 0, *image_offset; /* the total fits: scene_fits */
-    GnLight *lights;
-
     memset(r, 0, sizeof *r);
     r->g = g;
     r->sc = sc;
@@ -30,77 +99,15 @@ bool renderer_create(renderer *r, gpu *g, const scene *sc)
         r->failed = true;
         return false;
     }
-    for (uint32_t i = 0; i < sc->num_materials; i++)
-        r->material_features |= material_features(&sc->materials[i]);
-    if (!scene_fits(r)) {
+    r->material_features = r->path_features = scene_features(sc);
+    if (!render_scene_fits(g, sc, &r->geo, sheen_texels(r->material_features), render_lights_room(sc, &r->geo))) {
         r->failed = true;
         return false;
     }
-    if (sc->vertex_colors)
-        r->material_features |= GN_FEAT_VERTEX_COLOR;
-    for (uint32_t i = 0; i < sc->num_textures; i++) {
-        const float *t = sc->textures[i].transform;
-        if (t[0] != 1 || t[1] != 0 || t[2] != 0 || t[3] != 0 || t[4] != 1 || t[5] != 0)
-            r->material_features |= GN_FEAT_TEX_TRANSFORM;
-        if (sc->textures[i].flags & GN_TEX_UV1)
-            r->material_features |= GN_FEAT_UV1;
-    }
-    r->path_samples = path_samples(r);
-    r->path_features = r->material_features;
-
-    prims = r->geo.prims; /* (render_geometry.c: BVH order, corners in the walk's order) */
-
-    image_offset = util_calloc(sc->num_images + 1, sizeof *image_offset);
-    total_texels = sheen_prefix(r);
-    for (uint32_t i = 0; i < sc->num_images; i++) {
-        image_offset[i] = total_texels;
-        total_texels += sc->images[i].width * sc->images[i].height;
-    }
-    texels = util_malloc(sizeof *texels * (total_texels + 1));
-    texels[total_texels] = 0; /* the buffer is never empty */
-    memcpy(texels, brdf_sheen_table, sizeof *texels * sheen_prefix(r));
-    for (uint32_t i = 0; i < sc->num_images; i++)
-        memcpy(texels + image_offset[i], sc->images[i].rgba8,
-               (size_t)sc->images[i].width * sc->images[i].height * 4);
-    tex = util_calloc(sc->num_textures + 1, sizeof *tex);
-    for (uint32_t i = 0; i < sc->num_textures; i++) {
-        const scene_image *im = &sc->images[sc->textures[i].image];
-        const float *t = sc->textures[i].transform;
-        tex[i] = (GnTexture){image_offset[sc->textures[i].image], im->width, im->height,
-                             sc->textures[i].flags, {t[0], t[1], t[2]}, 0, {t[3], t[4], t[5]}, 0};
-    }
-
-    lights = scene_lights(r);
-
-    gpu_buffer_create(g, &r->frame, sizeof(GnFrame), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                      GPU_MEMORY_HOST);
-    gpu_buffer_create_texels(g, &r->nodes, r->geo.nodes, sizeof(GnBvhNode) * r->geo.num_nodes);
-    gpu_buffer_create_texels(g, &r->tris, r->geo.pairs, sizeof(GnTriPair) * r->geo.num_pairs);
-    gpu_buffer_create_texels(g, &r->prims, prims, sizeof(GnPrim) * r->geo.num_slots);
-    gpu_buffer_create_texels(g, &r->vertices, r->geo.vertices, sizeof(GnVertex) * r->geo.num_vertices);
-    gpu_buffer_create_texels(g, &r->materials, sc->materials, sizeof(GnMaterial) * sc->num_materials);
-    gpu_buffer_create_storage(g, &r->lights, lights, sizeof(GnLight) * r->num_lights);
-    gpu_buffer_create_texels_as(g, &r->texels, texels, sizeof(uint32_t) * (total_texels + 1),
-                                VK_FORMAT_R32_UINT);
-    gpu_buffer_create_texels(g, &r->textures, tex, sizeof(GnTexture) * (sc->num_textures + 1));
-    build_emitters(r, prims);
-    if (r->geo.two_levels) { /* the table, then each entry's instance (GnFrame.emitter_instances) */
-        gpu_buffer_create_texels(g, &r->emitters, NULL, 2 * sizeof(GnEmitter) * r->emitter_cap);
-        upload_emitter_instances(r);
-    } else {
-        gpu_buffer_create_texels(g, &r->emitters, NULL, sizeof(GnEmitter) * (r->num_emitters + 1));
-    }
-    gpu_buffer_create_texels_as(g, &r->env, NULL, 16, VK_FORMAT_R32_UINT);
-    vertex_colors_create(r);
-    gpu_buffer_create(g, &r->status, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
-    if (r->geo.two_levels)
-        gpu_buffer_create_texels(g, &r->instances, r->geo.top.instances, sizeof(GnInstance) * r->geo.top.num_instances);
-    else
-        gpu_buffer_create_texels(g, &r->instances, NULL, 16);
-    free(image_offset);
-    free(texels);
-    free(tex);
-    free(lights);
+    r->path_samples = render_path_samples(g, &r->geo);
+    upload_scene(r);
+    render_lights_create(&r->lights, g, sc, &r->geo);
+    render_gouraud_create(&r->gouraud, g, sc, &r->geo);
     r->setup_seconds = util_now() - t0;
     return true;
 }
@@ -119,44 +126,22 @@ bool renderer_update(renderer *r, const scene *sc)
         gpu_buffer_upload(r->g, &r->nodes, r->geo.nodes, sizeof(GnBvhNode) * r->geo.top.tree.num_nodes, 0);
         gpu_buffer_upload(r->g, &r->instances, r->geo.top.instances, sizeof(GnInstance) * r->geo.top.num_instances, 0);
     }
-    uint32_t before = r->num_lights;
-    GnLight *lights = scene_lights(r);
-    if (r->num_lights <= before) {
-        gpu_buffer_upload(r->g, &r->lights, lights, sizeof(GnLight) * r->num_lights, 0);
-    } else { /* (more of the stand-ins for emissive meshes than before: a new buffer) */
-        gpu_buffer_destroy(r->g, &r->lights);
-        gpu_buffer_create_storage(r->g, &r->lights, lights, sizeof(GnLight) * r->num_lights);
-        renderer_buffers_replaced(r);
-    }
-    free(lights);
-    free(r->emitter_table);
-    free(r->emitter_weight);
-    free(r->emitter_instance);
-    build_emitters(r, r->geo.prims); /* (the same room: the same triangles and lights) */
-    upload_emitter_instances(r);
-    r->env_source = NULL; /* the environment's weight follows the scene's bounds */
+    render_lights_update(&r->lights, r->g, sc, &r->geo);
     r->setup_seconds = util_now() - t0;
     return true;
 }
 
 void renderer_destroy(renderer *r)
 {
-    gpu_buffer *bufs[] = {&r->frame, &r->nodes, &r->tris, &r->prims, &r->vertices,
-                          &r->materials, &r->lights, &r->texels, &r->textures, &r->emitters,
-                          &r->vcolor, &r->status, &r->accum, &r->aov,
-                          &r->squares, &r->env, &r->pstate, &r->instances};
-    if (r->g) {
-        for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
-            gpu_buffer_destroy(r->g, bufs[i]);
-        for (uint32_t i = 0; i < GN_MODE_COUNT; i++)
-            gpu_pipeline_destroy(r->g, &r->pipelines[i]);
-        gpu_pipeline_destroy(r->g, &r->vertex_pass);
-    }
+    gpu_buffer *bufs[] = {&r->frame, &r->status, &r->nodes, &r->tris, &r->prims, &r->vertices,
+                          &r->materials, &r->texels, &r->textures, &r->instances};
+    for (size_t i = 0; r->g && i < sizeof bufs / sizeof *bufs; i++)
+        gpu_buffer_destroy(r->g, bufs[i]);
+    render_kernels_destroy(&r->kernels, r->g);
+    render_gouraud_destroy(&r->gouraud, r->g);
+    render_lights_destroy(&r->lights, r->g);
+    render_accum_destroy(&r->accum, r->g);
     render_geometry_destroy(&r->geo);
-    free_bands(r);
-    free(r->emitter_table);
-    free(r->emitter_weight);
-    free(r->emitter_instance);
     memset(r, 0, sizeof *r);
 }
 
@@ -202,30 +187,37 @@ uint32_t renderer_bindings(const renderer *r, gpu_binding *b)
         {GN_BIND_PRIMS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->prims},
         {GN_BIND_VERTICES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->vertices},
         {GN_BIND_MATERIALS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->materials},
-        {GN_BIND_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->lights},
+        {GN_BIND_LIGHTS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->lights.lights},
         {GN_BIND_TEXELS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->texels},
         {GN_BIND_TEXTURES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->textures},
-        {GN_BIND_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->accum},
-        {GN_BIND_AOV, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->aov},
-        {GN_BIND_VCOLOR, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->vcolor},
-        {GN_BIND_EMITTERS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->emitters},
+        {GN_BIND_ACCUM, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->accum.accum},
+        {GN_BIND_AOV, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->accum.aov},
+        {GN_BIND_VCOLOR, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->gouraud.vcolor},
+        {GN_BIND_EMITTERS, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->lights.emitters},
         {GN_BIND_STATUS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->status},
-        {GN_BIND_SQUARES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->squares},
-        {GN_BIND_ENV, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->env},
-        {GN_BIND_PSTATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->pstate},
+        {GN_BIND_SQUARES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->accum.squares},
+        {GN_BIND_ENV, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->lights.env},
+        {GN_BIND_PSTATE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, &r->accum.pstate},
         {GN_BIND_INSTANCES, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, &r->instances},
     };
+    _Static_assert(sizeof all / sizeof *all <= GN_BIND_COUNT, "more bindings than GN_BIND_COUNT");
     memcpy(b, all, sizeof all);
     return sizeof all / sizeof *all;
 }
 
+/* How often the parts have made a buffer the kernels bind anew: a kernel whose descriptor
+ * set was written at another count is pointed at the current buffers (render_kernels_get). */
+static uint32_t buffers_generation(const renderer *r)
+{
+    return r->accum.replaced + r->lights.replaced;
+}
 
-/* The path tracer's frame: its lights (render_lights.c), the GN_FEAT_* its kernel is
+/* The path tracer's frame: its lights (render_lights.h), the GN_FEAT_* its kernel is
  * specialised on, and the loop cap. */
 static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
 {
     double env;
-    if (!path_lights(r, s, frame, &env))
+    if (!render_lights_path(&r->lights, r->g, r->sc, &r->geo, s->env_map, s->env, frame, &env))
         return false;
     const uint32_t n = frame->num_emitters;
     frame->flags |= s->strategy;
@@ -234,14 +226,15 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
                        (s->strategy ? GN_FEAT_STRATEGY : 0u) | (n > 1 ? GN_FEAT_LIGHT_SEARCH : 0u) |
                        (env > 0 || s->env[0] != 0 || s->env[1] != 0 || s->env[2] != 0 ? GN_FEAT_ENV : 0u) |
                        (s->env_map ? GN_FEAT_ENV | GN_FEAT_ENV_MAP : 0u);
-    if (r->num_emitters > r->num_area_emitters) /* punctual lights follow the triangles */
+    if (r->lights.num_emitters > r->lights.num_area) /* punctual lights follow the triangles */
         r->path_features |= GN_FEAT_PUNCTUAL;
     /* The unspecialised kernel, for checking that specialisation changes nothing
      * (tests/regress/path.sh) and for ruling it out when chasing a bug. */
     if (getenv("GONIO_ALL_FEATURES"))
         r->path_features = GN_FEAT_ALL;
-    frame->traversal_budget = traversal_budget(r->g, 1); /* (unused: path.comp has loop_cap) */
-    loop_setup(r, frame);
+    frame->traversal_budget = render_traversal_budget(r->g, 1); /* (unused: path.comp has loop_cap) */
+    r->state_stride = render_state_stride(r->g, &r->geo);
+    r->loop_cap = render_loop_setup(r->state_stride, frame);
     return true;
 }
 
@@ -260,7 +253,7 @@ void render_region(const render_settings *s, int region[4])
 }
 
 /* The frame constants of s for the pixels `region` (no upload); false when the camera is bad. */
-bool frame_setup(renderer *r, const render_settings *s, const int region[4], GnFrame *frame)
+static bool frame_setup(renderer *r, const render_settings *s, const int region[4], GnFrame *frame)
 {
     memset(frame, 0, sizeof *frame);
     if (!renderer_camera(r, s, &frame->camera))
@@ -273,7 +266,7 @@ bool frame_setup(renderer *r, const render_settings *s, const int region[4], GnF
     frame->crop_height = (uint32_t)(region[3] - region[1]);
     frame->seed = s->seed;
     frame->max_depth = (uint32_t)s->max_depth;
-    frame->num_lights = r->num_lights;
+    frame->num_lights = r->lights.num_lights;
     frame->flags = (s->aov & RENDER_AOV_GPU ? GN_FRAME_AOV : 0u) | (!s->no_shadows ? GN_FRAME_SHADOWS : 0u) |
                    (s->aov & RENDER_AOV_VARIANCE ? GN_FRAME_VARIANCE : 0u) |
                    (r->sc->vertex_colors ? GN_FRAME_VERTEX_COLOR : 0u) |
@@ -283,24 +276,40 @@ bool frame_setup(renderer *r, const render_settings *s, const int region[4], GnF
     frame->env_cos = (float)cos(s->env_rotation * M_PI / 180);
     frame->env_sin = (float)-sin(s->env_rotation * M_PI / 180);
     frame->ambient = vec3_of(s->ambient_set ? s->ambient : r->sc->ambient);
-    frame->traversal_budget = traversal_budget(r->g, 1 + (!s->no_shadows ? r->num_lights : 0));
+    frame->traversal_budget = render_traversal_budget(r->g, 1 + (!s->no_shadows ? r->lights.num_lights : 0));
     r->state_stride = 0; /* path_begin sets it, and the loop cap, for the path kernel */
     return s->mode != GN_MODE_PATH || path_begin(r, s, frame);
 }
 
+/* The rows of a region one set of accumulation buffers holds (render_accum_rows). */
+static int region_rows(const renderer *r, const render_settings *s, int rw, int rh, char *why, size_t why_size)
+{
+    const uint32_t stride = s->mode == GN_MODE_PATH ? render_state_stride(r->g, &r->geo) : 0;
+    return render_accum_rows(r->g, r->sc->path, rw, rh, s->aov, stride, why, why_size);
+}
+
+/* Gouraud's vertex pass, where the mode has one (GN_MODEF_VERTEX_LIGHT), for the frame just
+ * uploaded. */
+static bool light_vertices(renderer *r, uint32_t mode)
+{
+    gpu_binding b[GN_BIND_COUNT];
+    if (!(render_modes[mode].flags & GN_MODEF_VERTEX_LIGHT))
+        return true;
+    return render_gouraud_light(&r->gouraud, r->g, r->sc->path, r->geo.two_levels, b, renderer_bindings(r, b),
+                                buffers_generation(r));
+}
+
 bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
 {
-    gpu *g = r->g;
     int region[4];
     render_region(s, region);
     const int rw = region[2] - region[0], rh = region[3] - region[1];
     char why[256];
     assert(rw > 0 && rh > 0 && region[0] >= 0 && region[1] >= 0 && region[2] <= s->width &&
            region[3] <= s->height);
-    free_bands(r);
     if (r->failed)
         return false;
-    int rows = band_rows(r, rw, rh, s->aov, s->mode, why, sizeof why);
+    int rows = region_rows(r, s, rw, rh, why, sizeof why);
     if (rows == 0)
         return false;
     if (rows < rh) {
@@ -310,78 +319,55 @@ bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame)
     }
     if (!frame_setup(r, s, region, frame))
         return false;
-    gpu_buffer_upload(g, &r->frame, frame, sizeof *frame, 0);
-    size_buffers(r, rw, rh, s->aov);
-    gpu_buffer_fill_zero(g, &r->accum);
-    gpu_buffer_fill_zero(g, &r->aov);
-    gpu_buffer_fill_zero(g, &r->squares);
-    gpu_buffer_fill_zero(g, &r->pstate);
-    gpu_buffer_fill_zero(g, &r->status);
-    return !(render_modes[s->mode].flags & GN_MODEF_VERTEX_LIGHT) || light_vertices(r);
+    gpu_buffer_upload(r->g, &r->frame, frame, sizeof *frame, 0);
+    render_accum_begin(&r->accum, r->g, rw, rh, s->aov, r->state_stride);
+    gpu_buffer_fill_zero(r->g, &r->status);
+    return light_vertices(r, s->mode);
 }
 
-/* The GN_FEAT_* a mode's kernel is built for: those it is specialised on as the scene and
- * settings need them, every other one compiled in. */
-static GnFeatures kernel_features(const renderer *r, uint32_t mode)
+/* A render in bands of `rows` rows: the frame for the first band (each band's is uploaded
+ * before its passes), one set of buffers for all, the whole region's sums on the host. */
+static bool begin_bands(renderer *r, const render_settings *s, const int region[4], int rows, GnFrame *frame)
 {
-    const GnFeatures spec = mode_kernel(mode)->specialised;
-    return (GN_FEAT_ALL & ~spec) | (r->path_features & spec);
+    if (!frame_setup(r, s, region, frame))
+        return false;
+    render_accum_begin_bands(&r->accum, r->g, region[2] - region[0], region[3] - region[1], rows, s->aov,
+                             r->state_stride);
+    gpu_buffer_fill_zero(r->g, &r->status);
+    return light_vertices(r, s->mode);
 }
 
-const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec)
+/* Band b's frame uploaded and its sums loaded into the buffers (load), or its sums put back
+ * (!load). */
+static void band_swap(renderer *r, GnFrame *frame, const int region[4], int rows, int b, bool load)
 {
-    spec->values[0] = mode;
-    spec->values[1] = (uint32_t)kernel_features(r, mode);
-    spec->values[2] = walk_regs(r);
-    spec->values[3] = 0; /* the loop cap: only the path kernel's (renderer_pipeline) */
-    spec->values[4] = (uint32_t)(kernel_features(r, mode) >> 32);
-    spec->values[5] = r->geo.two_levels; /* INSTANCES */
-    for (uint32_t i = 0; i < 6; i++)
-        spec->entries[i] = (VkSpecializationMapEntry){i, i * (uint32_t)sizeof(uint32_t), sizeof(uint32_t)};
-    assert(spec->entries[GN_SPEC_FEATURES].constantID == GN_SPEC_FEATURES &&
-           spec->entries[GN_SPEC_FEATURES_HI].constantID == GN_SPEC_FEATURES_HI &&
-           spec->entries[2].constantID == GN_SPEC_WALK_REGS && spec->entries[3].constantID == GN_SPEC_LOOP_CAP &&
-           spec->entries[5].constantID == GN_SPEC_INSTANCES);
-    spec->info = (VkSpecializationInfo){6, spec->entries, sizeof spec->values, spec->values};
-    return &spec->info;
+    const int y0 = b * rows, rh = region[3] - region[1], bh = rh - y0 < rows ? rh - y0 : rows;
+    if (load) {
+        frame->crop_y = (uint32_t)(region[1] + y0);
+        frame->crop_height = (uint32_t)bh;
+        gpu_buffer_upload(r->g, &r->frame, frame, sizeof *frame, 0);
+    }
+    render_accum_band_swap(&r->accum, y0, bh, load);
+}
+
+/* The key of mode's kernel for r's scene and current render. */
+static render_kernel_key kernel_key(const renderer *r, uint32_t mode)
+{
+    return (render_kernel_key){mode, r->path_features, render_walk_regs(&r->geo), r->loop_cap, r->geo.two_levels};
+}
+
+const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, render_spec *spec)
+{
+    render_kernel_key key = kernel_key(r, mode);
+    key.loop_cap = 0; /* (only the renderer's own batched kernels resume past the cap) */
+    return render_kernel_specialize(&key, spec);
 }
 
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode)
 {
-    gpu_pipeline *p = &r->pipelines[mode];
-    renderer_spec spec;
-    const VkSpecializationInfo *info = renderer_specialize(r, mode, &spec);
-    spec.values[3] = mode_kernel(mode)->batched ? r->loop_cap : 0u;
-    if (p->pipeline && memcmp(r->pipeline_spec[mode], spec.values, sizeof spec.values))
-        gpu_pipeline_destroy(r->g, p); /* built for other features: a new kernel */
-    if (!p->pipeline) {
-        gpu_binding b[GN_BIND_COUNT];
-        gpu_pipeline_desc pd = {
-            .name = mode_kernel(mode)->name, .code = mode_kernel(mode)->code,
-            .code_size = mode_kernel(mode)->code_size,
-            .local_size = {GN_TILE_X, GN_TILE_Y, 1}, .push_size = sizeof(GnPush),
-            .bindings = b, .num_bindings = renderer_bindings(r, b), .specialization = info};
-        gpu_pipeline_create(r->g, p, &pd);
-        memcpy(r->pipeline_spec[mode], spec.values, sizeof spec.values);
-        r->pipeline_bound[mode] = r->buffers_replaced;
-    } else {
-        renderer_rebind(r, p, &r->pipeline_bound[mode]);
-    }
-    return p;
-}
-
-void renderer_buffers_replaced(renderer *r)
-{
-    r->buffers_replaced++;
-}
-
-void renderer_rebind(renderer *r, gpu_pipeline *p, uint32_t *bound)
-{
     gpu_binding b[GN_BIND_COUNT];
-    if (*bound == r->buffers_replaced)
-        return;
-    gpu_pipeline_bind(r->g, p, b, renderer_bindings(r, b));
-    *bound = r->buffers_replaced;
+    const render_kernel_key key = kernel_key(r, mode);
+    return render_kernels_get(&r->kernels, r->g, &key, b, renderer_bindings(r, b), buffers_generation(r));
 }
 
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,
@@ -389,10 +375,10 @@ void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, ui
 {
     /* A batched kernel takes up to path_samples samples per dispatch (glsl/kernels/path.comp: a lane
      * whose path ends starts its next one); the others one. */
-    uint32_t per = mode_kernel(mode)->batched ? r->path_samples : 1u;
+    uint32_t per = render_mode_kernel(mode)->batched ? r->path_samples : 1u;
     for (uint32_t i = 0; i < count; i += per) {
         GnPush push = {first + i, 0, count - i < per ? count - i : per, 0};
-        gpu_dispatch(cmd, renderer_pipeline(r, mode), &push, (uint32_t)r->width, (uint32_t)r->height, 1);
+        gpu_dispatch(cmd, renderer_pipeline(r, mode), &push, (uint32_t)r->accum.width, (uint32_t)r->accum.height, 1);
         gpu_barrier(cmd);
     }
 }
@@ -403,10 +389,10 @@ uint32_t renderer_finish(renderer *r, uint32_t mode, uint32_t next)
     /* status[1]: the pixels pending after the last dispatch. Each dispatch that takes no new
      * samples gives every pending pixel one more invocation's worth of loop passes. */
     volatile const uint32_t *pending = (const uint32_t *)r->status.mapped + 1;
-    while (mode_kernel(mode)->batched && r->loop_cap && *pending) {
+    while (render_mode_kernel(mode)->batched && r->loop_cap && *pending) {
         VkCommandBuffer cmd = gpu_begin(r->g);
         GnPush push = {next, 0, 0, 0};
-        gpu_dispatch(cmd, renderer_pipeline(r, mode), &push, (uint32_t)r->width, (uint32_t)r->height, 1);
+        gpu_dispatch(cmd, renderer_pipeline(r, mode), &push, (uint32_t)r->accum.width, (uint32_t)r->accum.height, 1);
         gpu_barrier(cmd);
         gpu_submit_wait(r->g, cmd);
         n++;
@@ -414,58 +400,62 @@ uint32_t renderer_finish(renderer *r, uint32_t mode, uint32_t next)
     return n;
 }
 
-bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats)
+void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out)
 {
-    gpu *g = r->g;
-    GnFrame frame;
-    double t0;
-    int done = 0, batch = 1, region[4], rows, bands;
-    const int per = mode_kernel(s->mode)->batched ? (int)r->path_samples : 1;
+    render_accum_resolve(&r->accum, spp, aov, out);
+}
+
+void renderer_sums(const renderer *r, int spp, uint32_t aov, image *out)
+{
+    render_accum_sums(&r->accum, spp, aov, out);
+}
+
+/* A render's region as bands of `rows` rows (one band: the whole region). */
+typedef struct render_bands {
+    int region[4];
+    int rows, count;
+} render_bands;
+
+/* The bands the region of s needs, its buffers and frame set up for the first pass, the
+ * sums of s->resume loaded: false (with an error) when it cannot start. */
+static bool render_start(renderer *r, const render_settings *s, render_bands *bands, GnFrame *frame)
+{
     char why[256];
-
-    memset(stats, 0, sizeof *stats);
-    assert(s->mode < GN_MODE_COUNT);
-    if (r->failed)
+    render_region(s, bands->region);
+    const int rw = bands->region[2] - bands->region[0], rh = bands->region[3] - bands->region[1];
+    if ((bands->rows = region_rows(r, s, rw, rh, why, sizeof why)) == 0)
         return false;
-    render_region(s, region);
-    const int rw = region[2] - region[0], rh = region[3] - region[1];
-    const VkDeviceSize pixels = (VkDeviceSize)rw * rh;
-    if ((rows = band_rows(r, rw, rh, s->aov, s->mode, why, sizeof why)) == 0)
-        return false;
-    bands = (rh + rows - 1) / rows;
-    if (bands > 1) {
+    bands->count = (rh + bands->rows - 1) / bands->rows;
+    if (bands->count > 1) {
         /* Bands of about equal height, whole 8-row tiles where that stays within the limit. */
-        int even = (rh + bands - 1) / bands, tiled = (even + (int)GN_TILE_Y - 1) / (int)GN_TILE_Y * (int)GN_TILE_Y;
-        rows = tiled <= rows ? tiled : even;
-        bands = (rh + rows - 1) / rows;
-        util_info("%dx%d rendered in %d bands of %d rows: %s", rw, rh, bands, rows, why);
-        if (!begin_bands(r, s, region, rows, &frame))
+        int even = (rh + bands->count - 1) / bands->count;
+        int tiled = (even + (int)GN_TILE_Y - 1) / (int)GN_TILE_Y * (int)GN_TILE_Y;
+        bands->rows = tiled <= bands->rows ? tiled : even;
+        bands->count = (rh + bands->rows - 1) / bands->rows;
+        util_info("%dx%d rendered in %d bands of %d rows: %s", rw, rh, bands->count, bands->rows, why);
+        if (!begin_bands(r, s, bands->region, bands->rows, frame))
             return false;
-    } else if (!renderer_begin(r, s, &frame)) {
+    } else if (!renderer_begin(r, s, frame)) {
         return false;
     }
-    stats->bands = bands;
-    if (s->resume) {
-        if (!load_sums(r, s))
-            return false;
-        done = s->resume_spp;
-    }
+    return !s->resume || render_accum_load(&r->accum, s->resume, s->aov);
+}
 
-    /* Passes are submitted in batches sized to take 0.1 to 0.4 s each (per band): short
-     * enough for a responsive progress bar and an early stop, long enough to hide submission
-     * costs and to let the path kernel take several samples per dispatch
-     * (renderer_record_samples). The kernels add each sample to the buffers' sums in sample
-     * order (glsl/kernels/path.comp), so the bits do not depend on how the batches, dispatches and
-     * bands split the samples: the same command gives the same bits, and so do a render
-     * resumed from its sums (s->resume), a crop of it (GnFrame) and one in bands. A batch
-     * goes through every band before the next, so all pixels always have the same samples:
-     * a stop or --time ends the render after a whole round. The kernel is compiled first,
-     * so that --time, the progress and the rates count rendering, not the driver's compiler
-     * (the setup time includes it). */
-    t0 = util_now();
-    renderer_pipeline(r, s->mode);
-    double compile_seconds = util_now() - t0;
-    t0 = util_now();
+/* Passes are submitted in batches sized to take 0.1 to 0.4 s each (per band): short enough
+ * for a responsive progress bar and an early stop, long enough to hide submission costs and
+ * to let the path kernel take several samples per dispatch (renderer_record_samples). The
+ * kernels add each sample to the buffers' sums in sample order (glsl/kernels/path.comp), so
+ * the bits do not depend on how the batches, dispatches and bands split the samples: the
+ * same command gives the same bits, and so do a render resumed from its sums (s->resume), a
+ * crop of it (GnFrame) and one in bands. A batch goes through every band before the next, so
+ * all pixels always have the same samples: a stop or --time ends the render after a whole
+ * round. Returns the samples per pixel taken, from `done`. */
+static int render_passes(renderer *r, const render_settings *s, const render_bands *bands, GnFrame *frame,
+                         int done, render_stats *stats)
+{
+    const int per = render_mode_kernel(s->mode)->batched ? (int)r->path_samples : 1, first = done;
+    int batch = 1;
+    double t0 = util_now();
     if (s->progress)
         s->progress(s->progress_user, s, RENDER_PROGRESS_START, done, 0);
     while (s->time_limit > 0 || done < s->spp) {
@@ -473,38 +463,38 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
         int n = batch * per;
         if (s->time_limit <= 0 && n > s->spp - done)
             n = s->spp - done;
-        for (int b = 0; b < bands; b++) {
-            VkCommandBuffer cmd;
-            if (bands > 1)
-                band_swap(r, &frame, region, rows, b, true);
-            cmd = gpu_begin(g);
+        for (int b = 0; b < bands->count; b++) {
+            if (bands->count > 1)
+                band_swap(r, frame, bands->region, bands->rows, b, true);
+            VkCommandBuffer cmd = gpu_begin(r->g);
             renderer_record_samples(r, cmd, s->mode, (uint32_t)done, (uint32_t)n);
-            gpu_submit_wait(g, cmd);
+            gpu_submit_wait(r->g, cmd);
             stats->resumes += renderer_finish(r, s->mode, (uint32_t)(done + n));
-            if (bands > 1)
-                band_swap(r, &frame, region, rows, b, false);
+            if (bands->count > 1)
+                band_swap(r, frame, bands->region, bands->rows, b, false);
         }
         done += n;
-        if (done == n + (s->resume ? s->resume_spp : 0))
+        if (done == first + n)
             stats->first_pass_seconds = util_now() - t0;
-        tb = (util_now() - tb) / bands;
+        tb = (util_now() - tb) / bands->count;
         if (tb < 0.1 && batch < 1024)
             batch *= 2;
         else if (tb > 0.4 && batch > 1)
             batch /= 2;
         if (s->progress)
             s->progress(s->progress_user, s, RENDER_PROGRESS_BATCH, done, util_now() - t0);
-        if (s->stop && *s->stop)
-            break;
-        if (s->time_limit > 0 && util_now() - t0 >= s->time_limit)
+        if ((s->stop && *s->stop) || (s->time_limit > 0 && util_now() - t0 >= s->time_limit))
             break;
     }
     stats->seconds = util_now() - t0;
     if (s->progress)
         s->progress(s->progress_user, s, RENDER_PROGRESS_END, done, stats->seconds);
-    stats->spp = done;
-    stats->rays = (uint64_t)pixels * (uint64_t)(done - (s->resume ? s->resume_spp : 0));
-    stats->setup_seconds = r->setup_seconds + compile_seconds;
+    return done;
+}
+
+/* The kernels' counters after the passes: walks cut short. */
+static void render_check(const renderer *r, const render_settings *s, const GnFrame *frame, render_stats *stats)
+{
     stats->truncated = ((const uint32_t *)r->status.mapped)[0];
     if (getenv("GONIO_DEBUG_RESUMES")) /* tests/regress/path.sh: the interrupted paths were there */
         fprintf(stderr, "gonio: debug: %u dispatch(es) finished paths the loop cap interrupted\n",
@@ -517,7 +507,28 @@ bool renderer_render(renderer *r, const render_settings *s, image *out, render_s
                   r->sc->path, stats->truncated);
     else if (stats->truncated)
         util_warn("%s: %u ray(s) needed more BVH steps than the per-ray budget (%u) and may be "
-                  "wrong", r->sc->path, stats->truncated, frame.traversal_budget);
-    renderer_resolve(r, done, s->aov, out);
+                  "wrong", r->sc->path, stats->truncated, frame->traversal_budget);
+}
+
+bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats)
+{
+    GnFrame frame;
+    render_bands bands;
+    memset(stats, 0, sizeof *stats);
+    assert(s->mode < GN_MODE_COUNT);
+    if (r->failed || !render_start(r, s, &bands, &frame))
+        return false;
+    stats->bands = bands.count;
+    const int resumed = s->resume ? s->resume_spp : 0;
+    /* The kernel is compiled first, so that --time, the progress and the rates count
+     * rendering, not the driver's compiler (the setup time includes it). */
+    double t0 = util_now();
+    renderer_pipeline(r, s->mode);
+    stats->setup_seconds = r->setup_seconds + (util_now() - t0);
+    stats->spp = render_passes(r, s, &bands, &frame, resumed, stats);
+    const VkDeviceSize pixels = (VkDeviceSize)(bands.region[2] - bands.region[0]) * (bands.region[3] - bands.region[1]);
+    stats->rays = (uint64_t)pixels * (uint64_t)(stats->spp - resumed);
+    render_check(r, s, &frame, stats);
+    renderer_resolve(r, stats->spp, s->aov, out);
     return true;
 }

@@ -13,8 +13,13 @@
 
 #include "bvh.h"
 #include "gpu.h"
-#include "render_geometry.h"
 #include "image.h"
+#include "render_accum.h"
+#include "render_geometry.h"
+#include "render_gouraud.h"
+#include "render_kernels.h"
+#include "render_lights.h"
+#include "render_modes.h"
 #include "scene.h"
 
 /* Progress reports of renderer_render, for a display (the command line's: src/cli/progress.c):
@@ -71,18 +76,6 @@ typedef struct render_settings {
 /* The region s renders, {x0, y0, x1, y1}. */
 void render_region(const render_settings *s, int region[4]);
 
-/* The AOVs (extra EXR channels) a render can add. Normal, albedo and depth come from one
- * GPU pass (GN_FRAME_AOV) whichever of them is asked for; none asked costs nothing. */
-#define RENDER_AOV_NORMAL 1u   /* normal.X/Y/Z: world-space shading normal */
-#define RENDER_AOV_ALBEDO 2u   /* albedo.R/G/B: base colour */
-#define RENDER_AOV_DEPTH 4u    /* depth.Z: distance along the camera axis, 0 on a miss */
-#define RENDER_AOV_VARIANCE 8u /* variance.R/G/B: the estimated variance of each pixel's mean */
-#define RENDER_AOV_GPU (RENDER_AOV_NORMAL | RENDER_AOV_ALBEDO | RENDER_AOV_DEPTH)
-/* "normal", "albedo", "depth", "variance" -> RENDER_AOV_*; 0 when unknown. */
-uint32_t render_aov_from_name(const char *name);
-/* Every AOV's name, ", "-separated. */
-const char *render_aov_list(void);
-
 typedef struct render_stats {
     int spp;                /* samples per pixel actually taken */
     double seconds;         /* rendering time (passes only) */
@@ -94,45 +87,30 @@ typedef struct render_stats {
     int bands;              /* horizontal bands the region was rendered in (1: one piece) */
 } render_stats;
 
+/* The renderer: a scene on the GPU and what renders it, as parts that own their state
+ * (docs/architecture.md, src/render): the trees (render_geometry.h), the lights
+ * (render_lights.h), the accumulation (render_accum.h), the kernels (render_kernels.h) and
+ * Gouraud's vertex pass (render_gouraud.h); the renderer composes them, and the parts never
+ * call it. Read its fields, write none. */
 typedef struct renderer {
     gpu *g;
     const scene *sc;
     render_geometry geo;    /* the trees and the arrays the walk reads */
-    uint32_t num_lights, num_emitters;
-    uint32_t num_area_emitters; /* the emitter table's triangles, before its punctual lights */
-    gpu_buffer frame, nodes, tris, prims, vertices, materials, lights, texels, textures,
-        emitters, vcolor, status, instances;
-    gpu_buffer accum, aov;  /* sized for the current image */
-    gpu_pipeline pipelines[GN_MODE_COUNT]; /* created on first use */
-    gpu_pipeline vertex_pass; /* Gouraud's per-vertex lighting (glsl/kernels/vertex.comp) */
-    gpu_buffer squares, env; /* path: per-pixel sums of squares; the environment map */
-    gpu_buffer pstate;        /* path under a loop cap: the paths left pending (GN_BIND_PSTATE) */
-    uint32_t loop_cap;        /* path: the kernel's LOOP_CAP (glsl/lib/bvh.glsl), 0 without a cap */
-    uint32_t state_stride;    /* words a pixel of pstate (frame_setup), 0 without a cap */
-    GnEmitter *emitter_table; /* path: lights, then a slot for the environment */
-    double *emitter_weight;   /* their selection weights (flux / pi) */
-    uint32_t *emitter_instance; /* with instances: each entry's instance (GN_INVALID: a light) */
-    uint32_t emitter_cap;     /* the table's room (with instances, where the instances follow) */
-    uint32_t vcolor_count;    /* Gouraud's vertices: the scene's, or every instance's copies */
-    const image *env_source;  /* the map now in `env` */
-    double env_weight;        /* its selection weight */
-    int width, height;
-    double setup_seconds;
+    render_lights lights;
+    render_accum accum;     /* sized for the current image: accum.width x accum.height */
+    render_kernels kernels;
+    render_gouraud gouraud;
+    /* the renderer's own buffers: the frame constants, the kernels' counters (status[0]:
+     * truncated walks, status[1]: pixels pending past the loop cap), and the scene's arrays
+     * as the kernels read them */
+    gpu_buffer frame, status, nodes, tris, prims, vertices, materials, texels, textures, instances;
     GnFeatures material_features; /* GN_FEAT_* the materials need (renderer_create) */
     GnFeatures path_features;     /* ... and the current path render (renderer_begin) */
-    /* A kernel is compiled once for its specialisation (renderer_pipeline); buffers made anew
-     * (a larger image, more lights, another map) are pointed at by its descriptor set, not
-     * compiled again: renderer_buffers_replaced counts them, and each kernel rebinds once. */
-    uint32_t pipeline_spec[GN_MODE_COUNT][6]; /* what each cached kernel was built for */
-    uint32_t pipeline_bound[GN_MODE_COUNT], vertex_bound, buffers_replaced;
-    uint32_t path_samples;      /* samples per path dispatch (1..GN_PATH_SAMPLES) */
-    bool failed;                /* renderer_create refused the scene: nothing renders */
-    VkDeviceSize vcolor_bytes;  /* Gouraud's colours: more than a storage buffer holds when
-                                 * vcolor is a dummy (then --mode gouraud is refused) */
-    /* A render in bands (renderer_render): the whole region's sums on the host, which
-     * renderer_resolve and renderer_sums read instead of the buffers; NULL otherwise. */
-    float *band_accum, *band_aov, *band_squares;
-    int region_width, region_height;
+    uint32_t path_samples;  /* samples per path dispatch (1..GN_PATH_SAMPLES) */
+    uint32_t loop_cap;      /* path: the kernel's LOOP_CAP (glsl/lib/bvh.glsl), 0 without a cap */
+    uint32_t state_stride;  /* path: words a pixel of saved state (render_limits.h), 0 without a cap */
+    double setup_seconds;
+    bool failed;            /* renderer_create refused the scene: nothing renders */
 } renderer;
 
 /* Builds the BVH and uploads the scene. False (with an error naming the scene, the limit
@@ -156,27 +134,16 @@ bool renderer_camera(const renderer *r, const render_settings *s, GnCamera *out)
  * for them; 16-byte dummies otherwise). False (with an error) when the region needs more
  * than one buffer may hold: only renderer_render renders such a region, in bands. */
 bool renderer_begin(renderer *r, const render_settings *s, GnFrame *frame);
-/* The descriptor bindings of every render kernel (up to GN_BIND_COUNT entries). */
+/* The descriptor bindings of every render kernel (up to GN_BIND_COUNT entries), for a
+ * command's own kernel over the renderer's buffers (gonio bench's). */
 uint32_t renderer_bindings(const renderer *r, gpu_binding *out);
-
-/* Specialization constants of the render kernels: constant 0 = mode (or a kernel's own
- * variant); constants GN_SPEC_FEATURES and GN_SPEC_FEATURES_HI = the GN_FEAT_* set's two words (the
- * path kernel reads them; others ignore them). */
-typedef struct renderer_spec {
-    uint32_t values[6];
-    VkSpecializationMapEntry entries[6];
-    VkSpecializationInfo info;
-} renderer_spec;
-const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, renderer_spec *spec);
+/* The specialisation of mode's kernel for r's scene and current render (no loop cap), for
+ * such a kernel: render_kernels.h. */
+const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, render_spec *spec);
 
 /* The kernel of a mode (created on first use, kept until renderer_destroy or until its
  * specialisation changes), its descriptor set naming the renderer's current buffers. */
 gpu_pipeline *renderer_pipeline(renderer *r, uint32_t mode);
-/* After a buffer the kernels bind is destroyed and made anew: each kernel's descriptor set is
- * pointed at the new one before its next use. */
-void renderer_buffers_replaced(renderer *r);
-/* Points p's descriptor set at the renderer's buffers if any was made anew since *bound. */
-void renderer_rebind(renderer *r, gpu_pipeline *p, uint32_t *bound);
 /* Records one sample pass (sample `sample_index` in every pixel) and a barrier. Call
  * renderer_begin first. */
 void renderer_record_samples(renderer *r, VkCommandBuffer cmd, uint32_t mode, uint32_t first,
@@ -202,22 +169,5 @@ void renderer_sums(const renderer *r, int spp, uint32_t aov, image *out);
  * with the same bits: every batch of samples goes through all bands in turn (their sums
  * kept on the host), so --time, a stop and the progress act on whole rounds of bands. */
 bool renderer_render(renderer *r, const render_settings *s, image *out, render_stats *stats);
-
-/* The render modes (glsl/lib/shared.h: GN_MODES) as the host reads them, indexed by GN_MODE_*. */
-typedef struct render_mode_info {
-    const char *name; /* --mode's */
-    const char *help; /* a line */
-    uint32_t kernel;  /* GN_KERNEL_* */
-    uint32_t flags;   /* GN_MODEF_* */
-} render_mode_info;
-extern const render_mode_info render_modes[GN_MODE_COUNT];
-
-/* Name <-> GN_MODE_* ("path", "phong", ...); -1 when unknown. */
-int render_mode_from_name(const char *name);
-const char *render_mode_name(uint32_t mode);
-/* Comma-separated list of every mode name, for messages. */
-const char *render_mode_list(void);
-/* A line per mode, "name  help", for --mode's help. */
-const char *render_mode_help(void);
 
 #endif

@@ -1,12 +1,11 @@
-/* render_accum.c: where samples accumulate: the buffers of a region (sized within the
- * device's limits, or a render in bands with the sums kept on the host), the resolve into an
- * image with its AOVs, and the exact sums --resumable writes and --resume loads. */
+/* render_accum.c: where samples accumulate (render_accum.h). */
+#include "render_accum.h"
+
 #include <assert.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "render_internal.h"
 #include "util.h"
 
 
@@ -15,28 +14,27 @@
 static VkDeviceSize aov_pixel_bytes(uint32_t aov) { return aov & RENDER_AOV_GPU ? 48 : 0; }
 static VkDeviceSize squares_pixel_bytes(uint32_t aov) { return aov & RENDER_AOV_VARIANCE ? 16 : 0; }
 
-/* How many rows of a w x h region one set of accumulation buffers holds within the device's
- * limits: each buffer within gpu_storage_limit, all of them within half the host heap (the
- * rest for the scene and the image), at most 8 maxComputeWorkGroupCount[1] rows and each row
- * within maxComputeWorkGroupCount[0] work groups. 0 (with an error naming the limit and the
- * numbers) when not even one row fits; *why (may be NULL) names what bounds it, else NULL. */
-int band_rows(const renderer *r, int w, int h, uint32_t aov, uint32_t mode, char *why,
-                     size_t why_size)
+/* Each buffer within gpu_storage_limit, all of them within half the host heap (the rest for
+ * the scene and the image), at most 8 maxComputeWorkGroupCount[1] rows and each row within
+ * maxComputeWorkGroupCount[0] work groups; the saved paths within the device's own storage
+ * buffer range. */
+int render_accum_rows(const gpu *g, const char *scene_path, int w, int h, uint32_t aov, uint32_t state_stride,
+                      char *why, size_t why_size)
 {
     const char *limit_name;
-    const VkDeviceSize limit = gpu_storage_limit(r->g, &limit_name), heap = gpu_host_heap(r->g) / 2;
+    const VkDeviceSize limit = gpu_storage_limit(g, &limit_name), heap = gpu_host_heap(g) / 2;
     const VkDeviceSize largest = aov_pixel_bytes(aov) > 16 ? aov_pixel_bytes(aov) : 16;
     const VkDeviceSize all = 16 + aov_pixel_bytes(aov) + squares_pixel_bytes(aov);
     const uint32_t groups_x = (uint32_t)(w + GN_TILE_X - 1) / GN_TILE_X;
     VkDeviceSize rows = limit / (largest * (VkDeviceSize)w);
     const VkDeviceSize heap_rows = heap / (all * (VkDeviceSize)w);
-    const VkDeviceSize group_rows = (VkDeviceSize)gpu_max_groups(r->g, 1) * GN_TILE_Y;
+    const VkDeviceSize group_rows = (VkDeviceSize)gpu_max_groups(g, 1) * GN_TILE_Y;
     if (why)
         why[0] = 0;
-    if (groups_x > gpu_max_groups(r->g, 0)) {
+    if (groups_x > gpu_max_groups(g, 0)) {
         util_error("%s: a row of %d pixels needs %u work groups, more than the %u this device "
-                   "dispatches (maxComputeWorkGroupCount[0])", r->sc->path, w, groups_x,
-                   gpu_max_groups(r->g, 0));
+                   "dispatches (maxComputeWorkGroupCount[0])", scene_path, w, groups_x,
+                   gpu_max_groups(g, 0));
         return 0;
     }
     if (rows < (VkDeviceSize)h && why)
@@ -55,14 +53,14 @@ int band_rows(const renderer *r, int w, int h, uint32_t aov, uint32_t mode, char
         rows = group_rows;
         if (rows < (VkDeviceSize)h && why)
             snprintf(why, why_size, "its %d rows need more work groups than the device's "
-                     "maxComputeWorkGroupCount[1] (%u)", h, gpu_max_groups(r->g, 1));
+                     "maxComputeWorkGroupCount[1] (%u)", h, gpu_max_groups(g, 1));
     }
     /* The path kernel's saved paths (state_stride) are one more storage buffer, within the
      * device's own limit (GONIO_MAX_BUFFER_BYTES is for the accumulation buffers' bands). */
-    const VkDeviceSize state = 4 * (VkDeviceSize)state_stride(r, mode) * (VkDeviceSize)w;
-    VkDeviceSize state_limit = r->g->props.limits.maxStorageBufferRange;
-    if (r->g->max_allocation && r->g->max_allocation < state_limit)
-        state_limit = r->g->max_allocation;
+    const VkDeviceSize state = 4 * (VkDeviceSize)state_stride * (VkDeviceSize)w;
+    VkDeviceSize state_limit = g->props.limits.maxStorageBufferRange;
+    if (g->max_allocation && g->max_allocation < state_limit)
+        state_limit = g->max_allocation;
     if (state && state_limit / state < rows) {
         rows = state_limit / state;
         if (rows < (VkDeviceSize)h && why)
@@ -72,7 +70,7 @@ int band_rows(const renderer *r, int w, int h, uint32_t aov, uint32_t mode, char
     }
     if (rows == 0) {
         util_error("%s: a row of %d pixels needs %llu bytes of accumulation buffers, more than this "
-                   "device allows (%s: %llu bytes; half the memory heap: %llu bytes)", r->sc->path, w,
+                   "device allows (%s: %llu bytes; half the memory heap: %llu bytes)", scene_path, w,
                    (unsigned long long)(largest * (VkDeviceSize)w), limit_name,
                    (unsigned long long)limit, (unsigned long long)heap);
         return 0;
@@ -81,44 +79,65 @@ int band_rows(const renderer *r, int w, int h, uint32_t aov, uint32_t mode, char
 }
 
 
-/* (Re)allocates the accumulation buffers for w x h pixels: accum always, the AOV and squares
- * buffers only when the render writes them (16-byte dummies otherwise: every descriptor
- * must name a buffer). A buffer is kept while it holds the pixels and is at most twice the
- * size needed, so the bands of a tiled render share one set. */
-void size_buffers(renderer *r, int w, int h, uint32_t aov)
+/* (Re)allocates the buffers for w x h pixels: accum always, the AOV and squares buffers only
+ * when the render writes them, pstate with a saved state (16-byte dummies otherwise: every
+ * descriptor must name a buffer). A buffer is kept while it holds the pixels and is at most
+ * twice the size needed, so the bands of a tiled render share one set. */
+static void size_buffers(render_accum *a, gpu *g, int w, int h, uint32_t aov, uint32_t state_stride)
 {
     const VkDeviceSize pixels = (VkDeviceSize)w * h;
-    gpu_buffer *bufs[4] = {&r->accum, &r->aov, &r->squares, &r->pstate};
+    gpu_buffer *bufs[4] = {&a->accum, &a->aov, &a->squares, &a->pstate};
     const VkDeviceSize need[4] = {16 * pixels, aov_pixel_bytes(aov) ? aov_pixel_bytes(aov) * pixels : 16,
                                   squares_pixel_bytes(aov) ? squares_pixel_bytes(aov) * pixels : 16,
-                                  r->state_stride ? 4 * (VkDeviceSize)r->state_stride * pixels : 16};
+                                  state_stride ? 4 * (VkDeviceSize)state_stride * pixels : 16};
     bool changed = false;
     for (int i = 0; i < 4; i++) {
         if (bufs[i]->buffer && bufs[i]->size >= need[i] && bufs[i]->size / 2 <= need[i])
             continue;
-        gpu_buffer_destroy(r->g, bufs[i]);
-        gpu_buffer_create(r->g, bufs[i], need[i], VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
+        gpu_buffer_destroy(g, bufs[i]);
+        gpu_buffer_create(g, bufs[i], need[i], VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, GPU_MEMORY_HOST);
         assert(bufs[i]->mapped); /* resolve, resume and bands read and write them directly */
         changed = true;
     }
     if (changed && getenv("GONIO_DEBUG_BUFFERS")) /* tests/regress/limits.sh */
         fprintf(stderr, "gonio: debug: buffers for %dx%d: accum %llu, aov %llu, squares %llu bytes\n",
-                w, h, (unsigned long long)r->accum.size, (unsigned long long)r->aov.size,
-                (unsigned long long)r->squares.size);
-    r->width = w;
-    r->height = h;
+                w, h, (unsigned long long)a->accum.size, (unsigned long long)a->aov.size,
+                (unsigned long long)a->squares.size);
+    a->width = w;
+    a->height = h;
     if (changed) /* the cached kernels' descriptor sets name the old buffers */
-        renderer_buffers_replaced(r);
+        a->replaced++;
 }
 
-
-/* The host copies of a render in bands (renderer_render). */
-void free_bands(renderer *r)
+/* The host copies of a render in bands. */
+static void free_bands(render_accum *a)
 {
-    free(r->band_accum);
-    free(r->band_aov);
-    free(r->band_squares);
-    r->band_accum = r->band_aov = r->band_squares = NULL;
+    free(a->band_accum);
+    free(a->band_aov);
+    free(a->band_squares);
+    a->band_accum = a->band_aov = a->band_squares = NULL;
+}
+
+void render_accum_begin(render_accum *a, gpu *g, int w, int h, uint32_t aov, uint32_t state_stride)
+{
+    free_bands(a);
+    size_buffers(a, g, w, h, aov, state_stride);
+    gpu_buffer_fill_zero(g, &a->accum);
+    gpu_buffer_fill_zero(g, &a->aov);
+    gpu_buffer_fill_zero(g, &a->squares);
+    gpu_buffer_fill_zero(g, &a->pstate);
+}
+
+void render_accum_destroy(render_accum *a, gpu *g)
+{
+    if (g) {
+        gpu_buffer_destroy(g, &a->accum);
+        gpu_buffer_destroy(g, &a->aov);
+        gpu_buffer_destroy(g, &a->squares);
+        gpu_buffer_destroy(g, &a->pstate);
+    }
+    free_bands(a);
+    memset(a, 0, sizeof *a);
 }
 
 /* The AOVs' names, in the order of their RENDER_AOV_* bits. */
@@ -153,17 +172,17 @@ typedef struct sums_at {
     int width, height;
 } sums_at;
 
-static sums_at sums_of(const renderer *r)
+static sums_at sums_of(const render_accum *a)
 {
-    if (r->band_accum)
-        return (sums_at){r->band_accum, r->band_aov, r->band_squares, r->region_width, r->region_height};
-    return (sums_at){r->accum.mapped, r->aov.mapped, r->squares.mapped, r->width, r->height};
+    if (a->band_accum)
+        return (sums_at){a->band_accum, a->band_aov, a->band_squares, a->region_width, a->region_height};
+    return (sums_at){a->accum.mapped, a->aov.mapped, a->squares.mapped, a->width, a->height};
 }
 
 /* aov_offset: where the AOV is in each pixel's 12 floats of the aov buffer (GN_BIND_AOV). */
-static void add_gpu_aov(const renderer *r, int spp, const char *const *names, int n, int aov_offset, image *out)
+static void add_gpu_aov(const render_accum *a, int spp, const char *const *names, int n, int aov_offset, image *out)
 {
-    const sums_at at = sums_of(r);
+    const sums_at at = sums_of(a);
     const VkDeviceSize pixels = (VkDeviceSize)at.width * at.height;
     const float *aovs = at.aov;
     float inv = 1.0f / (float)spp;
@@ -176,10 +195,10 @@ static void add_gpu_aov(const renderer *r, int spp, const char *const *names, in
 
 /* Appends variance.R/G/B: the unbiased variance estimate of each pixel's mean,
  * (sum x^2 / n - mean^2) / (n - 1) (0 for n = 1), from the sums of squares. */
-static void add_variance(const renderer *r, int spp, image *out)
+static void add_variance(const render_accum *a, int spp, image *out)
 {
     static const char *const names[] = {"variance.R", "variance.G", "variance.B"};
-    const sums_at at = sums_of(r);
+    const sums_at at = sums_of(a);
     const VkDeviceSize pixels = (VkDeviceSize)at.width * at.height;
     const float *acc = at.accum, *sq = at.squares;
     for (int c = 0; c < 3; c++) {
@@ -191,13 +210,13 @@ static void add_variance(const renderer *r, int spp, image *out)
     }
 }
 
-void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out)
+void render_accum_resolve(const render_accum *a, int spp, uint32_t aov, image *out)
 {
     static const char *const names[] = {"R", "G", "B", "A"};
     static const char *const normal[] = {"normal.X", "normal.Y", "normal.Z"};
     static const char *const albedo[] = {"albedo.R", "albedo.G", "albedo.B"};
     static const char *const depth[] = {"depth.Z"};
-    const sums_at at = sums_of(r);
+    const sums_at at = sums_of(a);
     const VkDeviceSize pixels = (VkDeviceSize)at.width * at.height;
     const float *acc = at.accum;
     float inv = 1.0f / (float)spp;
@@ -206,16 +225,16 @@ void renderer_resolve(renderer *r, int spp, uint32_t aov, image *out)
         for (int c = 0; c < 4; c++)
             out->planes[c][p] = acc[4 * p + c] * inv;
     if (aov & RENDER_AOV_NORMAL)
-        add_gpu_aov(r, spp, normal, 3, 0, out);
+        add_gpu_aov(a, spp, normal, 3, 0, out);
     if (aov & RENDER_AOV_ALBEDO)
-        add_gpu_aov(r, spp, albedo, 3, 4, out);
+        add_gpu_aov(a, spp, albedo, 3, 4, out);
     if (aov & RENDER_AOV_DEPTH)
-        add_gpu_aov(r, spp, depth, 1, 8, out);
+        add_gpu_aov(a, spp, depth, 1, 8, out);
     if (aov & RENDER_AOV_VARIANCE)
-        add_variance(r, spp, out);
+        add_variance(a, spp, out);
 }
 
-/* The channels of renderer_sums: name, buffer (0 accum, 1 aov, 2 squares), float offset
+/* The channels of render_accum_sums: name, buffer (0 accum, 1 aov, 2 squares), float offset
  * in a pixel's entry of that buffer, and the AOV bit that needs it (0: always). */
 static const struct sum_channel {
     const char *name;
@@ -230,16 +249,16 @@ static const struct sum_channel {
     {"sum2.G", 2, 1, RENDER_AOV_VARIANCE}, {"sum2.B", 2, 2, RENDER_AOV_VARIANCE},
 };
 
-static float *sum_buffer(const renderer *r, int buffer, int *stride)
+static float *sum_buffer(const render_accum *a, int buffer, int *stride)
 {
-    const sums_at at = sums_of(r);
+    const sums_at at = sums_of(a);
     *stride = buffer == 1 ? 12 : 4;
     return buffer == 0 ? at.accum : buffer == 1 ? at.aov : at.squares;
 }
 
-void renderer_sums(const renderer *r, int spp, uint32_t aov, image *out)
+void render_accum_sums(const render_accum *a, int spp, uint32_t aov, image *out)
 {
-    const sums_at at = sums_of(r);
+    const sums_at at = sums_of(a);
     const VkDeviceSize pixels = (VkDeviceSize)at.width * at.height;
     float *n = add_channel(out, "sum.N");
     for (VkDeviceSize p = 0; p < pixels; p++)
@@ -247,7 +266,7 @@ void renderer_sums(const renderer *r, int spp, uint32_t aov, image *out)
     for (size_t k = 0; k < sizeof sum_channels / sizeof *sum_channels; k++) {
         const struct sum_channel *c = &sum_channels[k];
         int stride;
-        const float *buf = sum_buffer(r, c->buffer, &stride);
+        const float *buf = sum_buffer(a, c->buffer, &stride);
         float *plane;
         if (c->aov && !(aov & c->aov))
             continue;
@@ -257,71 +276,54 @@ void renderer_sums(const renderer *r, int spp, uint32_t aov, image *out)
     }
 }
 
-/* Loads the sums of s->resume into the freshly cleared buffers; false (with an error) when
- * a channel the render needs is missing or the size differs. */
-bool load_sums(renderer *r, const render_settings *s)
+bool render_accum_load(render_accum *a, const image *from, uint32_t aov)
 {
-    const sums_at at = sums_of(r);
+    const sums_at at = sums_of(a);
     const VkDeviceSize pixels = (VkDeviceSize)at.width * at.height;
-    if (s->resume->width != at.width || s->resume->height != at.height) {
+    if (from->width != at.width || from->height != at.height) {
         util_error("--resume: the file's %dx%d pixels are not the %dx%d region rendered",
-                   s->resume->width, s->resume->height, at.width, at.height);
+                   from->width, from->height, at.width, at.height);
         return false;
     }
     for (size_t k = 0; k < sizeof sum_channels / sizeof *sum_channels; k++) {
         const struct sum_channel *c = &sum_channels[k];
         int stride, ch;
-        float *buf = sum_buffer(r, c->buffer, &stride);
-        if (c->aov && !(s->aov & c->aov))
+        float *buf = sum_buffer(a, c->buffer, &stride);
+        if (c->aov && !(aov & c->aov))
             continue;
-        if ((ch = image_channel(s->resume, c->name)) < 0) {
+        if ((ch = image_channel(from, c->name)) < 0) {
             util_error("--resume: the file has no channel '%s' (not written with --resumable, or "
                        "with other --aov)", c->name);
             return false;
         }
         for (VkDeviceSize p = 0; p < pixels; p++)
-            buf[(VkDeviceSize)stride * p + (VkDeviceSize)c->offset] = s->resume->planes[ch][p];
+            buf[(VkDeviceSize)stride * p + (VkDeviceSize)c->offset] = from->planes[ch][p];
     }
     return true;
 }
 
-/* A render in bands of `rows` rows: the frame and buffers for the first band (the others
- * share them), and the whole region's sums on the host, zeroed. */
-bool begin_bands(renderer *r, const render_settings *s, const int region[4], int rows,
-                        GnFrame *frame)
+void render_accum_begin_bands(render_accum *a, gpu *g, int rw, int rh, int rows, uint32_t aov, uint32_t state_stride)
 {
-    const int rw = region[2] - region[0], rh = region[3] - region[1];
     const size_t pixels = (size_t)rw * (size_t)rh;
-    free_bands(r);
-    if (!frame_setup(r, s, region, frame))
-        return false;
-    size_buffers(r, rw, rows, s->aov);
-    gpu_buffer_fill_zero(r->g, &r->pstate);
-    gpu_buffer_fill_zero(r->g, &r->status);
-    r->band_accum = util_calloc(4 * pixels, sizeof(float));
-    if (s->aov & RENDER_AOV_GPU)
-        r->band_aov = util_calloc(12 * pixels, sizeof(float));
-    if (s->aov & RENDER_AOV_VARIANCE)
-        r->band_squares = util_calloc(4 * pixels, sizeof(float));
-    r->region_width = rw;
-    r->region_height = rh;
-    return !(render_modes[s->mode].flags & GN_MODEF_VERTEX_LIGHT) || light_vertices(r);
+    free_bands(a);
+    size_buffers(a, g, rw, rows, aov, state_stride);
+    gpu_buffer_fill_zero(g, &a->pstate);
+    a->band_accum = util_calloc(4 * pixels, sizeof(float));
+    if (aov & RENDER_AOV_GPU)
+        a->band_aov = util_calloc(12 * pixels, sizeof(float));
+    if (aov & RENDER_AOV_VARIANCE)
+        a->band_squares = util_calloc(4 * pixels, sizeof(float));
+    a->region_width = rw;
+    a->region_height = rh;
 }
 
-/* Band b's frame uploaded and its sums (host) copied into the buffers (load), or the
- * buffers' sums copied back to the host (!load). */
-void band_swap(renderer *r, GnFrame *frame, const int region[4], int rows, int b, bool load)
+void render_accum_band_swap(render_accum *a, int y0, int bh, bool load)
 {
-    const int y0 = b * rows, rh = region[3] - region[1], bh = rh - y0 < rows ? rh - y0 : rows;
-    const size_t first = (size_t)r->region_width * (size_t)y0, n = (size_t)r->region_width * (size_t)bh;
+    const size_t first = (size_t)a->region_width * (size_t)y0, n = (size_t)a->region_width * (size_t)bh;
     struct { float *host; gpu_buffer *buf; size_t floats; } parts[3] = {
-        {r->band_accum, &r->accum, 4}, {r->band_aov, &r->aov, 12}, {r->band_squares, &r->squares, 4}};
-    if (load) {
-        frame->crop_y = (uint32_t)(region[1] + y0);
-        frame->crop_height = (uint32_t)bh;
-        gpu_buffer_upload(r->g, &r->frame, frame, sizeof *frame, 0);
-        r->height = bh; /* the dispatch's rows; the buffers hold `rows` */
-    }
+        {a->band_accum, &a->accum, 4}, {a->band_aov, &a->aov, 12}, {a->band_squares, &a->squares, 4}};
+    if (load)
+        a->height = bh; /* the dispatch's rows; the buffers hold the band's */
     for (int i = 0; i < 3; i++) {
         float *host = parts[i].host ? parts[i].host + parts[i].floats * first : NULL;
         if (host && load)

@@ -110,6 +110,11 @@ static bool two_levels(render_geometry *g, const scene *sc)
         return false;
     g->top_seconds = g->top.build_seconds;
     g->build_seconds += g->top_seconds;
+    for (uint32_t i = 0; i < g->top.num_instances; i++) { /* each its copy of its mesh's vertices */
+        GnInstance *in = &g->top.instances[i];
+        in->vcolor_offset = (uint32_t)g->instance_vertices - g->vertex_base[in->mesh]; /* (uint arithmetic) */
+        g->instance_vertices += g->mesh_vertices[in->mesh];
+    }
     g->num_nodes = g->top.num_nodes;
     g->num_pairs = g->top.num_pairs;
     g->nodes = util_malloc(g->num_nodes * sizeof *g->nodes);

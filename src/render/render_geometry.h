@@ -24,6 +24,10 @@ typedef struct render_geometry {
     uint32_t first_instance; /* 1: the scene has world triangles (mesh 0, instance 0); else 0 */
     uint32_t *vertex_base;  /* per mesh: its first vertex in `vertices` */
     uint32_t *mesh_vertices; /* per mesh: its vertices */
+    /* two levels: the vertices of every instance's copy of its mesh, one after the other
+     * (Gouraud's colours: GnInstance.vcolor_offset is where an instance's copy starts, less
+     * its mesh's first vertex) */
+    uint64_t instance_vertices;
     /* the GPU arrays (one level: the tree's and the scene's own, not owned) */
     GnBvhNode *nodes;
     uint32_t num_nodes;

@@ -1,11 +1,10 @@
-/* render_lights.c: the lights of a render: emissive geometry as the local modes' lights,
- * the path tracer's light table (triangles, punctual lights, the environment) with its
- * selection weights, and the environment map with the CDFs that importance sample it. */
+/* render_lights.c: the lights of a render (render_lights.h). */
+#include "render_lights.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "render_internal.h"
 #include "util.h"
 #include "vec.h"
 
@@ -61,7 +60,7 @@ static void instanced_emission(const scene *sc, uint32_t m, double *area, double
  * Cornell box): one light per emissive material at the power-weighted centroid. A flat
  * emitter of area A and radiance L has radiant intensity L A cos(theta), a GN_LIGHT_COSINE;
  * one whose normals disagree is treated as isotropic with the same power (pi L A / 4 pi). */
-uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap)
+static uint32_t emissive_lights(const scene *sc, GnLight *out, uint32_t cap)
 {
     uint32_t n = 0;
     for (uint32_t m = 0; m < sc->num_materials && n < cap; m++) {
@@ -124,16 +123,15 @@ static double scene_radius2(const scene *sc)
 
 /* With two levels: each mesh's emissive triangles, as GPU slots (*count: how many), listed
  * once so that placing them costs only the instances' emitters. */
-static uint32_t *emissive_slots(const renderer *r, uint32_t *first, uint32_t *count)
+static uint32_t *emissive_slots(const scene *sc, const render_geometry *geo, uint32_t *first, uint32_t *count)
 {
-    const render_geometry *geo = &r->geo;
     uint32_t n = 0;
     uint32_t *list = util_calloc(geo->num_slots + 1, sizeof *list);
     for (uint32_t m = 0; m < geo->num_meshes; m++) {
         uint32_t base = 2 * geo->top.pair_base[m];
         first[m] = n;
         for (uint32_t j = 0; j < geo->meshes[m].num_slots; j++) {
-            const GnMaterial *mat = &r->sc->materials[geo->prims[base + j].material];
+            const GnMaterial *mat = &sc->materials[geo->prims[base + j].material];
             if (geo->meshes[m].tri_index[j] != GN_INVALID && vec_luminance(&mat->emissive.x) > 0 &&
                 !(mat->flags & GN_MAT_UNLIT))
                 list[n++] = base + j;
@@ -144,18 +142,17 @@ static uint32_t *emissive_slots(const renderer *r, uint32_t *first, uint32_t *co
 }
 
 /* With instances, each instance's emissive triangles, their areas in world space (a scale
- * changes them), and in r->emitter_instance the instance of each; returns the count. */
-static uint32_t instanced_emitters(renderer *r, uint32_t n)
+ * changes them), and in l->instance the instance of each; returns the count. */
+static uint32_t instanced_emitters(render_lights *l, const scene *sc, const render_geometry *geo, uint32_t n)
 {
-    const render_geometry *geo = &r->geo;
     uint32_t *first = util_calloc(geo->num_meshes, sizeof *first), *count = util_calloc(geo->num_meshes, sizeof *count);
-    uint32_t *slots = emissive_slots(r, first, count);
+    uint32_t *slots = emissive_slots(sc, geo, first, count);
     for (uint32_t i = 0; i < geo->top.num_instances; i++) {
         const GnInstance *in = &geo->top.instances[i];
         for (uint32_t k = first[in->mesh]; k < first[in->mesh] + count[in->mesh]; k++) {
             uint32_t j = slots[k];
             const GnPrim *pr = &geo->prims[j];
-            const GnMaterial *m = &r->sc->materials[pr->material];
+            const GnMaterial *m = &sc->materials[pr->material];
             double lum = vec_luminance(&m->emissive.x), p[3][3];
             const uint32_t v[3] = {pr->i0, pr->i1, pr->i2};
             for (int c3 = 0; c3 < 3; c3++) {
@@ -171,9 +168,9 @@ static uint32_t instanced_emitters(renderer *r, uint32_t n)
             double area = 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
             if (!(area > 0))
                 continue;
-            r->emitter_table[n] = (GnEmitter){j, (float)area, 0, 0};
-            r->emitter_instance[n] = i;
-            r->emitter_weight[n++] = lum * area * (m->flags & GN_MAT_DOUBLE_SIDED ? 2 : 1);
+            l->table[n] = (GnEmitter){j, (float)area, 0, 0};
+            l->instance[n] = i;
+            l->weight[n++] = lum * area * (m->flags & GN_MAT_DOUBLE_SIDED ? 2 : 1);
         }
     }
     free(slots);
@@ -182,17 +179,16 @@ static uint32_t instanced_emitters(renderer *r, uint32_t n)
     return n;
 }
 
-/* The light table's triangle entries at most: each instance's emissive triangles (counted
- * without their areas), or the scene's slots. */
-uint64_t emitter_room(const renderer *r)
+/* (each instance's emissive triangles counted without their areas) */
+uint64_t render_lights_room(const scene *sc, const render_geometry *geo)
 {
-    if (!r->geo.two_levels)
-        return r->geo.num_slots;
+    if (!geo->two_levels)
+        return geo->num_slots;
     uint64_t n = 0;
-    uint32_t *first = util_calloc(r->geo.num_meshes, sizeof *first), *count = util_calloc(r->geo.num_meshes, sizeof *count);
-    free(emissive_slots(r, first, count));
-    for (uint32_t i = 0; i < r->geo.top.num_instances; i++)
-        n += count[r->geo.top.instances[i].mesh];
+    uint32_t *first = util_calloc(geo->num_meshes, sizeof *first), *count = util_calloc(geo->num_meshes, sizeof *count);
+    free(emissive_slots(sc, geo, first, count));
+    for (uint32_t i = 0; i < geo->top.num_instances; i++)
+        n += count[geo->top.instances[i].mesh];
     free(first);
     free(count);
     return n;
@@ -202,18 +198,18 @@ uint64_t emitter_room(const renderer *r)
  * a selection weight proportional to its power, flux / pi: L A per emitting side for a
  * triangle (so picking one and then a uniform point has area density lum(L) sides / total),
  * 4 I for a point light, 2 (1 - cos outer) I for a spot, E r^2 for a directional light.
- * renderer_begin adds the environment and normalises. */
-void build_emitters(renderer *r, const GnPrim *prims)
+ * render_lights_path adds the environment and normalises. */
+static void build_emitters(render_lights *l, const scene *sc, const render_geometry *geo)
 {
-    const scene *sc = r->sc;
-    uint32_t cap = (uint32_t)emitter_room(r) + sc->num_lights + 1, n = 0;
-    r->emitter_table = util_calloc(cap, sizeof *r->emitter_table);
-    r->emitter_weight = util_calloc(cap, sizeof *r->emitter_weight);
-    r->emitter_instance = r->geo.two_levels ? util_calloc(cap, sizeof *r->emitter_instance) : NULL;
-    if (r->geo.two_levels)
-        n = instanced_emitters(r, n);
-    for (uint32_t i = 0; i < r->geo.num_slots && !r->geo.two_levels; i++) {
-        if (r->geo.world.tri_index[i] == GN_INVALID) /* the missing B of a lone triangle */
+    const GnPrim *prims = geo->prims; /* (BVH order, corners in the walk's order) */
+    uint32_t cap = (uint32_t)render_lights_room(sc, geo) + sc->num_lights + 1, n = 0;
+    l->table = util_calloc(cap, sizeof *l->table);
+    l->weight = util_calloc(cap, sizeof *l->weight);
+    l->instance = geo->two_levels ? util_calloc(cap, sizeof *l->instance) : NULL;
+    if (geo->two_levels)
+        n = instanced_emitters(l, sc, geo, n);
+    for (uint32_t i = 0; i < geo->num_slots && !geo->two_levels; i++) {
+        if (geo->world.tri_index[i] == GN_INVALID) /* the missing B of a lone triangle */
             continue;
         const GnMaterial *m = &sc->materials[prims[i].material];
         const vec3 *p0 = &sc->vertices[prims[i].i0].position, *p1 = &sc->vertices[prims[i].i1].position,
@@ -226,24 +222,34 @@ void build_emitters(renderer *r, const GnPrim *prims)
         double lum = vec_luminance(&m->emissive.x);
         if (lum <= 0 || !(area > 0) || (m->flags & GN_MAT_UNLIT))
             continue;
-        r->emitter_table[n] = (GnEmitter){i, (float)area, 0, 0};
-        r->emitter_weight[n++] = lum * area * (m->flags & GN_MAT_DOUBLE_SIDED ? 2 : 1);
+        l->table[n] = (GnEmitter){i, (float)area, 0, 0};
+        l->weight[n++] = lum * area * (m->flags & GN_MAT_DOUBLE_SIDED ? 2 : 1);
     }
-    r->num_area_emitters = n;
+    l->num_area = n;
     for (uint32_t i = 0; i < sc->num_lights; i++) {
-        const GnLight *l = &sc->lights[i];
-        double w = vec_luminance(&l->color.x);
-        w *= l->type == GN_LIGHT_POINT ? 4 : l->type == GN_LIGHT_SPOT ? 2 * (1 - l->outer_cos)
-                                                                         : scene_radius2(sc);
+        const GnLight *light = &sc->lights[i];
+        double w = vec_luminance(&light->color.x);
+        w *= light->type == GN_LIGHT_POINT ? 4 : light->type == GN_LIGHT_SPOT ? 2 * (1 - light->outer_cos)
+                                                                                 : scene_radius2(sc);
         if (w <= 0)
             continue;
-        if (r->emitter_instance)
-            r->emitter_instance[n] = GN_INVALID;
-        r->emitter_table[n] = (GnEmitter){GN_EMITTER_LIGHT | i, 0, 0, 0};
-        r->emitter_weight[n++] = w;
+        if (l->instance)
+            l->instance[n] = GN_INVALID;
+        l->table[n] = (GnEmitter){GN_EMITTER_LIGHT | i, 0, 0, 0};
+        l->weight[n++] = w;
     }
-    r->num_emitters = n;
-    r->emitter_cap = cap;
+    l->num_emitters = n;
+    l->cap = cap;
+}
+
+static void free_emitters(render_lights *l)
+{
+    free(l->table);
+    free(l->weight);
+    free(l->instance);
+    l->table = NULL;
+    l->weight = NULL;
+    l->instance = NULL;
 }
 
 
@@ -266,7 +272,7 @@ static uint16_t half_from_float(float f)
  * marginal CDF of the rows and each row's conditional CDF, over the weights
  * lum(texel) sin(theta) (the solid angle a texel covers). Its selection weight is the
  * environment's flux / pi onto the bounding sphere, 4 pi r^2 mean(L), as for a constant one. */
-static bool upload_env_map(renderer *r, const image *map)
+static bool upload_env_map(render_lights *l, gpu *g, const scene *sc, const image *map)
 {
     const int w = map->width, h = map->height;
     int cr = image_channel(map, "R"), cg = image_channel(map, "G"), cb = image_channel(map, "B");
@@ -281,9 +287,9 @@ static bool upload_env_map(renderer *r, const image *map)
         free(row);
         return false;
     }
-    if (words > gpu_max_texels(r->g, NULL)) {
+    if (words > gpu_max_texels(g, NULL)) {
         util_error("--env: the map's %dx%d texels and tables need %zu words, more than the %u "
-                   "of a texel buffer on this device", w, h, words, gpu_max_texels(r->g, NULL));
+                   "of a texel buffer on this device", w, h, words, gpu_max_texels(g, NULL));
         free(row);
         return false;
     }
@@ -318,78 +324,123 @@ static bool upload_env_map(renderer *r, const image *map)
         marg[y] = total > 0 ? (float)(acc / total) : (float)(y + 1) / h;
     }
     marg[h - 1] = 1;
-    if (r->env.buffer && r->env.size == words * 4) { /* (the same map again: an animation's next frame) */
-        gpu_buffer_upload(r->g, &r->env, data, words * 4, 0);
+    if (l->env.buffer && l->env.size == words * 4) { /* (the same map again: an animation's next frame) */
+        gpu_buffer_upload(g, &l->env, data, words * 4, 0);
     } else {
-        gpu_buffer_destroy(r->g, &r->env);
-        gpu_buffer_create_texels_as(r->g, &r->env, data, words * 4, VK_FORMAT_R32_UINT);
-        renderer_buffers_replaced(r); /* the kernels' descriptor sets name the old buffer */
+        gpu_buffer_destroy(g, &l->env);
+        gpu_buffer_create_texels_as(g, &l->env, data, words * 4, VK_FORMAT_R32_UINT);
+        l->replaced++; /* the kernels' descriptor sets name the old buffer */
     }
     /* mean L over the sphere = sum(L sin dtheta dphi) / 4 pi, dtheta dphi = 2 pi^2 / n */
-    r->env_weight = scene_radius2(r->sc) * 2 * M_PI * M_PI * total / (double)n;
-    r->env_source = map;
+    l->env_weight = scene_radius2(sc) * 2 * M_PI * M_PI * total / (double)n;
+    l->env_source = map;
     free(data);
     free(row);
     return true;
 }
 
-/* The path tracer's lights for s (render_internal.h): the table of build_emitters, then the
- * environment, with each one's selection pdf and CDF over the weights. */
-bool path_lights(renderer *r, const render_settings *s, GnFrame *frame, double *env_weight)
+/* The table of build_emitters, then the environment, with each one's selection pdf and CDF
+ * over the weights. */
+bool render_lights_path(render_lights *l, gpu *g, const scene *sc, const render_geometry *geo, const image *env_map,
+                        const float env_color[3], GnFrame *frame, double *env_weight)
 {
-    uint32_t n = r->num_emitters;
+    uint32_t n = l->num_emitters;
     double total = 0, acc = 0, env = 0;
-    if (s->env_map) {
-        if (s->env_map != r->env_source && !upload_env_map(r, s->env_map))
+    if (env_map) {
+        if (env_map != l->env_source && !upload_env_map(l, g, sc, env_map))
             return false;
         frame->flags |= GN_FRAME_ENV_MAP;
-        frame->env_width = (uint32_t)s->env_map->width;
-        frame->env_height = (uint32_t)s->env_map->height;
-        env = r->env_weight;
+        frame->env_width = (uint32_t)env_map->width;
+        frame->env_height = (uint32_t)env_map->height;
+        env = l->env_weight;
     } else {
-        env = 4 * M_PI * scene_radius2(r->sc) * vec_luminance(s->env);
+        env = 4 * M_PI * scene_radius2(sc) * vec_luminance(env_color);
     }
     if (env > 0) {
-        r->emitter_table[n] = (GnEmitter){GN_INVALID, 0, 0, 0};
-        r->emitter_weight[n++] = env;
+        l->table[n] = (GnEmitter){GN_INVALID, 0, 0, 0};
+        l->weight[n++] = env;
     }
     for (uint32_t i = 0; i < n; i++)
-        total += r->emitter_weight[i];
+        total += l->weight[i];
     for (uint32_t i = 0; i < n; i++) {
-        acc += r->emitter_weight[i];
-        r->emitter_table[i].pdf = (float)(r->emitter_weight[i] / total);
-        r->emitter_table[i].cdf = i + 1 == n ? 1.0f : (float)(acc / total);
+        acc += l->weight[i];
+        l->table[i].pdf = (float)(l->weight[i] / total);
+        l->table[i].cdf = i + 1 == n ? 1.0f : (float)(acc / total);
     }
     if (n)
-        gpu_buffer_upload(r->g, &r->emitters, r->emitter_table, sizeof(GnEmitter) * n, 0);
+        gpu_buffer_upload(g, &l->emitters, l->table, sizeof(GnEmitter) * n, 0);
     frame->num_emitters = n;
     frame->emitter_power = (float)total;
-    frame->emitter_instances = r->geo.two_levels ? r->emitter_cap : 0;
+    frame->emitter_instances = geo->two_levels ? l->cap : 0;
     frame->env_select = env > 0 ? (float)(env / total) : 0;
     *env_weight = env;
     return true;
 }
 
-/* The lights r uploads: the scene's punctual ones, or stand-ins for its emissive meshes in
- * the local modes (emissive_lights); sets r->num_lights. */
-GnLight *scene_lights(renderer *r)
+/* The local modes' lights: the scene's punctual ones, or stand-ins for its emissive meshes
+ * (emissive_lights); sets l->num_lights (the caller frees them). */
+static GnLight *local_lights(render_lights *l, const scene *sc)
 {
-    const scene *sc = r->sc;
     GnLight *lights = util_calloc(sc->num_lights + 16, sizeof *lights);
     if (sc->num_lights)
         memcpy(lights, sc->lights, sizeof *lights * sc->num_lights);
-    r->num_lights = sc->num_lights ? sc->num_lights : emissive_lights(sc, lights, 16);
+    l->num_lights = sc->num_lights ? sc->num_lights : emissive_lights(sc, lights, 16);
     return lights;
 }
 
 /* With instances, the light table's entries' instances, after the table (GnFrame.emitter_instances). */
-void upload_emitter_instances(renderer *r)
+static void upload_emitter_instances(render_lights *l, gpu *g, const render_geometry *geo)
 {
-    if (!r->geo.two_levels)
+    if (!geo->two_levels)
         return;
-    uvec4 *inst = util_calloc(r->emitter_cap, sizeof *inst);
-    for (uint32_t i = 0; i < r->num_emitters; i++)
-        inst[i].x = r->emitter_instance[i];
-    gpu_buffer_upload(r->g, &r->emitters, inst, sizeof *inst * r->emitter_cap, sizeof(GnEmitter) * r->emitter_cap);
+    uvec4 *inst = util_calloc(l->cap, sizeof *inst);
+    for (uint32_t i = 0; i < l->num_emitters; i++)
+        inst[i].x = l->instance[i];
+    gpu_buffer_upload(g, &l->emitters, inst, sizeof *inst * l->cap, sizeof(GnEmitter) * l->cap);
     free(inst);
+}
+
+void render_lights_create(render_lights *l, gpu *g, const scene *sc, const render_geometry *geo)
+{
+    memset(l, 0, sizeof *l);
+    GnLight *lights = local_lights(l, sc);
+    gpu_buffer_create_storage(g, &l->lights, lights, sizeof(GnLight) * l->num_lights);
+    free(lights);
+    build_emitters(l, sc, geo);
+    if (geo->two_levels) { /* the table, then each entry's instance (GnFrame.emitter_instances) */
+        gpu_buffer_create_texels(g, &l->emitters, NULL, 2 * sizeof(GnEmitter) * l->cap);
+        upload_emitter_instances(l, g, geo);
+    } else {
+        gpu_buffer_create_texels(g, &l->emitters, NULL, sizeof(GnEmitter) * (l->num_emitters + 1));
+    }
+    gpu_buffer_create_texels_as(g, &l->env, NULL, 16, VK_FORMAT_R32_UINT);
+}
+
+void render_lights_update(render_lights *l, gpu *g, const scene *sc, const render_geometry *geo)
+{
+    uint32_t before = l->num_lights;
+    GnLight *lights = local_lights(l, sc);
+    if (l->num_lights <= before) {
+        gpu_buffer_upload(g, &l->lights, lights, sizeof(GnLight) * l->num_lights, 0);
+    } else { /* (more of the stand-ins for emissive meshes than before: a new buffer) */
+        gpu_buffer_destroy(g, &l->lights);
+        gpu_buffer_create_storage(g, &l->lights, lights, sizeof(GnLight) * l->num_lights);
+        l->replaced++;
+    }
+    free(lights);
+    free_emitters(l);
+    build_emitters(l, sc, geo); /* (the same room: the same triangles and lights) */
+    upload_emitter_instances(l, g, geo);
+    l->env_source = NULL; /* the environment's weight follows the scene's bounds */
+}
+
+void render_lights_destroy(render_lights *l, gpu *g)
+{
+    if (g) {
+        gpu_buffer_destroy(g, &l->lights);
+        gpu_buffer_destroy(g, &l->emitters);
+        gpu_buffer_destroy(g, &l->env);
+    }
+    free_emitters(l);
+    memset(l, 0, sizeof *l);
 }

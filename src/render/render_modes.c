@@ -1,9 +1,9 @@
 /* render_modes.c: the registry of render modes (glsl/lib/shared.h: GN_MODES) and of the
- * kernels they run. Adding a mode: docs/architecture.md. */
+ * kernels they run (render_modes.h). */
+#include "render_modes.h"
+
 #include <stdio.h>
 #include <string.h>
-
-#include "render_internal.h"
 
 #include "local.h" /* spv_local: glsl/kernels/local.comp compiled by the build */
 #include "path.h"  /* spv_path: glsl/kernels/path.comp */
@@ -18,7 +18,7 @@ static const render_kernel kernels[] = {
                          false},
 };
 
-const render_kernel *mode_kernel(uint32_t mode) { return &kernels[render_modes[mode].kernel]; }
+const render_kernel *render_mode_kernel(uint32_t mode) { return &kernels[render_modes[mode].kernel]; }
 
 int render_mode_from_name(const char *name)
 {

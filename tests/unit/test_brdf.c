@@ -12,7 +12,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "brdf.h"
+#include "brdf_runner.h"
 #include "test.h"
 #include "util.h"
 

@@ -126,7 +126,7 @@ static bool render_scene(const scene *sc, uint32_t mode, int w, int h, bool want
     CHECKF(ok, "render in mode %s failed", render_mode_name(mode));
     if (ok && want_vcolor) {
         out->vcolor = util_malloc(32 * (size_t)sc->num_vertices);
-        gpu_buffer_download(&g, &r.vcolor, out->vcolor, 32 * (VkDeviceSize)sc->num_vertices, 0);
+        gpu_buffer_download(&g, &r.gouraud.vcolor, out->vcolor, 32 * (VkDeviceSize)sc->num_vertices, 0);
     }
     renderer_destroy(&r);
     gpu_destroy(&g);
