@@ -281,6 +281,20 @@ int cli_usage_error(const char *cmd, const char *fmt, ...)
     return 2;
 }
 
+int cli_image_outputs(const char *cmd, const char *out_path, const char *png_path, const char **exr_path)
+{
+    *exr_path = NULL;
+    if (!out_path && !png_path)
+        return cli_usage_error(cmd, "no output given (-o OUT.exr and/or --png OUT.png)");
+    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_UNKNOWN)
+        return cli_usage_error(cmd, "-o '%s': expected a .exr (OpenEXR) or .png name", out_path);
+    if (png_path && image_format_of(png_path) != IMAGE_FORMAT_PNG)
+        return cli_usage_error(cmd, "--png '%s': expected a .png name", png_path);
+    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_EXR)
+        *exr_path = out_path;
+    return -1;
+}
+
 /* gonio batch's device, kept between commands (cli_gpu_share). */
 static struct {
     bool on, kept;

@@ -564,15 +564,9 @@ int cmd_render(int argc, char **argv)
     j.s.no_shadows = no_shadows;
     const char *out_path = j.out_path, *png_path = j.png_path, *exr_path = NULL;
     warn_inapplicable(&command, &args, &j.s, png_path, out_path);
-    if (!out_path && !png_path)
-        return cli_usage_error("render", "no output given (-o OUT.exr and/or --png OUT.png)");
     /* The name says the format: -o OUT.png is the tonemapped PNG, as --png is. */
-    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_UNKNOWN)
-        return cli_usage_error("render", "-o '%s': expected a .exr (OpenEXR) or .png name", out_path);
-    if (png_path && image_format_of(png_path) != IMAGE_FORMAT_PNG)
-        return cli_usage_error("render", "--png '%s': expected a .png name", png_path);
-    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_EXR)
-        exr_path = out_path;
+    if ((rc = cli_image_outputs("render", out_path, png_path, &exr_path)) >= 0)
+        return rc;
     const char *exr_option = cli_given(&command, &args, "--compression") ? "--compression"
                              : cli_given(&command, &args, "--half")      ? "--half"
                                                                          : NULL;
