@@ -258,16 +258,23 @@ void cli_help(const cli_command *c, FILE *f)
             fputs(o->help, f);
             continue;
         }
-        int w = fprintf(f, "  %s%s%s", o->names, o->value ? " " : "", o->value ? o->value : "");
-        for (const char *line = o->help; *line;) {
-            size_t l = strcspn(line, "\n");
-            fprintf(f, "%*s%.*s\n", w + 2 <= HELP_COLUMN ? HELP_COLUMN - w : 2, "", (int)l, line);
-            line += l + (line[l] == '\n');
-            w = 0;
-        }
+        char name[256];
+        snprintf(name, sizeof name, "%s%s%s", o->names, o->value ? " " : "", o->value ? o->value : "");
+        cli_help_item(f, name, o->help);
     }
     if (c->epilog)
         fprintf(f, "\n%s", c->epilog);
+}
+
+void cli_help_item(FILE *f, const char *name, const char *help)
+{
+    int w = fprintf(f, "  %s", name);
+    for (const char *line = help; *line;) {
+        size_t l = strcspn(line, "\n");
+        fprintf(f, "%*s%.*s\n", w + 2 <= HELP_COLUMN ? HELP_COLUMN - w : 2, "", (int)l, line);
+        line += l + (line[l] == '\n');
+        w = 0;
+    }
 }
 
 int cli_usage_error(const char *cmd, const char *fmt, ...)

@@ -104,6 +104,9 @@ int cli_parse(const cli_command *c, int argc, char **argv, cli_args *out);
 /* Whether option `name` (any of its aliases) was on the command line. */
 bool cli_given(const cli_command *c, const cli_args *a, const char *name);
 void cli_help(const cli_command *c, FILE *f);
+/* One entry of a list in --help's layout, as the options are listed: "  NAME", then each line
+ * of help ('\n' between them) from the help column on. */
+void cli_help_item(FILE *f, const char *name, const char *help);
 
 /* Completion (gonio __complete WORD..., which completion/gonio runs): from now on cli_parse
  * takes argv as the words before `word`, the one being completed, and prints what may stand
