@@ -90,6 +90,7 @@ vpath %.comp glsl/kernels tests/kernels
 #                          (test-deps), fuzz (fuzz-deps), farm (test-farm), peer (bench-peer),
 #                          oidn (denoiser)
 #   deps/basisu.sh DIR     Basis Universal's sources (below)
+#   deps/oidn.sh DIR       Open Image Denoise's libraries (denoiser, below)
 
 # The build's packages (and the pkg-config modules of PKGS); make test's; make fuzz's.
 deps:
@@ -207,31 +208,15 @@ mutants: test-build
 	@config=$(config) tests/mutants.sh $(TESTS)
 
 # Intel Open Image Denoise 2 for `render --denoise` and `gonio denoise` (src/core/denoise.h,
-# docs/denoise.md). Debian 12 packages no OIDN 2: its CPU libraries (the RT filter's
-# weights in _core, the CPU device, TBB) come from PyPI's pyoidn wheel, fetched with pip
-# into build/oidn and unpacked there without the GPU devices' libraries (CUDA, HIP, SYCL),
-# which the CPU device does not load. gonio loads it at run time; a plain `make` fetches
-# nothing. `make test` fetches it where it can (its denoise tests skip, saying so, where
-# not); `make denoiser` fails where it cannot. Version pinned: the one measured in
-# docs/performance.md.
-OIDN_VERSION := 2.5.1
+# docs/denoise.md): its CPU libraries, from a pip wheel (deps/oidn.sh; pip: deps/debian.sh
+# oidn), in build/oidn/lib, where gonio loads them at run time. A plain `make` fetches
+# nothing. `make test` fetches them where it can (its denoise tests skip, saying so, where
+# not); `make denoiser` fails where it cannot.
 OIDN_LIB := build/oidn/lib/libOpenImageDenoise.so.2
-OIDN_FILES := libOpenImageDenoise.so.2 libOpenImageDenoise_core.so.$(OIDN_VERSION) \
-	libOpenImageDenoise_device_cpu.so.$(OIDN_VERSION) libtbb.so.12
 denoiser: $(OIDN_LIB)
 $(OIDN_LIB):
 	@deps/debian.sh oidn
-	@rm -rf build/oidn/wheel build/oidn/lib && mkdir -p build/oidn/wheel build/oidn/lib
-	@echo "gonio: fetching Open Image Denoise $(OIDN_VERSION) (pip: pyoidn==$(OIDN_VERSION).0) into build/oidn"
-	@python3 -m pip download -q --retries 1 --timeout 30 --no-deps --only-binary=:all: --platform manylinux2014_x86_64 \
-		-d build/oidn/wheel pyoidn==$(OIDN_VERSION).0 \
-		|| { rm -rf build/oidn; echo "gonio: pip could not fetch pyoidn==$(OIDN_VERSION).0"; exit 1; }
-	@python3 -c 'import sys, zipfile, glob, os; \
-		z = zipfile.ZipFile(glob.glob("build/oidn/wheel/*.whl")[0]); \
-		[open(os.path.join("build/oidn/lib", f), "wb").write(z.read("pyoidn/oidn/lib/" + f)) for f in sys.argv[1:]]' \
-		$(OIDN_FILES) || { rm -rf build/oidn; echo "gonio: the pyoidn wheel lacks the expected libraries"; exit 1; }
-	@rm -rf build/oidn/wheel
-	@echo "gonio: $(OIDN_LIB) and its CPU device are in place"
+	@deps/oidn.sh build/oidn
 # The denoiser's figures of docs/performance.md: quality against high-spp references and
 # the time to an RMSE with and without it (tests/denoise/quality.sh; about half an hour).
 bench-denoise: all $(TESTTOOL) denoiser
