@@ -91,6 +91,7 @@ vpath %.comp glsl/kernels tests/kernels
 #                          oidn (denoiser)
 #   deps/basisu.sh DIR     Basis Universal's sources (below)
 #   deps/oidn.sh DIR       Open Image Denoise's libraries (denoiser, below)
+#   deps/mitsuba.sh VENV   Mitsuba 3 for bench-peer (tests/peer/run.sh runs it)
 
 # The build's packages (and the pkg-config modules of PKGS); make test's; make fuzz's.
 deps:
@@ -248,9 +249,9 @@ device-check:
 	@tests/device/run.sh
 
 # gonio beside Mitsuba 3 on scenes it did not shape (tests/peer, docs/performance.md):
-# Mitsuba, Dr.Jit and a libLLVM for it come from PyPI into build/peer/venv (tests/peer/env.sh),
-# a venv python3-venv makes (deps/debian.sh peer). It skips, saying why, where they cannot be
-# installed.
+# Mitsuba, Dr.Jit and a libLLVM for it come by pip into build/peer/venv (deps/mitsuba.sh,
+# which tests/peer/run.sh runs), a venv python3-venv makes (deps/debian.sh peer). It skips,
+# saying why, where they cannot be installed.
 bench-peer: all
 	@deps/debian.sh peer || true
 	@tests/peer/run.sh $(GONIO) $(PEER_ARGS)
