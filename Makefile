@@ -4,7 +4,7 @@
 #   make bench-denoise | denoiser | docs-images | clean | install [PREFIX=/usr/local] [DESTDIR=]
 #   make fuzz (libFuzzer targets, clang, in build/fuzz) | fuzz-run [FUZZ_TIME=60]
 # Missing Debian packages are installed when run as root; otherwise the exact apt-get line
-# is printed and make stops.
+# is printed and make stops. What is fetched or installed is the scripts' of deps/ (below).
 
 config ?= release
 .DEFAULT_GOAL := all
@@ -83,14 +83,31 @@ SHADERS := $(wildcard glsl/kernels/*.comp tests/kernels/*.comp)
 SPV_HDR := $(patsubst %.comp,$(BUILD)/spv/%.h,$(notdir $(SHADERS)))
 vpath %.comp glsl/kernels tests/kernels
 
+# ---- dependencies: deps/*.sh ------------------------------------------------------------
+# One script a dependency; each does nothing where it is there already and says what it did:
+#   deps/debian.sh GROUP   Debian's packages of a group, checked and installed (as root; else
+#                          it prints the apt-get line and fails): build (deps), test
+#                          (test-deps), fuzz (fuzz-deps), farm (test-farm), peer (bench-peer),
+#                          oidn (denoiser)
+#   deps/basisu.sh DIR     Basis Universal's sources (below)
+#   deps/oidn.sh DIR       Open Image Denoise's libraries (denoiser, below)
+#   deps/mitsuba.sh VENV   Mitsuba 3 for bench-peer (tests/peer/run.sh runs it)
+
+# The build's packages (and the pkg-config modules of PKGS); make test's; make fuzz's.
+deps:
+	@PKGS='$(PKGS)' deps/debian.sh build
+test-deps: deps
+	@deps/debian.sh test
+fuzz-deps: deps
+	@deps/debian.sh fuzz
+
 # ---- Basis Universal (KHR_texture_basisu's KTX2 textures) --------------------------------
-# No Debian package has it: deps/basisu.sh fetches the crate basis-universal-sys with cargo,
-# once, and unpacks its C++ sources into build/basisu/src (shared by every config; the build is
-# offline after that). It writes gonio_basisu.mk, which make includes and re-reads once made
-# (BASISU is 1 when the sources are there), and gonio_basisu.h with the versions or the reason
-# they are missing: without them gonio builds without KTX2 support and says why. The sources
-# compile into $(BUILD)/basisu: the transcoder into every program, the encoder (the tests'
-# writer of KTX2 files, testtool ktx2) into testtool only.
+# No Debian package has it: deps/basisu.sh fetches its C++ sources once into build/basisu/src
+# (shared by every config) and writes gonio_basisu.mk, which make includes and re-reads once
+# made (BASISU is 1 when the sources are there), and gonio_basisu.h: without them gonio builds
+# without KTX2 support and says why. The sources compile into $(BUILD)/basisu: the transcoder
+# into every program, the encoder (the tests' writer of KTX2 files, testtool ktx2) into
+# testtool only.
 BASISU_DIR := build/basisu
 ifeq ($(filter clean,$(MAKECMDGOALS)),)
 -include $(BASISU_DIR)/gonio_basisu.mk
@@ -136,57 +153,10 @@ GONIO := $(BUILD)/gonio
 UNIT := $(BUILD)/unit_tests
 TESTTOOL := $(BUILD)/testtool
 
-# ---- Debian packages -------------------------------------------------------------------
-# nlohmann-json3-dev: the JSON library tinygltf parses with, which gltf_json.cpp uses to check
-# the document itself (tinygltf's package does not depend on it).
-DEB_BUILD := gcc g++ make pkg-config libvulkan-dev glslang-tools spirv-tools libglfw3-dev \
-	libopenexr-dev libtinygltf-dev nlohmann-json3-dev libpng-dev zlib1g-dev libstb-dev mesa-vulkan-drivers help2man \
-	libdraco-dev libmeshoptimizer-dev libwebp-dev libzstd-dev
-# man-db: tests/regress/cli.sh renders the installed man page with man -l.
-# webp: cwebp, the tests' encoder of WebP textures (tests/regress/image_formats.sh).
-# python3: the scripts' small helpers (tests/tool/*.py; the standard library only).
-# libmagickcore-6.q16-6-extra: ImageMagick's EXR coder (only a recommendation of imagemagick,
-# which --no-install-recommends leaves out); tests/regress/diff.sh writes EXRs with it.
-DEB_TEST := vulkan-validationlayers openexr xvfb xauth imagemagick libmagickcore-6.q16-6-extra \
-	x11-apps xdotool man-db webp python3
-DEPS_CHECK = { command -v glslangValidator && command -v spirv-val && command -v pkg-config \
-	&& command -v help2man && pkg-config --exists $(PKGS) && ls /usr/include/meshoptimizer.h && ls /usr/share/vulkan/icd.d/lvp_icd*.json; } >/dev/null 2>&1
-TEST_DEPS_CHECK = { ls /usr/share/vulkan/explicit_layer.d/VkLayer_khronos_validation.json \
-	&& command -v exrheader && command -v xvfb-run && command -v xauth && command -v import \
-	&& command -v xwd && command -v xdotool && command -v man && command -v cwebp && test -x /usr/bin/python3 \
-	&& convert -list format | grep -q 'EXR.*rw'; } >/dev/null 2>&1
-
-# make fuzz only: clang and its libFuzzer runtime (Debian 12's clang is clang-14).
-DEB_FUZZ := clang libclang-rt-14-dev
-FUZZ_DEPS_CHECK = { command -v clang && command -v clang++ && \
-	echo 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n) { return 0; }' | \
-	clang -x c -fsanitize=fuzzer -o /dev/null -; } >/dev/null 2>&1
-
 .PHONY: all deps test-deps run test test-build test-slow test-full mutants check-layers unit regress \
 	bench clean install shaders docs-images fuzz fuzz-deps fuzz-targets fuzz-run fuzz-partials test-farm \
 	bench-peer denoiser denoiser-if-possible bench-denoise device-check
 all: $(GONIO) build/gonio
-
-deps:
-	@if ! $(DEPS_CHECK); then $(call apt_install,$(DEB_BUILD)); fi
-test-deps: deps
-	@if ! $(TEST_DEPS_CHECK); then $(call apt_install,$(DEB_TEST)); fi
-
-define apt_install
-	if [ "$$(id -u)" = 0 ]; then \
-		echo "gonio: installing Debian packages: $(1)"; \
-		export DEBIAN_FRONTEND=noninteractive; \
-		{ apt-get install -y -q --no-install-recommends $(1) || \
-		  { apt-get update -q && apt-get install -y -q --no-install-recommends $(1); }; } >/dev/null \
-		|| { echo "gonio: apt-get install failed"; exit 1; }; \
-	else \
-		echo "gonio: missing packages; run as root:"; \
-		echo "  apt-get install $(1)"; exit 1; \
-	fi
-endef
-
-fuzz-deps: deps
-	@if ! $(FUZZ_DEPS_CHECK); then $(call apt_install,$(DEB_FUZZ)); fi
 
 build/gonio: $(GONIO)
 	@ln -sf $(config)/gonio build/gonio
@@ -239,32 +209,15 @@ mutants: test-build
 	@config=$(config) tests/mutants.sh $(TESTS)
 
 # Intel Open Image Denoise 2 for `render --denoise` and `gonio denoise` (src/core/denoise.h,
-# docs/denoise.md). Debian 12 packages no OIDN 2: its CPU libraries (the RT filter's
-# weights in _core, the CPU device, TBB) come from PyPI's pyoidn wheel, fetched with pip
-# into build/oidn and unpacked there without the GPU devices' libraries (CUDA, HIP, SYCL),
-# which the CPU device does not load. gonio loads it at run time; a plain `make` fetches
-# nothing. `make test` fetches it where it can (its denoise tests skip, saying so, where
-# not); `make denoiser` fails where it cannot. Version pinned: the one measured in
-# docs/performance.md.
-OIDN_VERSION := 2.5.1
+# docs/denoise.md): its CPU libraries, from a pip wheel (deps/oidn.sh; pip: deps/debian.sh
+# oidn), in build/oidn/lib, where gonio loads them at run time. A plain `make` fetches
+# nothing. `make test` fetches them where it can (its denoise tests skip, saying so, where
+# not); `make denoiser` fails where it cannot.
 OIDN_LIB := build/oidn/lib/libOpenImageDenoise.so.2
-OIDN_FILES := libOpenImageDenoise.so.2 libOpenImageDenoise_core.so.$(OIDN_VERSION) \
-	libOpenImageDenoise_device_cpu.so.$(OIDN_VERSION) libtbb.so.12
-DEB_OIDN := python3-pip
 denoiser: $(OIDN_LIB)
 $(OIDN_LIB):
-	@if ! python3 -m pip --version >/dev/null 2>&1; then $(call apt_install,$(DEB_OIDN)); fi
-	@rm -rf build/oidn/wheel build/oidn/lib && mkdir -p build/oidn/wheel build/oidn/lib
-	@echo "gonio: fetching Open Image Denoise $(OIDN_VERSION) (pip: pyoidn==$(OIDN_VERSION).0) into build/oidn"
-	@python3 -m pip download -q --retries 1 --timeout 30 --no-deps --only-binary=:all: --platform manylinux2014_x86_64 \
-		-d build/oidn/wheel pyoidn==$(OIDN_VERSION).0 \
-		|| { rm -rf build/oidn; echo "gonio: pip could not fetch pyoidn==$(OIDN_VERSION).0"; exit 1; }
-	@python3 -c 'import sys, zipfile, glob, os; \
-		z = zipfile.ZipFile(glob.glob("build/oidn/wheel/*.whl")[0]); \
-		[open(os.path.join("build/oidn/lib", f), "wb").write(z.read("pyoidn/oidn/lib/" + f)) for f in sys.argv[1:]]' \
-		$(OIDN_FILES) || { rm -rf build/oidn; echo "gonio: the pyoidn wheel lacks the expected libraries"; exit 1; }
-	@rm -rf build/oidn/wheel
-	@echo "gonio: $(OIDN_LIB) and its CPU device are in place"
+	@deps/debian.sh oidn
+	@deps/oidn.sh build/oidn
 # The denoiser's figures of docs/performance.md: quality against high-spp references and
 # the time to an RMSE with and without it (tests/denoise/quality.sh; about half an hour).
 bench-denoise: all $(TESTTOOL) denoiser
@@ -274,11 +227,10 @@ denoiser-if-possible:
 		echo "gonio: note: no Open Image Denoise; the denoise tests will skip (make denoiser says why)"
 
 # A one-node Slurm cluster on localhost runs farm/slurm-tiles.sh (tests/farm/slurm.sh);
-# it skips, saying why, where slurm-wlm and munge cannot be installed or started.
-DEB_FARM := slurm-wlm munge
-FARM_DEPS_CHECK = { command -v slurmctld && command -v slurmd && command -v munged; } >/dev/null 2>&1
+# it skips, saying why, where slurm-wlm and munge cannot be installed (deps/debian.sh farm)
+# or started.
 test-farm: all $(TESTTOOL)
-	@if ! $(FARM_DEPS_CHECK); then ( $(call apt_install,$(DEB_FARM)) ) || true; fi
+	@deps/debian.sh farm || true
 	@GONIO=$(GONIO) TESTTOOL=$(TESTTOOL) tests/farm/slurm.sh; rc=$$?; [ $$rc = 0 ] || [ $$rc = 77 ]
 
 # The include graph against LAYERS (also run by make test).
@@ -297,12 +249,11 @@ device-check:
 	@tests/device/run.sh
 
 # gonio beside Mitsuba 3 on scenes it did not shape (tests/peer, docs/performance.md):
-# Mitsuba, Dr.Jit and a libLLVM for it come from PyPI into build/peer/venv (tests/peer/env.sh);
-# python3-venv makes the venv. It skips, saying why, where they cannot be installed.
-DEB_PEER := python3-venv
-PEER_DEPS_CHECK = { python3 -c 'import ensurepip, venv'; } >/dev/null 2>&1
+# Mitsuba, Dr.Jit and a libLLVM for it come by pip into build/peer/venv (deps/mitsuba.sh,
+# which tests/peer/run.sh runs), a venv python3-venv makes (deps/debian.sh peer). It skips,
+# saying why, where they cannot be installed.
 bench-peer: all
-	@if ! $(PEER_DEPS_CHECK); then ( $(call apt_install,$(DEB_PEER)) ) || true; fi
+	@deps/debian.sh peer || true
 	@tests/peer/run.sh $(GONIO) $(PEER_ARGS)
 
 # libFuzzer targets over scene_load, image_read_exr, gonio merge and the WebP and KTX2

@@ -119,18 +119,20 @@ sheet() { # sheet OUT.png COLUMNS: the tiles so far, then none
 }
 A="--mode albedo --spp 1 --size 120x120" N="--mode normal --spp 1 --size 120x120"
 tiles=()
-tile "no transform" textures/plain.gltf $A
-tile "offset 0.25, -0.5" textures/offset.gltf $A
-tile "scale 2, 0.5" textures/scale.gltf $A
-tile "rotation 30 deg" textures/rotation.gltf $A
-tile "all three" textures/all.gltf $A
-tile "TEXCOORD_1" textures/uv1.gltf $A
-tile "transform texCoord 1" textures/uv1tt.gltf $A
-tile "REPEAT" textures/repeat.gltf $A
-tile "MIRRORED_REPEAT" textures/mirror.gltf $A
-tile "CLAMP_TO_EDGE" textures/clamp.gltf $A
-tile "CLAMP S, MIRROR T" textures/mixed.gltf $A
-tile "magFilter LINEAR" textures/linear.gltf $A
+while read -r -u 3 scene label; do tile "$label" textures/$scene.gltf $A; done 3<<'EOF'
+plain     no transform
+offset    offset 0.25, -0.5
+scale     scale 2, 0.5
+rotation  rotation 30 deg
+all       all three
+uv1       TEXCOORD_1
+uv1tt     transform texCoord 1
+repeat    REPEAT
+mirror    MIRRORED_REPEAT
+clamp     CLAMP_TO_EDGE
+mixed     CLAMP S, MIRROR T
+linear    magFilter LINEAR
+EOF
 sheet gltf-textures.png 6
 tile "float" textures/float_q.gltf $A
 tile "quantized" textures/quant.gltf $A

@@ -23,7 +23,7 @@ mutants=(
     # instead of wo.h: f is right, the sampled directions' density is not what pdf says.
     "brdf-blinn-pdf|unit/brdf|glsl/lib/brdf_bsdf.glsl|        pdf = (n + 1.0) / (2.0 * BRDF_PI) * v / (4.0 * oh);|        pdf = (n + 1.0) / (2.0 * BRDF_PI) * v / (4.0 * h.z);"
     # merge: every file weighted by the first one's sample count, not its own.
-    "merge-weights|unit/path regress/path.sh|src/cli/cmd_merge.c|                        double w = (double)spp[i], xv;|                        double w = (double)spp[0], xv;"
+    "merge-weights|unit/path regress/path.sh|src/cli/cmd_merge.c|                    double w = (double)in->spp[i], xv;|                    double w = (double)in->spp[0], xv;"
     # loader: the check that an accessor fits in its buffer view, removed.
     "loader-accessor-bounds|unit/scene regress/invalid.sh|src/scene/gltf_check.cpp|        if (!fits(a.byteOffset, stride, a.count, es, v.byteLength))|        if (false)"
     # path tracer: light sampling's area-to-solid-angle Jacobian without the emitter's cosine.

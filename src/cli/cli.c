@@ -258,16 +258,23 @@ void cli_help(const cli_command *c, FILE *f)
             fputs(o->help, f);
             continue;
         }
-        int w = fprintf(f, "  %s%s%s", o->names, o->value ? " " : "", o->value ? o->value : "");
-        for (const char *line = o->help; *line;) {
-            size_t l = strcspn(line, "\n");
-            fprintf(f, "%*s%.*s\n", w + 2 <= HELP_COLUMN ? HELP_COLUMN - w : 2, "", (int)l, line);
-            line += l + (line[l] == '\n');
-            w = 0;
-        }
+        char name[256];
+        snprintf(name, sizeof name, "%s%s%s", o->names, o->value ? " " : "", o->value ? o->value : "");
+        cli_help_item(f, name, o->help);
     }
     if (c->epilog)
         fprintf(f, "\n%s", c->epilog);
+}
+
+void cli_help_item(FILE *f, const char *name, const char *help)
+{
+    int w = fprintf(f, "  %s", name);
+    for (const char *line = help; *line;) {
+        size_t l = strcspn(line, "\n");
+        fprintf(f, "%*s%.*s\n", w + 2 <= HELP_COLUMN ? HELP_COLUMN - w : 2, "", (int)l, line);
+        line += l + (line[l] == '\n');
+        w = 0;
+    }
 }
 
 int cli_usage_error(const char *cmd, const char *fmt, ...)
@@ -279,6 +286,20 @@ int cli_usage_error(const char *cmd, const char *fmt, ...)
     va_end(ap);
     fprintf(stderr, "\n(see gonio %s --help)\n", cmd);
     return 2;
+}
+
+int cli_image_outputs(const char *cmd, const char *out_path, const char *png_path, const char **exr_path)
+{
+    *exr_path = NULL;
+    if (!out_path && !png_path)
+        return cli_usage_error(cmd, "no output given (-o OUT.exr and/or --png OUT.png)");
+    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_UNKNOWN)
+        return cli_usage_error(cmd, "-o '%s': expected a .exr (OpenEXR) or .png name", out_path);
+    if (png_path && image_format_of(png_path) != IMAGE_FORMAT_PNG)
+        return cli_usage_error(cmd, "--png '%s': expected a .png name", png_path);
+    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_EXR)
+        *exr_path = out_path;
+    return -1;
 }
 
 /* gonio batch's device, kept between commands (cli_gpu_share). */

@@ -104,6 +104,9 @@ int cli_parse(const cli_command *c, int argc, char **argv, cli_args *out);
 /* Whether option `name` (any of its aliases) was on the command line. */
 bool cli_given(const cli_command *c, const cli_args *a, const char *name);
 void cli_help(const cli_command *c, FILE *f);
+/* One entry of a list in --help's layout, as the options are listed: "  NAME", then each line
+ * of help ('\n' between them) from the help column on. */
+void cli_help_item(FILE *f, const char *name, const char *help);
 
 /* Completion (gonio __complete WORD..., which completion/gonio runs): from now on cli_parse
  * takes argv as the words before `word`, the one being completed, and prints what may stand
@@ -256,6 +259,10 @@ bool env_light_rule(const env_option *e, struct scene *sc, struct renderer *r, s
 
 /* "gonio CMD: MESSAGE" and the hint to use --help; returns 2. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);
+/* The image outputs of render and denoise, by name: -o (OUT.exr, or OUT.png: the format its
+ * name says) and --png (OUT.png), either NULL, not both. Returns -1 to go on, with *exr_path
+ * the -o name when it is an EXR and NULL otherwise, or 2 after a usage error naming the option. */
+int cli_image_outputs(const char *cmd, const char *out_path, const char *png_path, const char **exr_path);
 /* The Vulkan device for a command: --device, --validate (or GONIO_VALIDATE=1 in the
  * environment). While devices are shared (cli_gpu_share), the device the command before
  * handed back, when it has the same index and validation, with its compiled kernels. */

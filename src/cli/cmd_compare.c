@@ -183,15 +183,27 @@ typedef struct compare_row {
     image_metrics m;
 } compare_row;
 
+/* A CSV file at path with its header line: the stream for its rows (util_out_commit ends it),
+ * or NULL after an error. */
+static FILE *csv_open(util_out *out, const char *path, const char *header)
+{
+    FILE *f;
+    if (!util_out_open(out, path))
+        return NULL;
+    if (!(f = util_out_file(out))) {
+        util_out_commit(out, false);
+        return NULL;
+    }
+    fputs(header, f);
+    return f;
+}
+
 static bool write_metrics(const char *path, const compare_row *rows, int n, bool print)
 {
     util_out out;
-    FILE *f;
-    if (!util_out_open(&out, path))
+    FILE *f = csv_open(&out, path, "mode,reference,rmse,rel_bias,max_err\n");
+    if (!f)
         return false;
-    if (!(f = util_out_file(&out)))
-        return util_out_commit(&out, false);
-    fprintf(f, "mode,reference,rmse,rel_bias,max_err\n");
     if (print)
         printf("%-8s %-9s %10s %10s %10s\n", "mode", "reference", "rmse", "rel_bias", "max_err");
     for (int i = 0; i < n; i++) {
@@ -373,13 +385,10 @@ static bool write_sweep_plot(const char *path, const sweep_row *rows, int n)
 static bool write_sweep_csv(const char *path, const sweep_row *rows, int n, bool print)
 {
     util_out out;
-    FILE *f;
-    if (!util_out_open(&out, path))
+    FILE *f = csv_open(&out, path, "level,triangles,gouraud_rmse,gouraud_rel_bias,gouraud_max_err,"
+                                   "flat_rmse,flat_rel_bias,flat_max_err\n");
+    if (!f)
         return false;
-    if (!(f = util_out_file(&out)))
-        return util_out_commit(&out, false);
-    fprintf(f, "level,triangles,gouraud_rmse,gouraud_rel_bias,gouraud_max_err,"
-               "flat_rmse,flat_rel_bias,flat_max_err\n");
     if (print)
         printf("%5s %9s %12s %12s %12s\n", "level", "triangles", "gouraud_rmse", "flat_rmse",
                "gouraud_max");

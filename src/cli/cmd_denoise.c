@@ -231,15 +231,9 @@ int cmd_denoise(int argc, char **argv)
     if (rc >= 0)
         return rc;
     in_path = args.arg[0];
-    if (!out_path && !png_path)
-        return cli_usage_error("denoise", "no output given (-o OUT.exr and/or --png OUT.png)");
-    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_UNKNOWN)
-        return cli_usage_error("denoise", "-o '%s': expected a .exr (OpenEXR) or .png name", out_path);
-    if (png_path && image_format_of(png_path) != IMAGE_FORMAT_PNG)
-        return cli_usage_error("denoise", "--png '%s': expected a .png name", png_path);
-    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_EXR)
-        exr_path = out_path;
-    else
+    if ((rc = cli_image_outputs("denoise", out_path, png_path, &exr_path)) >= 0)
+        return rc;
+    if (!exr_path)
         png_o = out_path;
     if ((cli_given(&cmd, &args, "--half") || cli_given(&cmd, &args, "--compression")) && !exr_path)
         return cli_usage_error("denoise", "--half and --compression are for an EXR output (-o OUT.exr)");

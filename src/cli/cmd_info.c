@@ -2,6 +2,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "bvh.h"
 #include "cli.h"
@@ -9,6 +10,9 @@
 #include "render_geometry.h"
 #include "scene.h"
 #include "util.h"
+
+/* The keys' column: "triangles      ", "camera 0       " (names and values start after it). */
+#define INFO_KEY_WIDTH 14
 
 /* A name from the file, as printed: control characters escaped, "(unnamed)" when empty. Four
  * buffers in turn, for the printf calls that print up to four names. */
@@ -61,58 +65,19 @@ static void print_emitters(const scene *sc)
     free(count);
 }
 
-/* The materials with a medium or dispersion, as the path tracer reads them (glsl/kernels/path.comp:
- * sigma_a = -ln(attenuation colour) / attenuation distance). */
-static void print_media(const scene *sc)
+/* The lines the loader's extensions add (scene.h: scene_material_line), grouped by extension in
+ * the table's order: one a material that uses it, its label and index filling the column that
+ * the other lines' keys fill. */
+static void print_material_lines(const scene *sc)
 {
-    for (uint32_t i = 0; i < sc->num_materials; i++) {
-        const GnMaterial *m = &sc->materials[i];
-        const float *c = &m->attenuation_color.x;
-        double sigma[3];
-        if (!m->volume && !(m->dispersion > 0))
-            continue;
-        for (int k = 0; k < 3; k++)
-            sigma[k] = c[k] >= 1 ? 0 : -log(c[k] > 1e-30f ? c[k] : 1e-30f) / m->attenuation_distance;
-        printf("medium %-7u \"%s\" %s attenuation (%g, %g, %g) distance %g (sigma_a %g, %g, %g), "
-               "thickness %g, ior %g, dispersion %g\n", i, shown(sc->material_names[i]),
-               m->volume ? "volume" : "thin-walled", c[0], c[1], c[2], m->attenuation_distance, sigma[0], sigma[1],
-               sigma[2], m->thickness, m->ior, m->dispersion);
-    }
-}
-
-/* The materials with KHR_materials_anisotropy, as bsdf_anisotropy reads them. */
-static void print_anisotropy(const scene *sc)
-{
-    for (uint32_t i = 0; i < sc->num_materials; i++) {
-        const GnMaterial *m = &sc->materials[i];
-        if (!(m->anisotropy_strength > 0) && m->tex_anisotropy == GN_INVALID)
-            continue;
-        printf("anisotropy %-3u \"%s\" strength %g, rotation %g deg%s\n", i,
-               shown(sc->material_names[i]), m->anisotropy_strength,
-               m->anisotropy_rotation * 180 / M_PI, m->tex_anisotropy != GN_INVALID ? ", textured" : "");
-    }
-}
-
-/* KHR_materials_iridescence and _diffuse_transmission: one line per material that has them. */
-static void print_films(const scene *sc)
-{
-    for (uint32_t i = 0; i < sc->num_materials; i++) {
-        const GnMaterial *m = &sc->materials[i];
-        const char *name = shown(sc->material_names[i]);
-        if (m->iridescence > 0 && m->tex_iridescence_thickness != GN_INVALID)
-            printf("iridescence %-3u \"%s\" factor %g%s, film ior %g, thickness %g - %g nm (texture G)\n", i, name,
-                   m->iridescence, m->tex_iridescence != GN_INVALID ? " x texture" : "", m->iridescence_ior,
-                   m->iridescence_thickness_min, m->iridescence_thickness_max);
-        else if (m->iridescence > 0)
-            printf("iridescence %-3u \"%s\" factor %g%s, film ior %g, thickness %g nm\n", i, name, m->iridescence,
-                   m->tex_iridescence != GN_INVALID ? " x texture" : "", m->iridescence_ior,
-                   m->iridescence_thickness_max);
-        if (m->diffuse_transmission > 0)
-            printf("diffuse transmission %-3u \"%s\" factor %g%s, colour (%g, %g, %g)%s\n", i, name,
-                   m->diffuse_transmission, m->tex_diffuse_transmission != GN_INVALID ? " x texture" : "",
-                   m->diffuse_transmission_color.x, m->diffuse_transmission_color.y, m->diffuse_transmission_color.z,
-                   m->tex_diffuse_transmission_color != GN_INVALID ? " x texture" : "");
-    }
+    const scene_material_line *l;
+    char text[512];
+    for (size_t k = 0; (l = scene_material_line_at(k)); k++)
+        for (uint32_t i = 0; i < sc->num_materials; i++)
+            if (l->text(&sc->materials[i], text, sizeof text)) {
+                int w = INFO_KEY_WIDTH - (int)strlen(l->label) - 1;
+                printf("%s %-*u \"%s\" %s\n", l->label, w > 1 ? w : 1, i, shown(sc->material_names[i]), text);
+            }
 }
 
 /* The images' encodings (WebP: EXT_texture_webp, KTX2: KHR_texture_basisu), one count each. */
@@ -143,29 +108,42 @@ static void print_extensions(const scene *sc)
     }
 }
 
+#define INFO_INTRO                                                                              \
+    "Prints the scene's contents and its BVH statistics: the emissive triangles (the path\n"      \
+    "tracer's area lights) and the materials that emit, the skins (and their joints) and the\n"  \
+    "morph targets (and the meshes that have them), the load's time (and the part posing\n"      \
+    "skinned and morphed meshes took), and one line per camera (index, name,\n"                  \
+    "position, forward direction, vertical field of view or orthographic width x height;\n"      \
+    "the first is the one gonio render uses by default), the KHR_materials_variants\n"           \
+    "variants by index and name (for --variant), the images' formats (PNG, JPEG, WebP for\n"     \
+    "EXT_texture_webp, KTX2 for KHR_texture_basisu), one line per extension the file lists:\n"   \
+    "whether gonio supports it, partly (and what it leaves out) or not (and why); and for\n"     \
+    "each of these extensions, one line per material that uses it (index, name, what gonio\n"   \
+    "reads of it):\n"
+
+/* INFO_INTRO and the lines of the loader's extensions (scene_material_line), listed as the
+ * options are. */
+static const char *info_intro(void)
+{
+    static char text[8192];
+    const scene_material_line *l;
+    FILE *f = fmemopen(text, sizeof text, "w");
+    if (!f)
+        return INFO_INTRO;
+    fputs(INFO_INTRO, f);
+    for (size_t k = 0; (l = scene_material_line_at(k)); k++)
+        cli_help_item(f, l->label, l->help);
+    fclose(f);
+    return text;
+}
+
 int cmd_info(int argc, char **argv)
 {
     bool outside = false;
     const cli_option options[] = {CLI_OPT_ALLOW_OUTSIDE_FILES(&outside)};
     const cli_command cmd = {
         .name = "info", .synopsis = "SCENE.gltf|.glb [--allow-outside-files]",
-        .intro = "Prints the scene's contents and its BVH statistics: the emissive triangles (the path\n"
-                 "tracer's area lights) and the materials that emit, the skins (and their joints) and the\n"
-                 "morph targets (and the meshes that have them), the load's time (and the part posing\n"
-                 "skinned and morphed meshes took), and one line per camera (index, name,\n"
-                 "position, forward direction, vertical field of view or orthographic width x height;\n"
-                 "the first is the one gonio render uses by default), the KHR_materials_variants\n"
-                 "variants by index and name (for --variant), and one line per material that bounds a\n"
-                 "medium (KHR_materials_volume) or disperses (KHR_materials_dispersion): attenuation\n"
-                 "colour and distance, the absorption coefficient they give, thickness (unused by the\n"
-                 "path tracer), IOR and dispersion; one line per anisotropic material\n"
-                 "(KHR_materials_anisotropy): strength, rotation and whether a texture sets them;\n"
-                 "and one line per material with an iridescent film (KHR_materials_iridescence:\n"
-                 "factor, film IOR, thickness) or a diffuse transmission\n"
-                 "(KHR_materials_diffuse_transmission: factor, colour); the images' formats (PNG,\n"
-                 "JPEG, WebP for EXT_texture_webp, KTX2 for KHR_texture_basisu); and one line per\n"
-                 "extension the file lists: whether gonio supports it, partly (and what it leaves out)\n"
-                 "or not (and why).\n",
+        .intro = info_intro(),
         CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given",
         .complete_args = "*.gltf *.glb"};
     cli_args args;
@@ -218,9 +196,7 @@ int cmd_info(int argc, char **argv)
         printf("environment    %s (a %dx%d lat-long map)\n", shown(sc.environment_what), sc.environment.width,
                sc.environment.height);
     print_emitters(&sc);
-    print_media(&sc);
-    print_anisotropy(&sc);
-    print_films(&sc);
+    print_material_lines(&sc);
     printf("cameras        %u\n", sc.num_cameras);
     for (uint32_t i = 0; i < sc.num_cameras; i++) {
         const scene_camera *c = &sc.cameras[i];

@@ -163,6 +163,248 @@ static bool same_render(const char *a, const char *b)
     return true;
 }
 
+/* The inputs of a merge, as read (read_input). */
+typedef struct merge_inputs {
+    int n;
+    char **path;    /* the command line's names */
+    image *img;
+    int64_t *spp;
+    seed_list seeds;
+    double seconds; /* their gonio:seconds, summed */
+} merge_inputs;
+
+/* Reads input i and checks it alone and against input 0: a gonio render's sample count, not
+ * denoised, its data window inside its frame, finite pixels, input 0's frame and channels,
+ * the same render (same_render); its seeds into in->seeds (complete false when it says none)
+ * and its sample count into *total, which must fit the header's int. */
+static bool read_input(merge_inputs *in, int i, int64_t *total)
+{
+    const char *path = in->path[i], *first = in->path[0];
+    const image *img = &in->img[i], *img0 = &in->img[0];
+    char dn[256];
+    double s;
+    if (!image_read_exr(&in->img[i], path) || !read_spp(path, &in->spp[i]))
+        return false;
+    /* A denoised file's R, G, B are no mean of samples (render --denoise, gonio denoise). */
+    if (image_exr_attr_string(path, "gonio:denoiser", dn, sizeof dn)) {
+        util_error("%s: is denoised (gonio:denoiser '%s'): its R, G, B are not a mean of samples; merge "
+                   "renders made without --denoise, then denoise the merge (gonio denoise)", path, dn);
+        return false;
+    }
+    if (!image_inside_frame(img)) {
+        util_error("%s: its data window (%d,%d)+%dx%d lies outside its %dx%d display window: not a tile "
+                   "of a render", path, img->x0, img->y0, img->width, img->height, img->full_width,
+                   img->full_height);
+        return false;
+    }
+    if (!finite_pixels(path, img))
+        return false;
+    if (frame_width(img) != frame_width(img0) || frame_height(img) != frame_height(img0) ||
+        pixel_channels(img) != pixel_channels(img0)) {
+        util_error("%s: a %dx%d frame with %d channels, but %s is %dx%d with %d", path, frame_width(img),
+                   frame_height(img), pixel_channels(img), first, frame_width(img0), frame_height(img0),
+                   pixel_channels(img0));
+        return false;
+    }
+    for (int c = 0; c < img0->num_channels; c++)
+        if (!is_sum(img0->names[c]) && image_channel(img, img0->names[c]) < 0) {
+            util_error("%s: has no channel '%s' (which %s has)", path, img0->names[c], first);
+            return false;
+        }
+    if (i > 0 && !same_render(first, path))
+        return false;
+    if (!read_seeds(path, i, &in->seeds))
+        in->seeds.complete = false;
+    if (image_exr_attr_double(path, "gonio:seconds", &s))
+        in->seconds += s;
+    *total += in->spp[i]; /* each <= INT32_MAX: int64 cannot overflow for any argc */
+    if (*total > INT32_MAX) {
+        util_error("%s: the total sample count reaches %lld, more than the header's int holds (%d)", path,
+                   (long long)*total, INT32_MAX);
+        return false;
+    }
+    return true;
+}
+
+/* A seed may repeat in tiles that do not overlap; in overlapping ones its samples repeat: an
+ * error, or with force one warning for all the repeats, not one per pair. */
+static bool check_seeds(const merge_inputs *in, bool force)
+{
+    const seed_list *l = &in->seeds;
+    long repeats = 0;
+    int fa = 0, fb = 0;
+    uint32_t first_seed = 0;
+    for (int a = 0; a < l->count; a++)
+        for (int b = 0; b < a; b++)
+            if (l->seed[a] == l->seed[b] && overlap(&in->img[l->file[a]], &in->img[l->file[b]]) && repeats++ == 0) {
+                fa = l->file[b];
+                fb = l->file[a];
+                first_seed = l->seed[a];
+            }
+    if (repeats && !force) {
+        util_error("%s and %s: both have seed %u: its samples repeat and add no information "
+                   "(--force merges anyway)", in->path[fa], in->path[fb], first_seed);
+        return false;
+    }
+    if (repeats)
+        util_warn("%ld pair(s) of overlapping inputs share a seed, the first %s and %s (seed %u): merged "
+                  "(--force)", repeats, in->path[fa], in->path[fb], first_seed);
+    return true;
+}
+
+/* The merge's image: the union of the inputs' data windows (box: x0, y0, x1, y1 in the frame),
+ * placed in their frame unless it is the whole frame, with their channels but the sums. */
+static void create_output(image *out, int box[4], const merge_inputs *in)
+{
+    const image *img0 = &in->img[0];
+    const char *names[IMAGE_MAX_CHANNELS];
+    int nc = 0;
+    box[0] = box[1] = INT32_MAX;
+    box[2] = box[3] = 0;
+    for (int c = 0; c < img0->num_channels; c++)
+        if (!is_sum(img0->names[c]))
+            names[nc++] = img0->names[c];
+    for (int i = 0; i < in->n; i++) {
+        const image *img = &in->img[i];
+        box[0] = img->x0 < box[0] ? img->x0 : box[0];
+        box[1] = img->y0 < box[1] ? img->y0 : box[1];
+        box[2] = img->x0 + img->width > box[2] ? img->x0 + img->width : box[2];
+        box[3] = img->y0 + img->height > box[3] ? img->y0 + img->height : box[3];
+    }
+    image_create(out, box[2] - box[0], box[3] - box[1], nc, names);
+    if (out->width != frame_width(img0) || out->height != frame_height(img0)) {
+        out->x0 = box[0];
+        out->y0 = box[1];
+        out->full_width = frame_width(img0);
+        out->full_height = frame_height(img0);
+    }
+}
+
+/* Every pixel of out must have the same sample count: each has all the tiles' samples or the
+ * merge would be a patchwork of images of different noise (an error naming out_path
+ * otherwise). *total: that count. The seeds: complete only when every pixel's inputs have
+ * the same ones, then reduced to those of the inputs that cover a pixel. */
+static bool check_coverage(merge_inputs *in, const image *out, const int box[4], const char *out_path,
+                           int64_t *total)
+{
+    seed_list *l = &in->seeds;
+    const int n = in->n;
+    int64_t *covered = util_calloc((size_t)out->width * out->height, sizeof *covered);
+    unsigned char *inside_now = util_calloc((size_t)n, 1), *first_in = util_calloc((size_t)n, 1);
+    unsigned char *last_in = util_calloc((size_t)n, 1);
+    uint32_t *first_seeds = util_calloc((size_t)l->count + 1, sizeof *first_seeds);
+    uint32_t *pixel_seeds = util_calloc((size_t)l->count + 1, sizeof *pixel_seeds);
+    int first_count = 0;
+    bool even = true;
+    for (int y = 0; y < out->height && even; y++)
+        for (int x = 0; x < out->width && even; x++) {
+            int64_t *cv = &covered[(size_t)y * out->width + x];
+            for (int i = 0; i < n; i++) {
+                inside_now[i] = inside(&in->img[i], box[0] + x, box[1] + y);
+                *cv += inside_now[i] ? in->spp[i] : 0;
+            }
+            if (x == 0 && y == 0) {
+                memcpy(first_in, inside_now, (size_t)n);
+                first_count = covering_seeds(l, inside_now, first_seeds);
+                memcpy(last_in, inside_now, (size_t)n);
+            } else if (l->complete && memcmp(last_in, inside_now, (size_t)n)) {
+                /* other inputs here (tiles): the same seeds, or no one list for the file */
+                int k = covering_seeds(l, inside_now, pixel_seeds);
+                if (k != first_count || memcmp(pixel_seeds, first_seeds, sizeof *pixel_seeds * (size_t)k))
+                    l->complete = false;
+                memcpy(last_in, inside_now, (size_t)n);
+            }
+            if (*cv != covered[0]) {
+                util_error("%s: pixel (%d, %d) has %lld samples in the inputs, but pixel (%d, %d) %lld: "
+                           "the tiles leave a hole or overlap unevenly", out_path, box[0] + x, box[1] + y,
+                           (long long)*cv, box[0], box[1], (long long)covered[0]);
+                even = false;
+            }
+        }
+    *total = covered[0];
+    for (int k = l->count - 1; even && l->complete && k >= 0; k--)
+        if (!first_in[l->file[k]]) { /* only the seeds of the inputs that cover a pixel */
+            memmove(&l->seed[k], &l->seed[k + 1], sizeof *l->seed * (size_t)(l->count - k - 1));
+            memmove(&l->file[k], &l->file[k + 1], sizeof *l->file * (size_t)(l->count - k - 1));
+            l->count--;
+        }
+    free(covered);
+    free(inside_now);
+    free(first_in);
+    free(last_in);
+    free(first_seeds);
+    free(pixel_seeds);
+    return even;
+}
+
+/* Each pixel of out the mean of the total samples of the inputs covering it; a variance
+ * channel through the sums of x and x^2 its file's mean and variance imply. */
+static void merge_pixels(image *out, const int box[4], const merge_inputs *in, int64_t total)
+{
+    for (int c = 0; c < out->num_channels; c++) {
+        const char *name = out->names[c], *of = variance_of(name);
+        bool var = of && image_channel(&in->img[0], of) >= 0;
+        for (int y = 0; y < out->height; y++)
+            for (int x = 0; x < out->width; x++) {
+                double sum = 0, sq = 0;
+                for (int i = 0; i < in->n; i++) {
+                    const image *img = &in->img[i];
+                    int fx = box[0] + x - img->x0, fy = box[1] + y - img->y0;
+                    size_t p = (size_t)fy * img->width + fx;
+                    double w = (double)in->spp[i], xv;
+                    if (!inside(img, box[0] + x, box[1] + y))
+                        continue;
+                    xv = img->planes[image_channel(img, name)][p];
+                    if (var) { /* back to the sums of x and x^2 of this file */
+                        double m = img->planes[image_channel(img, of)][p];
+                        sum += w * m;
+                        sq += w * (xv * (w - 1) + m * m);
+                    } else {
+                        sum += w * xv;
+                    }
+                }
+                float *o = &out->planes[c][(size_t)y * out->width + x];
+                if (var) {
+                    double N = (double)total, m = sum / N, v = total > 1 ? (sq / N - m * m) / (N - 1) : 0;
+                    *o = v > 0 ? (float)v : 0;
+                } else {
+                    *o = (float)(sum / (double)total);
+                }
+            }
+    }
+}
+
+/* Writes out with the identity of the first input (all are equal), then the merge's own:
+ * gonio:spp total, every seed (when the inputs said them all), the seconds summed. */
+static bool write_merge(const image *out, const char *out_path, const merge_inputs *in, int64_t total,
+                        const image_exr_options *exr)
+{
+    enum { MAX_ID = 16 };
+    image_attr attrs[MAX_ID + 5];
+    char values[MAX_ID][512], *seed_text = NULL;
+    int na = 0;
+    for (int k = 0; render_identity_names[k] && k < MAX_ID; k++)
+        if (image_exr_attr_string(in->path[0], render_identity_names[k], values[na], sizeof values[0])) {
+            attrs[na] = (image_attr){render_identity_names[k], IMAGE_ATTR_STRING, values[na], 0, 0, NULL};
+            na++;
+        }
+    attrs[na++] = (image_attr){"gonio:spp", IMAGE_ATTR_INT, NULL, (int)total, 0, NULL};
+    if (in->seeds.complete) {
+        size_t len = 0;
+        seed_text = util_malloc(12 * (size_t)in->seeds.count + 1);
+        seed_text[0] = 0;
+        for (int k = 0; k < in->seeds.count; k++)
+            len += (size_t)sprintf(seed_text + len, "%s%u", k ? "," : "", in->seeds.seed[k]);
+        attrs[na++] = (image_attr){"gonio:seeds", IMAGE_ATTR_STRING, seed_text, 0, 0, NULL};
+    }
+    attrs[na++] = (image_attr){"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, in->seconds, NULL};
+    attrs[na++] = (image_attr){"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL};
+    attrs[na++] = (image_attr){"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL};
+    bool ok = image_write_exr_with(out, out_path, attrs, na, exr);
+    free(seed_text);
+    return ok;
+}
+
 #define MERGE_INTRO \
     "Combines renders of the same scene and settings made with different --seed values\n" \
     "into one, weighted by each file's sample count (its gonio:spp header): the result is\n" \
@@ -185,10 +427,8 @@ static bool same_render(const char *a, const char *b)
 
 int cmd_merge(int argc, char **argv)
 {
-    const char *out_path = NULL, **inputs;
-    int n, rc = 1;
+    const char *out_path = NULL;
     bool force = false;
-    image *imgs = NULL, out = {0};
     image_exr_options exr = IMAGE_EXR_DEFAULTS;
     const cli_option options[] = {
         {"-o, --output", "FILE", "the merged OpenEXR (a .exr name; written atomically)", CLI_STRING, CLI_AS(const char *, &out_path),
@@ -201,240 +441,40 @@ int cmd_merge(int argc, char **argv)
         .name = "merge", .synopsis = "A.exr B.exr ... -o OUT.exr [--force] [--half] [--compression C]",
         .intro = MERGE_INTRO, CLI_OPTIONS(options), .max_args = -1, .complete_args = "*.exr"};
     cli_args args;
-    if ((rc = cli_parse(&cmd, argc, argv, &args)) >= 0)
+    int rc = cli_parse(&cmd, argc, argv, &args);
+    if (rc >= 0)
         return rc;
-    rc = 1;
-    n = args.num_args;
-    inputs = util_calloc((size_t)n + 1, sizeof *inputs);
-    int64_t *spp = NULL, total = 0;
-    double seconds = 0;
-    seed_list seeds = {.complete = true};
-    char *seed_text = NULL;
-
-    for (int i = 0; i < n; i++)
-        inputs[i] = args.arg[i];
-    if (!out_path || n < 1) {
-        free(inputs);
+    if (!out_path || args.num_args < 1)
         return cli_usage_error("merge", out_path ? "no input files" : "no output given (-o OUT.exr)");
-    }
-    if (image_format_of(out_path) != IMAGE_FORMAT_EXR) {
-        free(inputs);
+    if (image_format_of(out_path) != IMAGE_FORMAT_EXR)
         return cli_usage_error("merge", "-o '%s': merge writes OpenEXR: expected a .exr name", out_path);
-    }
-    if (!util_check_output(out_path)) {
-        free(inputs);
+    if (!util_check_output(out_path))
         return 1;
-    }
 
-    imgs = util_calloc((size_t)n, sizeof *imgs);
-    spp = util_calloc((size_t)n, sizeof *spp);
-    for (int i = 0; i < n; i++) {
-        double s;
-        if (!image_read_exr(&imgs[i], inputs[i]) || !read_spp(inputs[i], &spp[i]))
-            goto done;
-        {
-            /* A denoised file's R, G, B are no mean of samples (render --denoise, gonio denoise). */
-            char dn[256];
-            if (image_exr_attr_string(inputs[i], "gonio:denoiser", dn, sizeof dn)) {
-                util_error("%s: is denoised (gonio:denoiser '%s'): its R, G, B are not a mean of samples; merge "
-                           "renders made without --denoise, then denoise the merge (gonio denoise)", inputs[i], dn);
-                goto done;
-            }
-        }
-        if (!image_inside_frame(&imgs[i])) {
-            util_error("%s: its data window (%d,%d)+%dx%d lies outside its %dx%d display window: not a tile "
-                       "of a render", inputs[i], imgs[i].x0, imgs[i].y0, imgs[i].width, imgs[i].height,
-                       imgs[i].full_width, imgs[i].full_height);
-            goto done;
-        }
-        if (!finite_pixels(inputs[i], &imgs[i]))
-            goto done;
-        if (frame_width(&imgs[i]) != frame_width(&imgs[0]) || frame_height(&imgs[i]) != frame_height(&imgs[0]) ||
-            pixel_channels(&imgs[i]) != pixel_channels(&imgs[0])) {
-            util_error("%s: a %dx%d frame with %d channels, but %s is %dx%d with %d", inputs[i],
-                       frame_width(&imgs[i]), frame_height(&imgs[i]), pixel_channels(&imgs[i]), inputs[0],
-                       frame_width(&imgs[0]), frame_height(&imgs[0]), pixel_channels(&imgs[0]));
-            goto done;
-        }
-        for (int c = 0; c < imgs[0].num_channels; c++)
-            if (!is_sum(imgs[0].names[c]) && image_channel(&imgs[i], imgs[0].names[c]) < 0) {
-                util_error("%s: has no channel '%s' (which %s has)", inputs[i], imgs[0].names[c], inputs[0]);
-                goto done;
-            }
-        if (i > 0 && !same_render(inputs[0], inputs[i]))
-            goto done;
-        if (!read_seeds(inputs[i], i, &seeds))
-            seeds.complete = false;
-        if (image_exr_attr_double(inputs[i], "gonio:seconds", &s))
-            seconds += s;
-        total += spp[i]; /* each <= INT32_MAX: int64 cannot overflow for any argc */
-        if (total > INT32_MAX) {
-            util_error("%s: the total sample count reaches %lld, more than the header's int holds (%d)",
-                       inputs[i], (long long)total, INT32_MAX);
-            goto done;
-        }
+    merge_inputs in = {.n = args.num_args, .path = args.arg, .seeds = {.complete = true}};
+    image out = {0};
+    int box[4];
+    int64_t total = 0;
+    bool ok = true;
+    in.img = util_calloc((size_t)in.n, sizeof *in.img);
+    in.spp = util_calloc((size_t)in.n, sizeof *in.spp);
+    for (int i = 0; i < in.n && ok; i++)
+        ok = read_input(&in, i, &total);
+    ok = ok && check_seeds(&in, force);
+    if (ok) {
+        create_output(&out, box, &in);
+        ok = check_coverage(&in, &out, box, out_path, &total);
     }
-    /* A seed may repeat in tiles that do not overlap; in overlapping ones its samples repeat.
-     * With --force, one warning for all the repeats, not one per pair. */
-    {
-        long repeats = 0;
-        int fa = 0, fb = 0;
-        uint32_t first_seed = 0;
-        for (int a = 0; a < seeds.count; a++)
-            for (int b = 0; b < a; b++)
-                if (seeds.seed[a] == seeds.seed[b] && overlap(&imgs[seeds.file[a]], &imgs[seeds.file[b]]) &&
-                    repeats++ == 0) {
-                    fa = seeds.file[b];
-                    fb = seeds.file[a];
-                    first_seed = seeds.seed[a];
-                }
-        if (repeats && !force) {
-            util_error("%s and %s: both have seed %u: its samples repeat and add no information "
-                       "(--force merges anyway)", inputs[fa], inputs[fb], first_seed);
-            goto done;
-        }
-        if (repeats)
-            util_warn("%ld pair(s) of overlapping inputs share a seed, the first %s and %s (seed %u): merged "
-                      "(--force)", repeats, inputs[fa], inputs[fb], first_seed);
+    if (ok) {
+        merge_pixels(&out, box, &in, total);
+        ok = write_merge(&out, out_path, &in, total, &exr);
     }
-
-    {
-        const char *names[IMAGE_MAX_CHANNELS];
-        int nc = 0, box[4] = {INT32_MAX, INT32_MAX, 0, 0}; /* the union of the data windows */
-        int64_t *covered;
-        unsigned char *in = util_calloc((size_t)n, 1), *first_in = util_calloc((size_t)n, 1);
-        unsigned char *last_in = util_calloc((size_t)n, 1);
-        uint32_t *first_seeds = util_calloc((size_t)seeds.count + 1, sizeof *first_seeds);
-        uint32_t *pixel_seeds = util_calloc((size_t)seeds.count + 1, sizeof *pixel_seeds);
-        int first_count = 0;
-        bool hole = false; /* the tiles leave a hole: refused after the scratch arrays are freed */
-        for (int c = 0; c < imgs[0].num_channels; c++)
-            if (!is_sum(imgs[0].names[c]))
-                names[nc++] = imgs[0].names[c];
-        for (int i = 0; i < n; i++) {
-            box[0] = imgs[i].x0 < box[0] ? imgs[i].x0 : box[0];
-            box[1] = imgs[i].y0 < box[1] ? imgs[i].y0 : box[1];
-            box[2] = imgs[i].x0 + imgs[i].width > box[2] ? imgs[i].x0 + imgs[i].width : box[2];
-            box[3] = imgs[i].y0 + imgs[i].height > box[3] ? imgs[i].y0 + imgs[i].height : box[3];
-        }
-        image_create(&out, box[2] - box[0], box[3] - box[1], nc, names);
-        if (out.width != frame_width(&imgs[0]) || out.height != frame_height(&imgs[0])) {
-            out.x0 = box[0];
-            out.y0 = box[1];
-            out.full_width = frame_width(&imgs[0]);
-            out.full_height = frame_height(&imgs[0]);
-        }
-        /* Every pixel must have the same sample count, gonio:spp: each has all the tiles'
-         * samples or the merge would be a patchwork of images of different noise. */
-        covered = util_calloc((size_t)out.width * out.height, sizeof *covered);
-        for (int y = 0; y < out.height; y++)
-            for (int x = 0; x < out.width; x++) {
-                int64_t *cv = &covered[(size_t)y * out.width + x];
-                for (int i = 0; i < n; i++) {
-                    in[i] = inside(&imgs[i], box[0] + x, box[1] + y);
-                    *cv += in[i] ? spp[i] : 0;
-                }
-                if (x == 0 && y == 0) {
-                    memcpy(first_in, in, (size_t)n);
-                    first_count = covering_seeds(&seeds, in, first_seeds);
-                    memcpy(last_in, in, (size_t)n);
-                } else if (seeds.complete && memcmp(last_in, in, (size_t)n)) {
-                    /* other inputs here (tiles): the same seeds, or no one list for the file */
-                    int k = covering_seeds(&seeds, in, pixel_seeds);
-                    if (k != first_count || memcmp(pixel_seeds, first_seeds, sizeof *pixel_seeds * (size_t)k))
-                        seeds.complete = false;
-                    memcpy(last_in, in, (size_t)n);
-                }
-                if (*cv != covered[0]) {
-                    util_error("%s: pixel (%d, %d) has %lld samples in the inputs, but pixel (%d, %d) %lld: "
-                               "the tiles leave a hole or overlap unevenly", out_path, box[0] + x, box[1] + y,
-                               (long long)*cv, box[0], box[1], (long long)covered[0]);
-                    hole = true;
-                    goto scratch;
-                }
-            }
-        total = covered[0];
-        for (int k = seeds.count - 1; seeds.complete && k >= 0; k--)
-            if (!first_in[seeds.file[k]]) { /* only the seeds of the inputs that cover a pixel */
-                memmove(&seeds.seed[k], &seeds.seed[k + 1], sizeof *seeds.seed * (size_t)(seeds.count - k - 1));
-                memmove(&seeds.file[k], &seeds.file[k + 1], sizeof *seeds.file * (size_t)(seeds.count - k - 1));
-                seeds.count--;
-            }
-    scratch:
-        free(covered);
-        free(in);
-        free(first_in);
-        free(last_in);
-        free(first_seeds);
-        free(pixel_seeds);
-        if (hole)
-            goto done;
-        for (int c = 0; c < out.num_channels; c++) {
-            const char *of = variance_of(names[c]);
-            bool var = of && image_channel(&imgs[0], of) >= 0;
-            for (int y = 0; y < out.height; y++)
-                for (int x = 0; x < out.width; x++) {
-                    double sum = 0, sq = 0;
-                    for (int i = 0; i < n; i++) {
-                        int fx = box[0] + x - imgs[i].x0, fy = box[1] + y - imgs[i].y0;
-                        size_t p = (size_t)fy * imgs[i].width + fx;
-                        double w = (double)spp[i], xv;
-                        if (!inside(&imgs[i], box[0] + x, box[1] + y))
-                            continue;
-                        xv = imgs[i].planes[image_channel(&imgs[i], names[c])][p];
-                        if (var) { /* back to the sums of x and x^2 of this file */
-                            double m = imgs[i].planes[image_channel(&imgs[i], of)][p];
-                            sum += w * m;
-                            sq += w * (xv * (w - 1) + m * m);
-                        } else {
-                            sum += w * xv;
-                        }
-                    }
-                    float *o = &out.planes[c][(size_t)y * out.width + x];
-                    if (var) {
-                        double N = (double)total, m = sum / N, v = total > 1 ? (sq / N - m * m) / (N - 1) : 0;
-                        *o = v > 0 ? (float)v : 0;
-                    } else {
-                        *o = (float)(sum / (double)total);
-                    }
-                }
-        }
-    }
-    {
-        /* The identity of the first input (all are equal), then the merge's own. */
-        enum { MAX_ID = 16 };
-        image_attr attrs[MAX_ID + 5];
-        char values[MAX_ID][512];
-        int na = 0;
-        for (int k = 0; render_identity_names[k] && k < MAX_ID; k++)
-            if (image_exr_attr_string(inputs[0], render_identity_names[k], values[na], sizeof values[0])) {
-                attrs[na] = (image_attr){render_identity_names[k], IMAGE_ATTR_STRING, values[na], 0, 0, NULL};
-                na++;
-            }
-        attrs[na++] = (image_attr){"gonio:spp", IMAGE_ATTR_INT, NULL, (int)total, 0, NULL};
-        if (seeds.complete) {
-            size_t len = 0;
-            seed_text = util_malloc(12 * (size_t)seeds.count + 1);
-            seed_text[0] = 0;
-            for (int k = 0; k < seeds.count; k++)
-                len += (size_t)sprintf(seed_text + len, "%s%u", k ? "," : "", seeds.seed[k]);
-            attrs[na++] = (image_attr){"gonio:seeds", IMAGE_ATTR_STRING, seed_text, 0, 0, NULL};
-        }
-        attrs[na++] = (image_attr){"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, seconds, NULL};
-        attrs[na++] = (image_attr){"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL};
-        attrs[na++] = (image_attr){"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL};
-        if (image_write_exr_with(&out, out_path, attrs, na, &exr))
-            rc = 0;
-    }
-done:
-    for (int i = 0; i < n && imgs; i++)
-        image_destroy(&imgs[i]);
+    for (int i = 0; i < in.n; i++)
+        image_destroy(&in.img[i]);
     image_destroy(&out);
-    free(imgs);
-    free(spp);
-    free(inputs);
-    free(seeds.seed);
-    free(seeds.file);
-    free(seed_text);
-    return rc;
+    free(in.img);
+    free(in.spp);
+    free(in.seeds.seed);
+    free(in.seeds.file);
+    return ok ? 0 : 1;
 }

@@ -264,38 +264,60 @@ static void catch_signals(bool quiet)
     sigaction(SIGTERM, &sa, NULL);
 }
 
+/* Where an option of render applies (warn_inapplicable). */
+typedef enum render_applies {
+    APPLIES_PATH,        /* --mode path only */
+    APPLIES_LOCAL,       /* the local modes only */
+    APPLIES_PNG,         /* with a PNG output only */
+    APPLIES_NO_TIME,     /* not with --time */
+    APPLIES_PATH_ALBEDO, /* --mode path and albedo (the model's colour) only */
+    APPLIES_EXR,         /* with an EXR output only */
+} render_applies;
+
 /* Options that the chosen mode or outputs do not use: a warning each, never silence. */
 static void warn_inapplicable(const cli_command *c, const cli_args *args, const render_settings *s,
                               const char *png_path, const char *out_path)
 {
     static const struct {
         const char *opt;
-        int when; /* 0: path mode only; 1: local modes only; 2: with a PNG only; 3: not with
-                   * --time; 4: path and albedo (the model's colour) only; 5: with an EXR only */
-    } rules[] = {{"--max-depth", 0}, {"--brdf", 4}, {"--estimator", 0}, {"--ambient", 1},
-                 {"--no-shadows", 1}, {"--exposure", 2}, {"--tonemap", 2}, {"--spp", 3},
-                 {"--aov", 5}};
+        render_applies when;
+    } rules[] = {{"--max-depth", APPLIES_PATH},   {"--brdf", APPLIES_PATH_ALBEDO}, {"--estimator", APPLIES_PATH},
+                 {"--ambient", APPLIES_LOCAL},    {"--no-shadows", APPLIES_LOCAL}, {"--exposure", APPLIES_PNG},
+                 {"--tonemap", APPLIES_PNG},      {"--spp", APPLIES_NO_TIME},      {"--aov", APPLIES_EXR}};
     const bool path = s->mode == GN_MODE_PATH;
     const bool png = png_path || (out_path && util_has_suffix(out_path, ".png"));
     const bool exr = out_path && util_has_suffix(out_path, ".exr");
     for (size_t k = 0; k < sizeof rules / sizeof *rules; k++) {
-        if (!cli_given(c, args, rules[k].opt))
+        const char *opt = rules[k].opt;
+        if (!cli_given(c, args, opt))
             continue;
-        if (rules[k].when == 0 && !path)
-            util_warn("%s applies to --mode path only; ignored with --mode %s", rules[k].opt,
-                      render_mode_name(s->mode));
-        else if (rules[k].when == 1 && path)
-            util_warn("%s applies to the local modes only; ignored with --mode path", rules[k].opt);
-        else if (rules[k].when == 2 && !png)
-            util_warn("%s applies to the PNG only; ignored without a PNG output", rules[k].opt);
-        else if (rules[k].when == 5 && !exr)
-            util_warn("%s applies to the EXR only; ignored without an EXR output", rules[k].opt);
-        else if (rules[k].when == 4 && !path && s->mode != GN_MODE_ALBEDO)
-            util_warn("%s applies to --mode path (and albedo, its colour) only; ignored with "
-                      "--mode %s", rules[k].opt, render_mode_name(s->mode));
-        else if (rules[k].when == 3 && s->time_limit > 0)
-            util_warn("%s is ignored with --time: the render takes as many samples as fit",
-                      rules[k].opt);
+        switch (rules[k].when) {
+        case APPLIES_PATH:
+            if (!path)
+                util_warn("%s applies to --mode path only; ignored with --mode %s", opt, render_mode_name(s->mode));
+            break;
+        case APPLIES_LOCAL:
+            if (path)
+                util_warn("%s applies to the local modes only; ignored with --mode path", opt);
+            break;
+        case APPLIES_PNG:
+            if (!png)
+                util_warn("%s applies to the PNG only; ignored without a PNG output", opt);
+            break;
+        case APPLIES_EXR:
+            if (!exr)
+                util_warn("%s applies to the EXR only; ignored without an EXR output", opt);
+            break;
+        case APPLIES_PATH_ALBEDO:
+            if (!path && s->mode != GN_MODE_ALBEDO)
+                util_warn("%s applies to --mode path (and albedo, its colour) only; ignored with --mode %s", opt,
+                          render_mode_name(s->mode));
+            break;
+        case APPLIES_NO_TIME:
+            if (s->time_limit > 0)
+                util_warn("%s is ignored with --time: the render takes as many samples as fit", opt);
+            break;
+        }
     }
 }
 
@@ -542,15 +564,9 @@ int cmd_render(int argc, char **argv)
     j.s.no_shadows = no_shadows;
     const char *out_path = j.out_path, *png_path = j.png_path, *exr_path = NULL;
     warn_inapplicable(&command, &args, &j.s, png_path, out_path);
-    if (!out_path && !png_path)
-        return cli_usage_error("render", "no output given (-o OUT.exr and/or --png OUT.png)");
     /* The name says the format: -o OUT.png is the tonemapped PNG, as --png is. */
-    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_UNKNOWN)
-        return cli_usage_error("render", "-o '%s': expected a .exr (OpenEXR) or .png name", out_path);
-    if (png_path && image_format_of(png_path) != IMAGE_FORMAT_PNG)
-        return cli_usage_error("render", "--png '%s': expected a .png name", png_path);
-    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_EXR)
-        exr_path = out_path;
+    if ((rc = cli_image_outputs("render", out_path, png_path, &exr_path)) >= 0)
+        return rc;
     const char *exr_option = cli_given(&command, &args, "--compression") ? "--compression"
                              : cli_given(&command, &args, "--half")      ? "--half"
                                                                          : NULL;

@@ -20,7 +20,8 @@ namespace gltf {
 /* ---- the extensions gonio knows: one table ---------------------------------------------------
  * A material extension's factors and textures are its rows of the material table
  * (glsl/lib/material.h), read by material_read; `read` is what the table cannot say (a
- * factor that scales another, a flag). Adding one: docs/architecture.md, "Adding a glTF
+ * factor that scales another, a flag); `info` what gonio info says of a material that uses
+ * it (scene.h: scene_material_line). Adding one: docs/architecture.md, "Adding a glTF
  * material extension". */
 struct Extension {
     const char *name;
@@ -28,6 +29,7 @@ struct Extension {
     const char *how;  /* what gonio does with it (partly: what is left out; unsupported: why) */
     bool material;    /* an extension of materials: its object is read by material_read */
     void (*read)(Doc &d, const Json &e, const std::string &p, MaterialDraft &m); /* after its rows */
+    const scene_material_line *info = nullptr;
 };
 
 /* A factor of an extension object that is no row of the table (it scales one): the row
@@ -86,6 +88,77 @@ void read_spec_gloss(Doc &d, const Json &e, const std::string &p, MaterialDraft 
     read_texture(d, e, p, m.what, "diffuseTexture", m.tex[GN_MAT_WORD(tex_base)]);
 }
 
+/* gonio info's lines (scene_material_line): the factors as the path tracer reads them. */
+
+/* The medium a KHR_materials_volume material bounds, or the dispersion of its refraction
+ * (glsl/kernels/path.comp: sigma_a = -ln(attenuation colour) / attenuation distance). */
+bool info_medium(const GnMaterial *m, char *out, size_t size)
+{
+    const float *c = &m->attenuation_color.x;
+    double sigma[3];
+    if (!m->volume && !(m->dispersion > 0))
+        return false;
+    for (int k = 0; k < 3; k++)
+        sigma[k] = c[k] >= 1 ? 0 : -std::log(double(c[k] > 1e-30f ? c[k] : 1e-30f)) / m->attenuation_distance;
+    snprintf(out, size, "%s attenuation (%g, %g, %g) distance %g (sigma_a %g, %g, %g), thickness %g, ior %g, "
+             "dispersion %g", m->volume ? "volume" : "thin-walled", c[0], c[1], c[2], m->attenuation_distance,
+             sigma[0], sigma[1], sigma[2], m->thickness, m->ior, m->dispersion);
+    return true;
+}
+const scene_material_line INFO_MEDIUM = {
+    "medium",
+    "KHR_materials_volume (a medium the material bounds) or\n"
+    "KHR_materials_dispersion: attenuation colour and distance, the\n"
+    "absorption coefficient they give, thickness (unused by the path\n"
+    "tracer), IOR and dispersion",
+    info_medium};
+
+bool info_anisotropy(const GnMaterial *m, char *out, size_t size)
+{
+    if (!(m->anisotropy_strength > 0) && m->tex_anisotropy == GN_INVALID)
+        return false;
+    snprintf(out, size, "strength %g, rotation %g deg%s", m->anisotropy_strength, m->anisotropy_rotation * 180 / M_PI,
+             m->tex_anisotropy != GN_INVALID ? ", textured" : "");
+    return true;
+}
+const scene_material_line INFO_ANISOTROPY = {
+    "anisotropy", "KHR_materials_anisotropy: strength, rotation and whether a texture\nsets them", info_anisotropy};
+
+/* The film's thickness: a range, mix(min, max, texture G), where a texture sets it. */
+bool info_iridescence(const GnMaterial *m, char *out, size_t size)
+{
+    const char *textured = m->tex_iridescence != GN_INVALID ? " x texture" : "";
+    if (!(m->iridescence > 0))
+        return false;
+    if (m->tex_iridescence_thickness != GN_INVALID)
+        snprintf(out, size, "factor %g%s, film ior %g, thickness %g - %g nm (texture G)", m->iridescence, textured,
+                 m->iridescence_ior, m->iridescence_thickness_min, m->iridescence_thickness_max);
+    else
+        snprintf(out, size, "factor %g%s, film ior %g, thickness %g nm", m->iridescence, textured, m->iridescence_ior,
+                 m->iridescence_thickness_max);
+    return true;
+}
+const scene_material_line INFO_IRIDESCENCE = {
+    "iridescence",
+    "KHR_materials_iridescence: factor (and whether a texture scales\n"
+    "it), film IOR, thickness (the range of a thickness texture's G)",
+    info_iridescence};
+
+bool info_diffuse_transmission(const GnMaterial *m, char *out, size_t size)
+{
+    if (!(m->diffuse_transmission > 0))
+        return false;
+    snprintf(out, size, "factor %g%s, colour (%g, %g, %g)%s", m->diffuse_transmission,
+             m->tex_diffuse_transmission != GN_INVALID ? " x texture" : "", m->diffuse_transmission_color.x,
+             m->diffuse_transmission_color.y, m->diffuse_transmission_color.z,
+             m->tex_diffuse_transmission_color != GN_INVALID ? " x texture" : "");
+    return true;
+}
+const scene_material_line INFO_DIFFUSE_TRANSMISSION = {
+    "diffuse transmission",
+    "KHR_materials_diffuse_transmission: factor and colour (and whether\ntextures scale them)",
+    info_diffuse_transmission};
+
 const Extension EXTENSIONS[] = {
     {"KHR_materials_emissive_strength", SCENE_SUPPORTED, "emissiveStrength scales emissiveFactor", true,
      read_emissive_strength},
@@ -96,13 +169,16 @@ const Extension EXTENSIONS[] = {
     {"KHR_materials_volume", SCENE_PARTLY,
      "absorption in the medium a closed mesh bounds; thicknessFactor and thicknessTexture only say there is one "
      "(the path tracer follows the real geometry)",
-     true, read_volume},
+     true, read_volume, &INFO_MEDIUM},
     {"KHR_materials_dispersion", SCENE_SUPPORTED, "an index per colour channel from the Abbe number", true, nullptr},
     {"KHR_materials_clearcoat", SCENE_SUPPORTED, "a GGX coat with its own roughness and normal map", true, nullptr},
     {"KHR_materials_sheen", SCENE_SUPPORTED, "a Charlie sheen over the base", true, nullptr},
-    {"KHR_materials_anisotropy", SCENE_SUPPORTED, "anisotropic GGX along the tangent frame's direction", true, nullptr},
-    {"KHR_materials_iridescence", SCENE_SUPPORTED, "a thin film over the base's Fresnel factor", true, nullptr},
-    {"KHR_materials_diffuse_transmission", SCENE_SUPPORTED, "a Lambert lobe through the surface", true, nullptr},
+    {"KHR_materials_anisotropy", SCENE_SUPPORTED, "anisotropic GGX along the tangent frame's direction", true, nullptr,
+     &INFO_ANISOTROPY},
+    {"KHR_materials_iridescence", SCENE_SUPPORTED, "a thin film over the base's Fresnel factor", true, nullptr,
+     &INFO_IRIDESCENCE},
+    {"KHR_materials_diffuse_transmission", SCENE_SUPPORTED, "a Lambert lobe through the surface", true, nullptr,
+     &INFO_DIFFUSE_TRANSMISSION},
     {"KHR_materials_unlit", SCENE_SUPPORTED, "the base colour is the radiance", true, read_unlit},
     {"KHR_materials_pbrSpecularGlossiness", SCENE_SUPPORTED,
      "read as metallic-roughness: the diffuse colour times 1 - max(specular) the base colour, specular the F0, "
@@ -887,6 +963,14 @@ bool load_materials(Ctx &c, scene *out)
 }
 
 } // namespace gltf
+
+const scene_material_line *scene_material_line_at(size_t k)
+{
+    for (const gltf::Extension &e : gltf::EXTENSIONS)
+        if (e.info && k-- == 0)
+            return e.info;
+    return nullptr;
+}
 
 scene_support scene_extension_support(const char *name, const char **how)
 {

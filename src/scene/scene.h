@@ -11,6 +11,7 @@
 #define GONIO_SCENE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "image.h"
@@ -175,6 +176,18 @@ bool scene_load(scene *out, const char *path);
  * (also for a name it does not know: SCENE_UNSUPPORTED, "unknown to gonio"; for
  * KHR_texture_basisu in a build without Basis Universal: SCENE_UNSUPPORTED, and why). */
 scene_support scene_extension_support(const char *name, const char **how);
+
+/* What gonio info says of a material for an extension of the loader's table (gltf_material.cpp),
+ * one line a material that uses it: "LABEL INDEX "NAME" TEXT". */
+typedef struct scene_material_line {
+    const char *label; /* the line's first words: "anisotropy" */
+    const char *help;  /* what the line says, for gonio info --help (lines of at most 68
+                        * characters, '\n' between them) */
+    /* The line's TEXT for material m into out, or false when m does not use the extension. */
+    bool (*text)(const GnMaterial *m, char *out, size_t size);
+} scene_material_line;
+/* The table's lines on materials, k = 0, 1, ... in its order; NULL after the last. */
+const scene_material_line *scene_material_line_at(size_t k);
 
 /* Limits of a decoded scene, checked before anything is allocated, with the numbers in the
  * error: triangles and vertices stored (the meshes used once after baking them into world

@@ -10,13 +10,17 @@
 
 #include "util.h"
 
+static void mesh_free(scene_instanced_mesh *im)
+{
+    free(im->vertices);
+    free(im->indices);
+    free(im->tri_material);
+}
+
 void scene_free_instances(scene *s)
 {
-    for (uint32_t m = 0; m < s->num_instanced_meshes; m++) {
-        free(s->instanced_meshes[m].vertices);
-        free(s->instanced_meshes[m].indices);
-        free(s->instanced_meshes[m].tri_material);
-    }
+    for (uint32_t m = 0; m < s->num_instanced_meshes; m++)
+        mesh_free(&s->instanced_meshes[m]);
     free(s->instanced_meshes);
     free(s->instances);
     s->instanced_meshes = NULL;
@@ -139,9 +143,7 @@ uint32_t scene_drop_invalid_instanced(scene *s)
     for (uint32_t m = 0; m < s->num_instanced_meshes; m++) {
         scene_instanced_mesh *im = &s->instanced_meshes[m];
         if (uses[m] == 0) {
-            free(im->vertices);
-            free(im->indices);
-            free(im->tri_material);
+            mesh_free(im);
             continue;
         }
         to[m] = meshes;

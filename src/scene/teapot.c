@@ -315,10 +315,4 @@ void teapot_tessellate(teapot_mesh *out, int level)
     free(nrm);
 }
 
-void teapot_destroy(teapot_mesh *m)
-{
-    free(m->positions);
-    free(m->normals);
-    free(m->indices);
-    memset(m, 0, sizeof *m);
-}
+void teapot_destroy(teapot_mesh *m) { meshgen_destroy(m); }

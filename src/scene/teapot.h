@@ -8,15 +8,11 @@
 #ifndef GONIO_TEAPOT_H
 #define GONIO_TEAPOT_H
 
-#include <stdint.h>
+#include "meshgen.h"
 
-typedef struct teapot_mesh {
-    uint32_t num_vertices;
-    float *positions;          /* 3 per vertex */
-    float *normals;            /* 3 per vertex, unit length, outward */
-    uint32_t num_triangles;
-    uint32_t *indices;         /* 3 per triangle, counter-clockwise seen from outside */
-} teapot_mesh;
+/* The procedural meshes' arrays (meshgen.h): normals unit length and outward, triangles
+ * counter-clockwise seen from outside. */
+typedef meshgen_mesh teapot_mesh;
 
 /* Evaluates every patch on an (level+1) x (level+1) grid of (u, v), two triangles per grid
  * cell, with normals from the patch derivatives; vertices that coincide across patch seams
@@ -29,7 +25,7 @@ typedef struct teapot_mesh {
  * are collinear, give 4 zero-area triangles. Precondition: 1 <= level <= 1024. */
 void teapot_tessellate(teapot_mesh *out, int level);
 
-/* Frees the arrays; accepts a zeroed struct. */
+/* Frees the arrays; accepts a zeroed struct (meshgen_destroy). */
 void teapot_destroy(teapot_mesh *m);
 
 #endif

@@ -1453,6 +1453,34 @@ TEST(scene, material_rows)
     }
 }
 
+/* gonio info's lines of the table's extensions (scene_material_line): each has a label and
+ * help that fits --help's column, says nothing of the default material, and speaks of a
+ * material that uses its extension. */
+TEST(scene, material_lines)
+{
+    GnMaterial plain, aniso;
+    char text[512];
+    size_t n = 0, anisotropy = 0;
+    const scene_material_line *l;
+    scene_material_default(&plain);
+    aniso = plain;
+    aniso.anisotropy_strength = 0.5f;
+    for (size_t k = 0; (l = scene_material_line_at(k)); k++, n++) {
+        CHECKF(l->label && *l->label && l->help && *l->help && l->text, "line %zu", k);
+        for (const char *line = l->help; *line;) {
+            size_t len = strcspn(line, "\n");
+            CHECKF(len <= 68, "%s: a help line of %zu characters", l->label, len);
+            line += len + (line[len] == '\n');
+        }
+        CHECKF(!l->text(&plain, text, sizeof text), "%s: the default material: %s", l->label, text);
+        if (!strcmp(l->label, "anisotropy")) {
+            anisotropy++;
+            CHECKF(l->text(&aniso, text, sizeof text) && !strcmp(text, "strength 0.5, rotation 0 deg"), "%s", text);
+        }
+    }
+    CHECKF(n >= 4 && anisotropy == 1, "%zu lines", n);
+}
+
 /* The extensions a file lists, once each in its order, with how gonio handles each: the
  * table's supported, partly and unsupported ones, and a name it does not know; a required
  * unsupported one refuses the file, naming it and why. */
