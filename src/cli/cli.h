@@ -7,10 +7,7 @@
 #include <stdio.h>
 
 #include "gpu.h"
-
-struct image;
-struct render_settings;
-struct scene;
+#include "render_default_light.h"
 
 int cmd_render(int argc, char **argv);
 int cmd_info(int argc, char **argv);
@@ -206,14 +203,8 @@ const char *cli_brdf_models(void);
 /* The camera options' parser (dest: the camera_option). */
 bool cli_take_camera(const char *cmd, const char *opt, const char *val, void *dest);
 
-typedef struct env_option {
-    bool given;              /* --env was on the command line */
-    const char *path;        /* a map (.exr or .hdr), else NULL: the constant `color` */
-    bool studio;             /* --env studio: gonio's studio, whatever lights the scene has */
-    float color[3];
-    float rotation;          /* degrees about +Y, right-handed (--env-rotate) */
-    float intensity;         /* scale of the radiance (--env-intensity); 0 means 1 */
-} env_option;
+/* The environment options' value: what the user asked of the light (src/render/render_default_light.h). */
+typedef render_light_request env_option;
 
 /* The environment options of render and preview: an env_option. CLI_OPT_ENV alone: --env
  * (bench: help its own wording). */
@@ -236,26 +227,6 @@ typedef struct env_option {
      CLI_CALL, CLI_AS(env_option, env), 0, 0, NULL, cli_take_env, NULL}
 /* The environment options' parser (dest: the env_option). */
 bool cli_take_env(const char *cmd, const char *opt, const char *val, void *dest);
-
-/* Sets s's environment (env, env_map, env_rotation) from e for scene sc, reading a map into
- * *map (which the caller destroys), or the studio when e is not given and the scene has no
- * light, announced on stderr unless quiet; *studio tells which. For a local mode (s->mode)
- * the environment's mean radiance becomes the ambient light (unless s->ambient_set) and the
- * studio's key light is added to sc's lights. False with an error naming the file on a bad
- * map. */
-bool env_setup(const env_option *e, struct scene *sc, bool quiet, struct image *map, struct render_settings *s,
-               bool *studio);
-/* The dark-view rule (options.c; docs/path-tracing.md, "Light when the scene has none"),
- * whole, after env_setup: with no --env and light of its own, a probe render of s's view; a
- * dark view gets the studio added (said unless quiet; ambient_given: --ambient was given, the
- * local modes' ambient stays); where the studio lights the view by default and a closed model
- * keeps it out, a headlight (a point light at the camera) in its place. *studio: in, the
- * studio lights the view already; out, whether it does now; *headlight: whether one was
- * added. True when sc's lights changed (the local modes' studio key light, the headlight):
- * the caller makes its renderer again. */
-struct renderer;
-bool env_light_rule(const env_option *e, struct scene *sc, struct renderer *r, struct render_settings *s,
-                    struct image *map, bool quiet, bool ambient_given, bool *studio, bool *headlight);
 
 /* "gonio CMD: MESSAGE" and the hint to use --help; returns 2. */
 int cli_usage_error(const char *cmd, const char *fmt, ...);

@@ -259,6 +259,94 @@ static bool take_reference(const char *cmd, const char *opt, const char *val, vo
     return true;
 }
 
+/* The scene's load time, its trees and their memory. */
+static void print_scene(const renderer *r, const scene *sc, const char *name, double t_load)
+{
+    printf("scene              %s\n", name);
+    printf("device             %s\n", r->g->props.deviceName);
+    printf("scene load         %.3f s (the file read and checked, meshes decoded; then the trees' build\n"
+           "                   and upload took %.3f s)\n", t_load, r->setup_seconds);
+    const render_geometry *geo = &r->geo;
+    render_geometry_bytes mem = render_geometry_size(geo);
+    if (geo->two_levels) {
+        uint32_t tris = 0;
+        for (uint32_t m = 0; m < geo->num_meshes; m++)
+            tris += geo->meshes[m].num_tris;
+        printf("triangles          %llu placed, %u stored (%u instances of %u meshes)\n",
+               (unsigned long long)scene_placed_triangles(sc), tris, geo->top.num_instances, geo->num_meshes);
+        printf("bvh leaf prims     %u\n", geo->num_pairs);
+        printf("bvh nodes          %u (top tree %u, depth %u; walks up to %u levels)\n", geo->num_nodes,
+               geo->top.tree.num_nodes, geo->top.tree.depth, geo->depth);
+    } else {
+        printf("triangles          %u\n", sc->num_triangles);
+        printf("bvh leaf prims     %u (%u triangle pairs, %u single triangles)\n", geo->world.num_pairs,
+               geo->world.num_tris - geo->world.num_pairs, 2 * geo->world.num_pairs - geo->world.num_tris);
+        printf("bvh nodes          %u (depth %u, SAH cost %.1f)\n", geo->world.num_nodes, geo->world.depth,
+               geo->world.sah_cost);
+    }
+    printf("scene memory       %.2f MB (nodes %.2f, triangles %.2f, shading %.2f, vertices %.2f, instances %.2f)\n",
+           (mem.nodes + mem.pairs + mem.prims + mem.vertices + mem.instances) * 1e-6, mem.nodes * 1e-6,
+           mem.pairs * 1e-6, mem.prims * 1e-6, mem.vertices * 1e-6, mem.instances * 1e-6);
+    fflush(stdout);
+}
+
+/* The rates of bench.comp's primary and diffuse rays through the renderer's buffers, for
+ * about `seconds` each after a warm-up pass (shader compilation), which defines the time to
+ * the first pixel. False when renderer_begin fails. */
+static bool bench_rays(renderer *r, const render_settings *s, double t_start, float seconds)
+{
+    GnFrame frame;
+    gpu_pipeline pipes[2] = {{0}};
+    double t_first = 0, t_primary = 0, t_diffuse = 0;
+    uint64_t n_primary = 0, n_diffuse = 0;
+    const int w = s->width, h = s->height;
+    int passes = 0;
+    if (!renderer_begin(r, s, &frame))
+        return false;
+    for (uint32_t mode = 0; mode < 2; mode++) {
+        gpu_binding b[GN_BIND_COUNT];
+        render_spec spec;
+        gpu_pipeline_desc pd = {.name = "bench", .code = spv_bench, .code_size = sizeof spv_bench,
+                                .local_size = {GN_TILE_X, GN_TILE_Y, 1},
+                                .push_size = sizeof(GnPush), .bindings = b,
+                                .num_bindings = renderer_bindings(r, b),
+                                .specialization = renderer_specialize(r, mode, &spec)};
+        gpu_pipeline_create(r->g, &pipes[mode], &pd);
+    }
+    for (uint32_t pass = 0;; pass++) {
+        GnPush push = {pass, 0, 0, 0};
+        double t0 = util_now(), t1, t2;
+        VkCommandBuffer cmd = gpu_begin(r->g);
+        gpu_dispatch(cmd, &pipes[0], &push, (uint32_t)w, (uint32_t)h, 1);
+        gpu_submit_wait(r->g, cmd);
+        t1 = util_now();
+        cmd = gpu_begin(r->g);
+        gpu_dispatch(cmd, &pipes[1], &push, (uint32_t)w, (uint32_t)h, 1);
+        gpu_submit_wait(r->g, cmd);
+        t2 = util_now();
+        if (pass == 0) {
+            t_first = t1 - t_start;
+            continue;
+        }
+        const float *rays = r->accum.aov.mapped; /* (bench.comp writes its rays into the AOV buffer) */
+        for (int p = 0; p < w * h; p++)
+            n_diffuse += rays[8 * p + 7] >= 0.0f;
+        n_primary += (uint64_t)w * h;
+        t_primary += t1 - t0;
+        t_diffuse += t2 - t1;
+        passes++;
+        if (t_primary + t_diffuse >= 2.0 * seconds && passes >= 2)
+            break;
+    }
+    printf("first pixel        %.3f s after start\n", t_first);
+    printf("primary rays       %.2f Mrays/s (%dx%d, %d passes)\n", n_primary / t_primary * 1e-6, w, h, passes);
+    printf("diffuse rays       %.2f Mrays/s (%.0f%% of pixels hit)\n", n_diffuse / t_diffuse * 1e-6,
+           100.0 * n_diffuse / n_primary);
+    for (int i = 0; i < 2; i++)
+        gpu_pipeline_destroy(r->g, &pipes[i]);
+    return true;
+}
+
 int cmd_bench(int argc, char **argv)
 {
     const double t_start = util_now();
@@ -304,13 +392,6 @@ int cmd_bench(int argc, char **argv)
     scene sc = {0};
     gpu g = {0};
     renderer r = {0};
-    gpu_pipeline pipes[2] = {{0}};
-    /* bench.comp writes its rays into the AOV buffer, which is allocated only when asked for. */
-    render_settings s = {.mode = GN_MODE_PHONG, .camera = -1, .aov = RENDER_AOV_GPU};
-    GnFrame frame;
-    double t_first = 0, t_primary = 0, t_diffuse = 0;
-    uint64_t n_primary = 0, n_diffuse = 0;
-    int passes = 0;
 
     if ((rc = cli_parse(&command, argc, argv, &args)) >= 0)
         return rc;
@@ -320,8 +401,6 @@ int cmd_bench(int argc, char **argv)
         return cli_usage_error("bench", "--denoise is for --paths");
     if (denoise && !denoise_load())
         return 1;
-    int w = size[0], h = size[1];
-
     double t_load = util_now();
     if (!build_scene(&sc, path, generate))
         return 1;
@@ -330,116 +409,27 @@ int cmd_bench(int argc, char **argv)
         scene_destroy(&sc);
         return 1;
     }
-    if (!renderer_create(&r, &g, &sc)) {
-        renderer_destroy(&r);
-        scene_destroy(&sc);
-        gpu_destroy(&g);
-        return 1;
+    bool ok = renderer_create(&r, &g, &sc);
+    if (ok) {
+        print_scene(&r, &sc, generate ? "generated mesh" : path ? path : "cornell (built in)", t_load);
+        /* bench.comp writes its rays into the AOV buffer, which is allocated only when asked for;
+         * --paths: the reference's own noise needs its squares. */
+        render_settings s = {.mode = paths ? GN_MODE_PATH : GN_MODE_PHONG, .camera = sc.num_cameras ? 0 : -1,
+                             .aov = paths ? RENDER_AOV_VARIANCE : RENDER_AOV_GPU, .no_shadows = true,
+                             .width = size[0] ? size[0] : paths ? 256 : 512,
+                             .height = size[0] ? size[1] : paths ? 256 : 512};
+        render_lighting light = {0};
+        if (!paths)
+            ok = bench_rays(&r, &s, t_start, seconds);
+        else if (!env.given || render_light_begin(&env, &sc, true, &s, &light))
+            ok = bench_paths(&r, &s, t_start, seconds, ref_w, ref_h, ref_spp, denoise);
+        else
+            ok = false;
+        render_lighting_destroy(&light);
+        if (ok || paths)
+            print_build(&sc);
     }
-    printf("scene              %s\n", generate ? "generated mesh" : path ? path : "cornell (built in)");
-    printf("device             %s\n", g.props.deviceName);
-    printf("scene load         %.3f s (the file read and checked, meshes decoded; then the trees' build\n"
-           "                   and upload took %.3f s)\n", t_load, r.setup_seconds);
-    const render_geometry *geo = &r.geo;
-    render_geometry_bytes mem = render_geometry_size(geo);
-    if (geo->two_levels) {
-        uint32_t tris = 0;
-        for (uint32_t m = 0; m < geo->num_meshes; m++)
-            tris += geo->meshes[m].num_tris;
-        printf("triangles          %llu placed, %u stored (%u instances of %u meshes)\n",
-               (unsigned long long)scene_placed_triangles(&sc), tris, geo->top.num_instances, geo->num_meshes);
-        printf("bvh leaf prims     %u\n", geo->num_pairs);
-        printf("bvh nodes          %u (top tree %u, depth %u; walks up to %u levels)\n", geo->num_nodes,
-               geo->top.tree.num_nodes, geo->top.tree.depth, geo->depth);
-    } else {
-        printf("triangles          %u\n", sc.num_triangles);
-        printf("bvh leaf prims     %u (%u triangle pairs, %u single triangles)\n", geo->world.num_pairs,
-               geo->world.num_tris - geo->world.num_pairs, 2 * geo->world.num_pairs - geo->world.num_tris);
-        printf("bvh nodes          %u (depth %u, SAH cost %.1f)\n", geo->world.num_nodes, geo->world.depth,
-               geo->world.sah_cost);
-    }
-    printf("scene memory       %.2f MB (nodes %.2f, triangles %.2f, shading %.2f, vertices %.2f, instances %.2f)\n",
-           (mem.nodes + mem.pairs + mem.prims + mem.vertices + mem.instances) * 1e-6, mem.nodes * 1e-6,
-           mem.pairs * 1e-6, mem.prims * 1e-6, mem.vertices * 1e-6, mem.instances * 1e-6);
-    fflush(stdout);
-    if (!w)
-        w = h = paths ? 256 : 512;
-    s.width = w;
-    s.height = h;
-    s.camera = sc.num_cameras ? 0 : -1;
-    s.no_shadows = true;
-    if (paths) {
-        bool ok, studio;
-        image env_map = {0};
-        s.mode = GN_MODE_PATH;
-        s.aov = RENDER_AOV_VARIANCE; /* the reference's own noise needs its squares */
-        if (env.given && !env_setup(&env, &sc, true, &env_map, &s, &studio)) {
-            renderer_destroy(&r);
-            scene_destroy(&sc);
-            gpu_destroy(&g);
-            return 1;
-        }
-        ok = bench_paths(&r, &s, t_start, seconds, ref_w, ref_h, ref_spp, denoise);
-        image_destroy(&env_map);
-        print_build(&sc);
-        renderer_destroy(&r);
-        scene_destroy(&sc);
-        return cli_gpu_finish(&g) && ok ? 0 : 1;
-    }
-    if (!renderer_begin(&r, &s, &frame)) {
-        renderer_destroy(&r);
-        gpu_destroy(&g);
-        scene_destroy(&sc);
-        return 1;
-    }
-    for (uint32_t mode = 0; mode < 2; mode++) {
-        gpu_binding b[GN_BIND_COUNT];
-        render_spec spec;
-        gpu_pipeline_desc pd = {.name = "bench", .code = spv_bench, .code_size = sizeof spv_bench,
-                                .local_size = {GN_TILE_X, GN_TILE_Y, 1},
-                                .push_size = sizeof(GnPush), .bindings = b,
-                                .num_bindings = renderer_bindings(&r, b),
-                                .specialization = renderer_specialize(&r, mode, &spec)};
-        gpu_pipeline_create(&g, &pipes[mode], &pd);
-    }
-
-    /* Pass 0 is the warm-up (shader compilation) and defines time to first pixel. */
-    for (uint32_t pass = 0;; pass++) {
-        GnPush push = {pass, 0, 0, 0};
-        double t0 = util_now(), t1, t2;
-        VkCommandBuffer cmd = gpu_begin(&g);
-        gpu_dispatch(cmd, &pipes[0], &push, (uint32_t)w, (uint32_t)h, 1);
-        gpu_submit_wait(&g, cmd);
-        t1 = util_now();
-        cmd = gpu_begin(&g);
-        gpu_dispatch(cmd, &pipes[1], &push, (uint32_t)w, (uint32_t)h, 1);
-        gpu_submit_wait(&g, cmd);
-        t2 = util_now();
-        if (pass == 0) {
-            t_first = t1 - t_start;
-            continue;
-        }
-        {
-            const float *rays = r.accum.aov.mapped;
-            for (int p = 0; p < w * h; p++)
-                n_diffuse += rays[8 * p + 7] >= 0.0f;
-        }
-        n_primary += (uint64_t)w * h;
-        t_primary += t1 - t0;
-        t_diffuse += t2 - t1;
-        passes++;
-        if (t_primary + t_diffuse >= 2.0 * seconds && passes >= 2)
-            break;
-    }
-    printf("first pixel        %.3f s after start\n", t_first);
-    printf("primary rays       %.2f Mrays/s (%dx%d, %d passes)\n", n_primary / t_primary * 1e-6,
-           w, h, passes);
-    printf("diffuse rays       %.2f Mrays/s (%.0f%% of pixels hit)\n",
-           n_diffuse / t_diffuse * 1e-6, 100.0 * n_diffuse / n_primary);
-    print_build(&sc);
-    for (int i = 0; i < 2; i++)
-        gpu_pipeline_destroy(&g, &pipes[i]);
     renderer_destroy(&r);
     scene_destroy(&sc);
-    return cli_gpu_finish(&g) ? 0 : 1;
+    return cli_gpu_finish(&g) && ok ? 0 : 1;
 }

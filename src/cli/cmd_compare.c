@@ -39,6 +39,7 @@ typedef struct compare_opts {
     bool size_given, validate, quiet;
     camera_option camera;   /* the rule of every command (src/scene/camera.h) */
     scene_camera view;      /* ... resolved for the scene being compared */
+    env_option env;         /* the light rule of every command (src/render/render_default_light.h) */
 } compare_opts;
 
 /* ---- rendering ---------------------------------------------------------------------------- */
@@ -60,15 +61,62 @@ static bool choose_view(const scene *sc, compare_opts *o)
     return true;
 }
 
-static bool render_one(renderer *r, const compare_opts *o, uint32_t mode, image *out)
+/* One mode's image; lit: the settings' light (render_light_begin), NULL: the scene's own. */
+static bool render_one(renderer *r, const compare_opts *o, const render_settings *lit, uint32_t mode, image *out)
 {
     render_stats st;
     cli_progress progress;
-    render_settings s = {.mode = mode, .width = o->width, .height = o->height,
-                         .spp = mode == GN_MODE_PATH || o->spp < COMPARE_LOCAL_SPP ? o->spp : COMPARE_LOCAL_SPP,
-                         .view = &o->view, .progress = o->quiet ? NULL : cli_progress_report,
-                         .progress_user = &progress};
+    render_settings s = lit ? *lit : (render_settings){0};
+    s.mode = mode;
+    s.width = o->width;
+    s.height = o->height;
+    s.spp = mode == GN_MODE_PATH || o->spp < COMPARE_LOCAL_SPP ? o->spp : COMPARE_LOCAL_SPP;
+    s.view = &o->view;
+    s.progress = o->quiet ? NULL : cli_progress_report;
+    s.progress_user = &progress;
     return renderer_render(r, &s, out, &st);
+}
+
+/* The modes of o that the path kernel renders (path) or the local one (!path), into imgs[i]
+ * for o->modes[i], from sc under the light rule for that kernel (which can add lights to sc;
+ * said unless quiet). */
+static bool render_kind(gpu *g, scene *sc, const compare_opts *o, bool path, bool quiet, image *imgs)
+{
+    render_settings lit = {.mode = path ? GN_MODE_PATH : GN_MODE_PHONG, .width = o->width, .height = o->height,
+                           .spp = 1, .camera = -1, .view = &o->view};
+    render_lighting light = {0};
+    renderer r = {0};
+    bool ok = render_light_begin(&o->env, sc, quiet, &lit, &light);
+    if (ok) {
+        renderer_create(&r, g, sc);
+        ok = render_light_finish(&o->env, sc, &r, &lit, quiet, &light);
+    }
+    for (int i = 0; i < o->num_modes && ok; i++)
+        if ((o->modes[i] == GN_MODE_PATH) == path)
+            ok = render_one(&r, o, &lit, o->modes[i], &imgs[i]);
+    renderer_destroy(&r);
+    lit.env_map = NULL;
+    render_lighting_destroy(&light);
+    return ok;
+}
+
+/* Every mode of o rendered from the scene `input` (sc: loaded, its view chosen), the local
+ * modes and the path tracer each under the light rule (the studio is the local modes' key
+ * light and ambient, the path tracer's environment, as gonio render has it): the scene is
+ * loaded again for the second kind when the first changed its lights. */
+static bool render_every_mode(gpu *g, scene *sc, const char *input, int scene_index, const compare_opts *o, image *imgs)
+{
+    bool local = false, path = false;
+    for (int i = 0; i < o->num_modes; i++)
+        *(o->modes[i] == GN_MODE_PATH ? &path : &local) = true;
+    if (local && !render_kind(g, sc, o, false, o->quiet, imgs))
+        return false;
+    if (local && path) {
+        scene_destroy(sc);
+        if (!scene_load_scene(sc, input, scene_index))
+            return false;
+    }
+    return !path || render_kind(g, sc, o, true, o->quiet || local, imgs);
 }
 
 /* ---- pictures --------------------------------------------------------------------------- */
@@ -216,23 +264,15 @@ static bool write_metrics(const char *path, const compare_row *rows, int n, bool
     return util_out_commit(&out, true);
 }
 
-static bool run_compare(renderer *r, const compare_opts *o)
+/* The files of a comparison of the images of o's modes (imgs[i] of o->modes[i]). */
+static bool run_compare(image *imgs, const compare_opts *o)
 {
-    image imgs[COMPARE_MAX_MODES] = {{0}};
-    uint32_t modes[COMPARE_MAX_MODES];
+    const uint32_t *modes = o->modes;
     char labels[COMPARE_MAX_MODES][64], path[4200], name[96];
     compare_row rows[2 * COMPARE_MAX_MODES];
     float *maps[2 * COMPARE_MAX_MODES] = {0}, scale[2] = {0, 0};
-    int n = 0, num_rows = 0, phong = -1, path_i = -1;
+    int n = o->num_modes, num_rows = 0, phong = -1, path_i = -1;
     bool ok = true;
-
-    for (int i = 0; i < o->num_modes && ok; i++) {
-        uint32_t m = o->modes[i];
-        if (!render_one(r, o, m, &imgs[n]))
-            ok = false;
-        else
-            modes[n++] = m;
-    }
     for (int i = 0; i < n && ok; i++) {
         image_attr attr = {"gonio:mode", IMAGE_ATTR_STRING, render_mode_name(modes[i]), 0, 0, NULL};
         snprintf(name, sizeof name, "%s.exr", render_mode_name(modes[i]));
@@ -289,8 +329,6 @@ static bool run_compare(renderer *r, const compare_opts *o)
         join(path, sizeof path, o->dir, "metrics.csv");
         ok = write_metrics(path, rows, num_rows, !o->quiet);
     }
-    for (int i = 0; i < COMPARE_MAX_MODES; i++)
-        image_destroy(&imgs[i]);
     for (int k = 0; k < num_rows; k++)
         free(maps[k]);
     return ok;
@@ -430,8 +468,8 @@ static bool run_sweep(gpu *g, compare_opts *o, const int *levels, int n)
         }
         renderer_create(&r, g, &sc);
         rows[i] = (sweep_row){.level = levels[i], .triangles = sc.num_triangles};
-        ok = render_one(&r, o, GN_MODE_PHONG, &phong) && render_one(&r, o, GN_MODE_GOURAUD, &gouraud) &&
-             render_one(&r, o, GN_MODE_FLAT, &flat) && image_compare(&gouraud, &phong, &rows[i].gouraud) &&
+        ok = render_one(&r, o, NULL, GN_MODE_PHONG, &phong) && render_one(&r, o, NULL, GN_MODE_GOURAUD, &gouraud) &&
+             render_one(&r, o, NULL, GN_MODE_FLAT, &flat) && image_compare(&gouraud, &phong, &rows[i].gouraud) &&
              image_compare(&flat, &phong, &rows[i].flat);
         image_destroy(&phong);
         image_destroy(&gouraud);
@@ -515,6 +553,8 @@ static bool make_dir(const char *dir)
     "  diff-A-vs-B.png           heat map of |A - B| (mean over R, G, B, viridis; the legend\n" \
     "                            gives the scale) for each mode against phong and path\n"       \
     "  metrics.csv               mode,reference,rmse,rel_bias,max_err (also printed)\n"         \
+    "Each mode is lit as gonio render lights it: by the file's own lights, its image-based\n"  \
+    "light, or gonio's studio environment (--env decides instead).\n"                         \
     "With --sweep, renders the teapot at each tessellation level (e.g. 1,2,4,8,16,32) and\n"   \
     "writes sweep.csv (flat's and Gouraud's error against per-pixel Phong shading, by\n"       \
     "triangle count) and sweep.png (the plot, log-log).\n"
@@ -559,6 +599,7 @@ int cmd_compare(int argc, char **argv)
                             "min(N, 16), which only anti-aliases them"),
         CLI_OPT_SIZE(o.size, "image size (default 320 wide, the camera's aspect)"),
         CAMERA_OPTIONS(&o.camera),
+        ENV_OPTIONS(&o.env),
         CLI_OPT_SCENE(&scene_index, "compare the file's glTF scene N (default: its default scene)"),
         CLI_OPT_ALLOW_OUTSIDE_FILES(&outside),
         CLI_OPT_DEVICE(&o.device),
@@ -579,8 +620,10 @@ int cmd_compare(int argc, char **argv)
     }
     input = args.num_args ? args.arg[0] : NULL;
     sweep = cli_given(&command, &args, "--sweep") ? "" : NULL;
-    if (sweep && (cli_given(&command, &args, "--scene") || outside))
-        return cli_usage_error("compare", "--sweep renders gonio's teapot: --scene and --allow-outside-files do not apply");
+    if (sweep && (cli_given(&command, &args, "--scene") || outside || o.env.given || o.env.rotation != 0 ||
+                  o.env.intensity > 0))
+        return cli_usage_error("compare", "--sweep renders gonio's teapot under its own light: --scene, "
+                                          "--allow-outside-files and the --env options do not apply");
     scene_allow_outside_files(outside);
     if (!input)
         return cli_usage_error("compare", sweep ? "--sweep: no scene generator given (teapot)" : "no scene given");
@@ -599,21 +642,16 @@ int cmd_compare(int argc, char **argv)
             rc = run_sweep(&g, &o, sweep_levels.v, sweep_levels.n) ? 0 : 1;
     } else {
         scene sc = {0};
+        image imgs[COMPARE_MAX_MODES] = {{0}};
         if (!scene_load_scene(&sc, input, scene_index))
             return 1;
-        /* The comparison is of shading models under the scene's own lights; gonio render's
-         * studio environment would light the local modes and the path tracer differently. */
-        if (!env_scene_has_light(&sc))
-            util_warn("%s has no lights: compare renders it black (gonio render lights such a scene "
-                      "with its studio environment)", input);
         if (!choose_view(&sc, &o)) {
             /* camera_resolve said why */
         } else if (cli_gpu_create(&g, o.device, o.validate)) {
-            renderer r = {0};
-            renderer_create(&r, &g, &sc);
-            rc = run_compare(&r, &o) ? 0 : 1;
-            renderer_destroy(&r);
+            rc = render_every_mode(&g, &sc, input, scene_index, &o, imgs) && run_compare(imgs, &o) ? 0 : 1;
         }
+        for (int i = 0; i < COMPARE_MAX_MODES; i++)
+            image_destroy(&imgs[i]);
         scene_destroy(&sc);
     }
     if (g.device && !cli_gpu_finish(&g))

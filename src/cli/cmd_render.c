@@ -606,183 +606,205 @@ static bool denoise_render(image *img, uint32_t user_aov, const char *name, deno
     return true;
 }
 
+/* One render of the job as it goes through render_run's steps. */
+typedef struct render_state {
+    const render_job *job;
+    render_settings s;
+    camera_option cam;
+    scene_camera view;
+    char camera_text[160];
+    render_lighting light;
+    scene own_sc, *sc;   /* the scene: its own, or (--frames) the cache's */
+    gpu own_g, *g;
+    renderer own_r, *r;
+    const char *exr_path, *png_o; /* -o as EXR or as PNG */
+    image img, prev;     /* the render; the --resume file */
+    render_stats st;
+} render_state;
+
+/* The scene loaded with its --brdf, light and camera, the image's size and region: 0, or
+ * the exit status of the error it reported. */
+static int load_view(render_state *rs)
+{
+    const render_job *job = rs->job;
+    render_settings *s = &rs->s;
+    scene_animation_time(job->frame >= 0 ? job->frame / (double)job->fps : job->at);
+    if (!scene_load_scene(&rs->own_sc, job->scene_path, job->scene_index))
+        return 1;
+    if (!render_material_overrides(&rs->own_sc, job->brdf) ||
+        !render_light_begin(&job->env, &rs->own_sc, job->quiet, s, &rs->light) ||
+        !camera_resolve(&rs->cam, &rs->own_sc, job->size_given ? (float)s->width / (float)s->height : 1.0f, &rs->view))
+        return 1;
+    if (!job->size_given) {
+        if (rs->cam.width > 0) { /* --camera FILE.exr: that render's size, as its view had it */
+            s->width = rs->cam.width;
+            s->height = rs->cam.height;
+        } else {
+            camera_default_size(&rs->view, 512, &s->width, &s->height);
+        }
+        camera_resolve(&rs->cam, &rs->own_sc, (float)s->width / (float)s->height, &rs->view); /* framing: the real aspect */
+    }
+    if (job->crop.given && !apply_crop(&job->crop, s, job->crop_text))
+        return 2;
+    s->view = &rs->view;
+    camera_describe(&rs->cam, &rs->own_sc, rs->camera_text, sizeof rs->camera_text);
+    s->camera_label = rs->camera_text;
+    return 0;
+}
+
+/* The device and the renderer of the scene (--frames: the cache's, the renderer only updated
+ * while the geometry stays the same), and the light rule's second step. */
+static bool start_renderer(render_state *rs)
+{
+    frame_cache *cache = rs->job->cache;
+    if (cache && cache->gpu_live) {
+        rs->g = &cache->g;
+    } else if (!cli_gpu_create(&rs->own_g, rs->job->device, rs->job->validate)) {
+        return false;
+    } else if (cache) { /* the first frame's device serves them all */
+        cache->g = rs->own_g;
+        cache->gpu_live = true;
+        rs->g = &cache->g;
+    } else {
+        rs->g = &rs->own_g;
+    }
+    catch_signals(rs->job->quiet);
+    rs->sc = &rs->own_sc;
+    rs->r = &rs->own_r;
+    if (cache) { /* (a frame's scene moves into the cache) */
+        bool same = cache->renderer_live && scene_same_geometry(&cache->sc, &rs->own_sc);
+        if (cache->renderer_live && !same)
+            renderer_destroy(&cache->r);
+        if (cache->renderer_live)
+            scene_destroy(&cache->sc);
+        cache->sc = rs->own_sc;
+        memset(&rs->own_sc, 0, sizeof rs->own_sc);
+        rs->sc = &cache->sc;
+        rs->r = &cache->r;
+        if (same) {
+            /* the frame before's trees and kernels: only the instances moved */
+            renderer_update(rs->r, rs->sc);
+            if (!rs->job->quiet)
+                fprintf(stderr, "gonio: frame %d: the same geometry, moved: the top tree over %u instances rebuilt "
+                                "and the lights updated in %.2f ms\n", rs->job->frame, rs->r->geo.top.num_instances,
+                        rs->r->setup_seconds * 1e3);
+        } else {
+            renderer_create(rs->r, rs->g, rs->sc);
+        }
+        cache->renderer_live = true;
+    } else {
+        renderer_create(rs->r, rs->g, rs->sc);
+    }
+    if (!render_light_finish(&rs->job->env, rs->sc, rs->r, &rs->s, rs->job->quiet, &rs->light))
+        return false;
+    rs->s.env_label = rs->light.label;
+    return true;
+}
+
+/* The header of the finished render: the renderer's, the animation's time and frame. */
+static void build_header(const render_state *rs, render_header *h)
+{
+    const render_job *job = rs->job;
+    render_header_build(h, rs->r, &rs->s, &rs->st, job->brdf, cli_command_line());
+    double at = job->frame >= 0 ? job->frame / (double)job->fps : job->at;
+    if (at >= 0 && h->count + 2 <= RENDER_HEADER_MAX) {
+        h->attrs[h->count++] = (image_attr){"gonio:time", IMAGE_ATTR_DOUBLE, NULL, 0, at, NULL};
+        if (job->frame >= 0)
+            h->attrs[h->count++] = (image_attr){"gonio:frame", IMAGE_ATTR_INT, NULL, job->frame, 0, NULL};
+    }
+}
+
+/* The rendered image denoised (--denoise), with the resumable sums, written to the EXR and
+ * PNGs asked for, and the summary said: the exit status. */
+static int write_outputs(render_state *rs)
+{
+    const render_job *job = rs->job;
+    const render_settings *s = &rs->s;
+    const char *out_path = job->out_path ? job->out_path : job->png_path;
+    render_header h;
+    denoise_info dn = {0};
+    int region[4];
+    bool ok = true;
+    build_header(rs, &h);
+    if (stop_requested && !job->quiet)
+        util_warn("interrupted: writing the %d spp rendered so far%s", rs->st.spp,
+                  stop_requested == SIGTERM && rs->exr_path ? " (resumable: --resume)" : "");
+    if (job->denoise) {
+        ok = denoise_render(&rs->img, job->s.aov, out_path, &dn);
+        if (ok) {
+            assert(h.count + 2 <= RENDER_HEADER_MAX); /* a path render's header has 22 at most */
+            h.attrs[h.count++] = (image_attr){"gonio:denoiser", IMAGE_ATTR_STRING, dn.description, 0, 0, NULL};
+            h.attrs[h.count++] = (image_attr){"gonio:denoise-seconds", IMAGE_ATTR_DOUBLE, NULL, 0, dn.seconds, NULL};
+        }
+    }
+    /* With --denoise the sums include the guides', so that --resume --denoise goes on. */
+    if (ok && (job->resumable || stop_requested == SIGTERM))
+        renderer_sums(rs->r, rs->st.spp, s->aov, &rs->img);
+    render_region(s, region);
+    if (s->crop_x1 > 0) { /* the region in the whole frame: OpenEXR's data window */
+        rs->img.x0 = region[0];
+        rs->img.y0 = region[1];
+        rs->img.full_width = s->width;
+        rs->img.full_height = s->height;
+    }
+    image_exr_options exr = job->exr;
+    exr.exact_prefix = "sum"; /* sum.* and sum2.*: the state --resume needs exactly */
+    if (ok && rs->exr_path)
+        ok = image_write_exr_with(&rs->img, rs->exr_path, h.attrs, h.count, &exr);
+    if (ok && rs->png_o)
+        ok = render_write_png(&rs->img, s->mode, rs->png_o, job->exposure, job->tm);
+    if (ok && job->png_path)
+        ok = render_write_png(&rs->img, s->mode, job->png_path, job->exposure, job->tm);
+    if (ok && !job->quiet)
+        /* One camera ray per pixel and sample: a whole path in path mode. */
+        fprintf(stderr, "gonio: %s %dx%d, %s, %s, %d spp in %.2f s (%.2f %s), setup %.2f s\n", out_path, s->width,
+                s->height, rs->camera_text, render_mode_name(s->mode), rs->st.spp, rs->st.seconds,
+                rs->st.seconds > 0 ? (double)rs->st.rays / rs->st.seconds * 1e-6 : 0.0,
+                s->mode == GN_MODE_PATH ? "M paths/s" : "Mrays/s primary", rs->st.setup_seconds);
+    if (ok && !job->quiet && job->denoise)
+        fprintf(stderr, "gonio: denoised in %.2f s (%s; library and device setup %.2f s)\n", dn.seconds,
+                dn.description, dn.setup_seconds);
+    return !ok ? 1 : stop_requested ? 128 + stop_requested : 0;
+}
+
 /* One render of the job: load, render, write. */
 static int render_run(const render_job *job)
 {
-    const char *scene_path = job->scene_path, *out_path = job->out_path, *png_path = job->png_path;
-    const char *brdf = job->brdf, *crop_text = job->crop_text, *resume_path = job->resume_path;
-    image env_map = {0};
-    render_settings s = job->s;
-    camera_option cam = job->cam;
-    env_option env = job->env;
-    crop_option crop = job->crop;
-    scene_camera view;
-    char camera_text[160];
-    const bool size_given = job->size_given, quiet = job->quiet, resumable = job->resumable;
-    bool studio = false;
-    const int frame = job->frame, device = job->device, scene_index = job->scene_index;
-    double at = job->at;
-    image prev = {0};
-    image_exr_options exr = job->exr;
-    const char *exr_path = NULL, *png_o = NULL; /* -o as EXR or as PNG */
-    scene sc = {0};
-    gpu own_g = {0}, *gp = &own_g;
-    renderer own_r = {0}, *rp = &own_r;
-    frame_cache *cache = job->cache;
-    image img = {0};
-    render_stats st;
-    int rc = 1;
-
-    if (out_path && image_format_of(out_path) == IMAGE_FORMAT_EXR)
-        exr_path = out_path;
-    else
-        png_o = out_path;
-    exr.exact_prefix = "sum"; /* sum.* and sum2.*: the state --resume needs exactly */
-    util_set_quiet(quiet);
+    render_state rs = {.job = job, .s = job->s, .cam = job->cam};
     cli_progress progress;
-    s.progress = quiet ? NULL : cli_progress_report;
-    s.progress_user = &progress;
+    int rc = 1;
+    if (job->out_path && image_format_of(job->out_path) == IMAGE_FORMAT_EXR)
+        rs.exr_path = job->out_path;
+    else
+        rs.png_o = job->out_path;
+    util_set_quiet(job->quiet);
+    rs.s.progress = job->quiet ? NULL : cli_progress_report;
+    rs.s.progress_user = &progress;
     scene_allow_outside_files(job->outside);
-    if ((out_path && !util_check_output(out_path)) || (png_path && !util_check_output(png_path)))
+    if ((job->out_path && !util_check_output(job->out_path)) || (job->png_path && !util_check_output(job->png_path)))
         return 1;
     if (job->denoise) { /* the library is there, before any work; the guides are rendered */
         if (!denoise_load())
             return 1;
-        s.aov |= RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL;
+        rs.s.aov |= RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL;
     }
-
-    if (frame >= 0)
-        at = frame / (double)job->fps;
-    scene_animation_time(at);
-    if (!scene_load_scene(&sc, scene_path, scene_index))
-        return 1;
-    if (!render_material_overrides(&sc, brdf) || !env_setup(&env, &sc, quiet, &env_map, &s, &studio) ||
-        !camera_resolve(&cam, &sc, size_given ? (float)s.width / (float)s.height : 1.0f, &view)) {
-        scene_destroy(&sc);
-        image_destroy(&env_map);
-        return 1;
+    if ((rc = load_view(&rs)) == 0) {
+        rc = 1;
+        if (start_renderer(&rs) && (!job->resume_path || check_resume(job->resume_path, rs.r, &rs.s, job->brdf, &rs.prev)) &&
+            renderer_render(rs.r, &rs.s, &rs.img, &rs.st))
+            rc = write_outputs(&rs);
     }
-    if (!size_given) {
-        if (cam.width > 0) { /* --camera FILE.exr: that render's size, as its view had it */
-            s.width = cam.width;
-            s.height = cam.height;
-        } else {
-            camera_default_size(&view, 512, &s.width, &s.height);
-        }
-        camera_resolve(&cam, &sc, (float)s.width / (float)s.height, &view); /* framing: the real aspect */
-    }
-    if (crop.given && !apply_crop(&crop, &s, crop_text)) {
-        scene_destroy(&sc);
-        image_destroy(&env_map);
-        return 2;
-    }
-    s.view = &view;
-    camera_describe(&cam, &sc, camera_text, sizeof camera_text);
-    s.camera_label = camera_text;
-    if (cache && cache->gpu_live) {
-        gp = &cache->g;
-    } else if (!cli_gpu_create(gp, device, job->validate)) {
-        scene_destroy(&sc);
-        image_destroy(&env_map);
-        return 1;
-    } else if (cache) { /* the first frame's device serves them all */
-        cache->g = *gp;
-        cache->gpu_live = true;
-        gp = &cache->g;
-    }
-    catch_signals(quiet);
-    if (cache && cache->renderer_live && scene_same_geometry(&cache->sc, &sc)) {
-        /* the frame before's trees and kernels: only the instances moved */
-        scene_destroy(&cache->sc);
-        cache->sc = sc;
-        memset(&sc, 0, sizeof sc);
-        rp = &cache->r;
-        renderer_update(rp, &cache->sc);
-        if (!quiet)
-            fprintf(stderr, "gonio: frame %d: the same geometry, moved: the top tree over %u instances rebuilt "
-                            "and the lights updated in %.2f ms\n", frame, rp->geo.top.num_instances,
-                    rp->setup_seconds * 1e3);
-    } else if (cache) {
-        if (cache->renderer_live) {
-            renderer_destroy(&cache->r);
-            scene_destroy(&cache->sc);
-        }
-        cache->sc = sc;
-        memset(&sc, 0, sizeof sc);
-        renderer_create(&cache->r, gp, &cache->sc);
-        cache->renderer_live = true;
-        rp = &cache->r;
-    } else {
-        renderer_create(rp, gp, &sc);
-    }
-    scene *scp = cache ? &cache->sc : &sc; /* (a frame's scene moves into the cache) */
-    bool headlight;
-    if (env_light_rule(&env, scp, rp, &s, &env_map, quiet, job->s.ambient_set, &studio, &headlight)) {
-        renderer_destroy(rp); /* the studio's key light or the headlight joined the scene's lights */
-        renderer_create(rp, gp, scp);
-    }
-    s.env_label = headlight ? "headlight" : studio ? "studio" : env.path ? env.path : env.given ? "constant" : "none";
-    if ((!resume_path || check_resume(resume_path, rp, &s, brdf, &prev)) && renderer_render(rp, &s, &img, &st)) {
-        char seconds[32];
-        render_header h;
-        bool ok = true;
-        int region[4];
-        denoise_info dn = {0};
-        render_header_build(&h, rp, &s, &st, brdf, cli_command_line());
-        if (at >= 0 && h.count + 2 <= RENDER_HEADER_MAX) { /* the animation's time, and frame */
-            h.attrs[h.count++] = (image_attr){"gonio:time", IMAGE_ATTR_DOUBLE, NULL, 0, at, NULL};
-            if (frame >= 0)
-                h.attrs[h.count++] = (image_attr){"gonio:frame", IMAGE_ATTR_INT, NULL, frame, 0, NULL};
-        }
-        if (stop_requested && !quiet)
-            util_warn("interrupted: writing the %d spp rendered so far%s", st.spp,
-                      stop_requested == SIGTERM && exr_path ? " (resumable: --resume)" : "");
-        if (job->denoise) {
-            ok = denoise_render(&img, job->s.aov, out_path ? out_path : png_path, &dn);
-            if (ok) {
-                assert(h.count + 2 <= RENDER_HEADER_MAX); /* a path render's header has 22 at most */
-                h.attrs[h.count++] = (image_attr){"gonio:denoiser", IMAGE_ATTR_STRING, dn.description, 0, 0, NULL};
-                h.attrs[h.count++] = (image_attr){"gonio:denoise-seconds", IMAGE_ATTR_DOUBLE, NULL, 0, dn.seconds, NULL};
-            }
-        }
-        /* With --denoise the sums include the guides', so that --resume --denoise goes on. */
-        if (ok && (resumable || stop_requested == SIGTERM))
-            renderer_sums(rp, st.spp, s.aov, &img);
-        render_region(&s, region);
-        if (s.crop_x1 > 0) { /* the region in the whole frame: OpenEXR's data window */
-            img.x0 = region[0];
-            img.y0 = region[1];
-            img.full_width = s.width;
-            img.full_height = s.height;
-        }
-        if (ok && exr_path)
-            ok = image_write_exr_with(&img, exr_path, h.attrs, h.count, &exr);
-        if (ok && png_o)
-            ok = render_write_png(&img, s.mode, png_o, job->exposure, job->tm);
-        if (ok && png_path)
-            ok = render_write_png(&img, s.mode, png_path, job->exposure, job->tm);
-        snprintf(seconds, sizeof seconds, "%.2f", st.seconds);
-        if (ok && !quiet)
-            /* One camera ray per pixel and sample: a whole path in path mode. */
-            fprintf(stderr, "gonio: %s %dx%d, %s, %s, %d spp in %s s (%.2f %s), setup %.2f s\n",
-                    out_path ? out_path : png_path, s.width, s.height, camera_text, render_mode_name(s.mode),
-                    st.spp, seconds, st.seconds > 0 ? (double)st.rays / st.seconds * 1e-6 : 0.0,
-                    s.mode == GN_MODE_PATH ? "M paths/s" : "Mrays/s primary", st.setup_seconds);
-        if (ok && !quiet && job->denoise)
-            fprintf(stderr, "gonio: denoised in %.2f s (%s; library and device setup %.2f s)\n", dn.seconds,
-                    dn.description, dn.setup_seconds);
-        rc = !ok ? 1 : stop_requested ? 128 + stop_requested : 0;
-    }
-    image_destroy(&img);
-    image_destroy(&prev);
-    image_destroy(&env_map);
+    image_destroy(&rs.img);
+    image_destroy(&rs.prev);
+    rs.s.env_map = NULL;
+    render_lighting_destroy(&rs.light);
     if (job->denoise)
         denoise_shutdown();
-    if (!cache) {
-        renderer_destroy(rp);
-        if (!cli_gpu_finish(gp))
+    if (!job->cache && rs.g) {
+        renderer_destroy(rs.r);
+        if (!cli_gpu_finish(rs.g))
             rc = 1;
     }
-    scene_destroy(&sc);
+    scene_destroy(&rs.own_sc);
     return rc;
 }

@@ -827,19 +827,94 @@ static bool teardown(preview *p)
     return cli_gpu_finish(&p->g);
 }
 
+/* The scene with its light and its first view, and the window's size. */
+static bool load_view(preview *p, const char *scene_path, int scene_index, camera_option *cam,
+                      const render_light_request *env, bool size_given, int *width, int *height,
+                      scene_camera *start_view, render_lighting *light)
+{
+    if (!scene_load_scene(&p->sc, scene_path, scene_index))
+        return false;
+    if (!render_light_begin(env, &p->sc, false, &p->s, light) ||
+        !camera_resolve(cam, &p->sc, size_given ? (float)*width / (float)*height : 1.0f, start_view))
+        return false;
+    /* The shared rule (src/scene/camera.h): the file's cameras by index, so that C steps on. */
+    p->s.camera = cam->kind == CAMERA_INDEX ? cam->index : cam->kind == CAMERA_AUTO && p->sc.num_cameras ? 0 : -1;
+    if (cam->kind == CAMERA_LOOK_AT || cam->fov > 0) /* --fov: that view, as render has it */
+        p->start_view = p->s.view = start_view;
+    if (!size_given && cam->width > 0) { /* --camera FILE.exr: that render's size */
+        *width = cam->width;
+        *height = cam->height;
+    }
+    if (!size_given && p->s.camera >= 0 && start_view->aspect > 0)
+        *height = (int)fmaxf(1.0f, 640.0f / start_view->aspect + 0.5f);
+    p->start_camera = p->s.camera;
+    return true;
+}
+
+/* --denoise: the library and the denoiser's thread, before the window (a clear error and
+ * exit 1 without them), and the guides rendered. */
+static bool start_denoiser(preview *p)
+{
+    if (!denoise_load() || !preview_denoiser_start(&p->denoiser))
+        return false;
+    p->denoise_view = true;
+    p->s.aov |= RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL;
+    return true;
+}
+
+/* The window's loop until it is closed, Q, or max_frames frames (0: no limit); then what
+ * P asked to save and the screenshot. False when a frame failed or a file could not be
+ * written. */
+static bool run_window(preview *p, const char *scene_path, int max_frames, const char *screenshot)
+{
+    double submit_time = 0, last_frame = util_now();
+    int frames = 0, last_passes = 0;
+    bool ok = true;
+    util_info("preview: %s on %s; press H in the window for the keys", scene_path, p->g.props.deviceName);
+    while (!glfwWindowShouldClose(p->window) && !p->quit_key) {
+        if (idle(p))
+            glfwWaitEventsTimeout(PREVIEW_IDLE_SECONDS);
+        else
+            glfwPollEvents();
+        double now = util_now();
+        if (idle(p) && now - last_frame < PREVIEW_IDLE_SECONDS)
+            continue; /* woken early by an event that changed nothing */
+        fly(p, (float)fmin(now - last_frame, 0.1));
+        if (!frame(p, &submit_time, &last_passes)) {
+            if (p->failed) {
+                ok = false;
+                break;
+            }
+            glfwWaitEventsTimeout(PREVIEW_IDLE_SECONDS); /* minimised */
+            continue;
+        }
+        p->frame_seconds = now - last_frame;
+        last_frame = now;
+        update_title(p);
+        if (max_frames && ++frames >= max_frames)
+            break;
+    }
+    vkDeviceWaitIdle(p->g.device);
+    if (p->save)
+        ok = save_accumulated(p) && ok;
+    if (screenshot)
+        ok = save_screenshot(p, screenshot) && ok;
+    util_info("preview: %d frame(s), %s, %d spp, %dx%d", frames, render_mode_name(p->s.mode), p->spp,
+              p->r.accum.width, p->r.accum.height);
+    return ok;
+}
+
 int cmd_preview(int argc, char **argv)
 {
     static preview pv; /* large, and the GLFW callbacks reach it through the window */
     preview *p = &pv;
     const char *scene_path = NULL, *screenshot = NULL;
     bool validate = false, size_given = false, ok = true;
-    int device = -1, width, height, size[2] = {640, 480}, max_frames = 0, frames = 0, last_passes = 0;
-    double submit_time = 0, last_frame;
+    int device = -1, width, height, size[2] = {640, 480}, max_frames = 0;
     camera_option cam = {0};
     env_option env = {0};
-    image env_map = {0};
+    render_lighting light = {0};
     scene_camera start_view;
-    bool studio;
 
     memset(p, 0, sizeof *p);
     p->s = (render_settings){.mode = GN_MODE_PATH, .camera = -1};
@@ -899,89 +974,23 @@ int cmd_preview(int argc, char **argv)
                    "xvfb-run gonio preview %s", scene_path);
         return 1;
     }
-    if (!scene_load_scene(&p->sc, scene_path, scene_index)) {
-        glfwTerminate();
-        return 1;
-    }
-    const bool ambient_given = p->s.ambient_set;
-    if (!env_setup(&env, &p->sc, false, &env_map, &p->s, &studio) ||
-        !camera_resolve(&cam, &p->sc, size_given ? (float)width / (float)height : 1.0f, &start_view)) {
-        image_destroy(&env_map);
-        scene_destroy(&p->sc);
-        glfwTerminate();
-        return 1;
-    }
-    /* The shared rule (src/scene/camera.h): the file's cameras by index, so that C steps on. */
-    p->s.camera = cam.kind == CAMERA_INDEX ? cam.index : cam.kind == CAMERA_AUTO && p->sc.num_cameras ? 0 : -1;
-    if (cam.kind == CAMERA_LOOK_AT || cam.fov > 0) /* --fov: that view, as render has it */
-        p->start_view = p->s.view = &start_view;
-    if (!size_given && cam.width > 0) { /* --camera FILE.exr: that render's size */
-        width = cam.width;
-        height = cam.height;
-    }
-    if (!size_given && p->s.camera >= 0 && start_view.aspect > 0)
-        height = (int)fmaxf(1.0f, 640.0f / start_view.aspect + 0.5f);
-    p->start_camera = p->s.camera;
-
-    if (denoise) { /* the library, before the window: a clear error and exit 1 without it */
-        if (!denoise_load() || !preview_denoiser_start(&p->denoiser)) {
-            image_destroy(&env_map);
-            scene_destroy(&p->sc);
-            glfwTerminate();
-            return 1;
-        }
-        p->denoise_view = true;
-        p->s.aov |= RENDER_AOV_ALBEDO | RENDER_AOV_NORMAL;
-    }
-    const bool started = setup(p, device, validate, width, height);
-    bool had_studio = studio, headlight = false;
-    if (started && env_light_rule(&env, &p->sc, &p->r, &p->s, &env_map, false, ambient_given, &studio, &headlight)) {
-        renderer_destroy(&p->r); /* the studio's key light or the headlight joined the scene's lights */
-        renderer_create(&p->r, &p->g, &p->sc);
-    }
-    if (studio != had_studio || headlight)
-        p->restart = true;
-    if (started) {
-        util_info("preview: %s on %s; press H in the window for the keys", scene_path,
-                  p->g.props.deviceName);
-        last_frame = util_now();
-        while (!glfwWindowShouldClose(p->window) && !p->quit_key) {
-            double now;
-            if (idle(p))
-                glfwWaitEventsTimeout(PREVIEW_IDLE_SECONDS);
-            else
-                glfwPollEvents();
-            now = util_now();
-            if (idle(p) && now - last_frame < PREVIEW_IDLE_SECONDS)
-                continue; /* woken early by an event that changed nothing */
-            fly(p, (float)fmin(now - last_frame, 0.1));
-            if (!frame(p, &submit_time, &last_passes)) {
-                if (p->failed) {
-                    ok = false;
-                    break;
-                }
-                glfwWaitEventsTimeout(PREVIEW_IDLE_SECONDS); /* minimised */
-                continue;
-            }
-            p->frame_seconds = now - last_frame;
-            last_frame = now;
-            update_title(p);
-            if (max_frames && ++frames >= max_frames)
-                break;
-        }
-        vkDeviceWaitIdle(p->g.device);
-        if (p->save)
-            ok = save_accumulated(p) && ok;
-        if (screenshot)
-            ok = save_screenshot(p, screenshot) && ok;
-        util_info("preview: %d frame(s), %s, %d spp, %dx%d", frames, render_mode_name(p->s.mode),
-                  p->spp, p->r.accum.width, p->r.accum.height);
+    if (!load_view(p, scene_path, scene_index, &cam, &env, size_given, &width, &height, &start_view, &light) ||
+        (denoise && !start_denoiser(p))) {
+        ok = false;
+    } else if (setup(p, device, validate, width, height)) {
+        bool had_studio = light.studio;
+        ok = render_light_finish(&env, &p->sc, &p->r, &p->s, false, &light);
+        if (light.studio != had_studio || light.headlight)
+            p->restart = true;
+        ok = ok && run_window(p, scene_path, max_frames, screenshot);
+        ok = teardown(p) && ok;
     } else {
+        teardown(p);
         ok = false;
     }
-    ok = teardown(p) && ok;
     glfwTerminate();
     scene_destroy(&p->sc);
-    image_destroy(&env_map);
+    p->s.env_map = NULL;
+    render_lighting_destroy(&light);
     return ok ? 0 : 1;
 }

@@ -62,6 +62,32 @@ check "Gouraud error falls as the mesh gets finer" awk -F, \
 check "sweep.png is 640x440" test "$(size_of "$tmp/s/sweep.png")" = 640x440
 check "no teapot scenes left in the sweep folder" sh -c "! ls '$tmp/s' | grep -q gltf"
 
+# ---- the light rule of gonio render: each image is render's ----------------------------------
+# Box has no lights: the studio lights it, the local modes through its key light and mean, the
+# path tracer through the map; compare's images must be render's, bit for bit.
+box=${GONIO_ASSETS:-}/gltf/Box/glTF/Box.gltf
+if [ -f "$box" ]; then
+    check "compare Box" "$G" compare "$box" -o "$tmp/box" --size 48x36 --spp 4 --modes gouraud,path
+    cp "$tmp/out" "$tmp/box.log"
+    check "compare says the studio lights Box" grep -q "lit by gonio's studio environment" "$tmp/box.log"
+    for m in gouraud path; do
+        check "render Box, $m" "$G" render "$box" --mode $m --size 48x36 --spp 4 -o "$tmp/box/render-$m.exr" --quiet
+        check "compare's $m image is render's" "$G" diff "$tmp/box/$m.exr" "$tmp/box/render-$m.exr" --max-error 0
+    done
+    # The studio lights a file without lights once: for the local modes its key light joins
+    # the scene's lights, which must not then pass for the file's own (a second studio).
+    check "render Box, phong, --env studio" "$G" render "$box" --mode phong --size 48x36 --spp 4 --env studio \
+        -o "$tmp/box/studio.exr" --quiet
+    check "render Box, phong" "$G" render "$box" --mode phong --size 48x36 --spp 4 -o "$tmp/box/default.exr"
+    cp "$tmp/out" "$tmp/box.log"
+    check "the studio is added once" sh -c "! grep -q 'leaves the view dark' '$tmp/box.log'"
+    check "a file without lights renders as with --env studio" "$G" diff "$tmp/box/default.exr" "$tmp/box/studio.exr" \
+        --max-error 0
+    check_fails "--sweep takes no --env" 2 "$G" compare --sweep 2,4 teapot -o "$tmp/x" --env 1
+else
+    echo "  skipped: the light rule's checks ($box is absent)"
+fi
+
 # ---- bad usage and bad input -------------------------------------------------------------
 check_fails "unknown mode" 2 "$G" compare $T -o "$tmp/x" --modes flat,bogus
 check_fails "mode given twice" 2 "$G" compare $T -o "$tmp/x" --modes flat,flat
