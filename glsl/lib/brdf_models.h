@@ -161,7 +161,7 @@ GN_STRUCT(BrdfQuery) {
     vec3 wi; float coat_tilt; /* wi: toward the light */
     vec3 u; float pad0;     /* the sample's random numbers in [0, 1) */
     vec4 args;
-} GN_END(BrdfQuery); /* 400 bytes */
+} GN_END(BrdfQuery); /* a GnMaterial, then 64 bytes */
 
 /* BRDF_OP_EVAL: f, pdf. BRDF_OP_SAMPLE: s_* (s_f, s_pdf_eval: eval and pdf at s_wi).
  * BRDF_OP_FRESNEL: f = (dielectric, Schlick, the sheen's albedo E from its table), s_f =
@@ -181,12 +181,12 @@ GN_STRUCT(BrdfSphere) {
     vec3 light_dir; uint width;        /* unit, toward the light */
     vec3 light_irradiance; uint height; /* W/m^2 on a surface facing the light */
     vec3 env; uint max_depth;          /* environment radiance; path length limit */
-} GN_END(BrdfSphere); /* 384 bytes */
+} GN_END(BrdfSphere); /* a GnMaterial, then 48 bytes */
 
 #ifndef VULKAN
-GN_STATIC_ASSERT(sizeof(BrdfSphere) == 384, "BrdfSphere layout");
-GN_STATIC_ASSERT(sizeof(BrdfQuery) == 400, "BrdfQuery layout");
-GN_STATIC_ASSERT(offsetof(BrdfQuery, wo) == 336, "BrdfQuery layout");
+GN_STATIC_ASSERT(sizeof(BrdfSphere) == 4 * GN_MATERIAL_WORDS + 48, "BrdfSphere layout");
+GN_STATIC_ASSERT(sizeof(BrdfQuery) == 4 * GN_MATERIAL_WORDS + 64, "BrdfQuery layout");
+GN_STATIC_ASSERT(offsetof(BrdfQuery, wo) == 4 * GN_MATERIAL_WORDS, "BrdfQuery layout");
 GN_STATIC_ASSERT(sizeof(BrdfResult) == 64, "BrdfResult layout");
 #endif
 

@@ -345,7 +345,7 @@ GN_STRUCT(GnVertex) {
 #include "material.h"
 GN_STRUCT(GnMaterial) {
     GN_MATERIAL(GN_MAT_DECL_PARAM, GN_MAT_DECL_TEX, GN_MAT_DECL_FIELD)
-} GN_END(GnMaterial); /* 336 bytes */
+} GN_END(GnMaterial); /* 4 GN_MATERIAL_WORDS bytes (material.h) */
 
 /* glTF KHR_lights_punctual light in world space. color = colour * intensity (W/sr for point
  * and spot, W/m^2 for directional: gonio reads photometric units as radiometric). direction

@@ -19,6 +19,13 @@
      {UNPAREN params}, (lobe_feats) | (feats)},
 
 const brdf_model brdf_models[] = {BRDF_MODELS(MODEL)};
+/* Each model's parameters fit brdf_model.params, in every build: beyond BRDF_MAX_PARAMS an
+ * initializer's excess elements would only be a warning, and a build without -Werror (make
+ * fuzz's) would drop them silently. */
+#define MODEL_FITS(id, name, summary, lobe, fresnel, layout, lobe_feats, feats, params)               \
+    _Static_assert(sizeof((brdf_param[]){UNPAREN params}) / sizeof(brdf_param) <= BRDF_MAX_PARAMS, \
+                   "BRDF model " name ": more parameters than BRDF_MAX_PARAMS (src/render/brdf.h)");
+BRDF_MODELS(MODEL_FITS)
 const int brdf_num_models = (int)(sizeof brdf_models / sizeof *brdf_models);
 
 const float brdf_sheen_table[BRDF_SHEEN_TABLE_SIZE] = {SHEEN_ALBEDO_VALUES};

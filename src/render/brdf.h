@@ -16,6 +16,8 @@
  * in their own fields. */
 #define BRDF_SLOT_COLOR ((int)GN_MAT_WORD(base_color))
 #define BRDF_SLOT_PARAMS ((int)GN_MAT_WORD(brdf_params))
+/* The parameters a model may have: the glTF model's are every BRDF column of the material
+ * table (glsl/lib/material.h); a model with more fails the build (brdf.c). */
 #define BRDF_MAX_PARAMS 18
 
 typedef struct brdf_param {
