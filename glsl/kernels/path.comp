@@ -582,188 +582,164 @@ void path_load()
     ended = false;
 }
 
-void main()
+// ---- a pixel's work: its sums, its paths' vertices, what it leaves to the next dispatch -----
+
+// The strategies of the estimator ablations (--estimator light|bsdf); MIS otherwise.
+bool light_only, bsdf_only;
+// The pixel's sums in the region's buffers; without their AOVs the aov and squares buffers
+// are 16-byte dummies, never indexed.
+uint slot;
+bool aov_on, squares_on;
+
+// The pixel's state at the dispatch's start: the samples it takes (those pending from the
+// last dispatch first) and its sums so far. The sums go on from the buffers, one sample at a
+// time in sample order, so a pixel's sum is the same float whichever dispatches (or runs:
+// --resume) took its samples.
+void pixel_begin()
 {
-    px = tile_pixel();
-    if (px.x >= frame.crop_width || px.y >= frame.crop_height)
-        return;
-    uint slot = px.y * frame.crop_width + px.x; // in the region's buffers
-    px += uvec2(frame.crop_x, frame.crop_y);    // in the whole image
+    slot = px.y * frame.crop_width + px.x; // in the region's buffers
+    px += uvec2(frame.crop_x, frame.crop_y); // in the whole image
     pixel = px.y * frame.width + px.x;
     rng_pixel = pixel;
-    bool light_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_LIGHT_ONLY) != 0u;
-    bool bsdf_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_BSDF_ONLY) != 0u;
+    light_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_LIGHT_ONLY) != 0u;
+    bsdf_only = GN_HAS(GN_FEAT_STRATEGY) && (frame.flags & GN_FRAME_BSDF_ONLY) != 0u;
     suspended = false;
     ps_base = slot * frame.state_stride;
     if (LOOP_CAP > 0u)
         pstate_behind = pstate[ps_base];
     samples = pstate_behind + push.samples;
     taken = 0u;
-    // The sums go on from the buffers, one sample at a time in sample order, so a pixel's
-    // sum is the same float whichever dispatches (or runs: --resume) took its samples.
-    bool aov_on = GN_HAS(GN_FEAT_AOV) && (frame.flags & GN_FRAME_AOV) != 0u;
-    // Without them the aov and squares buffers are 16-byte dummies: never indexed.
-    bool squares_on = GN_HAS(GN_FEAT_VARIANCE) && (frame.flags & GN_FRAME_VARIANCE) != 0u;
+    aov_on = GN_HAS(GN_FEAT_AOV) && (frame.flags & GN_FRAME_AOV) != 0u;
+    squares_on = GN_HAS(GN_FEAT_VARIANCE) && (frame.flags & GN_FRAME_VARIANCE) != 0u;
     sum = accum[slot];
     sum_sq = squares_on ? squares[slot].rgb : vec3(0.0);
     sum_n = aov_on ? aov[3u * slot + 0u].xyz : vec3(0.0);
     sum_a = aov_on ? aov[3u * slot + 1u].xyz : vec3(0.0);
     sum_depth = aov_on ? aov[3u * slot + 2u].x : 0.0;
+}
 
-    if (pstate_behind > 0u)
-        path_load();
-    else if (samples > 0u)
-        path_start();
-    // One path vertex an iteration: the walk of its ray, the vertex shaded (its light sample
-    // and next ray chosen), the walk of its shadow ray, in that order; a path resumed in its
-    // shadow ray's walk starts at the third.
-    loop_left = LOOP_CAP / gl_SubgroupSize;
-    while (samples > 0u) {
-        ended = true;
-        if (LOOP_CAP > 0u) // (the vertex's loops other than its walks)
-            loop_left -= min(loop_left, frame.loop_overhead);
-        // One vertex, in a loop of one iteration: a path's end is a `break` out of it.
-        // (llvmpipe masks lanes for a break cheaply; a continue or an early return masks
-        // every later statement again, which is slower: docs/performance.md.)
-        do {
-            if (phase == PHASE_RAY) {
-            Hit h;
-            if (RETRACE == 0u) {
-                h = trace_resume(true, o, d, tmin, false, depth == 0u, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
-            } else {
-                // A lane whose ray leaves the scene ends its path and walks its next path's
-                // camera ray at once, up to RETRACE times, so that fewer lanes idle through
-                // the shading and the shadow ray below. The same samples in the same order:
-                // the same bits.
-                bool again = true;
-                for (uint k = 0u; again; k++) {
-                    if (LOOP_CAP > 0u && k > 0u) // (a pass counts as a vertex: its walk's loop tests and this loop's)
-                        loop_left -= min(loop_left, frame.loop_overhead);
-                    h = trace_resume(true, o, d, tmin, false, depth == 0u, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
-                    again = !suspended && h.tri == GN_INVALID && k < RETRACE && taken + 1u < samples;
-                    if (again) {
-                        path_miss(h, light_only, bsdf_only);
-                        path_end();
-                        ended = true; // (path_start's false is for path_step, after the vertex)
-                    }
-                }
-            }
-            if (suspended)
-                break;
-            if (GN_HAS(GN_FEAT_VOLUME) && h.tri != GN_INVALID) // absorption by the medium the segment crossed
-                beta *= medium_transmittance(medium_top(), distance(seg_from, o + h.t * d));
-            alive = false;
-            tmin = 0.0;
-            if (h.tri == GN_INVALID) {
+// The walk of the path's ray. With RETRACE, a lane whose ray leaves the scene ends its path
+// and walks its next path's camera ray at once, up to RETRACE times, so that fewer lanes idle
+// through the shading and the shadow ray below. The same samples in the same order: the same
+// bits.
+Hit vertex_walk()
+{
+    Hit h;
+    if (RETRACE == 0u) {
+        h = trace_resume(true, o, d, tmin, false, depth == 0u, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
+    } else {
+        bool again = true;
+        for (uint k = 0u; again; k++) {
+            if (LOOP_CAP > 0u && k > 0u) // (a pass counts as a vertex: its walk's loop tests and this loop's)
+                loop_left -= min(loop_left, frame.loop_overhead);
+            h = trace_resume(true, o, d, tmin, false, depth == 0u, DIM_ALPHA + DIM_ALPHA_RAY * 2u * depth);
+            again = !suspended && h.tri == GN_INVALID && k < RETRACE && taken + 1u < samples;
+            if (again) {
                 path_miss(h, light_only, bsdf_only);
-                break;
+                path_end();
+                ended = true; // (path_start's false is for path_step, after the vertex)
             }
-            Surface s = surface_at(h.tri, h.inst, h.t, h.u, h.v, o, d);
-            GnMaterial m = material_at(s.material);
-            covered = covered || depth == 0u;
-            if (GN_HAS(GN_FEAT_AOV) && depth == 0u) {
-                normal = s.sh.n;
-                albedo = s.sh.m.base_color.rgb;
-                depth_aov = h.t * dot(d, frame.camera.forward);
-            }
-            if (GN_HAS(GN_FEAT_UNLIT) && (m.flags & GN_MAT_UNLIT) != 0u) { // KHR_materials_unlit: the colour is the radiance
-                radiance += beta * s.sh.m.base_color.rgb;
-                break;
-            }
-            if (GN_HAS(GN_FEAT_EMISSIVE) && (s.front || (m.flags & GN_MAT_DOUBLE_SIDED) != 0u) &&
-                luminance(m.emissive) > 0.0) {
-                float w = 1.0;
-                if (!prev_delta) {
-                    float pl = luminance(m.emissive) * area_sides(m) / frame.emitter_power * h.t * h.t /
-                               abs(dot(s.ng, d));
-                    w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, pl);
-                }
-                radiance += beta * s.sh.m.emissive * w;
-            }
-            if (frame.max_depth != 0u && depth >= frame.max_depth)
-                break;
-
-            Bsdf b = bsdf_material(s.sh);
-            // A transmitting surface needs the side: a Bsdf's normal points outside.
-            bool flip = b.dielectric > 0.0 && !s.front;
-            vec3 n = flip ? -s.sh.n : s.sh.n, ng = flip ? -s.ng : s.ng, tx, ty;
-            sampling_basis(n, tx, ty);
-            vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
-            vec3 cn = flip ? -s.sh.coat_n : s.sh.coat_n; // (the anisotropy's direction on the shading plane)
-            b = bsdf_orient(b, s.sh, normalize(vec3(dot(cn, tx), dot(cn, ty), dot(cn, n))),
-                            vec2(dot(s.sh.aniso_t, tx), dot(s.sh.aniso_t, ty)));
-            vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
-            uint far = GN_INVALID; // the medium beyond a transmitting surface
-            if (GN_HAS(GN_FEAT_VOLUME))
-                far = medium_interface(s, m, b, ub.w, beta);
-
-            bool shadow = false;
-            if (frame.num_emitters > 0u && bsdf_has_smooth(b)) {
-                LightSample ls = light_sample(s.p, ul.xyz);
-                vec3 wi = vec3(dot(ls.wi, tx), dot(ls.wi, ty), dot(ls.wi, n));
-                // The shading and geometric normals must agree on the side of wi (no light leaks).
-                if (ls.pdf > 0.0 && !(bsdf_only && !ls.delta) && dot(ng, ls.wi) * wi.z > 0.0 &&
-                    luminance(ls.L) > 0.0) {
-                    vec3 f;
-                    float pb;
-                    bsdf_eval_pdf(b, wo, wi, f, pb);
-                    float w = ls.delta || light_only ? 1.0 : power_heuristic(ls.pdf, pb);
-                    c = beta * f * abs(wi.z) * ls.L * (w / ls.pdf);
-                    if (GN_HAS(GN_FEAT_VOLUME))
-                        c *= medium_transmittance(wi.z * wo.z > 0.0 ? medium_top() : far, ls.dist);
-                    if (luminance(c) > 0.0) {
-                        // (walked below, after the next ray is chosen: the state a walk that
-                        // stops leaves to save is then the two rays, c and the path's sums)
-                        shadow = true;
-                        so = offset_origin(s.p, ng, ls.wi);
-                        sd = ls.wi;
-                        smax = ls.dist * (1.0 - 1e-3);
-                    }
-                }
-            }
-
-            BsdfSample bs = bsdf_sample(b, wo, ub.xyz);
-            vec3 wi = bs.wi.x * tx + bs.wi.y * ty + bs.wi.z * n;
-            alive = bs.flags != 0u && dot(ng, wi) * bs.wi.z > 0.0;
-            if (alive) {
-                beta *= bs.weight;
-                if (GN_HAS(GN_FEAT_VOLUME) && (bs.flags & BRDF_FLAG_TRANSMISSION) != 0u && medium_of(m))
-                    medium_cross(s.material, s.front);
-                prev_delta = (bs.flags & BRDF_FLAG_DELTA) != 0u;
-                prev_pdf = bs.pdf;
-                o = offset_origin(s.p, ng, wi);
-                seg_from = s.p;
-                d = wi;
-                if (depth + 1u >= ROULETTE_DEPTH) {
-                    float q = min(max(beta.r, max(beta.g, beta.b)), 0.95);
-                    alive = ul.w < q;
-                    if (alive)
-                        beta /= q;
-                }
-            }
-            if (shadow) {
-                phase = PHASE_SHADOW;
-                trace_begin(0.0, smax);
-            }
-            }
-            if (phase == PHASE_SHADOW) {
-                Hit sh = trace_resume(true, so, sd, 0.0, true, false, DIM_ALPHA + DIM_ALPHA_RAY * (2u * depth + 1u));
-                if (suspended)
-                    break;
-                if (sh.tri == GN_INVALID)
-                    radiance += c;
-                phase = PHASE_RAY;
-            }
-            // A path's vertex is over when its rays are: alive, it goes on with the next ray.
-            if (!alive)
-                break;
-            ended = false;
-            trace_begin(0.0, 1e30);
-        } while (false);
-        if (suspended || path_step() == samples)
-            break;
+        }
     }
-    // The rest, and the path it stopped in, wait for the next dispatch.
+    return h;
+}
+
+// The first hit's coverage and AOVs.
+void vertex_seen(Surface s, Hit h)
+{
+    covered = covered || depth == 0u;
+    if (GN_HAS(GN_FEAT_AOV) && depth == 0u) {
+        normal = s.sh.n;
+        albedo = s.sh.m.base_color.rgb;
+        depth_aov = h.t * dot(d, frame.camera.forward);
+    }
+}
+
+// The light the surface emits toward the path, MIS-weighted against the light sample of the
+// vertex before.
+void vertex_emission(Surface s, GnMaterial m, Hit h)
+{
+    if (GN_HAS(GN_FEAT_EMISSIVE) && (s.front || (m.flags & GN_MAT_DOUBLE_SIDED) != 0u) && luminance(m.emissive) > 0.0) {
+        float w = 1.0;
+        if (!prev_delta) {
+            float pl = luminance(m.emissive) * area_sides(m) / frame.emitter_power * h.t * h.t / abs(dot(s.ng, d));
+            w = light_only ? 0.0 : bsdf_only ? 1.0 : power_heuristic(prev_pdf, pl);
+        }
+        radiance += beta * s.sh.m.emissive * w;
+    }
+}
+
+// The vertex's scattering: its Bsdf, a light sample (its shadow ray set up, walked after the
+// next ray is chosen: the state a walk that stops leaves to save is then the two rays, c and
+// the path's sums), and the next ray with roulette (alive: the path goes on).
+void vertex_scatter(Surface s, GnMaterial m)
+{
+    Bsdf b = bsdf_material(s.sh);
+    // A transmitting surface needs the side: a Bsdf's normal points outside.
+    bool flip = b.dielectric > 0.0 && !s.front;
+    vec3 n = flip ? -s.sh.n : s.sh.n, ng = flip ? -s.ng : s.ng, tx, ty;
+    sampling_basis(n, tx, ty);
+    vec3 wo = vec3(dot(-d, tx), dot(-d, ty), dot(-d, n));
+    vec3 cn = flip ? -s.sh.coat_n : s.sh.coat_n; // (the anisotropy's direction on the shading plane)
+    b = bsdf_orient(b, s.sh, normalize(vec3(dot(cn, tx), dot(cn, ty), dot(cn, n))),
+                    vec2(dot(s.sh.aniso_t, tx), dot(s.sh.aniso_t, ty)));
+    vec4 ul = rng(pixel, 1u + 2u * depth), ub = rng(pixel, 2u + 2u * depth);
+    uint far = GN_INVALID; // the medium beyond a transmitting surface
+    if (GN_HAS(GN_FEAT_VOLUME))
+        far = medium_interface(s, m, b, ub.w, beta);
+
+    bool shadow = false;
+    if (frame.num_emitters > 0u && bsdf_has_smooth(b)) {
+        LightSample ls = light_sample(s.p, ul.xyz);
+        vec3 wi = vec3(dot(ls.wi, tx), dot(ls.wi, ty), dot(ls.wi, n));
+        // The shading and geometric normals must agree on the side of wi (no light leaks).
+        if (ls.pdf > 0.0 && !(bsdf_only && !ls.delta) && dot(ng, ls.wi) * wi.z > 0.0 && luminance(ls.L) > 0.0) {
+            vec3 f;
+            float pb;
+            bsdf_eval_pdf(b, wo, wi, f, pb);
+            float w = ls.delta || light_only ? 1.0 : power_heuristic(ls.pdf, pb);
+            c = beta * f * abs(wi.z) * ls.L * (w / ls.pdf);
+            if (GN_HAS(GN_FEAT_VOLUME))
+                c *= medium_transmittance(wi.z * wo.z > 0.0 ? medium_top() : far, ls.dist);
+            if (luminance(c) > 0.0) {
+                shadow = true;
+                so = offset_origin(s.p, ng, ls.wi);
+                sd = ls.wi;
+                smax = ls.dist * (1.0 - 1e-3);
+            }
+        }
+    }
+
+    BsdfSample bs = bsdf_sample(b, wo, ub.xyz);
+    vec3 wi = bs.wi.x * tx + bs.wi.y * ty + bs.wi.z * n;
+    alive = bs.flags != 0u && dot(ng, wi) * bs.wi.z > 0.0;
+    if (alive) {
+        beta *= bs.weight;
+        if (GN_HAS(GN_FEAT_VOLUME) && (bs.flags & BRDF_FLAG_TRANSMISSION) != 0u && medium_of(m))
+            medium_cross(s.material, s.front);
+        prev_delta = (bs.flags & BRDF_FLAG_DELTA) != 0u;
+        prev_pdf = bs.pdf;
+        o = offset_origin(s.p, ng, wi);
+        seg_from = s.p;
+        d = wi;
+        if (depth + 1u >= ROULETTE_DEPTH) {
+            float q = min(max(beta.r, max(beta.g, beta.b)), 0.95);
+            alive = ul.w < q;
+            if (alive)
+                beta /= q;
+        }
+    }
+    if (shadow) {
+        phase = PHASE_SHADOW;
+        trace_begin(0.0, smax);
+    }
+}
+
+// The pixel's sums written back, and what it leaves pending to the next dispatch (the rest of
+// its samples, and the path it stopped in) saved and counted (status[1]); status[0] counts
+// what only a bug gives: llvmpipe's own cap stopping a walk or the loop.
+void pixel_end()
+{
     uint behind = suspended ? samples - taken : 0u;
     if (LOOP_CAP > 0u) {
         if (suspended)
@@ -787,4 +763,70 @@ void main()
         aov[3u * slot + 1u] = vec4(sum_a, 0.0);
         aov[3u * slot + 2u] = vec4(sum_depth, 0.0, 0.0, 0.0);
     }
+}
+
+void main()
+{
+    px = tile_pixel();
+    if (px.x >= frame.crop_width || px.y >= frame.crop_height)
+        return;
+    pixel_begin();
+    if (pstate_behind > 0u)
+        path_load();
+    else if (samples > 0u)
+        path_start();
+    // One path vertex an iteration: the walk of its ray, the vertex shaded (its light sample
+    // and next ray chosen), the walk of its shadow ray, in that order; a path resumed in its
+    // shadow ray's walk starts at the third.
+    loop_left = LOOP_CAP / gl_SubgroupSize;
+    while (samples > 0u) {
+        ended = true;
+        if (LOOP_CAP > 0u) // (the vertex's loops other than its walks)
+            loop_left -= min(loop_left, frame.loop_overhead);
+        // One vertex, in a loop of one iteration: a path's end is a `break` out of it.
+        // (llvmpipe masks lanes for a break cheaply; a continue or an early return masks
+        // every later statement again, which is slower: docs/performance.md.)
+        do {
+            if (phase == PHASE_RAY) {
+                Hit h = vertex_walk();
+                if (suspended)
+                    break;
+                if (GN_HAS(GN_FEAT_VOLUME) && h.tri != GN_INVALID) // absorption by the medium the segment crossed
+                    beta *= medium_transmittance(medium_top(), distance(seg_from, o + h.t * d));
+                alive = false;
+                tmin = 0.0;
+                if (h.tri == GN_INVALID) {
+                    path_miss(h, light_only, bsdf_only);
+                    break;
+                }
+                Surface s = surface_at(h.tri, h.inst, h.t, h.u, h.v, o, d);
+                GnMaterial m = material_at(s.material);
+                vertex_seen(s, h);
+                if (GN_HAS(GN_FEAT_UNLIT) && (m.flags & GN_MAT_UNLIT) != 0u) { // KHR_materials_unlit: the colour is the radiance
+                    radiance += beta * s.sh.m.base_color.rgb;
+                    break;
+                }
+                vertex_emission(s, m, h);
+                if (frame.max_depth != 0u && depth >= frame.max_depth)
+                    break;
+                vertex_scatter(s, m);
+            }
+            if (phase == PHASE_SHADOW) {
+                Hit sh = trace_resume(true, so, sd, 0.0, true, false, DIM_ALPHA + DIM_ALPHA_RAY * (2u * depth + 1u));
+                if (suspended)
+                    break;
+                if (sh.tri == GN_INVALID)
+                    radiance += c;
+                phase = PHASE_RAY;
+            }
+            // A path's vertex is over when its rays are: alive, it goes on with the next ray.
+            if (!alive)
+                break;
+            ended = false;
+            trace_begin(0.0, 1e30);
+        } while (false);
+        if (suspended || path_step() == samples)
+            break;
+    }
+    pixel_end();
 }
