@@ -57,7 +57,7 @@ vec4 rng(uint pixel, uint dim)
     return rng_uniform4(pixel, sample_now, dim, frame.seed);
 }
 
-float luminance(vec3 c) { return dot(c, vec3(0.2126, 0.7152, 0.0722)); }
+float luminance(vec3 c) { return dot(c, vec3(GN_LUMA_R, GN_LUMA_G, GN_LUMA_B)); }
 
 float power_heuristic(float a, float b) { return a * a / (a * a + b * b); }
 

@@ -30,6 +30,11 @@ typedef uint32_t uint;
 
 /* ---- constants of the host and the kernels, each defined once --------------------------- */
 #define GN_PI 3.14159265358979323846 /* a double in C, a float in GLSL (the same float either way) */
+/* Rec. 709 luminance of linear RGB, the weights of the host's (src/core/vec.h: vec_luminance)
+ * and the kernels' (glsl/kernels/path.comp: luminance) one definition */
+#define GN_LUMA_R 0.2126
+#define GN_LUMA_G 0.7152
+#define GN_LUMA_B 0.0722
 /* llvmpipe (lavapipe) ends an invocation's loops silently after this many iterations in
  * total (docs/architecture.md: The loop cap): the walk budgets and the path kernel's cap. */
 #define GN_LLVMPIPE_LOOP_LIMIT 65535u

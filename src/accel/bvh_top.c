@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "util.h"
+#include "vec.h"
 
 uint32_t bvh_top_max_depth(uint32_t mesh_depth)
 {
@@ -43,12 +44,7 @@ static bool instance_transforms(GnInstance *g, const float m[12])
     for (int r = 0; r < 3; r++)
         for (int k = 0; k < 3; k++)
             a[r][k] = m[4 * r + k];
-    for (int r = 0; r < 3; r++)
-        for (int k = 0; k < 3; k++) {
-            int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-            c[r][k] = a[r1][k1] * a[r2][k2] - a[r1][k2] * a[r2][k1];
-        }
-    det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+    det = vec_cofactors3(a, c);
     if (!(det != 0) || !isfinite(det))
         return false;
     for (int r = 0; r < 3; r++)

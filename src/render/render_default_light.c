@@ -138,7 +138,8 @@ static float env_probe_lit_fraction(renderer *r, const render_settings *s, bool 
     for (size_t i = 0; ch[0] >= 0 && ch[1] >= 0 && ch[2] >= 0 && ch[3] >= 0 && i < (size_t)img.width * img.height; i++) {
         if (!(img.planes[ch[3]][i] > 0.5f))
             continue;
-        float lum = 0.2126f * img.planes[ch[0]][i] + 0.7152f * img.planes[ch[1]][i] + 0.0722f * img.planes[ch[2]][i];
+        const float rgb[3] = {img.planes[ch[0]][i], img.planes[ch[1]][i], img.planes[ch[2]][i]};
+        double lum = vec_luminance(rgb);
         seen++;
         lit += lum > ENV_PROBE_LEVEL;
     }

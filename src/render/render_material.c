@@ -8,8 +8,7 @@
 #include "brdf.h"
 #include "lobes.h"
 #include "util.h"
-
-static double luminance(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+#include "vec.h"
 
 static bool any_positive(const float *v, int n)
 {
@@ -39,7 +38,7 @@ GnFeatures material_features(const GnMaterial *m)
         f |= GN_FEAT_ALPHA;
     if (!(m->flags & GN_MAT_DOUBLE_SIDED))
         f |= GN_FEAT_CULL;
-    if (luminance(&m->emissive.x) > 0)
+    if (vec_luminance(&m->emissive.x) > 0)
         f |= GN_FEAT_EMISSIVE;
     if (m->brdf == BRDF_GLTF) {
         /* bsdf_gltf: a GGX lobe (the mirror where lobes_smooth) with Schlick's F of weight

@@ -16,6 +16,7 @@
 
 extern "C" {
 #include "tangent.h"
+#include "vec.h"
 }
 
 namespace gltf {
@@ -656,12 +657,7 @@ bool bake_mesh(Ctx &c, const Instance &in, const Mat &w, GnVertex *vertices, uin
         for (int k = 0; k < 3; k++)
             a[r][k] = w[size_t(k * 4 + r)];
     double cof[3][3];
-    for (int r = 0; r < 3; r++)
-        for (int k = 0; k < 3; k++) {
-            int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-            cof[r][k] = a[r1][k1] * a[r2][k2] - a[r1][k2] * a[r2][k1];
-        }
-    double det = a[0][0] * cof[0][0] + a[0][1] * cof[0][1] + a[0][2] * cof[0][2];
+    double det = vec_cofactors3(a, cof);
     double sgn = det < 0 ? -1 : 1;
     uint32_t default_material = uint32_t(c.m.materials.size());
     for (const Prim &base : c.meshes[size_t(in.mesh)]) {
@@ -738,12 +734,7 @@ bool instance_transform(const Mat &w, float out[12])
     for (int r = 0; r < 3; r++)
         for (int k = 0; k < 3; k++)
             a[r][k] = out[4 * r + k];
-    for (int r = 0; r < 3; r++)
-        for (int k = 0; k < 3; k++) {
-            int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-            c[r][k] = a[r1][k1] * a[r2][k2] - a[r1][k2] * a[r2][k1];
-        }
-    double det = a[0][0] * c[0][0] + a[0][1] * c[0][1] + a[0][2] * c[0][2];
+    double det = vec_cofactors3(a, c);
     if (!(det != 0) || !std::isfinite(det))
         return false;
     for (int r = 0; r < 3; r++)

@@ -7,6 +7,7 @@
  * that sum, tangents the sum itself. A posed primitive belongs to its node alone: it is
  * baked like any other, triangles in world space. */
 #include "gltf_internal.h"
+#include "vec.h"
 
 #include <algorithm>
 #include <cmath>
@@ -408,12 +409,7 @@ bool pose_primitive(Ctx &c, const Instance &in, const Prim &p, Prim &out)
             for (int r = 0; r < 3; r++)
                 for (int k = 0; k < 3; k++)
                     a[r][k] = s[size_t(k * 4 + r)];
-            for (int r = 0; r < 3; r++)
-                for (int k = 0; k < 3; k++) {
-                    int r1 = (r + 1) % 3, r2 = (r + 2) % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-                    cof[r][k] = a[r1][k1] * a[r2][k2] - a[r1][k2] * a[r2][k1];
-                }
-            const double det = a[0][0] * cof[0][0] + a[0][1] * cof[0][1] + a[0][2] * cof[0][2];
+            const double det = vec_cofactors3(a, cof);
             const double sgn = det < 0 ? -1 : 1;
             if (!nrm.empty() && !p.flat) {
                 double *n = &nrm[v * 3];
