@@ -13,6 +13,10 @@ TEST_BUDGET_S=10
 # manager's shim first on PATH costs about 75 ms a call, and a run calls Python hundreds of
 # times.
 if [ -x /usr/bin/python3 ]; then python3() { /usr/bin/python3 "$@"; }; fi
+# It imports tests/tool's modules by name: gltf_fixture (the scenes and images the scripts
+# write) and exrtool (an EXR reader of its own).
+PYTHONPATH=$(cd "$(dirname "${BASH_SOURCE[0]}")/tool" && pwd)${PYTHONPATH:+:$PYTHONPATH}
+export PYTHONPATH
 pass() { n_pass=$((n_pass + 1)); }
 fail() { n_fail=$((n_fail + 1)); echo "  FAIL: $*"; }
 # over_budget WHAT T0: the note for a check that started at $EPOCHREALTIME T0, if it was slow.
