@@ -139,3 +139,36 @@ fixture() {
     ) 9>"$f.lock" || return 1
     echo "$f"
 }
+
+# ---- checks several scripts make --------------------------------------------------------
+# same_halves A.exr LEFT.exr RIGHT.exr WIDTH: A's left half is LEFT's and its right half
+# RIGHT's, pixel by pixel (R, G and B within 1e-4, relative above 1; the two columns at the
+# seam are not compared), and LEFT and RIGHT differ somewhere by more than 0.01, or the check
+# proves nothing; LEFT and RIGHT may be one file (A is that image, but at the seam).
+# (The renders of a quad whose texture splits it in two against untextured twins of its
+# halves: slots.sh, specgloss.sh.)
+same_halves() {
+    python3 - "$@" <<'PY'
+import sys
+import exrtool
+def rgb(path):
+    _, ch = exrtool.read(path)
+    return [ch[c][1] for c in "RGB"]
+t, l, r = rgb(sys.argv[1]), rgb(sys.argv[2]), rgb(sys.argv[3])
+one = sys.argv[2] == sys.argv[3]
+w = int(sys.argv[4])
+bad = differ = 0
+for c in range(3):
+    for i, v in enumerate(t[c]):
+        x = i % w
+        if x in (w // 2 - 1, w // 2):
+            continue
+        want = l[c][i] if x < w // 2 else r[c][i]
+        if abs(v - want) > 1e-4 * max(1.0, abs(want)):
+            bad += 1
+            if bad <= 5: print("pixel %d channel %d: %.6f, not %.6f" % (i, c, v, want))
+        differ += abs(l[c][i] - r[c][i]) > 0.01
+print("%d values wrong, %d differ between the two references" % (bad, differ))
+sys.exit(1 if bad or (differ == 0 and not one) else 0)
+PY
+}
