@@ -140,6 +140,15 @@ fixture() {
     echo "$f"
 }
 
+# write_scenes <<'PY' ... PY: runs that Python, which writes the script's scenes into the
+# folder it is given (sys.argv[1], the script's $tmp; gltf_fixture builds them). Without
+# python3 the script is skipped, and where the scenes cannot be written it fails and ends:
+# call it before any check.
+write_scenes() {
+    command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
+    python3 - "$tmp" || { fail "scenes"; finish; exit; }
+}
+
 # ---- checks several scripts make --------------------------------------------------------
 # same_halves A.exr LEFT.exr RIGHT.exr WIDTH: A's left half is LEFT's and its right half
 # RIGHT's, pixel by pixel (R, G and B within 1e-4, relative above 1; the two columns at the
