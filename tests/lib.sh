@@ -181,3 +181,70 @@ print("%d values wrong, %d differ between the two references" % (bad, differ))
 sys.exit(1 if bad or (differ == 0 and not one) else 0)
 PY
 }
+
+# need_denoiser WHAT: ends the script here where gonio has no Open Image Denoise (make
+# denoiser) and GONIO_OIDN_LIB names none: skipped, saying that WHAT did not run, when no
+# check has failed; a failure instead where GONIO_REQUIRE_DENOISER=1 (CI) requires it.
+need_denoiser() {
+    local lib
+    lib=$(dirname "$GONIO")/../oidn/lib/libOpenImageDenoise.so.2
+    [ -e "$lib" ] || [ -n "${GONIO_OIDN_LIB:-}" ] && return 0
+    if [ "${GONIO_REQUIRE_DENOISER:-}" = 1 ]; then
+        fail "Open Image Denoise is required here (GONIO_REQUIRE_DENOISER=1) but $lib is absent"
+        finish
+        exit 1
+    fi
+    [ "$n_fail" = 0 ] || { finish; exit 1; }
+    skip_all "no Open Image Denoise at $lib (make denoiser fetches it): $1"
+}
+
+# ---- gonio preview in a virtual X display (preview.sh, denoise_preview.sh) ---------------
+# in_xvfb "$@": runs the script again inside one virtual X display (xvfb-run -a: a free
+# server number; 24-bit for Vulkan), or skips it where a tool is missing. First thing.
+in_xvfb() {
+    [ "${GONIO_PREVIEW_XVFB:-}" = 1 ] && return 0
+    local t
+    for t in xvfb-run xauth xdotool import compare identify; do
+        command -v $t >/dev/null || skip_all "$t is missing (make test-deps installs it)"
+    done
+    GONIO_PREVIEW_XVFB=1 exec xvfb-run -a -s "-screen 0 320x240x24" "$0" "$@"
+}
+# same_image A.png B.png: same size, no channel of any pixel more than one level apart, and
+# at most 1% of the pixels different at all (GLSL's float pow may round the odd value
+# otherwise than image.c's double one; a systematic error changes most pixels).
+same_image() {
+    local size e n
+    size=$(identify -format %wx%h "$1")
+    [ "$size" = "$(identify -format %wx%h "$2")" ] || return 1
+    e=$(compare -metric PAE "$1" "$2" null: 2>&1 | sed -n 's/.*(\(.*\)).*/\1/p')
+    n=$(compare -metric AE "$1" "$2" null: 2>&1)
+    echo "$1 vs $2: peak $e, $n pixel(s) differ"
+    awk -v e="$e" -v n="$n" -v s="$size" 'BEGIN { split(s, d, "x")
+        exit !(e != "" && e <= 1.5 / 255 && n + 0 <= d[1] * d[2] / 100) }'
+}
+differs() { ! same_image "$@"; }
+# preview_open OUT ARGS...: starts `gonio preview ARGS` in the background (its stdout in
+# OUT.out, stderr in OUT.err; stopped after 120 s) and finds its window: $pid, $wid (empty
+# when no window opened within 30 s). preview_close OUT: Esc; the preview exits 0 (2 checks).
+preview_open() {
+    local out=$1; shift
+    timeout 120 "$GONIO" preview "$@" >"$out.out" 2>"$out.err" &
+    pid=$!
+    wid=$(timeout 30 xdotool search --sync --name '^gonio preview')
+}
+preview_close() {
+    check "Esc" xdotool key Escape
+    wait $pid
+    local rc=$?
+    [ $rc = 0 ] && pass || { fail "preview exit status $rc"; cat "$1.err"; }
+}
+# wait_title PATTERN: waits up to $title_wait_s seconds (30 unless set) for the title of the
+# window $wid to match PATTERN (grep -E)
+wait_title() {
+    local i
+    for i in $(seq $((${title_wait_s:-30} * 10))); do
+        xdotool getwindowname "$wid" 2>/dev/null | grep -Eq "$1" && return 0
+        sleep 0.1
+    done
+    echo "title: $(xdotool getwindowname "$wid" 2>&1)"; return 1
+}
