@@ -13,6 +13,10 @@ TEST_BUDGET_S=10
 # manager's shim first on PATH costs about 75 ms a call, and a run calls Python hundreds of
 # times.
 if [ -x /usr/bin/python3 ]; then python3() { /usr/bin/python3 "$@"; }; fi
+# It imports tests/tool's modules by name: gltf_fixture (the scenes and images the scripts
+# write) and exrtool (an EXR reader of its own).
+PYTHONPATH=$(cd "$(dirname "${BASH_SOURCE[0]}")/tool" && pwd)${PYTHONPATH:+:$PYTHONPATH}
+export PYTHONPATH
 pass() { n_pass=$((n_pass + 1)); }
 fail() { n_fail=$((n_fail + 1)); echo "  FAIL: $*"; }
 # over_budget WHAT T0: the note for a check that started at $EPOCHREALTIME T0, if it was slow.
@@ -134,4 +138,113 @@ fixture() {
         fi
     ) 9>"$f.lock" || return 1
     echo "$f"
+}
+
+# write_scenes <<'PY' ... PY: runs that Python, which writes the script's scenes into the
+# folder it is given (sys.argv[1], the script's $tmp; gltf_fixture builds them). Without
+# python3 the script is skipped, and where the scenes cannot be written it fails and ends:
+# call it before any check.
+write_scenes() {
+    command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
+    python3 - "$tmp" || { fail "scenes"; finish; exit; }
+}
+
+# ---- checks several scripts make --------------------------------------------------------
+# same_halves A.exr LEFT.exr RIGHT.exr WIDTH: A's left half is LEFT's and its right half
+# RIGHT's, pixel by pixel (R, G and B within 1e-4, relative above 1; the two columns at the
+# seam are not compared), and LEFT and RIGHT differ somewhere by more than 0.01, or the check
+# proves nothing; LEFT and RIGHT may be one file (A is that image, but at the seam).
+# (The renders of a quad whose texture splits it in two against untextured twins of its
+# halves: slots.sh, specgloss.sh.)
+same_halves() {
+    python3 - "$@" <<'PY'
+import sys
+import exrtool
+def rgb(path):
+    _, ch = exrtool.read(path)
+    return [ch[c][1] for c in "RGB"]
+t, l, r = rgb(sys.argv[1]), rgb(sys.argv[2]), rgb(sys.argv[3])
+one = sys.argv[2] == sys.argv[3]
+w = int(sys.argv[4])
+bad = differ = 0
+for c in range(3):
+    for i, v in enumerate(t[c]):
+        x = i % w
+        if x in (w // 2 - 1, w // 2):
+            continue
+        want = l[c][i] if x < w // 2 else r[c][i]
+        if abs(v - want) > 1e-4 * max(1.0, abs(want)):
+            bad += 1
+            if bad <= 5: print("pixel %d channel %d: %.6f, not %.6f" % (i, c, v, want))
+        differ += abs(l[c][i] - r[c][i]) > 0.01
+print("%d values wrong, %d differ between the two references" % (bad, differ))
+sys.exit(1 if bad or (differ == 0 and not one) else 0)
+PY
+}
+
+# need_denoiser WHAT: ends the script here where gonio has no Open Image Denoise (make
+# denoiser) and GONIO_OIDN_LIB names none: skipped, saying that WHAT did not run, when no
+# check has failed; a failure instead where GONIO_REQUIRE_DENOISER=1 (CI) requires it.
+need_denoiser() {
+    local lib
+    lib=$(dirname "$GONIO")/../oidn/lib/libOpenImageDenoise.so.2
+    [ -e "$lib" ] || [ -n "${GONIO_OIDN_LIB:-}" ] && return 0
+    if [ "${GONIO_REQUIRE_DENOISER:-}" = 1 ]; then
+        fail "Open Image Denoise is required here (GONIO_REQUIRE_DENOISER=1) but $lib is absent"
+        finish
+        exit 1
+    fi
+    [ "$n_fail" = 0 ] || { finish; exit 1; }
+    skip_all "no Open Image Denoise at $lib (make denoiser fetches it): $1"
+}
+
+# ---- gonio preview in a virtual X display (preview.sh, denoise_preview.sh) ---------------
+# in_xvfb "$@": runs the script again inside one virtual X display (xvfb-run -a: a free
+# server number; 24-bit for Vulkan), or skips it where a tool is missing. First thing.
+in_xvfb() {
+    [ "${GONIO_PREVIEW_XVFB:-}" = 1 ] && return 0
+    local t
+    for t in xvfb-run xauth xdotool import compare identify; do
+        command -v $t >/dev/null || skip_all "$t is missing (make test-deps installs it)"
+    done
+    GONIO_PREVIEW_XVFB=1 exec xvfb-run -a -s "-screen 0 320x240x24" "$0" "$@"
+}
+# same_image A.png B.png: same size, no channel of any pixel more than one level apart, and
+# at most 1% of the pixels different at all (GLSL's float pow may round the odd value
+# otherwise than image.c's double one; a systematic error changes most pixels).
+same_image() {
+    local size e n
+    size=$(identify -format %wx%h "$1")
+    [ "$size" = "$(identify -format %wx%h "$2")" ] || return 1
+    e=$(compare -metric PAE "$1" "$2" null: 2>&1 | sed -n 's/.*(\(.*\)).*/\1/p')
+    n=$(compare -metric AE "$1" "$2" null: 2>&1)
+    echo "$1 vs $2: peak $e, $n pixel(s) differ"
+    awk -v e="$e" -v n="$n" -v s="$size" 'BEGIN { split(s, d, "x")
+        exit !(e != "" && e <= 1.5 / 255 && n + 0 <= d[1] * d[2] / 100) }'
+}
+differs() { ! same_image "$@"; }
+# preview_open OUT ARGS...: starts `gonio preview ARGS` in the background (its stdout in
+# OUT.out, stderr in OUT.err; stopped after 120 s) and finds its window: $pid, $wid (empty
+# when no window opened within 30 s). preview_close OUT: Esc; the preview exits 0 (2 checks).
+preview_open() {
+    local out=$1; shift
+    timeout 120 "$GONIO" preview "$@" >"$out.out" 2>"$out.err" &
+    pid=$!
+    wid=$(timeout 30 xdotool search --sync --name '^gonio preview')
+}
+preview_close() {
+    check "Esc" xdotool key Escape
+    wait $pid
+    local rc=$?
+    [ $rc = 0 ] && pass || { fail "preview exit status $rc"; cat "$1.err"; }
+}
+# wait_title PATTERN: waits up to $title_wait_s seconds (30 unless set) for the title of the
+# window $wid to match PATTERN (grep -E)
+wait_title() {
+    local i
+    for i in $(seq $((${title_wait_s:-30} * 10))); do
+        xdotool getwindowname "$wid" 2>/dev/null | grep -Eq "$1" && return 0
+        sleep 0.1
+    done
+    echo "title: $(xdotool getwindowname "$wid" 2>&1)"; return 1
 }

@@ -35,13 +35,12 @@ if python3 tests/tool/instances.py "$tmp/instances" >/dev/null 2>&1; then
     for f in "$tmp"/instances/*.gltf; do link "$tmp/seed-scene" "$f"; done
 fi
 # Textures: a WebP by cwebp and a KTX2 of each Basis Universal mode by testtool ktx2, as GLBs
-# that use them (tests/tool/texture_glb.py) for the scene fuzzer, and bare for fuzz_image in
-# its layout: a format byte (1 KTX2, 0 WebP), then the file past its 12-byte signature.
+# that use them (tests/tool/gltf_fixture.py textured-glb) for the scene fuzzer, and bare for
+# fuzz_image in its layout: a format byte (1 KTX2, 0 WebP), then the file past its 12-byte
+# signature.
 mkdir -p "$tmp/tex" "$tmp/seed-image"
-python3 -c 'import struct, sys, zlib
-rows = b"".join(b"\0" + b"".join(bytes((40 + 60 * (i // 2), 40 + 60 * (j // 2), 30 * i, 255 - 20 * j)) for i in range(8)) for j in range(8))
-c = lambda t, d: struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
-open(sys.argv[1], "wb").write(b"\x89PNG\r\n\x1a\n" + c(b"IHDR", struct.pack(">IIBBBBB", 8, 8, 8, 6, 0, 0, 0)) + c(b"IDAT", zlib.compress(rows)) + c(b"IEND", b""))' "$tmp/tex/tex.png"
+PYTHONPATH=tests/tool python3 -c 'import sys, gltf_fixture as gf
+open(sys.argv[1], "wb").write(gf.png(8, 8, lambda i, j: (40 + 60 * (i // 2), 40 + 60 * (j // 2), 30 * i, 255 - 20 * j)))' "$tmp/tex/tex.png"
 if command -v cwebp >/dev/null; then
     cwebp -quiet -lossless "$tmp/tex/tex.png" -o "$tmp/tex/lossless.webp"
     cwebp -quiet -q 80 "$tmp/tex/tex.png" -o "$tmp/tex/lossy.webp"
@@ -54,8 +53,8 @@ done
 for f in "$tmp"/tex/*.webp "$tmp"/tex/*.ktx2; do
     [ -f "$f" ] || continue
     b=$(basename "$f")
-    python3 tests/tool/texture_glb.py "$tmp/seed-scene/tex-$b.glb" "$f"
-    python3 tests/tool/texture_glb.py "$tmp/seed-scene/tex-$b-fallback.glb" "$f" "$tmp/tex/tex.png"
+    python3 tests/tool/gltf_fixture.py textured-glb "$tmp/seed-scene/tex-$b.glb" "$f"
+    python3 tests/tool/gltf_fixture.py textured-glb "$tmp/seed-scene/tex-$b-fallback.glb" "$f" "$tmp/tex/tex.png"
     python3 -c 'import sys; d = open(sys.argv[1], "rb").read(); open(sys.argv[2], "wb").write(bytes([sys.argv[1].endswith(".ktx2")]) + d[12:])' \
         "$f" "$tmp/seed-image/$b"
 done

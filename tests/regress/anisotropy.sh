@@ -18,41 +18,24 @@ R="--spp 16 --size 96x96 --env 0 --quiet"
 # at y = 3 looking down (image right = +x, image down = +z), the light at y = 2.5.
 scene() {
     python3 - "$@" <<'PY'
-import base64, json, struct, sys, zlib
+import sys
+import gltf_fixture as gf
 strength, rotation, out = float(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
 tex = [int(c) for c in sys.argv[4].split(",")] if len(sys.argv) > 4 else None
-pos = [-2, 0, -2, 2, 0, -2, 2, 0, 2, -2, 0, 2]
-nrm = [0, 1, 0] * 4
-uv = [0, 0, 1, 0, 1, 1, 0, 1]
-idx = [0, 2, 1, 0, 3, 2]
-data = struct.pack("12f", *pos) + struct.pack("12f", *nrm) + struct.pack("8f", *uv) + struct.pack("6H", *idx)
-views = [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 48},
-         {"buffer": 0, "byteOffset": 96, "byteLength": 32}, {"buffer": 0, "byteOffset": 128, "byteLength": 12}]
-acc = [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-2, 0, -2], "max": [2, 0, 2]},
-       {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
-       {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
-       {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}]
+g = gf.Gltf()
 mat = {"name": "brushed", "pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.9, 0.9, 1], "metallicFactor": 1,
-                                                   "roughnessFactor": 0.3},
-       "extensions": {"KHR_materials_anisotropy": {"anisotropyStrength": strength, "anisotropyRotation": rotation}}}
-d = {"asset": {"version": "2.0"},
-     "extensionsUsed": ["KHR_materials_anisotropy", "KHR_lights_punctual"],
-     "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 20}]}},
-     "buffers": [{"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
-     "bufferViews": views, "accessors": acc, "materials": [mat],
-     "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": 0}]}],
-     "cameras": [{"type": "perspective", "perspective": {"yfov": 1.0, "znear": 0.01}}],
-     "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 3, 0], "rotation": [-0.70710678, 0, 0, 0.70710678]},
-               {"translation": [0, 2.5, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}}],
-     "scenes": [{"nodes": [0, 1, 2]}], "scene": 0}
-if tex:  # a 1x1 RGB PNG: the signature, IHDR, IDAT, IEND
-    chunk = lambda t, b: struct.pack(">I", len(b)) + t + b + struct.pack(">I", zlib.crc32(t + b))
-    png = (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 1, 1, 8, 2, 0, 0, 0)) +
-           chunk(b"IDAT", zlib.compress(bytes([0] + tex))) + chunk(b"IEND", b""))
-    d["images"] = [{"uri": "data:image/png;base64," + base64.b64encode(png).decode()}]
-    d["textures"] = [{"source": 0}]
-    mat["extensions"]["KHR_materials_anisotropy"]["anisotropyTexture"] = {"index": 0}
-json.dump(d, open(out, "w"))
+                                                   "roughnessFactor": 0.3}}
+aniso = g.extend(mat, "KHR_materials_anisotropy", anisotropyStrength=strength, anisotropyRotation=rotation)
+if tex:  # a 1x1 RGB texture
+    aniso["anisotropyTexture"] = {"index": g.texture(g.image(gf.png(1, 1, bytes(tex), channels=3)))}
+square = {"attributes": {"POSITION": g.accessor([-2, 0, -2, 2, 0, -2, 2, 0, 2, -2, 0, 2], "VEC3", bounds=True),
+                         "NORMAL": g.accessor([0, 1, 0] * 4, "VEC3"),
+                         "TEXCOORD_0": g.accessor([0, 0, 1, 0, 1, 1, 0, 1], "VEC2")},
+          "indices": g.accessor([0, 2, 1, 0, 3, 2], "SCALAR", gf.UNSIGNED_SHORT), "material": g.material(mat)}
+g.scene([g.node(mesh=g.mesh(square)),
+         g.node(camera=g.perspective(1.0, 0.01), translation=[0, 3, 0], rotation=[-0.70710678, 0, 0, 0.70710678]),
+         g.node(light=g.light("point", intensity=20), translation=[0, 2.5, 0])])
+g.write(out)
 PY
 }
 

@@ -8,47 +8,26 @@ G=$GONIO
 command -v python3 >/dev/null || skip_all "python3 is needed to write the test scene"
 S=$tmp/cameras.gltf
 python3 - "$S" <<'PY'
-import base64, json, struct, sys
-def quad(x0, y0, x1, y1, z):
-    return [x0, y0, z, x1, y0, z, x1, y1, z, x0, y1, z]
-pos = quad(-5, -5, 5, 5, 0) + quad(-0.5, -0.5, 0.5, 0.5, 0)  # the red square around its node
-nrm = [0, 0, 1] * 8
-idx = [0, 1, 2, 0, 2, 3]
-blob = struct.pack("<24f", *pos) + struct.pack("<24f", *nrm) + struct.pack("<6H", *idx) + b"\0\0"
-views = [(0, 48), (48, 48), (96, 48), (144, 48), (192, 12)]
-doc = {
-    "asset": {"version": "2.0", "generator": "camera.sh"},
-    "buffers": [{"byteLength": len(blob),
-                 "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
-    "bufferViews": [{"buffer": 0, "byteOffset": o, "byteLength": n} for o, n in views],
-    "accessors": [
-        {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-5, -5, 0], "max": [5, 5, 0]},
-        {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-0.5, -0.5, 0], "max": [0.5, 0.5, 0]},
-        {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC3"},
-        {"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC3"},
-        {"bufferView": 4, "componentType": 5123, "count": 6, "type": "SCALAR"}],
-    "materials": [
-        {"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0}},
-        {"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 1], "metallicFactor": 0}}],
-    "meshes": [
-        {"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 2}, "indices": 4, "material": 0}]},
-        {"primitives": [{"attributes": {"POSITION": 1, "NORMAL": 3}, "indices": 4, "material": 1}]}],
-    "cameras": [
-        {"name": "B", "type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 1, "znear": 0.1}},
-        {"name": "A", "type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 1, "znear": 0.1}},
-        {"name": "C", "type": "orthographic", "orthographic": {"xmag": 2, "ymag": 1, "znear": 0.1, "zfar": 100}}],
-    # Depth-first: node 0 (quad), its child 3 (camera A), node 1 (camera B), node 2 (red
-    # square at (1.3, 0.4)), its child 4 (camera C, 5 above the square).
-    "nodes": [
-        {"mesh": 0, "children": [3]},
-        {"camera": 0, "translation": [0, 0, 5]},
-        {"mesh": 1, "translation": [1.3, 0.4, 0.01], "children": [4]},
-        {"camera": 1, "translation": [1.3, 0.4, 5]},
-        {"camera": 2, "translation": [0, 0, 5]}],
-    "scenes": [{"nodes": [0, 1, 2]}, {"nodes": [1, 2]}],
-    "scene": 0,
-}
-json.dump(doc, open(sys.argv[1], "w"))
+import sys
+import gltf_fixture as gf
+g = gf.Gltf(generator="camera.sh")
+white = g.material({"name": "white", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0}})
+red = g.material({"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 1], "metallicFactor": 0}})
+quad = g.mesh(g.quad(white, half=5, uv=False))
+square = g.mesh(g.quad(red, half=0.5, uv=False))  # the red square, around its node
+B = g.perspective(0.5, 0.1, aspect=1, name="B")
+A = g.perspective(0.5, 0.1, aspect=1, name="A")
+C = g.orthographic(2, 1, name="C")
+# Depth-first: node 0 (quad), its child 3 (camera A), node 1 (camera B), node 2 (red square
+# at (1.3, 0.4)), its child 4 (camera C, 5 above the square).
+g.node(mesh=quad, children=[3])
+g.node(camera=B, translation=[0, 0, 5])
+g.node(mesh=square, translation=[1.3, 0.4, 0.01], children=[4])
+g.node(camera=A, translation=[1.3, 0.4, 5])
+g.node(camera=C, translation=[0, 0, 5])
+g.scene([0, 1, 2])
+g.scene([1, 2])
+g.write(sys.argv[1])
 PY
 [ -s "$S" ] || skip_all "could not write the test scene"
 

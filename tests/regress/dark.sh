@@ -52,44 +52,23 @@ in_tier fast || { finish; exit; }
 # A white floor and a grey cube under a point light above the front: deliberate light that
 # lights the view (no camera: the framing view).
 python3 - "$tmp" <<'PY'
-import base64, json, struct, sys
+import sys
+import gltf_fixture as gf
 out = sys.argv[1]
-def cube(s, c):
-    p, n, i = [], [], []
-    for ax in range(3):
-        for sg in (-1, 1):
-            u, v = [(ax + 1) % 3, (ax + 2) % 3]
-            base = len(p) // 3
-            for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
-                q = [0, 0, 0]; q[ax] = sg; q[u] = a; q[v] = b
-                p += [c[k] + s * q[k] for k in range(3)]
-                nn = [0, 0, 0]; nn[ax] = sg; n += nn
-            i += [base, base + 1, base + 2, base, base + 2, base + 3] if sg > 0 else [base, base + 2, base + 1, base, base + 3, base + 2]
-    return p, n, i
 def write(name, size, centre, with_floor, light, color):
-    P, N, I = cube(size, centre)
+    P, N, I = gf.box([c - size for c in centre], [c + size for c in centre])
     if with_floor:
         b = len(P) // 3; f = 4 * size; y = centre[1] - size
         P += [centre[0] - f, y, centre[2] - f, centre[0] + f, y, centre[2] - f, centre[0] + f, y, centre[2] + f, centre[0] - f, y, centre[2] + f]
         N += [0, 1, 0] * 4; I += [b, b + 2, b + 1, b, b + 3, b + 2]
-    nv = len(P) // 3
-    blob = struct.pack("<%df" % len(P), *P) + struct.pack("<%df" % len(N), *N) + struct.pack("<%dI" % len(I), *I)
-    lo = [min(P[k::3]) for k in range(3)]; hi = [max(P[k::3]) for k in range(3)]
-    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0] + ([1] if light else [])}],
-           "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
-           "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 12 * nv}, {"buffer": 0, "byteOffset": 12 * nv, "byteLength": 12 * nv},
-                           {"buffer": 0, "byteOffset": 24 * nv, "byteLength": 4 * len(I)}],
-           "accessors": [{"bufferView": 0, "componentType": 5126, "count": nv, "type": "VEC3", "min": lo, "max": hi},
-                         {"bufferView": 1, "componentType": 5126, "count": nv, "type": "VEC3"},
-                         {"bufferView": 2, "componentType": 5125, "count": len(I), "type": "SCALAR"}],
-           "materials": [{"pbrMetallicRoughness": {"baseColorFactor": color + [1], "metallicFactor": 0, "roughnessFactor": 1}}],
-           "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "material": 0}]}],
-           "nodes": [{"mesh": 0}]}
+    g = gf.Gltf()
+    m = g.material({"pbrMetallicRoughness": {"baseColorFactor": color + [1], "metallicFactor": 0, "roughnessFactor": 1}})
+    nodes = [g.node(mesh=g.mesh(g.primitive(P, N, I, m)))]
     if light:
-        doc["extensionsUsed"] = ["KHR_lights_punctual"]
-        doc["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": light}]}}
-        doc["nodes"].append({"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [centre[0] + 1.5 * size, centre[1] + 4 * size, centre[2] + 3 * size]})
-    json.dump(doc, open(f"{out}/{name}.gltf", "w"))
+        nodes.append(g.node(light=g.light("point", intensity=light),
+                            translation=[centre[0] + 1.5 * size, centre[1] + 4 * size, centre[2] + 3 * size]))
+    g.scene(nodes)
+    g.write(f"{out}/{name}.gltf")
 write("lit", 1.0, [0, 0, 0], True, 60.0, [0.8, 0.8, 0.8])
 write("dim", 1.0, [0, 0, 0], True, 0.05, [0.8, 0.8, 0.8])
 write("tiny", 1e-3, [5e-3, -2e-3, 1e-3], False, 0, [1, 0, 0])
@@ -103,51 +82,27 @@ PY
 # it: a black metal reflects nothing); "lamp" has a point light inside the sky that lights the view (deliberate: unchanged),
 # "dimlamp" one 400 times dimmer (dark: the studio added, kept out, then the headlight).
 python3 - "$tmp" <<'PY'
-import base64, json, struct, sys
+import sys
+import gltf_fixture as gf
 out = sys.argv[1]
-def box(lo, hi):
-    p, n, i = [], [], []
-    for ax in range(3):
-        for sg in (-1, 1):
-            u, v = (ax + 1) % 3, (ax + 2) % 3
-            b = len(p) // 3
-            for a, c in ((0, 0), (1, 0), (1, 1), (0, 1)):
-                q = [0, 0, 0]; q[ax] = hi[ax] if sg > 0 else lo[ax]
-                q[u] = (lo[u], hi[u])[a]; q[v] = (lo[v], hi[v])[c]
-                p += q; nn = [0, 0, 0]; nn[ax] = sg; n += nn
-            i += [b, b + 1, b + 2, b, b + 2, b + 3] if sg > 0 else [b, b + 2, b + 1, b, b + 3, b + 2]
-    return p, n, i
 def write(name, sky, lamp, dark=False):
-    parts = [(box([-20, -1, -20], [20, 0, 20]), 0)]
-    parts += [(box([x - 0.5, 0, z - 0.5], [x + 0.5, h, z + 0.5]), 1) for x, z, h in ((-1.5, -2, 1), (0.5, -4, 2), (2, -1.5, 0.8))]
+    parts = [(gf.box([-20, -1, -20], [20, 0, 20]), 0)]
+    parts += [(gf.box([x - 0.5, 0, z - 0.5], [x + 0.5, h, z + 0.5]), 1) for x, z, h in ((-1.5, -2, 1), (0.5, -4, 2), (2, -1.5, 0.8))]
     if sky:
-        parts.append((box([-25, -5, -25], [25, 25, 25]), 2))
-    blob, views, accs, prims = b"", [], [], []
-    for (P, N, I), mat in parts:
-        nv = len(P) // 3
-        for data, fmt, typ, comp in ((P, "f", "VEC3", 5126), (N, "f", "VEC3", 5126), (I, "I", "SCALAR", 5125)):
-            views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": 4 * len(data)})
-            a = {"bufferView": len(views) - 1, "componentType": comp, "count": len(data) // (3 if typ == "VEC3" else 1), "type": typ}
-            if data is P:
-                a["min"] = [min(P[k::3]) for k in range(3)]; a["max"] = [max(P[k::3]) for k in range(3)]
-            accs.append(a)
-            blob += struct.pack("<%d%s" % (len(data), fmt), *data)
-        k = len(accs)
-        prims.append({"attributes": {"POSITION": k - 3, "NORMAL": k - 2}, "indices": k - 1, "material": mat})
+        parts.append((gf.box([-25, -5, -25], [25, 25, 25]), 2))
+    g = gf.Gltf()
+    prims = [g.primitive(P, N, I, mat) for (P, N, I), mat in parts]
     colours = ([0.0] * 3, [0.0] * 3) if dark else ([0.5, 0.5, 0.5], [0.9, 0.9, 0.9])
     mats = [{"pbrMetallicRoughness": {"baseColorFactor": c + [1], "metallicFactor": 1 if dark else 0, "roughnessFactor": 1}} for c in colours + ([0.4, 0.6, 0.9],)]
     mats[2]["doubleSided"] = True
-    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
-           "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
-           "bufferViews": views, "accessors": accs, "materials": mats, "meshes": [{"primitives": prims}],
-           "cameras": [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.05}}],
-           "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 1.5, 4], "rotation": [-0.13, 0, 0, 0.9915]}]}
+    for m in mats:
+        g.material(m)
+    nodes = [g.node(mesh=g.mesh(*prims)),
+             g.node(camera=g.perspective(0.9, 0.05), translation=[0, 1.5, 4], rotation=[-0.13, 0, 0, 0.9915])]
     if lamp:
-        doc["extensionsUsed"] = ["KHR_lights_punctual"]
-        doc["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": lamp}]}}
-        doc["nodes"].append({"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [1, 6, 3]})
-        doc["scenes"][0]["nodes"].append(2)
-    json.dump(doc, open(f"{out}/{name}.gltf", "w"))
+        nodes.append(g.node(light=g.light("point", intensity=lamp), translation=[1, 6, 3]))
+    g.scene(nodes)
+    g.write(f"{out}/{name}.gltf")
 write("sky", True, 0)
 write("open", False, 0)
 write("black", False, 0, dark=True)

@@ -31,16 +31,7 @@ check "... with the loader's reason" grep -q "fake.so" "$tmp/last"
 check_fails "--denoise with --mode phong is bad usage" 2 "$G" render $C -o "$tmp/x.exr" --mode phong --denoise $R
 check "... saying it is for path" grep -q "denoise is for --mode path" "$tmp/last"
 
-lib=$(dirname "$G")/../oidn/lib/libOpenImageDenoise.so.2
-if [ ! -e "$lib" ] && [ -z "${GONIO_OIDN_LIB:-}" ]; then
-    if [ "${GONIO_REQUIRE_DENOISER:-}" = 1 ]; then
-        fail "Open Image Denoise is required here (GONIO_REQUIRE_DENOISER=1) but $lib is absent"
-        finish
-        exit 1
-    fi
-    [ "$n_fail" = 0 ] || { finish; exit 1; }
-    skip_all "no Open Image Denoise at $lib (make denoiser fetches it): the checks that denoise did not run"
-fi
+need_denoiser "the checks that denoise did not run"
 
 # The renders and the bench below run in one batch (lib.sh: queue), the checks after it; the
 # lines run in order, so --resume finds its 8 spp file. (The commands that set GONIO_OIDN_LIB,

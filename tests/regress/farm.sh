@@ -134,36 +134,24 @@ fi
 # anim FILE NODE INTERP TIMES VALUES: a red 0.4 x 0.4 square (node 0, at the origin) seen by
 # an orthographic camera (node 1, at z = 5, xmag 2, ymag 1), one animation whose sampler
 # (INTERP, key TIMES, output VALUES: x of a VEC3 each, y = 0, z = 0 or the camera's 5)
-# drives NODE's translation. Written here, buffer and all (perl packs the floats).
+# drives NODE's translation.
 anim() {
-    local file=$1 node=$2 interp=$3 times=$4 values=$5 nt nv z=0 b64
-    [ "$node" = 1 ] && z=5
-    nt=$(echo $times | wc -w)
-    nv=$(echo $values | wc -w)
-    b64=$(perl -e '
-        my ($z, $t, $v) = @ARGV;
-        my @t = split " ", $t; my @v = map { ($_, 0, $z) } split " ", $v;
-        print pack("f<12 S<6 x4 f<* f<*", -0.2,-0.2,0, 0.2,-0.2,0, 0.2,0.2,0, -0.2,0.2,0,
-                   0,1,2, 0,2,3, @t, @v);' "$z" "$times" "$values" | base64 -w0)
-    cat >"$file" <<EOF
-{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
- "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}],
- "cameras": [{"type": "orthographic", "orthographic": {"xmag": 2, "ymag": 1, "znear": 0.1, "zfar": 100}}],
- "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 1]}, "doubleSided": true}],
- "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
- "buffers": [{"byteLength": $((64 + 4 * nt + 12 * nv)), "uri": "data:application/octet-stream;base64,$b64"}],
- "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 48},
-                 {"buffer": 0, "byteOffset": 48, "byteLength": 12},
-                 {"buffer": 0, "byteOffset": 64, "byteLength": $((4 * nt))},
-                 {"buffer": 0, "byteOffset": $((64 + 4 * nt)), "byteLength": $((12 * nv))}],
- "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3",
-                "min": [-0.2, -0.2, 0], "max": [0.2, 0.2, 0]},
-               {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
-               {"bufferView": 2, "componentType": 5126, "count": $nt, "type": "SCALAR"},
-               {"bufferView": 3, "componentType": 5126, "count": $nv, "type": "VEC3"}],
- "animations": [{"name": "move", "samplers": [{"input": 2, "output": 3, "interpolation": "$interp"}],
-                 "channels": [{"sampler": 0, "target": {"node": $node, "path": "translation"}}]}]}
-EOF
+    python3 - "$@" <<'PY'
+import sys
+import gltf_fixture as gf
+out, node, interp = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+times, values = [float(t) for t in sys.argv[4].split()], [float(v) for v in sys.argv[5].split()]
+g = gf.Gltf()
+red = g.material({"pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 1]}, "doubleSided": True})
+square = g.primitive([-0.2, -0.2, 0, 0.2, -0.2, 0, 0.2, 0.2, 0, -0.2, 0.2, 0], indices=gf.QUAD_INDICES, material=red,
+                     index_type=gf.UNSIGNED_SHORT)
+g.scene([g.node(mesh=g.mesh(square)), g.node(camera=g.orthographic(2, 1), translation=[0, 0, 5])])
+key = g.accessor(times, "SCALAR")
+moves = g.accessor([c for v in values for c in (v, 0, 5 if node == 1 else 0)], "VEC3")
+g.add("animations", {"name": "move", "samplers": [{"input": key, "output": moves, "interpolation": interp}],
+                     "channels": [{"sampler": 0, "target": {"node": node, "path": "translation"}}]})
+g.write(out)
+PY
 }
 # at FILE.exr X: the red square's centre in the image is where world x = X maps
 # (200 px over 4 units: pixel 50 X + 100), within a pixel.

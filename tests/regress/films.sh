@@ -16,45 +16,39 @@
 . "$(dirname "$0")/../lib.sh"
 G=$GONIO
 T=$TESTTOOL
-command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
 
-python3 - "$tmp" <<'PY' || { fail "scenes"; finish; exit; }
-import base64, json, math, struct, sys
+write_scenes <<'PY'
+import math, sys
+import gltf_fixture as gf
 out = sys.argv[1]
 A, H, LE = 2.0, 1.0, 2.0  # emitter half-size, distance, radiance
-def quad(z, a, down):
+def quad(z, a, down):  # the square [-a, a]^2 at height z facing +z (down: -z), as two triangles' corners
     p = [(-a, -a, z), (a, -a, z), (a, a, z), (-a, a, z)]
-    return [p[0], p[2], p[1], p[0], p[3], p[2]] if down else [p[0], p[1], p[2], p[0], p[2], p[3]]
+    return [c for k in ((0, 2, 1, 0, 3, 2) if down else (0, 1, 2, 0, 2, 3)) for c in p[k]]
+def write(name, shapes, materials, mag, eye):
+    """shapes: (corners, material) each a mesh; an orthographic camera of xmag = ymag = mag at
+    node `eye` (its fields)"""
+    g = gf.Gltf()
+    for m in materials:
+        g.material(m)
+    nodes = [g.node(mesh=g.mesh(g.primitive(corners, material=m))) for corners, m in shapes]
+    g.scene(nodes + [g.node(camera=g.orthographic(mag, mag, 0.01, 100), **eye)])
+    g.declare_extensions()
+    g.write("%s/%s.gltf" % (out, name))
+emitter = lambda le: {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [1, 1, 1],
+                      "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": le}}}
 def scene(name, sheet_ext, irid=None):
-    pos = quad(0.0, 1.0, False) + quad(H, A, True)
-    raw = b"".join(struct.pack("<3f", *p) for p in pos)
     # double-sided: the camera sees the sheet's back, where the light comes through (a
     # single-sided sheet is culled for camera rays there, as glTF's doubleSided false says)
     sheet = {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0, "roughnessFactor": 1},
              "extensions": dict({"KHR_materials_specular": {"specularFactor": 0}}, **sheet_ext), "doubleSided": True}
+    # below the sheet, looking up (+z), or (iridescence) above the emitter's light, looking down
+    eye, down = {"translation": [0, 0, -5], "rotation": [0, 1, 0, 0]}, False
     if irid is not None:
         sheet = {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1], "metallicFactor": 1, "roughnessFactor": 0.3},
                  "extensions": irid, "doubleSided": True}
-        pos[:6] = quad(0.0, 1.0, True)  # faces the camera: the emitter's light reflected
-        raw = b"".join(struct.pack("<3f", *p) for p in pos)
-    emitter = {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [1, 1, 1],
-               "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": LE}}}
-    d = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
-         "buffers": [{"byteLength": len(raw), "uri": "data:application/octet-stream;base64," + base64.b64encode(raw).decode()}],
-         "bufferViews": [{"buffer": 0, "byteLength": 72}, {"buffer": 0, "byteOffset": 72, "byteLength": 72}],
-         "accessors": [{"bufferView": i, "componentType": 5126, "count": 6, "type": "VEC3",
-                        "min": [min(p[a] for p in pos[6 * i:6 * i + 6]) for a in range(3)],
-                        "max": [max(p[a] for p in pos[6 * i:6 * i + 6]) for a in range(3)]} for i in range(2)],
-         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]},
-                    {"primitives": [{"attributes": {"POSITION": 1}, "material": 1}]}],
-         "materials": [sheet, emitter],
-         "cameras": [{"type": "orthographic", "orthographic": {"xmag": 0.1, "ymag": 0.1, "znear": 0.01, "zfar": 100}}],
-         # below the sheet, looking up (+z), or (iridescence) above the emitter's light, looking down
-         "nodes": [{"mesh": 0}, {"mesh": 1},
-                   {"camera": 0, "translation": [0, 0, -5], "rotation": [0, 1, 0, 0]} if irid is None else
-                   {"camera": 0, "translation": [0, 0, 0.5]}]}
-    d["extensionsUsed"] = sorted({e for m in d["materials"] for e in m.get("extensions", {})})
-    json.dump(d, open("%s/%s.gltf" % (out, name), "w"))
+        eye, down = {"translation": [0, 0, 0.5]}, True  # the sheet faces the camera: the emitter's light reflected
+    write(name, [(quad(0.0, 1.0, down), 0), (quad(H, A, True), 1)], [sheet, emitter(LE)], 0.1, eye)
 C = [1.0, 0.5, 0.25]
 scene("dt", {"KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 0.6, "diffuseTransmissionColorFactor": C}})
 scene("dt0", {"KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 0, "diffuseTransmissionColorFactor": C}})
@@ -66,37 +60,15 @@ scene("noirid", {}, {})
 # inside facing the camera: light reaches the camera only through the medium, by light samples
 # from the cube's faces into it and by paths that cross it.
 def cube_scene(name, volume):
-    pos = []
-    for ax in range(3):
-        for sg in (-1, 1):
-            u, v = (ax + 1) % 3, (ax + 2) % 3
-            def P(a, b):
-                q = [0.0] * 3; q[ax] = float(sg); q[u] = float(a); q[v] = float(b); return tuple(q)
-            c = [P(-1, -1), P(1, -1), P(1, 1), P(-1, 1)]
-            pos += [c[0], c[1], c[2], c[0], c[2], c[3]] if sg > 0 else [c[0], c[2], c[1], c[0], c[3], c[2]]
-    pos += quad(0.5, 0.4, False)  # the emitter at z = 0.5, facing +z
-    raw = b"".join(struct.pack("<3f", *p) for p in pos)
+    P, _, I = gf.box([-1.0] * 3, [1.0] * 3)
     ext = {"KHR_materials_specular": {"specularFactor": 0},
            "KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1}}
     if volume:
         ext["KHR_materials_volume"] = {"thicknessFactor": 2, "attenuationColor": [0.5, 0.7, 0.9], "attenuationDistance": 0.5}
     shell = {"pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0, "roughnessFactor": 1},
              "extensions": ext}
-    emitter = {"pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1]}, "emissiveFactor": [1, 1, 1],
-               "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}}
-    d = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
-         "buffers": [{"byteLength": len(raw), "uri": "data:application/octet-stream;base64," + base64.b64encode(raw).decode()}],
-         "bufferViews": [{"buffer": 0, "byteLength": 36 * 12}, {"buffer": 0, "byteOffset": 36 * 12, "byteLength": 72}],
-         "accessors": [{"bufferView": 0, "componentType": 5126, "count": 36, "type": "VEC3", "min": [-1] * 3, "max": [1] * 3},
-                       {"bufferView": 1, "componentType": 5126, "count": 6, "type": "VEC3",
-                        "min": [-0.4, -0.4, 0.5], "max": [0.4, 0.4, 0.5]}],
-         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]},
-                    {"primitives": [{"attributes": {"POSITION": 1}, "material": 1}]}],
-         "materials": [shell, emitter],
-         "cameras": [{"type": "orthographic", "orthographic": {"xmag": 0.3, "ymag": 0.3, "znear": 0.01, "zfar": 100}}],
-         "nodes": [{"mesh": 0}, {"mesh": 1}, {"camera": 0, "translation": [0, 0, 5]}]}
-    d["extensionsUsed"] = sorted({e for m in d["materials"] for e in m.get("extensions", {})})
-    json.dump(d, open("%s/%s.gltf" % (out, name), "w"))
+    # the emitter at z = 0.5, facing +z
+    write(name, [(gf.unindexed(P, I), 0), (quad(0.5, 0.4, False), 1)], [shell, emitter(4)], 0.3, {"translation": [0, 0, 5]})
 cube_scene("dtvol", True)
 cube_scene("dtnovol", False)
 X = Y = A / H

@@ -12,14 +12,17 @@ T=$TESTTOOL
 command -v python3 >/dev/null || skip_all "python3 is needed to edit the test scenes"
 R="--spp 4 --size 96x72 --quiet"
 
-"$G" scene cornell -o "$tmp/cornell.gltf" && "$G" teapot --level 4 -o "$tmp/teapot.gltf" || { fail "scenes"; finish; exit; }
+# the scenes (gonio's own Cornell box, shared with untrusted.sh: lib.sh, fixture)
+declare -A src
+src[cornell]=$(fixture cornell.gltf "$G" scene cornell -o {}) && src[teapot]=$tmp/teapot.gltf &&
+    "$G" teapot --level 4 -o "${src[teapot]}" || { fail "scenes"; finish; exit; }
 # Q ID SCENE ARGS...: queues a render (lib.sh: queue); the script's renders run in one batch,
 # after the compressed and edited scenes are written, then the checks read each one's status,
 # output ($tmp/last) and image.
 Q() { local id=$1 f=$2; shift 2; queue "$id" render "$f" -o "$tmp/$id.exr" $R "$@"; }
 for s in cornell teapot; do
     for k in draco meshopt; do
-        check "$s: $k encode" "$T" compress $k "$tmp/$s.gltf" "$tmp/$s-$k.gltf"
+        check "$s: $k encode" "$T" compress $k "${src[$s]}" "$tmp/$s-$k.gltf"
         check "$s: $k file uses the extension" grep -q "$([ $k = draco ] && echo KHR_draco_mesh_compression || echo EXT_meshopt_compression)" "$tmp/$s-$k.gltf"
     done
 done
@@ -27,35 +30,36 @@ done
 # Corrupt compressed bytes: every 7th byte of the last buffer (the compressed one) flipped.
 for k in draco meshopt; do
     python3 - "$tmp/cornell-$k.gltf" "$tmp/bad-$k.gltf" <<'PY'
-import base64, json, sys
-d = json.load(open(sys.argv[1]))
-head, data = d["buffers"][-1]["uri"].split(",")
-raw = bytearray(base64.b64decode(data))
+import base64, sys
+import gltf_fixture as gf
+g = gf.Gltf.load(sys.argv[1])
+b = g.doc["buffers"][-1]
+raw = bytearray(base64.b64decode(b["uri"].split(",")[1]))
 for i in range(0, len(raw), 7):
     raw[i] ^= 0x5A
-d["buffers"][-1]["uri"] = head + "," + base64.b64encode(bytes(raw)).decode()
-json.dump(d, open(sys.argv[2], "w"))
+b["uri"] = gf.data_uri(bytes(raw))
+g.write(sys.argv[2])
 PY
 done
 
 # Variants: "green_left" maps the red wall (mesh 3) to the green material (2).
-python3 - "$tmp/cornell.gltf" "$tmp/variants.gltf" "$tmp/green.gltf" <<'PY'
-import json, sys
-d = json.load(open(sys.argv[1]))
-d["extensionsUsed"] = d.get("extensionsUsed", []) + ["KHR_materials_variants"]
-d.setdefault("extensions", {})["KHR_materials_variants"] = {"variants": [{"name": "as_is"}, {"name": "green_left"}]}
-p = d["meshes"][3]["primitives"][0]
+python3 - "${src[cornell]}" "$tmp/variants.gltf" "$tmp/green.gltf" <<'PY'
+import sys
+import gltf_fixture as gf
+g = gf.Gltf.load(sys.argv[1])
+g.variants("as_is", "green_left")
+p = g.doc["meshes"][3]["primitives"][0]
 assert p["material"] == 1
-p["extensions"] = {"KHR_materials_variants": {"mappings": [{"material": 2, "variants": [1]}, {"material": 1, "variants": [0]}]}}
-json.dump(d, open(sys.argv[2], "w"))
+g.extend(p, "KHR_materials_variants", mappings=[{"material": 2, "variants": [1]}, {"material": 1, "variants": [0]}])
+g.write(sys.argv[2])
 del p["extensions"]
 p["material"] = 2
-json.dump(d, open(sys.argv[3], "w"))
+g.write(sys.argv[3])
 PY
 
 # ---- the renders, queued ------------------------------------------------------------------
 for s in cornell teapot; do
-    Q $s "$tmp/$s.gltf"
+    Q $s "${src[$s]}"
     for k in draco meshopt; do Q $s-$k "$tmp/$s-$k.gltf"; done
 done
 for k in draco meshopt; do Q bad-$k "$tmp/bad-$k.gltf"; done
@@ -92,10 +96,10 @@ check_queued "variants: unknown name" 1 v-x
 check "variants: the error lists the variants" grep -q "no material variant 'nosuch' (variants: 'as_is', 'green_left')" "$tmp/last"
 
 # Extension rules.
-sed 's/"asset": {/"extensionsRequired": ["EXT_nosuch_a"],\n  "asset": {/' "$tmp/cornell.gltf" >"$tmp/req.gltf"
+sed 's/"asset": {/"extensionsRequired": ["EXT_nosuch_a"],\n  "asset": {/' "${src[cornell]}" >"$tmp/req.gltf"
 check_fails "required unknown extension" 1 "$G" info "$tmp/req.gltf"
 check "the error names it" grep -q "req.gltf: requires unsupported extension EXT_nosuch_a" "$tmp/last"
-sed 's/"extensionsUsed": \[/"extensionsUsed": ["EXT_nosuch_b","EXT_nosuch_c","EXT_nosuch_b",/' "$tmp/cornell.gltf" >"$tmp/used.gltf"
+sed 's/"extensionsUsed": \[/"extensionsUsed": ["EXT_nosuch_b","EXT_nosuch_c","EXT_nosuch_b",/' "${src[cornell]}" >"$tmp/used.gltf"
 check_fails "used unknown extensions only warn" 0 "$G" info "$tmp/used.gltf"
 for e in EXT_nosuch_b EXT_nosuch_c; do
     check "one warning for $e" test "$(grep -c "warning: .*used.gltf: uses unsupported extension $e" "$tmp/last")" = 1

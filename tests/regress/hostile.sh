@@ -9,47 +9,43 @@ command -v python3 >/dev/null || skip_all "python3 is needed to write the test s
 D=$tmp/scenes
 mkdir -p "$D/a/b" "$tmp/cwd"
 python3 - "$tmp" <<'PY'
-import json, struct, sys
+import sys
+import gltf_fixture as gf
 t = sys.argv[1]
-blob = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+# a triangle, its buffer the file the case names
+g = gf.Gltf()
+g.scene([g.node(mesh=g.mesh(g.primitive([0, 0, 0, 1, 0, 0, 0, 1, 0])))])
+blob = bytes(g.data)
 for f in ("secret.bin", "scenes/a/b/tri.bin", "cwd/only-here.bin"):
     open(f"{t}/{f}", "wb").write(blob)
 open(f"{t}/big-secret.bin", "wb").write(blob * 70)  # 2520 bytes: a size an error must not tell
-def doc(uri, length=36):
-    return {"asset": {"version": "2.0"}, "buffers": [{"uri": uri, "byteLength": length}],
-            "bufferViews": [{"buffer": 0, "byteLength": 36}],
-            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
-                           "min": [0, 0, 0], "max": [1, 1, 0]}],
-            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-            "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}
 cases = {"ok": "tri.bin", "up": "../../../secret.bin", "pct": "%2e%2e/%2e%2e/%2e%2e/secret.bin",
          "abs": f"{t}/secret.bin", "dot": ".", "dotdot": "..", "root": "/", "link": "link.bin",
          "cwd": "only-here.bin", "size": "../../../big-secret.bin"}
 for name, uri in cases.items():
-    json.dump(doc(uri, 12 if name == "size" else 36), open(f"{t}/scenes/a/b/{name}.gltf", "w"))
+    g.doc["buffers"][0]["byteLength"] = 12 if name == "size" else 36
+    g.write(f"{t}/scenes/a/b/{name}.gltf", uri=uri)
 PY
 ln -sf "$tmp/secret.bin" "$D/a/b/link.bin"
 B=$D/a/b
 # A camera aspect ratio from the file (0.004), for the render of the longer side's 512 below.
 python3 - "$B/ok.gltf" "$B/thin.gltf" <<'PY'
-import json, sys
-d = json.load(open(sys.argv[1]))
-d["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 0.004, "znear": 0.1}}]
-d["nodes"].append({"camera": 0, "translation": [0.3, 0.3, 3]})
-d["scenes"][0]["nodes"].append(1)
-json.dump(d, open(sys.argv[2], "w"))
+import sys
+import gltf_fixture as gf
+g = gf.Gltf.load(sys.argv[1])
+g.doc["scenes"][0]["nodes"].append(g.node(camera=g.perspective(0.5, 0.1, aspect=0.004), translation=[0.3, 0.3, 3]))
+g.write(sys.argv[2])
 PY
 # A light and an emitter of 1e39, for the renders of finite pixels below.
 python3 - "$B/ok.gltf" "$B/bright.gltf" <<'PY'
-import json, sys
-d = json.load(open(sys.argv[1]))
-d["extensionsUsed"] = ["KHR_lights_punctual", "KHR_materials_emissive_strength"]
-d["extensions"] = {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1e39}]}}
-d["materials"] = [{"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e39}}}]
-d["meshes"][0]["primitives"][0]["material"] = 0
-d["nodes"].append({"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0.2, 0.2, 1]})
-d["scenes"][0]["nodes"].append(1)
-json.dump(d, open(sys.argv[2], "w"))
+import sys
+import gltf_fixture as gf
+g = gf.Gltf.load(sys.argv[1])
+g.doc["scenes"][0]["nodes"].append(g.node(light=g.light("point", intensity=1e39), translation=[0.2, 0.2, 1]))
+m = {"emissiveFactor": [1, 1, 1]}
+g.extend(m, "KHR_materials_emissive_strength", emissiveStrength=1e39)
+g.doc["meshes"][0]["primitives"][0]["material"] = g.material(m)
+g.write(sys.argv[2])
 PY
 # Outputs (the checks below): an existing file of mode 640, and one of another owner (when
 # root), that a render replaces; stale temporary files of a gonio killed while writing.
@@ -119,34 +115,30 @@ check "... at most 512 pixels on its longer side" sh -c "exrheader '$tmp/thin.ex
 # 4,000,000 zero positions (no buffer view) drawn by 13 primitives is 17.3 M triangles, over
 # SCENE_MAX_TRIANGLES (2^24): refused before anything is read, with the numbers.
 python3 - "$B/amplified.gltf" <<'PY'
-import json, sys
-prims = [{"attributes": {"POSITION": 0}} for _ in range(13)]
-d = {"asset": {"version": "2.0"},
-     "accessors": [{"componentType": 5126, "count": 4000000, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0]}],
-     "meshes": [{"primitives": prims}], "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}
-json.dump(d, open(sys.argv[1], "w"))
+import sys
+import gltf_fixture as gf
+g = gf.Gltf()
+zeros = g.add("accessors", {"componentType": gf.FLOAT, "count": 4000000, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0]})
+g.scene([g.node(mesh=g.mesh(*[{"attributes": {"POSITION": zeros}} for _ in range(13)]))])
+g.write(sys.argv[1])
 PY
 check_fails "a 17 M-triangle amplification is refused" 1 "$G" info "$B/amplified.gltf"
 check "... with the numbers" grep -q "scene too large: .* the limit is 16777216" "$tmp/last"
 # Images: the same bytes are decoded once and count once against SCENE_MAX_TEXELS (2^28).
 # A 16384 x 4096 grey PNG is 67 M texels: listed 8 times it loads, 5 different ones do not.
 python3 - "$B" <<'PY'
-import json, struct, sys, zlib
-def png(path, w, h, value):
-    def chunk(t, data):
-        return struct.pack(">I", len(data)) + t + data + struct.pack(">I", zlib.crc32(t + data) & 0xffffffff)
-    row = b"\0" + bytes([value]) * w
-    raw = zlib.compress(row * h, 6)
-    open(path, "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0)) +
-                           chunk(b"IDAT", raw) + chunk(b"IEND", b""))
-d = json.load(open(sys.argv[1] + "/ok.gltf"))
+import sys
+import gltf_fixture as gf
+b = sys.argv[1]
 for k in range(5):
-    png(f"{sys.argv[1]}/big{k}.png", 16384, 4096, 40 * k)
-same, different = dict(d), dict(d)
-same["images"] = [{"uri": "big0.png"} for _ in range(8)]
-different["images"] = [{"uri": f"big{k}.png"} for k in range(5)]
-json.dump(same, open(sys.argv[1] + "/same-images.gltf", "w"))
-json.dump(different, open(sys.argv[1] + "/many-images.gltf", "w"))
+    open(f"{b}/big{k}.png", "wb").write(gf.png(16384, 4096, bytes([40 * k]) * (16384 * 4096), channels=1))
+same, different = gf.Gltf.load(b + "/ok.gltf"), gf.Gltf.load(b + "/ok.gltf")
+for _ in range(8):
+    same.image(uri="big0.png")
+for k in range(5):
+    different.image(uri=f"big{k}.png")
+same.write(b + "/same-images.gltf")
+different.write(b + "/many-images.gltf")
 PY
 check "one 67 M-texel image listed 8 times loads (decoded once)" "$G" info "$B/same-images.gltf"
 check_fails "5 different ones (335 M texels) are refused" 1 "$G" info "$B/many-images.gltf"
@@ -157,34 +149,24 @@ check "... with the numbers" grep -q "images too large: 335544320 texels with im
 ln -sfn "$B" "$tmp/linked"
 check "a scene in a symlinked folder loads its buffer" "$G" info "$tmp/linked/ok.gltf"
 python3 - "$B/ok.gltf" "$B/dotslash.gltf" <<'PY'
-import json, sys
-d = json.load(open(sys.argv[1]))
-d["buffers"][0]["uri"] = "./tri.bin"
-json.dump(d, open(sys.argv[2], "w"))
+import sys
+import gltf_fixture as gf
+g = gf.Gltf.load(sys.argv[1])
+g.doc["buffers"][0]["uri"] = "./tri.bin"
+g.write(sys.argv[2])
 PY
 check "a ./ URI of a scene named without a folder" sh -c "cd '$B' && '$G' info dotslash.gltf"
 
 # Images in a .glb's buffer views count against SCENE_MAX_TEXELS too.
 python3 - "$B" <<'PY'
-import json, struct, sys
+import sys
+import gltf_fixture as gf
 b = sys.argv[1]
-d = json.load(open(b + "/ok.gltf"))
-blob = open(b + "/tri.bin", "rb").read()
-views = [{"buffer": 0, "byteLength": len(blob)}]
+g = gf.Gltf()  # ok.gltf's triangle, and the five images in the binary chunk
+g.scene([g.node(mesh=g.mesh(g.primitive([0, 0, 0, 1, 0, 0, 0, 1, 0])))])
 for k in range(5):
-    png = open(f"{b}/big{k}.png", "rb").read()
-    while len(blob) % 4: blob += b"\0"
-    views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(png)})
-    blob += png
-while len(blob) % 4: blob += b"\0"
-d["buffers"] = [{"byteLength": len(blob)}]
-d["bufferViews"] = views
-d["images"] = [{"bufferView": 1 + k, "mimeType": "image/png"} for k in range(5)]
-js = json.dumps(d).encode()
-while len(js) % 4: js += b" "
-out = struct.pack("<III", 0x46546C67, 2, 12 + 8 + len(js) + 8 + len(blob))
-out += struct.pack("<II", len(js), 0x4E4F534A) + js + struct.pack("<II", len(blob), 0x004E4942) + blob
-open(b + "/many-images.glb", "wb").write(out)
+    g.image(open(f"{b}/big{k}.png", "rb").read(), in_buffer=True)
+g.glb(b + "/many-images.glb")
 PY
 check_fails "5 different 67 M-texel images in a .glb are refused" 1 "$G" info "$B/many-images.glb"
 check "... with the numbers" grep -q "images too large: 335544320 texels" "$tmp/last"

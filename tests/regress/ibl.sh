@@ -8,21 +8,12 @@
 # --env replaces the file's light; bad lights are errors naming their JSON path.
 . "$(dirname "$0")/../lib.sh"
 G=$GONIO
-command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
 root=$(cd "$(dirname "$0")/../.." && pwd)
 
-python3 - "$tmp" <<'PY' || { fail "scenes"; finish; exit; }
-import base64, json, math, struct, sys, zlib
+write_scenes <<'PY'
+import math, sys
+import gltf_fixture as gf
 out = sys.argv[1]
-
-def png(w, h, pixels, alpha):
-    """pixels(x, y) -> tuple of 3 or 4 bytes; an 8-bit RGB or RGBA PNG as bytes."""
-    n = 4 if alpha else 3
-    raw = b"".join(b"\0" + b"".join(bytes(pixels(x, y)[:n]) for x in range(w)) for y in range(h))
-    def chunk(t, d):
-        return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
-    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 6 if alpha else 2, 0, 0, 0)) +
-            chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 
 S = 16
 # (colour, alpha or None): faces +X, -X, +Y, -Y, +Z, -Z; +Y and -Z are RGBD
@@ -39,39 +30,31 @@ s2 = math.sqrt(0.5)
 looks = {"+X": [0, -s2, 0, s2], "-X": [0, s2, 0, s2], "+Y": [s2, 0, 0, s2], "-Y": [-s2, 0, 0, s2],
          "+Z": [0, 1, 0, 0], "-Z": [0, 0, 0, 1]}
 def scene(name, images, light=None, rotation=None, intensity=None, yfov=0.2, extra=None):
-    # one small triangle far away along (1, 1, 1), in no camera's view; a camera per axis
-    tri = [(10, 11, 10), (11, 10, 10), (10, 10, 11)]
-    raw = b"".join(struct.pack("<3f", *p) for p in tri)
-    nodes = [{"mesh": 0}] + [{"camera": 0, "rotation": q, "name": k} for k, q in looks.items()]
+    g = gf.Gltf()
     l = {"irradianceCoefficients": [[0, 0, 0]] * 9, "specularImageSize": S,
          "specularImages": [list(range(6))]}
     if rotation: l["rotation"] = rotation
     if intensity is not None: l["intensity"] = intensity
     if light: l.update(light)
-    d = {"asset": {"version": "2.0"}, "scene": 0,
-         "extensionsUsed": ["EXT_lights_image_based"],
-         "extensions": {"EXT_lights_image_based": {"lights": [l]}},
-         "scenes": [{"nodes": list(range(len(nodes))), "extensions": {"EXT_lights_image_based": {"light": 0}}}],
-         "nodes": nodes,
-         "cameras": [{"type": "perspective", "perspective": {"yfov": yfov, "znear": 0.01, "aspectRatio": 1}}],
-         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-         "buffers": [{"byteLength": len(raw), "uri": "data:application/octet-stream;base64," + base64.b64encode(raw).decode()}],
-         "bufferViews": [{"buffer": 0, "byteLength": len(raw)}],
-         "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
-                        "min": [10, 10, 10], "max": [11, 11, 11]}],
-         "images": [{"uri": f"{name}-{i}.png"} for i in range(len(images))]}
-    if extra: extra(d)
+    g.extend(g.doc, "EXT_lights_image_based", lights=[l])
+    # one small triangle far away along (1, 1, 1), in no camera's view; a camera per axis
+    nodes = [g.node(mesh=g.mesh(g.primitive([10, 11, 10, 11, 10, 10, 10, 10, 11])))]
+    cam = g.perspective(yfov, 0.01, aspect=1)
+    nodes += [g.node(camera=cam, rotation=q, name=k) for k, q in looks.items()]
+    g.scene(nodes, extensions={"EXT_lights_image_based": {"light": 0}})
     for i, data in enumerate(images):
         open(f"{out}/{name}-{i}.png", "wb").write(data)
-    json.dump(d, open(f"{out}/{name}.gltf", "w"))
+        g.image(uri=f"{name}-{i}.png")
+    if extra: extra(g.doc)
+    g.write(f"{out}/{name}.gltf")
 
-uniform = [png(S, S, lambda x, y, c=c, a=a: c + ((a,) if a else ()), a is not None) for c, a in faces]
+uniform = [gf.png(S, S, lambda x, y, c=c, a=a: c + ((a,) if a else ()), 3 if a is None else 4) for c, a in faces]
 scene("faces", uniform)
 scene("bright", uniform, intensity=2.5)
 scene("turned", uniform, rotation=[0, s2, 0, s2])
 # -Z split: left half red, right half blue (as seen from the centre)
 split = list(uniform)
-split[5] = png(S, S, lambda x, y: (220, 30, 30) if x < S // 2 else (30, 30, 220), False)
+split[5] = gf.png(S, S, lambda x, y: (220, 30, 30) if x < S // 2 else (30, 30, 220), 3)
 scene("split", split, yfov=1.0)
 # bad lights
 scene("bad-index", uniform, light={"specularImages": [[0, 1, 2, 3, 4, 9]]})

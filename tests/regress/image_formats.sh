@@ -31,13 +31,10 @@ N=48
 EXR="python3 $(dirname "$0")/../tool/exrtool.py"
 
 python3 - "$tmp" <<'PY'
-import struct, sys, zlib
-d = sys.argv[1]
+import sys
+import gltf_fixture as gf
 def png(name, w, h, px):
-    rows = b"".join(b"\0" + b"".join(bytes(px(i, j)) for i in range(w)) for j in range(h))
-    def chunk(t, b): return struct.pack(">I", len(b)) + t + b + struct.pack(">I", zlib.crc32(t + b) & 0xffffffff)
-    open(d + "/" + name, "wb").write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 6, 0, 0, 0)) +
-                                     chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
+    open(sys.argv[1] + "/" + name, "wb").write(gf.png(w, h, px))
 png("blocks.png", 16, 16, lambda i, j: (40 + 60 * (i // 4), 40 + 60 * (j // 4), 0, 255))
 png("grad.png", 64, 64, lambda i, j: (4 * i, 4 * j, 2 * (i + j), 255 - 2 * i))
 png("fallback.png", 4, 4, lambda i, j: (200, 0, 200, 255))
@@ -89,35 +86,20 @@ PY
 fi
 
 # ---- glTF files that use the extensions ------------------------------------------------------
-# gen.py OUT.gltf JSON: images (file names), texture (the texture object), used, required
+# gen.py OUT.gltf JSON: the quad view (gltf_fixture), its material's base colour the texture
+# (NEAREST filtering); JSON: images (file names), texture (the texture object), used, required
 cat >"$tmp/gen.py" <<'PY'
-import base64, json, struct, sys
+import json, sys
+import gltf_fixture as gf
 out, opt = sys.argv[1], json.loads(sys.argv[2])
-pos = [-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0]
-uv = [0, 1, 1, 1, 1, 0, 0, 0]  # (0, 0) at the top left
-blob = struct.pack("<12f", *pos) + struct.pack("<12f", *[0, 0, 1] * 4) + struct.pack("<8f", *uv) + struct.pack("<6H", 0, 1, 2, 0, 2, 3)
-views = [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 48},
-         {"buffer": 0, "byteOffset": 96, "byteLength": 32}, {"buffer": 0, "byteOffset": 128, "byteLength": 12}]
-accs = [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
-        {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
-        {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
-        {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}]
-doc = {
-    "asset": {"version": "2.0", "generator": "image_formats.sh"},
-    "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
-    "bufferViews": views, "accessors": accs,
-    "images": [{"uri": u} for u in opt["images"]],
-    "samplers": [{"magFilter": 9728, "minFilter": 9728}],
-    "textures": [dict(opt["texture"], sampler=0)],
-    "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}],
-    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3, "material": 0}]}],
-    "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 100}}],
-    "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}],
-    "scenes": [{"nodes": [0, 1]}], "scene": 0,
-}
-if opt.get("used"): doc["extensionsUsed"] = opt["used"]
-if opt.get("required"): doc["extensionsRequired"] = opt["required"]
-json.dump(doc, open(out, "w"))
+g = gf.Gltf(generator="image_formats.sh")
+g.use(*opt.get("used", []))
+g.require(*opt.get("required", []))
+for u in opt["images"]:
+    g.image(uri=u)
+g.texture(**dict(opt["texture"], sampler=g.sampler(gf.NEAREST, gf.NEAREST)))
+g.quad_view(g.quad(g.material({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}})))
+g.write(out)
 PY
 
 # probe.py IMAGE.exr TOL: every 3rd pixel well inside a block has the block's colour,
@@ -189,7 +171,7 @@ fi
 # Images in a GLB's binary chunk, with their mimeType (decoded once the buffer views are
 # checked, where files named by a uri are decoded as tinygltf reads them).
 glb_case() { # glb_case NAME TOL DESCRIPTION IMAGE [FALLBACK]: write, queue, then case_'s checks
-    python3 "$(dirname "$0")/../tool/texture_glb.py" "$tmp/$1.glb" "${@:4}"
+    python3 -m gltf_fixture textured-glb "$tmp/$1.glb" "${@:4}"
     QR "$1" "$tmp/$1.glb"
     after_queue render_checks "$@"
 }

@@ -108,55 +108,33 @@ fi
 M=$tmp/mutants
 mkdir -p "$M"
 python3 - "$M" >"$M/list" <<'PY'
-import base64, copy, json, struct, sys
+import base64, copy, json, sys
+import gltf_fixture as gf
 out = sys.argv[1]
-pos = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
-idx = struct.pack("<3H", 0, 1, 2) + b"\0\0"
-times = struct.pack("<2f", 0, 1)
-trans = struct.pack("<6f", 0, 0, 0, 0, 0, 1)
-sparse_idx = struct.pack("<H", 1) + b"\0\0"
-sparse_val = struct.pack("<3f", 1, 0, 0)
-data = pos + idx + times + trans + sparse_idx + sparse_val
+g = gf.Gltf()
+tri = [0, 0, 0, 1, 0, 0, 0, 1, 0]
+strided = g.view(gf.pack(gf.FLOAT, tri), stride=12)
+g.accessor(tri, "VEC3", view=strided, bounds=True)
+g.accessor([0, 1, 2], "SCALAR", gf.UNSIGNED_SHORT)
+keys = g.view(gf.pack(gf.FLOAT, [0, 1] + [0, 0, 0, 0, 0, 1]))  # an animation's key times, then its translations
+g.accessor([0, 1], "SCALAR", view=keys, bounds=True)
+g.accessor(None, "VEC3", view=keys, count=2, byteOffset=8)
+sparse = {"count": 1, "indices": {"bufferView": g.view(gf.pack(gf.UNSIGNED_SHORT, [1])), "componentType": gf.UNSIGNED_SHORT},
+          "values": {"bufferView": g.view(gf.pack(gf.FLOAT, [1, 0, 0])), "byteOffset": 0}}
+g.accessor(tri, "VEC3", view=strided, bounds=True, sparse=sparse)
 png = base64.b64decode("iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8DwHwAFBQIAX8jx0gAAAABJRU5ErkJggg==")
-base = {
-    "asset": {"version": "2.0"},
-    "extensionsUsed": ["KHR_lights_punctual"],
-    "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 1}]}},
-    "buffers": [{"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
-    "bufferViews": [
-        {"buffer": 0, "byteOffset": 0, "byteLength": 36, "byteStride": 12},
-        {"buffer": 0, "byteOffset": 36, "byteLength": 6},
-        {"buffer": 0, "byteOffset": 44, "byteLength": 32},
-        {"buffer": 0, "byteOffset": 76, "byteLength": 2},
-        {"buffer": 0, "byteOffset": 80, "byteLength": 12},
-    ],
-    "accessors": [
-        {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
-        {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"},
-        {"bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1]},
-        {"bufferView": 2, "byteOffset": 8, "componentType": 5126, "count": 2, "type": "VEC3"},
-        {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0],
-         "sparse": {"count": 1, "indices": {"bufferView": 3, "componentType": 5123},
-                    "values": {"bufferView": 4, "byteOffset": 0}}},
-    ],
-    "images": [{"uri": "data:image/png;base64," + base64.b64encode(png).decode()}],
-    "samplers": [{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 33071}],
-    "textures": [{"sampler": 0, "source": 0}],
-    "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 0}}, "alphaMode": "OPAQUE"}],
-    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0, "mode": 4}]},
-               {"primitives": [{"attributes": {"POSITION": 4}}]}],
-    "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}],
-    "nodes": [
-        {"mesh": 0, "children": [1, 2]},
-        {"camera": 0, "translation": [0.3, 0.3, 3]},
-        {"matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 2, 0, 0, 1], "mesh": 1,
-         "extensions": {"KHR_lights_punctual": {"light": 0}}},
-    ],
-    "animations": [{"samplers": [{"input": 2, "output": 3, "interpolation": "LINEAR"}],
-                    "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]}],
-    "scenes": [{"nodes": [0]}],
-    "scene": 0,
-}
+g.texture(g.image(png), g.sampler(mag=gf.LINEAR, min=9987, wrap=[gf.REPEAT, gf.CLAMP_TO_EDGE]))
+g.material({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 0}}, "alphaMode": "OPAQUE"})
+g.mesh({"attributes": {"POSITION": 0}, "indices": 1, "material": 0, "mode": 4})
+g.mesh({"attributes": {"POSITION": 4}})
+g.node(mesh=0, children=[1, 2])
+g.node(camera=g.perspective(0.8, 0.1), translation=[0.3, 0.3, 3])
+g.node(matrix=[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 2, 0, 0, 1], mesh=1, light=g.light("point", intensity=1))
+g.add("animations", {"samplers": [{"input": 2, "output": 3, "interpolation": "LINEAR"}],
+                     "channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}]})
+g.scene([0])
+g.write(out + "/base.gltf")
+base = g.doc
 # NAME, JSON path (a list of keys), the new value (DELETE removes it), exit status wanted,
 # a fragment of the error (of the warning when the status is 0) wanted.
 DELETE = object()
@@ -246,7 +224,6 @@ def put(doc, path, value):
         del doc[path[-1]]
     else:
         doc[path[-1]] = value
-json.dump(base, open(out + "/base.gltf", "w"))
 print("base\t0\t")
 for name, path, value, rc, msg in mutants:
     doc = copy.deepcopy(base)

@@ -240,41 +240,35 @@ check "unwritable output: message names the path" grep -q "/nonexistent/dir/x.ex
 check_fails "camera out of range" 1 "$G" render $C -o "$tmp/x.exr" --camera 9 --quiet
 check "no output after failures" test ! -e "$tmp/x.exr"
 
-# Tiny glTF files made here: an empty scene, NaN and huge positions.
-b64() { printf "$1" | base64 -w0; }
-tri_gltf() { # tri_gltf FILE BUFFER_BYTES_PRINTF
-    cat >"$1" <<EOF
-{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
- "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
- "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],
- "bufferViews":[{"buffer":0,"byteLength":36}],
- "buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,$(b64 "$2")"}]}
-EOF
-}
-one='\000\000\200\077'; zero='\000\000\000\000'; nan='\000\000\300\177'; huge='\231\166\226\176'
-tri_gltf "$tmp/ok.gltf" "$zero$zero$zero$one$zero$zero$zero$one$zero"
-tri_gltf "$tmp/nan.gltf" "$nan$zero$zero$one$zero$zero$zero$one$zero"
-tri_gltf "$tmp/huge.gltf" "$huge$zero$zero$one$zero$zero$zero$one$zero"
-echo '{"asset":{"version":"2.0"},"scenes":[{"nodes":[]}],"scene":0}' >"$tmp/empty.gltf"
-# Vertex colours (glTF COLOR_0) multiply the base colour: a triangle painted red through
-# COLOR_0 (float RGB, or normalised unsigned-byte RGBA) under a white material renders
-# exactly like the same triangle with a red base colour, in every mode that shows it.
-col_gltf() { # col_gltf FILE BASE_RGB COLOR_ATTRIBUTE_JSON COLOR_ACCESSOR_JSON COLOR_BYTES_PRINTF COLOR_BYTE_LENGTH
-    cat >"$1" <<EOF
-{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
- "materials":[{"pbrMetallicRoughness":{"baseColorFactor":[$2,1],"metallicFactor":0}}],
- "meshes":[{"primitives":[{"attributes":{"POSITION":0$3},"material":0}]}],
- "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}$4],
- "bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":$6}],
- "buffers":[{"byteLength":$((36 + $6)),"uri":"data:application/octet-stream;base64,$(b64 "$zero$zero$zero$one$zero$zero$zero$one$zero$5")"}]}
-EOF
-}
-red_f="$one$zero$zero"; red_u8='\377\000\000\377'
-col_gltf "$tmp/col_base.gltf" "1,0,0" "" "" "$zero" 4
-col_gltf "$tmp/col_f.gltf" "1,1,1" ',"COLOR_0":1' \
-    ',{"bufferView":1,"componentType":5126,"count":3,"type":"VEC3"}' "$red_f$red_f$red_f" 36
-col_gltf "$tmp/col_u8.gltf" "1,1,1" ',"COLOR_0":1' \
-    ',{"bufferView":1,"componentType":5121,"normalized":true,"count":3,"type":"VEC4"}' "$red_u8$red_u8$red_u8" 12
+# Tiny glTF files made here: an empty scene, NaN and huge positions. Vertex colours (glTF
+# COLOR_0) multiply the base colour: a triangle painted red through COLOR_0 (float RGB, or
+# normalised unsigned-byte RGBA) under a white material renders exactly like the same
+# triangle with a red base colour, in every mode that shows it.
+python3 - "$tmp" <<'PY'
+import sys
+import gltf_fixture as gf
+out = sys.argv[1]
+def triangle(name, x0=0.0, base=None, colour=None):
+    """(x0, 0, 0), (1, 0, 0), (0, 1, 0), its bounds as if x0 were 0; a material of the base
+    colour (RGB) where given, and colour(g), COLOR_0's accessor"""
+    g = gf.Gltf()
+    prim = {"attributes": {"POSITION": g.accessor([x0, 0, 0, 1, 0, 0, 0, 1, 0], "VEC3", min=[0, 0, 0], max=[1, 1, 0])}}
+    if base:
+        prim["material"] = g.material({"pbrMetallicRoughness": {"baseColorFactor": base + [1], "metallicFactor": 0}})
+    if colour:
+        prim["attributes"]["COLOR_0"] = colour(g)
+    g.scene([g.node(mesh=g.mesh(prim))])
+    g.write(f"{out}/{name}.gltf")
+triangle("ok")
+triangle("nan", float("nan"))
+triangle("huge", 1e38)
+g = gf.Gltf()
+g.scene([])
+g.write(out + "/empty.gltf")
+triangle("col_base", base=[1, 0, 0])
+triangle("col_f", base=[1, 1, 1], colour=lambda g: g.accessor([1, 0, 0] * 3, "VEC3"))
+triangle("col_u8", base=[1, 1, 1], colour=lambda g: g.accessor([255, 0, 0, 255] * 3, "VEC4", gf.UNSIGNED_BYTE, normalized=True))
+PY
 # (the renders of the rest of this script, in one batch)
 col_modes=()
 for mode in albedo phong gouraud flat path; do

@@ -11,37 +11,20 @@ G=$GONIO
 command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
 
 # gen.py OUT.gltf QUAD...: QUAD = z,half-size,r,g,b,double(0|1),facing(+1|-1): a square at
-# depth z facing +z or -z by its winding and normals; an orthographic camera at z = 5 looks
-# down -z.
+# depth z facing +z or -z by its winding and normals (gltf_fixture's quad); an orthographic
+# camera at z = 5 looks down -z.
 cat >"$tmp/gen.py" <<'PY'
-import base64, json, struct, sys
-out, quads = sys.argv[1], [list(map(float, q.split(","))) for q in sys.argv[2:]]
-blob, views, accs, meshes, mats, nodes = b"", [], [], [], [], []
-for i, (z, s, r, g, b, double, facing) in enumerate(quads):
-    corners = [(-s, -s), (s, -s), (s, s), (-s, s)]
-    if facing < 0:
-        corners.reverse()
-    pos = [c for x, y in corners for c in (x, y, z)]
-    data = struct.pack("<12f", *pos) + struct.pack("<12f", *[0, 0, facing] * 4) + struct.pack("<6H", 0, 1, 2, 0, 2, 3)
-    base = len(blob)
-    blob += data  # (108 bytes: every view stays 4-aligned)
-    for k, (off, n) in enumerate([(0, 48), (48, 48), (96, 12)]):
-        views.append({"buffer": 0, "byteOffset": base + off, "byteLength": n})
-    v = len(views) - 3
-    accs += [{"bufferView": v, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-s, -s, z], "max": [s, s, z]},
-             {"bufferView": v + 1, "componentType": 5126, "count": 4, "type": "VEC3"},
-             {"bufferView": v + 2, "componentType": 5123, "count": 6, "type": "SCALAR"}]
-    meshes.append({"primitives": [{"attributes": {"POSITION": v, "NORMAL": v + 1}, "indices": v + 2, "material": i}]})
-    mats.append({"pbrMetallicRoughness": {"baseColorFactor": [r, g, b, 1], "metallicFactor": 0, "roughnessFactor": 1},
-                 "doubleSided": double > 0})
-    nodes.append({"mesh": i})
-nodes.append({"camera": 0, "translation": [0, 0, 5]})
-doc = {"asset": {"version": "2.0"},
-       "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
-       "bufferViews": views, "accessors": accs, "meshes": meshes, "materials": mats,
-       "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 100}}],
-       "nodes": nodes, "scenes": [{"nodes": list(range(len(nodes)))}], "scene": 0}
-json.dump(doc, open(out, "w"))
+import sys
+import gltf_fixture as gf
+g = gf.Gltf()
+for q in sys.argv[2:]:
+    z, s, r, green, b, double, facing = map(float, q.split(","))
+    m = g.material({"pbrMetallicRoughness": {"baseColorFactor": [r, green, b, 1], "metallicFactor": 0, "roughnessFactor": 1},
+                    "doubleSided": double > 0})
+    g.node(mesh=g.mesh(g.quad(m, half=s, z=z, facing=facing, uv=False)))
+g.node(camera=g.orthographic(), translation=[0, 0, 5])
+g.scene(range(len(g.doc["nodes"])))
+g.write(sys.argv[1])
 PY
 # centre.py IMAGE.exr TOOLDIR: the mean R G B of the 4x4 pixels at the centre
 cat >"$tmp/centre.py" <<'PY'

@@ -15,65 +15,56 @@ command -v python3 >/dev/null || skip_all "python3 is needed to write the scenes
 TOOL=$(cd "$(dirname "$0")/../tool" && pwd)
 
 python3 - "$tmp" <<'PY'
-import base64, json, math, struct, sys
+import math, sys
+import gltf_fixture as gf
 out = sys.argv[1]
-buf = bytearray()
-views, accs = [], []
-def acc(fmt, values, comp, typ, count, **extra):
-    while len(buf) % 4:
-        buf.append(0)
-    views.append({"buffer": 0, "byteOffset": len(buf), "byteLength": struct.calcsize("<" + fmt * len(values))})
-    buf.extend(struct.pack("<" + fmt * len(values), *values))
-    a = {"bufferView": len(views) - 1, "componentType": comp, "type": typ, "count": count}
-    a.update(extra)
-    accs.append(a)
-    return len(accs) - 1
+g = gf.Gltf()
+U16 = gf.UNSIGNED_SHORT
 # the morphed quad, left half: base z 0, target 0 lifts the corners by 0, 0.4, 1, 0.2,
 # target 1 (sparse: no buffer view) lifts corner 3 by 0.8
 quad = [(-0.9, -0.8, 0), (-0.1, -0.8, 0), (-0.1, 0.8, 0), (-0.9, 0.8, 0)]
-qpos = acc("f", sum(map(list, quad), []), 5126, "VEC3", 4, min=[-0.9, -0.8, 0], max=[-0.1, 0.8, 0])
-qidx = acc("H", [0, 1, 2, 0, 2, 3], 5123, "SCALAR", 6)
+qpos = g.accessor(sum(map(list, quad), []), "VEC3", bounds=True)
+qidx = g.accessor([0, 1, 2, 0, 2, 3], "SCALAR", U16)
 t0 = [0, 0, 0, 0, 0, 0.4, 0, 0, 1, 0, 0, 0.2]
-qt0 = acc("f", t0, 5126, "VEC3", 4)
-iv = len(views); acc("H", [3, 0], 5123, "SCALAR", 1)  # sparse indices (padded)
-vv = len(views); acc("f", [0, 0, 0.8], 5126, "VEC3", 1)
-accs.append({"componentType": 5126, "type": "VEC3", "count": 4,
-             "sparse": {"count": 1, "indices": {"bufferView": iv, "componentType": 5123}, "values": {"bufferView": vv}}})
-qt1 = len(accs) - 1
+qt0 = g.accessor(t0, "VEC3")
+# target 1's sparse indices (padded to 4 bytes) and values: accessors too (the accessor
+# numbers the broken variants' messages name below count them)
+iv = g.doc["accessors"][g.accessor([3, 0], "SCALAR", U16, count=1)]["bufferView"]
+vv = g.doc["accessors"][g.accessor([0, 0, 0.8], "VEC3")]["bufferView"]
+qt1 = g.add("accessors", {"componentType": gf.FLOAT, "type": "VEC3", "count": 4,
+                          "sparse": {"count": 1, "indices": {"bufferView": iv, "componentType": U16},
+                                     "values": {"bufferView": vv}}})
 # CUBICSPLINE weights, keys at 0 and 1: (in, value, out) per key, 2 targets each
-wkeys = acc("f", [0, 1], 5126, "SCALAR", 2, min=[0], max=[1])
+wkeys = g.accessor([0, 1], "SCALAR", bounds=True)
 wcub = [0, 0, 0.2, 0.1, 1.5, -0.5, -1, 0.5, 1, 0.6, 0, 0]
-wout = acc("f", wcub, 5126, "SCALAR", 12)
+wout = g.accessor(wcub, "SCALAR")
 # the skinned strip, right half: rows y -0.8, 0, 0.8; joint 0 at (0.5, -0.8, 0), joint 1 its
 # child at (0, 0.8, 0); row 0 joint 0, row 1 half each, row 2 joint 1
 strip = [(x, y, 0) for y in (-0.8, 0, 0.8) for x in (0.1, 0.9)]
-spos = acc("f", sum(map(list, strip), []), 5126, "VEC3", 6, min=[0.1, -0.8, 0], max=[0.9, 0.8, 0])
-sidx = acc("H", [0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4], 5123, "SCALAR", 12)
-sj = acc("B", [0, 1, 0, 0] * 6, 5121, "VEC4", 6)
-sw = acc("f", [1, 0, 0, 0] * 2 + [0.5, 0.5, 0, 0] * 2 + [0, 1, 0, 0] * 2, 5126, "VEC4", 6)
-ibm = acc("f", [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -0.5, 0.8, 0, 1,
-                1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -0.5, 0, 0, 1], 5126, "MAT4", 2)
-rkeys = acc("f", [0, 1], 5126, "SCALAR", 2, min=[0], max=[1])
+spos = g.accessor(sum(map(list, strip), []), "VEC3", bounds=True)
+sidx = g.accessor([0, 1, 3, 0, 3, 2, 2, 3, 5, 2, 5, 4], "SCALAR", U16)
+sj = g.accessor([0, 1, 0, 0] * 6, "VEC4", gf.UNSIGNED_BYTE)
+sw = g.accessor([1, 0, 0, 0] * 2 + [0.5, 0.5, 0, 0] * 2 + [0, 1, 0, 0] * 2, "VEC4")
+ibm = g.accessor([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -0.5, 0.8, 0, 1,
+                  1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -0.5, 0, 0, 1], "MAT4")
+rkeys = g.accessor([0, 1], "SCALAR", bounds=True)
 s30 = math.sin(math.radians(30))
-rout = acc("f", [0, 0, 0, 1, s30, 0, 0, math.cos(math.radians(30))], 5126, "VEC4", 2)
-d = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1, 2, 4]}],
-     "nodes": [{"mesh": 0},
-               {"mesh": 1, "skin": 0, "translation": [0, 0, -2]},
-               {"translation": [0.5, -0.8, 0], "children": [3]},
-               {"translation": [0, 0.8, 0]},
-               {"camera": 0, "translation": [0, 0, 5]}],
-     "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 100}}],
-     "meshes": [{"primitives": [{"attributes": {"POSITION": qpos}, "indices": qidx,
-                                 "targets": [{"POSITION": qt0}, {"POSITION": qt1}]}], "weights": [0.5, 0.5]},
-                {"primitives": [{"attributes": {"POSITION": spos, "JOINTS_0": sj, "WEIGHTS_0": sw}, "indices": sidx}]}],
-     "skins": [{"joints": [2, 3], "inverseBindMatrices": ibm}],
-     "animations": [{"samplers": [{"input": wkeys, "output": wout, "interpolation": "CUBICSPLINE"},
+rout = g.accessor([0, 0, 0, 1, s30, 0, 0, math.cos(math.radians(30))], "VEC4")
+morphed = g.mesh({"attributes": {"POSITION": qpos}, "indices": qidx, "targets": [{"POSITION": qt0}, {"POSITION": qt1}]},
+                 weights=[0.5, 0.5])
+skinned = g.mesh({"attributes": {"POSITION": spos, "JOINTS_0": sj, "WEIGHTS_0": sw}, "indices": sidx})
+g.node(mesh=morphed)
+g.node(mesh=skinned, skin=0, translation=[0, 0, -2])
+g.node(translation=[0.5, -0.8, 0], children=[3])
+g.node(translation=[0, 0.8, 0])
+g.node(camera=g.orthographic(), translation=[0, 0, 5])
+g.scene([0, 1, 2, 4])
+g.add("skins", {"joints": [2, 3], "inverseBindMatrices": ibm})
+g.add("animations", {"samplers": [{"input": wkeys, "output": wout, "interpolation": "CUBICSPLINE"},
                                   {"input": rkeys, "output": rout}],
                      "channels": [{"sampler": 0, "target": {"node": 0, "path": "weights"}},
-                                  {"sampler": 1, "target": {"node": 3, "path": "rotation"}}]}],
-     "bufferViews": views, "accessors": accs,
-     "buffers": [{"byteLength": len(buf), "uri": "data:application/octet-stream;base64," + base64.b64encode(bytes(buf)).decode()}]}
-json.dump(d, open(out + "/pose.gltf", "w"))
+                                  {"sampler": 1, "target": {"node": 3, "path": "rotation"}}]})
+g.write(out + "/pose.gltf")
 
 # ---- the expected pose at T, computed here ----
 def weights_at(t):

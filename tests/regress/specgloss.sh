@@ -15,38 +15,17 @@ A=${GONIO_ASSETS:-}
 command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
 W=16 H=8
 
-# gen.py OUT.gltf MATERIAL-JSON EXTENSIONS-JSON: slots.sh's quad, orthographic camera, the
-# 2x1 texture (left texel 255 in every channel, right 0) as texture 0, NEAREST filtering.
+# gen.py OUT.gltf MATERIAL-JSON EXTENSIONS-JSON: the quad view (gltf_fixture), the 2x1 texture
+# (left texel 255 in every channel, right 0) as texture 0, NEAREST filtering.
 cat >"$tmp/gen.py" <<'PY'
-import base64, json, struct, sys, zlib
+import json, sys
+import gltf_fixture as gf
 out, material, exts = sys.argv[1], json.loads(sys.argv[2]), json.loads(sys.argv[3])
-pos = [-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0]
-uv = [0, 1, 1, 1, 1, 0, 0, 0]
-blob = struct.pack("<12f", *pos) + struct.pack("<12f", *[0, 0, 1] * 4) + struct.pack("<8f", *uv) + \
-       struct.pack("<6H", 0, 1, 2, 0, 2, 3)
-views = [{"buffer": 0, "byteOffset": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 48},
-         {"buffer": 0, "byteOffset": 96, "byteLength": 32}, {"buffer": 0, "byteOffset": 128, "byteLength": 12}]
-accs = [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0]},
-        {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC3"},
-        {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
-        {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}]
-rows = b"\0" + bytes([255, 255, 255, 255, 0, 0, 0, 0])
-def chunk(t, d): return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
-png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 2, 1, 8, 6, 0, 0, 0)) + \
-      chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b"")
-doc = {
-    "asset": {"version": "2.0"}, "extensionsUsed": exts,
-    "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
-    "bufferViews": views, "accessors": accs,
-    "images": [{"uri": "data:image/png;base64," + base64.b64encode(png).decode()}],
-    "samplers": [{"magFilter": 9728, "minFilter": 9728}], "textures": [{"source": 0, "sampler": 0}],
-    "materials": [material],
-    "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}, "indices": 3,
-                                "material": 0}]}],
-    "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 100}}],
-    "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}], "scenes": [{"nodes": [0, 1]}], "scene": 0,
-}
-json.dump(doc, open(out, "w"))
+g = gf.Gltf()
+g.use(*exts)
+g.texture(g.image(gf.png(2, 1, bytes([255] * 4 + [0] * 4))), g.sampler(gf.NEAREST, gf.NEAREST))
+g.quad_view(g.quad(g.material(material)))
+g.write(out)
 PY
 
 # mr DIFFUSE(3) SPECULAR(3) GLOSSINESS: the metallic-roughness twin of a spec-gloss material,
@@ -93,37 +72,11 @@ for s in sg-factors mr-factors sg-tex mr-white mr-black; do
     check_queued "$s renders" 0 $s
 done
 
-# halves.py A.exr LEFT.exr RIGHT.exr TOOLDIR W: A's left half is LEFT's, its right half
-# RIGHT's, pixel by pixel (but the seam's two columns); LEFT and RIGHT differ (unless the
-# same file).
-cat >"$tmp/halves.py" <<'PY'
-import sys
-sys.path.insert(0, sys.argv[4])
-import exrtool
-def rgb(path):
-    _, ch = exrtool.read(path)
-    return [ch[c][1] for c in "RGB"]
-t, l, r = rgb(sys.argv[1]), rgb(sys.argv[2]), rgb(sys.argv[3])
-w = int(sys.argv[5])
-bad = differ = 0
-for c in range(3):
-    for i, v in enumerate(t[c]):
-        x = i % w
-        if l is not r and x in (w // 2 - 1, w // 2):
-            continue
-        want = l[c][i] if x < w // 2 else r[c][i]
-        if abs(v - want) > 1e-4 * max(1.0, abs(want)):
-            bad += 1
-            if bad <= 5: print("pixel %d channel %d: %.6f, not %.6f" % (i, c, v, want))
-        differ += abs(l[c][i] - r[c][i]) > 0.01
-print("%d values wrong, %d differ between the two references" % (bad, differ))
-sys.exit(1 if bad or (differ == 0 and sys.argv[2] != sys.argv[3]) else 0)
-PY
 T=$(dirname "$0")/../tool
 check "factors: the spec-gloss quad renders as its metallic-roughness twin" \
-    python3 "$tmp/halves.py" "$tmp/sg-factors.exr" "$tmp/mr-factors.exr" "$tmp/mr-factors.exr" "$T" $W
+    same_halves "$tmp/sg-factors.exr" "$tmp/mr-factors.exr" "$tmp/mr-factors.exr" $W
 check "specularGlossinessTexture: RGB scales the specular colour, A the glossiness, texel by texel" \
-    python3 "$tmp/halves.py" "$tmp/sg-tex.exr" "$tmp/mr-white.exr" "$tmp/mr-black.exr" "$T" $W
+    same_halves "$tmp/sg-tex.exr" "$tmp/mr-white.exr" "$tmp/mr-black.exr" $W
 
 # a bad value: an error naming the JSON path, exit 1
 check_queued "a specularFactor of the wrong type is refused" 1 bad

@@ -12,77 +12,47 @@ G=$GONIO
 command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
 N=48 # image size: 12 pixels a texel at uv scale 1
 
-# gen.py OUT.gltf JSON-OPTIONS: the scene; options: wrap [S, T], mag (filter), tt (the
-# KHR_texture_transform object), texcoord (the reference's), uv0/uv1 (the uv of the quad's
-# top-left and bottom-right corners per set, or null), quant (store attributes quantized),
-# declare_quant, normal (the quad's normal, for the quantization check in --mode normal).
+# gen.py OUT.gltf JSON-OPTIONS: the quad view (gltf_fixture), textured; options: wrap [S, T],
+# mag and min (the filters), tt (the KHR_texture_transform object), texcoord (the
+# reference's), uv0/uv1 (the uv of the quad's top-left and bottom-right corners per set, or
+# null), quant (store attributes quantized), declare_quant, normal (the quad's normal, for
+# the quantization check in --mode normal).
 cat >"$tmp/gen.py" <<'PY'
-import base64, json, struct, sys
+import json, sys
+import gltf_fixture as gf
 out, opt = sys.argv[1], json.loads(sys.argv[2])
 def corners(a, b):  # uv at the quad's corners (-1,-1), (1,-1), (1,1), (-1,1); a top-left, b bottom-right
     return [a[0], b[1], b[0], b[1], b[0], a[1], a[0], a[1]]
-pos = [-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0]
 nrm = opt.get("normal", [0, 0, 1]) * 4
-idx = [0, 1, 2, 0, 2, 3]
 q = opt.get("quant", False)
-blob, views, accs = b"", [], []
-def add(data, acc, stride=None):
-    global blob
-    while len(blob) % 4: blob += b"\0"
-    views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data)})
-    if stride: views[-1]["byteStride"] = stride
-    blob += data
-    acc["bufferView"] = len(views) - 1
-    accs.append(acc)
-    return len(accs) - 1
+g = gf.Gltf(generator="textures.sh")
 attrs = {}
 if q:  # POSITION as unsigned shorts 0..2 (the node moves them back by -1), NORMAL as bytes
-    attrs["POSITION"] = add(struct.pack("<12H", *[int(v + 1) if i % 3 < 2 else 0 for i, v in enumerate(pos)]),
-                            {"componentType": 5123, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [2, 2, 0]})
-    attrs["NORMAL"] = add(struct.pack("<16b", *sum([[round(c * 127) for c in nrm[0:3]] + [0] for _ in range(4)], [])),
-                          {"componentType": 5120, "normalized": True, "count": 4, "type": "VEC3"}, 4)
+    attrs["POSITION"] = g.accessor([int(v + 1) if i % 3 < 2 else 0 for i, v in enumerate(gf.QUAD_POSITIONS)],
+                                   "VEC3", gf.UNSIGNED_SHORT, bounds=True)
+    attrs["NORMAL"] = g.accessor(sum([[round(c * 127) for c in nrm[0:3]] + [0] for _ in range(4)], []),
+                                 "VEC3", gf.BYTE, count=4, stride=4, normalized=True)
 else:
-    attrs["POSITION"] = add(struct.pack("<12f", *pos), {"componentType": 5126, "count": 4, "type": "VEC3",
-                                                        "min": [-1, -1, 0], "max": [1, 1, 0]})
-    attrs["NORMAL"] = add(struct.pack("<12f", *nrm), {"componentType": 5126, "count": 4, "type": "VEC3"})
+    attrs["POSITION"] = g.accessor(gf.QUAD_POSITIONS, "VEC3", bounds=True)
+    attrs["NORMAL"] = g.accessor(nrm, "VEC3")
 for s in (0, 1):
     c = opt.get("uv%d" % s)
     if c is None: continue
     uv = corners(*c)
     if q:  # signed shorts, not normalized: the corners are integers here
-        attrs["TEXCOORD_%d" % s] = add(struct.pack("<8h", *[int(v) for v in uv]),
-                                       {"componentType": 5122, "count": 4, "type": "VEC2"})
+        attrs["TEXCOORD_%d" % s] = g.accessor([int(v) for v in uv], "VEC2", gf.SHORT)
     else:
-        attrs["TEXCOORD_%d" % s] = add(struct.pack("<8f", *uv), {"componentType": 5126, "count": 4, "type": "VEC2"})
-ind = add(struct.pack("<6H", *idx), {"componentType": 5123, "count": 6, "type": "SCALAR"})
+        attrs["TEXCOORD_%d" % s] = g.accessor(uv, "VEC2")
+ind = g.accessor(gf.QUAD_INDICES, "SCALAR", gf.UNSIGNED_SHORT)
 # the 4x4 RGBA image: texel (i, j) (column, row from the top) has R = 40 + 60 i, G = 40 + 60 j
-import zlib
-rows = b"".join(b"\0" + b"".join(bytes([40 + 60 * i, 40 + 60 * j, 0, 255]) for i in range(4)) for j in range(4))
-def chunk(t, d): return struct.pack(">I", len(d)) + t + d + struct.pack(">I", zlib.crc32(t + d) & 0xffffffff)
-png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 4, 4, 8, 6, 0, 0, 0)) + \
-      chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b"")
-ref = {"index": 0}
+image = g.image(gf.png(4, 4, lambda i, j: (40 + 60 * i, 40 + 60 * j, 0, 255)))
+ref = {"index": g.texture(image, g.sampler(opt.get("mag", gf.NEAREST), opt.get("min"), opt.get("wrap", [gf.REPEAT] * 2)))}
 if "texcoord" in opt: ref["texCoord"] = opt["texcoord"]
-if "tt" in opt: ref["extensions"] = {"KHR_texture_transform": opt["tt"]}
-wrap = opt.get("wrap", [10497, 10497])
-sampler = {"wrapS": wrap[0], "wrapT": wrap[1]}
-if opt.get("mag", 9728) is not None: sampler["magFilter"] = opt.get("mag", 9728)
-if "min" in opt: sampler["minFilter"] = opt["min"]
-used = (["KHR_texture_transform"] if "tt" in opt else []) + (["KHR_mesh_quantization"] if opt.get("declare_quant", q) else [])
-doc = {
-    "asset": {"version": "2.0", "generator": "textures.sh"},
-    "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
-    "bufferViews": views, "accessors": accs,
-    "images": [{"uri": "data:image/png;base64," + base64.b64encode(png).decode()}],
-    "samplers": [sampler], "textures": [{"source": 0, "sampler": 0}],
-    "materials": [{"pbrMetallicRoughness": {"baseColorTexture": ref, "metallicFactor": 0}}],
-    "meshes": [{"primitives": [{"attributes": attrs, "indices": ind, "material": 0}]}],
-    "cameras": [{"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 100}}],
-    "nodes": [{"mesh": 0, "translation": [-1, -1, 0] if q else [0, 0, 0]}, {"camera": 0, "translation": [0, 0, 5]}],
-    "scenes": [{"nodes": [0, 1]}], "scene": 0,
-}
-if used: doc["extensionsUsed"] = used
-json.dump(doc, open(out, "w"))
+if "tt" in opt: g.extend(ref, "KHR_texture_transform", opt["tt"])
+if opt.get("declare_quant", q): g.use("KHR_mesh_quantization")
+material = g.material({"pbrMetallicRoughness": {"baseColorTexture": ref, "metallicFactor": 0}})
+g.quad_view({"attributes": attrs, "indices": ind, "material": material}, translation=[-1, -1, 0] if q else [0, 0, 0])
+g.write(out)
 PY
 
 # probe.py IMAGE.exr JSON-OPTIONS: every 3rd pixel whose centre lies well inside one texel

@@ -63,12 +63,11 @@ fifo_refused "--camera a FIFO" "$G" render $S -o "$F/x.exr" $R --camera "$F/view
 fifo_refused "merge of a FIFO" "$G" merge "$F/ok.exr" "$F/tile.exr" -o "$F/x.exr"
 fifo_refused "diff of a FIFO" "$G" diff "$F/ok.exr" "$F/tile.exr"
 python3 - "$F" <<'PY'
-import json, sys
-d = {"asset": {"version": "2.0"}, "buffers": [{"uri": "buffer.bin", "byteLength": 36}],
-     "bufferViews": [{"buffer": 0, "byteLength": 36}],
-     "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]}],
-     "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}], "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}]}
-json.dump(d, open(sys.argv[1] + "/buffer.gltf", "w"))
+import sys
+import gltf_fixture as gf
+g = gf.Gltf()  # a triangle whose buffer is the FIFO buffer.bin
+g.scene([g.node(mesh=g.mesh(g.primitive([0, 0, 0, 1, 0, 0, 0, 1, 0])))], default=False)
+g.write(sys.argv[1] + "/buffer.gltf", uri="buffer.bin")
 PY
 check_fails "a FIFO as a scene's buffer" 1 timeout 20 "$G" info "$F/buffer.gltf"
 check "... is not a regular file" grep -q "buffer.bin' is not a regular file" "$tmp/last"
@@ -160,14 +159,14 @@ check "... naming it" grep -q "out of range: must be in \[0, 1000000000\]" "$tmp
 
 # ---- text from files: control characters escaped --------------------------------------------
 python3 - "$tmp/esc.gltf" <<'PY'
-import json, sys
-d = json.load(open("scenes/cornell.gltf"))
-for m in d["materials"]:
+import sys
+import gltf_fixture as gf
+g = gf.Gltf.load("scenes/cornell.gltf")
+for m in g.doc["materials"]:
     if m.get("name") == "light":  # the emitter: gonio info names it
         m["name"] = "light\x1b[2J\x1b]0;owned\x07\nforged line"
-d["extensionsUsed"] = d.get("extensionsUsed", []) + ["KHR_materials_variants"]
-d.setdefault("extensions", {})["KHR_materials_variants"] = {"variants": [{"name": "v\x1b[31m"}]}
-json.dump(d, open(sys.argv[1], "w"))
+g.variants("v\x1b[31m")
+g.write(sys.argv[1])
 PY
 esc=$(printf '\033')
 check_fails "gonio info on names with escape sequences" 0 "$G" info "$tmp/esc.gltf"
@@ -179,22 +178,22 @@ check "... is printed escaped" sh -c "! grep -q '$esc' '$tmp/last' && grep -qF '
 # ---- the loader: variants, compressed-mesh bindings, animation keys ---------------------------
 L=$tmp/loader
 mkdir -p "$L"
-"$G" scene cornell -o "$L/cornell.gltf"
+# gonio's own Cornell box, shared with gltf_ext.sh (lib.sh, fixture)
+cornell=$(fixture cornell.gltf "$G" scene cornell -o {})
 # bad_scene NAME DESCRIPTION GREP: gonio info L/NAME.gltf fails naming the JSON path and value
 bad_scene() {
     check_fails "$2" 1 "$G" info "$L/$1.gltf"
     check "... naming it: $3" grep -qF -- "$3" "$tmp/last"
 }
-python3 - "$L" <<'PY'
-import json, sys
+python3 - "$L" "$cornell" <<'PY'
+import sys
+import gltf_fixture as gf
 L = sys.argv[1]
-base = json.load(open(L + "/cornell.gltf"))
 def variants(name, mappings, names=("a", "b")):
-    d = json.loads(json.dumps(base))
-    d["extensionsUsed"] = d.get("extensionsUsed", []) + ["KHR_materials_variants"]
-    d.setdefault("extensions", {})["KHR_materials_variants"] = {"variants": [{"name": n} for n in names]}
-    d["meshes"][3]["primitives"][0]["extensions"] = {"KHR_materials_variants": {"mappings": mappings}}
-    json.dump(d, open(f"{L}/{name}.gltf", "w"))
+    g = gf.Gltf.load(sys.argv[2])
+    g.variants(*names)
+    g.extend(g.doc["meshes"][3]["primitives"][0], "KHR_materials_variants", mappings=mappings)
+    g.write(f"{L}/{name}.gltf")
 variants("var-ok", [{"material": 2, "variants": [1]}, {"material": 1, "variants": [0]}])
 variants("var-range", [{"material": 2, "variants": [5]}])
 variants("var-negative", [{"material": 2, "variants": [-1]}])
@@ -220,29 +219,25 @@ check_fails "--variant '' is bad usage" 2 "$G" render "$L/var-ok.gltf" -o "$L/x.
 "$TESTTOOL" compress meshopt "$L/teapot.gltf" "$L/teapot-meshopt.gltf"
 "$TESTTOOL" compress draco "$L/teapot.gltf" "$L/teapot-draco.gltf"
 python3 - "$L" <<'PY'
-import json, sys
+import sys
+import gltf_fixture as gf
 L = sys.argv[1]
-m = json.load(open(L + "/teapot-meshopt.gltf"))
-views = [v for v in m["bufferViews"] if "EXT_meshopt_compression" in v.get("extensions", {})]
-fb = views[0]["buffer"]
+meshopt = lambda g: [v for v in g.doc["bufferViews"] if "EXT_meshopt_compression" in v.get("extensions", {})]
 # The fallback buffer: no data, and too short for the views that decode into it.
-short = json.loads(json.dumps(m))
-short["buffers"][fb] = {"byteLength": 16, "extensions": {"EXT_meshopt_compression": {"fallback": True}}}
-short["extensionsRequired"] = sorted(set(short.get("extensionsRequired", []) + ["EXT_meshopt_compression"]))
-json.dump(short, open(L + "/meshopt-short.gltf", "w"))
-big = json.loads(json.dumps(m))
-[v for v in big["bufferViews"] if "EXT_meshopt_compression" in v.get("extensions", {})][0]["extensions"]["EXT_meshopt_compression"]["count"] = 4294967295
-json.dump(big, open(L + "/meshopt-count.gltf", "w"))
-d = json.load(open(L + "/teapot-draco.gltf"))
-pos = d["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
-vec2 = json.loads(json.dumps(d))
-vec2["accessors"][pos]["type"] = "VEC2"
-vec2["accessors"][pos]["min"] = vec2["accessors"][pos]["min"][:2]
-vec2["accessors"][pos]["max"] = vec2["accessors"][pos]["max"][:2]
-json.dump(vec2, open(L + "/draco-vec2.gltf", "w"))
-short_pos = json.loads(json.dumps(d))
-short_pos["accessors"][pos]["componentType"] = 5122
-json.dump(short_pos, open(L + "/draco-short.gltf", "w"))
+short = gf.Gltf.load(L + "/teapot-meshopt.gltf")
+short.doc["buffers"][meshopt(short)[0]["buffer"]] = {"byteLength": 16, "extensions": {"EXT_meshopt_compression": {"fallback": True}}}
+short.doc["extensionsRequired"] = sorted(set(short.doc.get("extensionsRequired", []) + ["EXT_meshopt_compression"]))
+short.write(L + "/meshopt-short.gltf")
+big = gf.Gltf.load(L + "/teapot-meshopt.gltf")
+meshopt(big)[0]["extensions"]["EXT_meshopt_compression"]["count"] = 4294967295
+big.write(L + "/meshopt-count.gltf")
+vec2, short_pos = gf.Gltf.load(L + "/teapot-draco.gltf"), gf.Gltf.load(L + "/teapot-draco.gltf")
+pos = vec2.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
+a = vec2.doc["accessors"][pos]
+a["type"], a["min"], a["max"] = "VEC2", a["min"][:2], a["max"][:2]
+vec2.write(L + "/draco-vec2.gltf")
+short_pos.doc["accessors"][pos]["componentType"] = gf.SHORT
+short_pos.write(L + "/draco-short.gltf")
 PY
 check "the meshopt and Draco teapots load" sh -c "'$G' info '$L/teapot-meshopt.gltf' && '$G' info '$L/teapot-draco.gltf'"
 bad_scene meshopt-short "a meshopt fallback buffer shorter than the views over it" "lie beyond buffers["
@@ -255,12 +250,12 @@ A=${GONIO_ASSETS:-}/gltf/RiggedSimple/glTF/RiggedSimple.gltf
 if [ -f "$A" ]; then
     # Draco keeps JOINTS_0 unsigned short: a compressed skinned mesh loads like the original.
     python3 - "$A" "$L/rigged.gltf" <<'PY'
-import base64, json, os, sys
-d = json.load(open(sys.argv[1]))
-for b in d["buffers"]:
-    raw = open(os.path.join(os.path.dirname(sys.argv[1]), b["uri"]), "rb").read()
-    b["uri"] = "data:application/octet-stream;base64," + base64.b64encode(raw).decode()
-json.dump(d, open(sys.argv[2], "w"))
+import os, sys
+import gltf_fixture as gf
+g = gf.Gltf.load(sys.argv[1])
+for b in g.doc["buffers"]:
+    b["uri"] = gf.data_uri(open(os.path.join(os.path.dirname(sys.argv[1]), b["uri"]), "rb").read())
+g.write(sys.argv[2])
 PY
     check "RiggedSimple (unsigned short joints) compresses with Draco" "$TESTTOOL" compress draco "$L/rigged.gltf" "$L/rigged-draco.gltf"
     check "... and loads" "$G" info "$L/rigged-draco.gltf"
@@ -271,34 +266,21 @@ else
 fi
 
 # Animation samplers, checked whether or not --at samples them.
-python3 - "$L" <<'PY'
-import base64, json, struct, sys
+python3 - "$L" "$cornell" <<'PY'
+import sys
+import gltf_fixture as gf
 L = sys.argv[1]
-base = json.load(open(L + "/cornell.gltf"))
-def anim(name, times, values, comp=5126, normalized=False, path="rotation", vtype="VEC4"):
-    d = json.loads(json.dumps(base))
-    fmt = {5126: "f", 5122: "h", 5120: "b"}[comp]
-    tb = struct.pack("<%df" % len(times), *times)
-    vb = struct.pack("<%d%s" % (len(values), fmt), *values)
-    while len(vb) % 4: vb += b"\0"
-    d["buffers"].append({"byteLength": len(tb) + len(vb),
-                         "uri": "data:application/octet-stream;base64," + base64.b64encode(tb + vb).decode()})
-    b = len(d["buffers"]) - 1
-    d["bufferViews"] += [{"buffer": b, "byteLength": len(tb)}, {"buffer": b, "byteOffset": len(tb), "byteLength": len(vb)}]
-    nv = len(d["bufferViews"])
-    d["accessors"] += [{"bufferView": nv - 2, "componentType": 5126, "count": len(times), "type": "SCALAR",
-                        "min": [min(times)], "max": [max(times)]},
-                       {"bufferView": nv - 1, "componentType": comp, "normalized": normalized,
-                        "count": len(times), "type": vtype}]
-    na = len(d["accessors"])
-    d["animations"] = [{"samplers": [{"input": na - 2, "output": na - 1}],
-                        "channels": [{"sampler": 0, "target": {"node": 1, "path": path}}]}]
-    json.dump(d, open(f"{L}/{name}.gltf", "w"))
+def anim(name, times, values, comp=gf.FLOAT, normalized=False, path="rotation", vtype="VEC4"):
+    g = gf.Gltf.load(sys.argv[2])  # its views in a buffer of their own, after the box's
+    key = g.accessor(times, "SCALAR", bounds=True)
+    g.add("animations", {"samplers": [{"input": key, "output": g.accessor(values, vtype, comp, normalized=normalized)}],
+                         "channels": [{"sampler": 0, "target": {"node": 1, "path": path}}]})
+    g.write(f"{L}/{name}.gltf")
 q = [0, 0, 0, 1]
 anim("anim-ok", [0, 1], q + q)
 anim("anim-equal", [0, 1, 1], q + q + q)
-anim("anim-short-rot", [0, 1], [0, 0, 0, 32767] * 2, comp=5122)
-anim("anim-short-rot-n", [0, 1], [0, 0, 0, 32767] * 2, comp=5122, normalized=True)
+anim("anim-short-rot", [0, 1], [0, 0, 0, 32767] * 2, comp=gf.SHORT)
+anim("anim-short-rot-n", [0, 1], [0, 0, 0, 32767] * 2, comp=gf.SHORT, normalized=True)
 PY
 check "an animation as the spec allows loads" "$G" info "$L/anim-ok.gltf"
 check "normalized short rotations load" "$G" info "$L/anim-short-rot-n.gltf"

@@ -19,54 +19,41 @@
 . "$(dirname "$0")/../lib.sh"
 G=$GONIO
 T=$TESTTOOL
-command -v python3 >/dev/null || skip_all "python3 is needed to write the test scenes"
 
-python3 - "$tmp" <<'PY' || { fail "scenes"; finish; exit; }
-import base64, json, math, struct, sys
+write_scenes <<'PY'
+import math, sys
+import gltf_fixture as gf
 out = sys.argv[1]
 def scene(name, shapes, materials, camera, eye=(0, 0, 5)):
-    pos, idx, prims = [], [], []
-    for tris, mat in shapes:
-        first = len(idx)
-        for t in tris:
-            for p in t:
-                idx.append(len(pos)); pos.append(p)
-        prims.append((first, len(idx) - first, mat))
-    raw = b"".join(struct.pack("<3f", *p) for p in pos) + b"".join(struct.pack("<I", i) for i in idx)
-    nb = 12 * len(pos)
-    d = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": list(range(len(prims) + 1))}],
-         "buffers": [{"byteLength": len(raw), "uri": "data:application/octet-stream;base64," + base64.b64encode(raw).decode()}],
-         "bufferViews": [{"buffer": 0, "byteLength": nb, "target": 34962},
-                         {"buffer": 0, "byteOffset": nb, "byteLength": len(raw) - nb, "target": 34963}],
-         "accessors": [{"bufferView": 0, "componentType": 5126, "count": len(pos), "type": "VEC3",
-                        "min": [min(p[a] for p in pos) for a in range(3)], "max": [max(p[a] for p in pos) for a in range(3)]}],
-         "meshes": [], "nodes": [], "materials": materials, "cameras": [camera]}
-    for i, (first, n, mat) in enumerate(prims):
-        d["accessors"].append({"bufferView": 1, "byteOffset": 4 * first, "componentType": 5125, "count": n, "type": "SCALAR"})
-        d["meshes"].append({"primitives": [{"attributes": {"POSITION": 0}, "indices": i + 1, "material": mat}]})
-        d["nodes"].append({"mesh": i})
-    d["nodes"].append({"camera": 0, "translation": list(eye)})
-    used = sorted({e for m in materials for e in m.get("extensions", {})})
-    if used:
-        d["extensionsUsed"] = used
-    json.dump(d, open("%s/%s.gltf" % (out, name), "w"))
-def box(h, inward=False):  # outward-facing (counter-clockwise seen from outside) unless inward
-    tris = []
-    for ax in range(3):
-        for s in (-1, 1):
-            u, v = (ax + 1) % 3, (ax + 2) % 3
-            def P(a, b):
-                p = [0.0] * 3; p[ax] = s * h[ax]; p[u] = a * h[u]; p[v] = b * h[v]; return p
-            q = [P(-1, -1), P(1, -1), P(1, 1), P(-1, 1)]
-            if (s < 0) != inward: q = q[::-1]
-            tris += [(q[0], q[1], q[2]), (q[0], q[2], q[3])]
-    return tris
+    """shapes: (corners, material), the corners of triangles (a flat list) one primitive of
+    its own node each, all in one POSITION accessor"""
+    g = gf.Gltf()
+    pos = [c for corners, _ in shapes for c in corners]
+    position = g.accessor(pos, "VEC3", bounds=True, target=gf.ARRAY_BUFFER)
+    indices = g.view(gf.pack(gf.UNSIGNED_INT, range(len(pos) // 3)), target=gf.ELEMENT_ARRAY_BUFFER)
+    for m in materials:
+        g.material(m)
+    nodes, first = [], 0
+    for corners, mat in shapes:
+        n = len(corners) // 3
+        idx = g.accessor(None, "SCALAR", gf.UNSIGNED_INT, count=n, view=indices, byteOffset=4 * first)
+        nodes.append(g.node(mesh=g.mesh({"attributes": {"POSITION": position}, "indices": idx, "material": mat})))
+        first += n
+    g.scene(nodes + [g.node(camera=g.add("cameras", camera), translation=list(eye))])
+    g.declare_extensions()
+    g.write("%s/%s.gltf" % (out, name))
+def box(h, inward=False):  # [-h, h]'s corners, outward-facing unless inward
+    P, _, I = gf.box([-x for x in h], h)
+    if inward:
+        I = [I[t + k] for t in range(0, len(I), 3) for k in (0, 2, 1)]
+    return gf.unindexed(P, I)
 def sphere(r, n=48):
     m = n // 2
     V = lambda i, j: [r * math.sin(math.pi * i / m) * math.cos(2 * math.pi * j / n),
                       r * math.sin(math.pi * i / m) * math.sin(2 * math.pi * j / n), r * math.cos(math.pi * i / m)]
-    return [t for i in range(m) for j in range(n) for k, t in enumerate(((V(i, j), V(i + 1, j), V(i, j + 1)),
+    tris = [t for i in range(m) for j in range(n) for k, t in enumerate(((V(i, j), V(i + 1, j), V(i, j + 1)),
             (V(i + 1, j), V(i + 1, j + 1), V(i, j + 1)))) if (k == 0 and i > 0) or (k == 1 and i < m - 1)]
+    return [c for t in tris for p in t for c in p]
 def glass(ior, color=None, dist=None, dispersion=None, volume=True):
     e = {"KHR_materials_transmission": {"transmissionFactor": 1}, "KHR_materials_ior": {"ior": ior}}
     if volume:
@@ -89,7 +76,7 @@ e = 0.001  # the liquid overlaps the shell's inner wall by e
 scene("touching", [(box([1, 1, 1]), 0), (box([0.5, 0.5, 0.5], True), 0), (box([0.5 + e] * 3), 1)],
       [glass(1, Ag, Dg), glass(1, Al, Dl)], ortho)
 light = {"emissiveFactor": [1, 1, 1], "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4}}}
-bar = [([0.1, -3, -3], [0.5, -3, -3], [0.5, 3, -3]), ([0.1, -3, -3], [0.5, 3, -3], [0.1, 3, -3])]
+bar = [0.1, -3, -3, 0.5, -3, -3, 0.5, 3, -3, 0.1, -3, -3, 0.5, 3, -3, 0.1, 3, -3]
 persp = {"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.01}}
 def prism(name, m):
     scene(name, [(sphere(1), 0), (bar, 1)], [m, light], persp, (0, 0, 4))

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "scene.h"
+#include "scene_files.h"
 #include "test.h"
 #include "util.h"
 
@@ -38,26 +39,6 @@ static const char *tmp_path(const char *ext)
 #define TMP_GLB tmp_path("glb")
 
 /* ---- helpers ------------------------------------------------------------------------------ */
-
-static char load_log[16384];
-
-/* scene_load with its messages captured in load_log (printed by the tests only on failure). */
-static bool load(scene *s, const char *path)
-{
-    FILE *tmp = tmpfile();
-    int saved = dup(2);
-    fflush(stderr);
-    dup2(fileno(tmp), 2);
-    bool ok = scene_load(s, path);
-    fflush(stderr);
-    dup2(saved, 2);
-    close(saved);
-    rewind(tmp);
-    size_t n = fread(load_log, 1, sizeof load_log - 1, tmp);
-    load_log[n] = 0;
-    fclose(tmp);
-    return ok;
-}
 
 static const char *asset(char *buf, size_t cap, const char *rel)
 {
@@ -88,22 +69,6 @@ static vec3 placed(const scene *s, uint32_t i, vec3 p)
     const float *w = s->instances[i].to_world;
     return (vec3){w[0] * p.x + w[1] * p.y + w[2] * p.z + w[3], w[4] * p.x + w[5] * p.y + w[6] * p.z + w[7],
                   w[8] * p.x + w[9] * p.y + w[10] * p.z + w[11]};
-}
-
-static char *base64(const void *data, size_t n)
-{
-    static const char tab[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    const unsigned char *p = data;
-    char *out = util_malloc(4 * ((n + 2) / 3) + 1), *o = out;
-    for (size_t i = 0; i < n; i += 3) {
-        unsigned v = (unsigned)p[i] << 16 | (i + 1 < n ? (unsigned)p[i + 1] << 8 : 0) | (i + 2 < n ? p[i + 2] : 0);
-        *o++ = tab[v >> 18 & 63];
-        *o++ = tab[v >> 12 & 63];
-        *o++ = i + 1 < n ? tab[v >> 6 & 63] : '=';
-        *o++ = i + 2 < n ? tab[v & 63] : '=';
-    }
-    *o = 0;
-    return out;
 }
 
 static void write_bytes(const char *path, const void *data, size_t n)
