@@ -66,7 +66,15 @@ export GONIO_TEST_TIER=$tier
 # compiles in about half the time and runs about 40 % slower (docs/performance.md). The slow
 # tier keeps the optimised kernels (make test-full runs every check so). GALLIVM_PERF set
 # outside (even empty) wins.
+[ -n "${GALLIVM_PERF+x}" ] && gallivm_outside=1
 [ "$tier" = fast ] && export GALLIVM_PERF=${GALLIVM_PERF-nopt}
+# ... but for the jobs whose kernels run far longer than they compile, which take less CPU
+# optimised (unit/brdf: its BRDF kernels evaluate millions of queries; 61 s of CPU against
+# 71 with nopt, docs/performance.md).
+optimised_jobs=" unit/brdf "
+# The jobs run side by side, as many as there are CPUs, so lavapipe's own threads would only
+# contend with the other jobs for them: one each (LP_NUM_THREADS set outside wins).
+export LP_NUM_THREADS=${LP_NUM_THREADS-1}
 
 # ---- the jobs ------------------------------------------------------------------------------
 # job_name[i], job_cmd[i] (an argument list, joined by the unit separator \037)
@@ -147,6 +155,7 @@ run_job() {
     local i=$1 t0=$EPOCHREALTIME rc
     local IFS=$'\037'
     local cmd=(${job_cmd[i]})
+    case $optimised_jobs in *" ${job_name[i]} "*) [ -n "${gallivm_outside+x}" ] || local GALLIVM_PERF= ;; esac
     "${cmd[@]}" >"$jobdir/$i.out" 2>&1 </dev/null
     rc=$?
     # times' second line: the CPU time of this job's processes (user, system), as 1m2.345s

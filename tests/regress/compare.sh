@@ -12,8 +12,23 @@ size_of() { identify -format '%wx%h' "$1" 2>/dev/null; }
 # The highest channel value inside a region WxH+X+Y of a PNG, 0..1 (ink on a dark band).
 ink() { convert "$1" -crop "$2" +repage -colorspace Gray -format '%[fx:maxima]' info: 2>/dev/null; }
 
-check "compare the teapot" "$G" compare $T -o "$tmp/c" --size ${W}x$H --spp 4 --modes flat,gouraud,phong,path
-cp "$tmp/out" "$tmp/printed"
+# The commands that render, in one batch (lib.sh: queue): each kernel compiled once for all.
+box=${GONIO_ASSETS:-}/gltf/Box/glTF/Box.gltf
+queue teapot compare $T -o "$tmp/c" --size ${W}x$H --spp 4 --modes flat,gouraud,phong,path
+queue sweep compare --sweep 2,4,8,16 teapot -o "$tmp/s" --size ${W}x$H --quiet
+if [ -f "$box" ]; then
+    mkdir -p "$tmp/box"
+    queue box compare "$box" -o "$tmp/box" --size 48x36 --spp 4 --modes gouraud,path
+    for m in gouraud path; do
+        queue box-$m render "$box" --mode $m --size 48x36 --spp 4 -o "$tmp/box/render-$m.exr" --quiet
+    done
+    queue box-studio render "$box" --mode phong --size 48x36 --spp 4 --env studio -o "$tmp/box/studio.exr" --quiet
+    queue box-default render "$box" --mode phong --size 48x36 --spp 4 -o "$tmp/box/default.exr"
+fi
+run_queue
+
+check_queued "compare the teapot" 0 teapot
+cp "$tmp/last" "$tmp/printed"
 modes="flat gouraud phong path"
 n=$(echo $modes | wc -w)
 for m in $modes; do
@@ -54,7 +69,7 @@ check "no temporary files left" sh -c "! ls -a '$tmp/c' | grep -q tmp-"
 # ---- the sweep: Gouraud's error against per-pixel Phong falls with every refinement -----
 # (Level 1, 56 triangles, is left out: there the per-pixel reference itself misses the
 # highlight; see docs/shading.md.)
-check "sweep" "$G" compare --sweep 2,4,8,16 teapot -o "$tmp/s" --size ${W}x$H --quiet
+check_queued "sweep" 0 sweep
 check "sweep.csv has 4 levels" test "$(tail -n +2 "$tmp/s/sweep.csv" | wc -l)" = 4
 check "sweep triangle counts 64 L^2 - 8 L" awk -F, 'NR > 1 && $2 != 64 * $1 * $1 - 8 * $1 { exit 1 }' "$tmp/s/sweep.csv"
 check "Gouraud error falls as the mesh gets finer" awk -F, \
@@ -65,21 +80,19 @@ check "no teapot scenes left in the sweep folder" sh -c "! ls '$tmp/s' | grep -q
 # ---- the light rule of gonio render: each image is render's ----------------------------------
 # Box has no lights: the studio lights it, the local modes through its key light and mean, the
 # path tracer through the map; compare's images must be render's, bit for bit.
-box=${GONIO_ASSETS:-}/gltf/Box/glTF/Box.gltf
 if [ -f "$box" ]; then
-    check "compare Box" "$G" compare "$box" -o "$tmp/box" --size 48x36 --spp 4 --modes gouraud,path
-    cp "$tmp/out" "$tmp/box.log"
+    check_queued "compare Box" 0 box
+    cp "$tmp/last" "$tmp/box.log"
     check "compare says the studio lights Box" grep -q "lit by gonio's studio environment" "$tmp/box.log"
     for m in gouraud path; do
-        check "render Box, $m" "$G" render "$box" --mode $m --size 48x36 --spp 4 -o "$tmp/box/render-$m.exr" --quiet
+        check_queued "render Box, $m" 0 box-$m
         check "compare's $m image is render's" "$G" diff "$tmp/box/$m.exr" "$tmp/box/render-$m.exr" --max-error 0
     done
     # The studio lights a file without lights once: for the local modes its key light joins
     # the scene's lights, which must not then pass for the file's own (a second studio).
-    check "render Box, phong, --env studio" "$G" render "$box" --mode phong --size 48x36 --spp 4 --env studio \
-        -o "$tmp/box/studio.exr" --quiet
-    check "render Box, phong" "$G" render "$box" --mode phong --size 48x36 --spp 4 -o "$tmp/box/default.exr"
-    cp "$tmp/out" "$tmp/box.log"
+    check_queued "render Box, phong, --env studio" 0 box-studio
+    check_queued "render Box, phong" 0 box-default
+    cp "$tmp/last" "$tmp/box.log"
     check "the studio is added once" sh -c "! grep -q 'leaves the view dark' '$tmp/box.log'"
     check "a file without lights renders as with --env studio" "$G" diff "$tmp/box/default.exr" "$tmp/box/studio.exr" \
         --max-error 0
