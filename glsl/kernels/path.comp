@@ -51,10 +51,16 @@ layout(push_constant) uniform PushBlock { GnPush push; };
 #define RETRACE (GN_HAS(GN_FEAT_ENV) ? 6u : 0u)
 layout(std430, binding = GN_BIND_PSTATE) buffer StateBlock { uint pstate[]; };
 
+// The sampler (GN_SAMPLER_*). Its dimensions, four numbers each (sampling.glsl:
+// sampler_get4, .yz a 2D pair): 0 the film position (.yz); per bounce d, 1 + 2d the light
+// choice (.x), the point on the light (.yz) and roulette (.w), 2 + 2d the BSDF's lobe choice
+// (.x), its direction (.yz) and the medium boundary's choice (.w). The alpha tests' numbers
+// (DIM_ALPHA, bvh.glsl) stay independent.
+layout(constant_id = GN_SPEC_SAMPLER) const uint SAMPLER = GN_SAMPLER_SOBOL;
 uint sample_now; // the sample index of the path being traced
 vec4 rng(uint pixel, uint dim)
 {
-    return rng_uniform4(pixel, sample_now, dim, frame.seed);
+    return sampler_get4(SAMPLER, pixel, sample_now, dim, frame.seed);
 }
 
 float luminance(vec3 c) { return dot(c, vec3(GN_LUMA_R, GN_LUMA_G, GN_LUMA_B)); }
@@ -464,7 +470,7 @@ void path_start()
     sample_now = push.sample_index - pstate_behind + taken;
     rng_sample = sample_now;
     depth = 0u;
-    camera_ray(vec2(px) + rng(pixel, 0u).xy, o, d, tmin);
+    camera_ray(vec2(px) + rng(pixel, 0u).yz, o, d, tmin);
     radiance = vec3(0.0);
     beta = vec3(1.0);
     prev_pdf = 0.0;

@@ -70,4 +70,68 @@ vec4 rng_uniform4(uint pixel, uint sample_index, uint dimension, uint seed)
     return vec4(h >> 8u) * (1.0 / 16777216.0);
 }
 
+// ---- the samplers (GN_SAMPLER_*; docs/path-tracing.md: "Samplers") -----------------------
+// A sampler's numbers are, like rng_uniform4's, a pure function of (pixel, sample index,
+// dimension, seed): any sample of any pixel is computed on its own, so tiles, resumed and
+// merged renders are exact whichever sampler made them.
+
+// Laine & Karras's permutation of a 32-bit word: output bit k depends only on input bits
+// 0..k and the seed (additions and products carry upwards only), so applied to a value's
+// reversed bits it is a nested uniform (Owen) scramble: each digit flipped by a function of
+// the digits above it (Burley 2020, "Practical Hash-based Owen Scrambling", JCGT 9(4)).
+uint sampler_lk_permute(uint x, uint seed)
+{
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return x;
+}
+
+// Sobol's second dimension of index i, its bits reversed (bit j: the digit of weight 2^-(j+1)).
+// Its generator matrix is Pascal's triangle mod 2: digit j is the XOR of the index bits k
+// with binomial(k, j) odd, that is (Lucas) of those k whose bits hold all of j's: a superset
+// XOR over the five bits of a bit position, one shift-and-mask per bit, no loop. The first
+// dimension is the index itself reversed (van der Corput), so the reversed pair is (i, this).
+uint sampler_sobol1_reversed(uint i)
+{
+    i ^= (i >> 1u) & 0x55555555u;
+    i ^= (i >> 2u) & 0x33333333u;
+    i ^= (i >> 4u) & 0x0f0f0f0fu;
+    i ^= (i >> 8u) & 0x00ff00ffu;
+    i ^= (i >> 16u) & 0x0000ffffu;
+    return i;
+}
+
+// Sample i of Sobol's first two dimensions with the index shuffled and each coordinate
+// Owen-scrambled by the three words of h (Burley 2020): the first 2^m shuffled indices are
+// one aligned block of 2^m Sobol points, so every power-of-two prefix of a pixel's samples
+// is a (0, m, 2)-net of the square and every prefix is a (0, 2)-sequence's: stratified in
+// every elementary interval.
+vec2 sampler_sobol2(uint i, uvec3 h)
+{
+    uint j = bitfieldReverse(sampler_lk_permute(bitfieldReverse(i), h.x));
+    uint x = bitfieldReverse(sampler_lk_permute(j, h.y));
+    uint y = bitfieldReverse(sampler_lk_permute(sampler_sobol1_reversed(j), h.z));
+    return vec2(uvec2(x, y) >> 8u) * (1.0 / 16777216.0);
+}
+
+// Four numbers for (pixel, sample index, dimension, seed) from the sampler `kind`
+// (GN_SAMPLER_*). The
+// path kernel's layout (docs/path-tracing.md): .yz a 2D decision (film position, a point on
+// a light, a direction), .x and .w two 1D ones (light or lobe choice, roulette or medium).
+// With GN_SAMPLER_SOBOL .yz is one scrambled Sobol pair and (.x, .w) another, each pair's
+// index shuffled by its own hash of (pixel, dimension, seed), so pairs, dimensions and
+// pixels are decorrelated while each pair is stratified over a pixel's samples.
+vec4 sampler_get4(uint kind, uint pixel, uint sample_index, uint dimension, uint seed)
+{
+    if (kind != GN_SAMPLER_SOBOL)
+        return rng_uniform4(pixel, sample_index, dimension, seed);
+    uvec4 h = rng_pcg4d(uvec4(pixel, dimension, seed, 0x5ab01u));
+    uvec4 g = rng_pcg4d(uvec4(pixel, dimension, seed, 0x5ab02u));
+    vec2 a = sampler_sobol2(sample_index, h.xyz), b = sampler_sobol2(sample_index, g.xyz);
+    return vec4(b.x, a, b.y);
+}
+
 #endif

@@ -90,6 +90,22 @@ typedef uint32_t uint;
  * without it): the two-level walk and the instances' transforms compile away for scenes
  * without them. */
 #define GN_SPEC_INSTANCES 5u
+/* The path kernel's sampler (specialization constant 6, SAMPLER in glsl/kernels/path.comp):
+ * where its random numbers come from (glsl/lib/sampling.glsl: sampler_get4; --sampler,
+ * docs/path-tracing.md: "Samplers"). X(ID, value, name, help): GN_SAMPLER_<ID> = value,
+ * list order is --sampler's, the first the default (render_settings.sampler 0). */
+#define GN_SPEC_SAMPLER 6u
+#define GN_SAMPLERS(X) \
+    X(SOBOL, 0u, "sobol", "Owen-scrambled Sobol pairs, decorrelated per pixel (default)") \
+    X(INDEPENDENT, 1u, "independent", "independent hashed random numbers")
+#ifdef VULKAN
+#define GN_SAMPLER_ID(id, value, name, help) const uint GN_SAMPLER_##id = value;
+GN_SAMPLERS(GN_SAMPLER_ID)
+#else
+#define GN_SAMPLER_ID(id, value, name, help) GN_SAMPLER_##id = value,
+enum { GN_SAMPLERS(GN_SAMPLER_ID) GN_SAMPLER_COUNT };
+#endif
+#undef GN_SAMPLER_ID
 /* A path's saved state (glsl/kernels/path.comp: path_save, path_load; GN_BIND_PSTATE,
  * GnFrame.state_stride words a pixel): word 0, the pixel's samples still to take, then the
  * fields of GN_PATH_STATE in order, then the walk's stack; with instances, the last two words

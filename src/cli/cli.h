@@ -140,6 +140,10 @@ void cli_complete_print(const char *list);
 #define CLI_OPT_MODE(dest)                                                                        \
     {"--mode", "M", render_mode_help(), CLI_CALL, CLI_AS(uint32_t, dest), 0, 0, NULL, cli_take_mode, \
      render_mode_list()}
+/* The path tracer's sampler (GN_SAMPLERS; dest: uint32_t). */
+#define CLI_OPT_SAMPLER(dest)                                                                     \
+    {"--sampler", "S", render_sampler_help(), CLI_CALL, CLI_AS(uint32_t, dest), 0, 0, NULL,        \
+     cli_take_sampler, render_sampler_list()}
 #define CLI_OPT_VARIANT(help)                                                                     \
     {"--variant", "NAME", help, CLI_CALL, NULL, 0, 0, NULL, cli_take_variant, NULL}
 #define CLI_OPT_NO_SHADOWS(dest)                                                                  \
@@ -178,6 +182,7 @@ void cli_complete_print(const char *list);
  * value may be. */
 bool cli_take_size(const char *cmd, const char *opt, const char *value, void *dest); /* WxH: int[2] */
 bool cli_take_mode(const char *cmd, const char *opt, const char *value, void *dest); /* uint32_t GN_MODE_* */
+bool cli_take_sampler(const char *cmd, const char *opt, const char *value, void *dest); /* uint32_t GN_SAMPLER_* */
 bool cli_take_tonemap(const char *cmd, const char *opt, const char *value, void *dest); /* image_tonemap */
 bool cli_take_variant(const char *cmd, const char *opt, const char *value, void *dest); /* no dest: scene_select_variant */
 bool cli_take_exr_compression(const char *cmd, const char *opt, const char *value, void *dest); /* int */

@@ -179,13 +179,18 @@ static bool bench_paths(renderer *r, render_settings *s, double t_start, float s
          first += r->path_samples, samples += (int)r->path_samples)
         t_paths += path_pass(r, first, r->path_samples);
     printf("first pixel        %.3f s after start (path, %dx%d)\n", t_first, s->width, s->height);
-    printf("paths              %.3f M paths/s (%dx%d, %d spp, unbounded depth, MIS)\n",
-           (double)s->width * s->height * samples / t_paths * 1e-6, s->width, s->height, samples);
+    printf("paths              %.3f M paths/s (%dx%d, %d spp, unbounded depth, MIS, %s sampler)\n",
+           (double)s->width * s->height * samples / t_paths * 1e-6, s->width, s->height, samples,
+           render_sampler_name(s->sampler));
     fflush(stdout);
 
+    /* The reference by independent samples (seed 1): their variance estimates its noise
+     * below (a low-discrepancy sampler's mean errs less than its samples' variance says). */
+    const uint32_t sampler = s->sampler;
     s->width = ref_w;
     s->height = ref_h;
     s->seed = 1;
+    s->sampler = GN_SAMPLER_INDEPENDENT;
     if (!renderer_begin(r, s, &frame))
         return false;
     t_ref = util_now();
@@ -201,6 +206,7 @@ static bool bench_paths(renderer *r, render_settings *s, double t_start, float s
             ref_noise += (sq / ref_spp - m * m) / (ref_spp - 1);
         }
     ref_noise /= 3.0 * ref_w * ref_h;
+    s->sampler = sampler;
     printf("reference          %dx%d, %d spp in %.1f s (its own rmse %.4f)\n", ref_w, ref_h,
            ref_spp, t_ref, sqrt(ref_noise));
 
@@ -356,6 +362,7 @@ int cmd_bench(int argc, char **argv)
     env_option env = {0};
     int device = -1, size[2] = {0, 0}, ref_w = 128, ref_h = 128, ref_spp = 512;
     bool validate = false, paths = false, denoise = false;
+    uint32_t sampler = GN_SAMPLER_SOBOL;
     reference_option ref = {&ref_w, &ref_h, &ref_spp};
     const cli_option options[] = {
         /* meshgen_bench_mesh's 16 spheres and ground need about 1000 triangles. */
@@ -366,6 +373,7 @@ int cmd_bench(int argc, char **argv)
          FLT_MIN, 1e6, "a number > 0", NULL, NULL},
         {"--paths", NULL, "measure the path tracer", CLI_FLAG, CLI_AS(bool, &paths), 0, 0, NULL, NULL, NULL},
         CLI_OPT_ENV(&env, "--paths: the environment, as gonio render's (default 0: black)"),
+        CLI_OPT_SAMPLER(&sampler),
         {"--reference", "WxH:SPP", "--paths: the RMSE reference (default 128x128:512)", CLI_CALL, &ref,
          0, 0, "WxH:SPP", take_reference, NULL},
         CLI_OPT_DENOISE(&denoise, "--paths: also the time to each RMSE of the denoised image (render\n"
@@ -417,7 +425,7 @@ int cmd_bench(int argc, char **argv)
         render_settings s = {.mode = paths ? GN_MODE_PATH : GN_MODE_PHONG, .camera = sc.num_cameras ? 0 : -1,
                              .aov = paths ? RENDER_AOV_VARIANCE : RENDER_AOV_GPU, .no_shadows = true,
                              .width = size[0] ? size[0] : paths ? 256 : 512,
-                             .height = size[0] ? size[1] : paths ? 256 : 512};
+                             .height = size[0] ? size[1] : paths ? 256 : 512, .sampler = sampler};
         render_lighting light = {0};
         if (!paths)
             ok = bench_rays(&r, &s, t_start, seconds);

@@ -225,6 +225,15 @@ static bool check_resume(const char *path, const renderer *r, render_settings *s
         util_error("%s: cannot resume: its seed is not this render's %u (--seed)", path, s->seed);
         return false;
     }
+    if (s->mode == GN_MODE_PATH) { /* (renders before the samplers: independent numbers) */
+        char file[64] = "independent";
+        image_exr_attr_string(path, "gonio:sampler", file, sizeof file);
+        if (strcmp(file, render_sampler_name(s->sampler))) {
+            util_error("%s: cannot resume: its samples are the %s sampler's, this render's the %s one's (--sampler)",
+                       path, file, render_sampler_name(s->sampler));
+            return false;
+        }
+    }
     render_region(s, region);
     {
         bool whole = region[0] == 0 && region[1] == 0 && region[2] == s->width && region[3] == s->height;
@@ -501,6 +510,7 @@ int cmd_render(int argc, char **argv)
                         "(gonio info lists them; default: the file's own materials)"),
         CLI_OPT_ALLOW_OUTSIDE_FILES(&j.outside),
         CLI_OPT_SEED(&j.s.seed, "random seed (default 0); renders with different seeds merge"),
+        CLI_OPT_SAMPLER(&j.s.sampler),
         {"--frame", "N", "the scene's glTF animations at frame N / --fps (all play at once:\n"
                          "node translation, rotation, scale; meshes, cameras, lights)",
          CLI_INT, CLI_AS(int, &j.frame), 0, 1 << 24, "a frame number >= 0", NULL, NULL},

@@ -37,6 +37,17 @@ bool cli_take_mode(const char *cmd, const char *opt, const char *value, void *de
     return true;
 }
 
+bool cli_take_sampler(const char *cmd, const char *opt, const char *value, void *dest)
+{
+    int k = render_sampler_from_name(value);
+    if (k < 0) {
+        cli_usage_error(cmd, "%s '%s': expected one of %s", opt, value, render_sampler_list());
+        return false;
+    }
+    *(uint32_t *)dest = (uint32_t)k;
+    return true;
+}
+
 bool cli_take_tonemap(const char *cmd, const char *opt, const char *value, void *dest)
 {
     (void)cmd, (void)opt;

@@ -931,6 +931,7 @@ int cmd_preview(int argc, char **argv)
         CLI_OPT_VARIANT("the glTF KHR_materials_variants variant NAME's materials"),
         CLI_OPT_ALLOW_OUTSIDE_FILES(&outside),
         CLI_OPT_SEED(&p->s.seed, "random seed (default 0)"),
+        CLI_OPT_SAMPLER(&p->s.sampler),
         CLI_OPT_MAX_DEPTH(&p->s.max_depth, "path tracer: maximum path length (default 0: roulette only)"),
         ENV_OPTIONS(&env),
         CLI_OPT_NO_SHADOWS(&no_shadows),

@@ -235,6 +235,7 @@ static bool path_begin(renderer *r, const render_settings *s, GnFrame *frame)
     frame->traversal_budget = render_traversal_budget(r->g, 1); /* (unused: path.comp has loop_cap) */
     r->state_stride = render_state_stride(r->g, &r->geo);
     r->loop_cap = render_loop_setup(r->state_stride, frame);
+    r->sampler = s->sampler;
     return true;
 }
 
@@ -353,7 +354,8 @@ static void band_swap(renderer *r, GnFrame *frame, const int region[4], int rows
 /* The key of mode's kernel for r's scene and current render. */
 static render_kernel_key kernel_key(const renderer *r, uint32_t mode)
 {
-    return (render_kernel_key){mode, r->path_features, render_walk_regs(&r->geo), r->loop_cap, r->geo.two_levels};
+    return (render_kernel_key){mode, r->path_features, render_walk_regs(&r->geo), r->loop_cap, r->geo.two_levels,
+                               r->sampler};
 }
 
 const VkSpecializationInfo *renderer_specialize(const renderer *r, uint32_t mode, render_spec *spec)

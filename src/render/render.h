@@ -45,6 +45,7 @@ typedef struct render_settings {
     int spp;                /* samples per pixel */
     double time_limit;      /* > 0: stop after this many seconds (at least one pass) */
     uint32_t seed;
+    uint32_t sampler;       /* path: GN_SAMPLER_* (0: Sobol) */
     int camera;             /* glTF camera index, -1 = frame the scene */
     uint32_t aov;           /* RENDER_AOV_* set: the extra channels to add */
     bool no_shadows;        /* local modes: no ray-traced shadows (false, the default: shadows) */
@@ -107,6 +108,7 @@ typedef struct renderer {
     GnFeatures material_features; /* GN_FEAT_* the materials need (renderer_create) */
     GnFeatures path_features;     /* ... and the current path render (renderer_begin) */
     uint32_t path_samples;  /* samples per path dispatch (1..GN_PATH_SAMPLES) */
+    uint32_t sampler;       /* path: the current render's GN_SAMPLER_* */
     uint32_t loop_cap;      /* path: the kernel's LOOP_CAP (glsl/lib/bvh.glsl), 0 without a cap */
     uint32_t state_stride;  /* path: words a pixel of saved state (render_limits.h), 0 without a cap */
     double setup_seconds;

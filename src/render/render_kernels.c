@@ -14,9 +14,10 @@ const VkSpecializationInfo *render_kernel_specialize(const render_kernel_key *ke
     spec->values[GN_SPEC_LOOP_CAP] = render_mode_kernel(key->mode)->batched ? key->loop_cap : 0u;
     spec->values[GN_SPEC_FEATURES_HI] = (uint32_t)(features >> 32);
     spec->values[GN_SPEC_INSTANCES] = key->instances;
+    spec->values[GN_SPEC_SAMPLER] = render_mode_kernel(key->mode)->batched ? key->sampler : 0u;
     _Static_assert(GN_SPEC_FEATURES < RENDER_SPEC_COUNT && GN_SPEC_FEATURES_HI < RENDER_SPEC_COUNT &&
                        GN_SPEC_WALK_REGS < RENDER_SPEC_COUNT && GN_SPEC_LOOP_CAP < RENDER_SPEC_COUNT &&
-                       GN_SPEC_INSTANCES < RENDER_SPEC_COUNT,
+                       GN_SPEC_INSTANCES < RENDER_SPEC_COUNT && GN_SPEC_SAMPLER < RENDER_SPEC_COUNT,
                    "a specialisation constant's id beyond render_spec's values");
     for (uint32_t i = 0; i < RENDER_SPEC_COUNT; i++)
         spec->entries[i] = (VkSpecializationMapEntry){i, i * (uint32_t)sizeof(uint32_t), sizeof(uint32_t)};

@@ -15,8 +15,9 @@
 /* The specialisation constants of the render kernels (constant ids: glsl/lib/shared.h):
  * 0 the mode (or a kernel's own variant), GN_SPEC_FEATURES and GN_SPEC_FEATURES_HI the two
  * words of the GN_FEAT_* set it is built for, GN_SPEC_WALK_REGS, GN_SPEC_LOOP_CAP (the path
- * kernel's; 0 for the others) and GN_SPEC_INSTANCES. */
-#define RENDER_SPEC_COUNT 6
+ * kernel's; 0 for the others), GN_SPEC_INSTANCES and GN_SPEC_SAMPLER (the path kernel's; 0
+ * for the others). */
+#define RENDER_SPEC_COUNT 7
 typedef struct render_spec {
     uint32_t values[RENDER_SPEC_COUNT];
     VkSpecializationMapEntry entries[RENDER_SPEC_COUNT];
@@ -31,6 +32,7 @@ typedef struct render_kernel_key {
     GnFeatures scene_features;
     uint32_t walk_regs, loop_cap;
     bool instances;
+    uint32_t sampler; /* GN_SAMPLER_* (the path kernel's) */
 } render_kernel_key;
 
 /* Fills spec for key and returns its VkSpecializationInfo (pointing into spec). */

@@ -26,6 +26,13 @@ const char *render_mode_list(void);
 /* A line per mode, "name  help", for --mode's help. */
 const char *render_mode_help(void);
 
+/* The samplers (glsl/lib/shared.h: GN_SAMPLERS), as the modes: an index or -1, a name
+ * ("?" out of range), "a, b" and the help lines. */
+int render_sampler_from_name(const char *name);
+const char *render_sampler_name(uint32_t sampler);
+const char *render_sampler_list(void);
+const char *render_sampler_help(void);
+
 /* The kernels the modes name. specialised: the GN_FEAT_* the kernel is built for as the
  * scene needs them (the others compiled in); the path kernel is specialised on all, the
  * local one only on what its lookups test per pixel (surfaces cut away: glsl/lib/bvh.glsl;

@@ -107,6 +107,8 @@ void render_header_build(render_header *h, const renderer *r, const render_setti
     }
     add_attr(h, (image_attr){"gonio:spp", IMAGE_ATTR_INT, NULL, st->spp, 0, NULL});
     add_attr(h, (image_attr){"gonio:seed", IMAGE_ATTR_INT, NULL, (int)s->seed, 0, NULL});
+    if (s->mode == GN_MODE_PATH)
+        add_string(h, "gonio:sampler", "%s", render_sampler_name(s->sampler));
     add_string(h, "gonio:scene-path", "%s", r->sc->path);
     /* The view for people and for --camera FILE.exr (src/scene/camera.h), and OpenEXR's own. */
     {

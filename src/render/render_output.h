@@ -37,8 +37,9 @@ typedef struct render_header {
 extern const char *const render_identity_names[];
 
 /* Every header attribute of a finished render: the identity, then gonio:spp (int),
- * gonio:seed (int), gonio:scene-path; the view: gonio:camera-name (s->camera_label),
- * gonio:look-at, gonio:view (src/scene/camera.h), gonio:fov or gonio:ortho-half-height (double),
+ * gonio:seed (int), gonio:sampler (path: its name), gonio:scene-path; the view:
+ * gonio:camera-name (s->camera_label), gonio:look-at, gonio:view (src/scene/camera.h),
+ * gonio:fov or gonio:ortho-half-height (double),
  * worldToCamera (m44f, OpenEXR's), gonio:environment (s->env_label); then gonio:brdf (when
  * brdf is not NULL), gonio:seconds, gonio:command (`command`, the command line),
  * gonio:version. */

@@ -29,6 +29,9 @@ queue frac render $S "${common[@]}" --spp 5 --aov variance,depth --crop 0.5,0.25
 # A local mode too (one sample a dispatch, another kernel).
 "$G" render $S "${common[@]}" --mode phong --spp 3 -o "$tmp/phong.exr"
 queue phong_crop render $S "${common[@]}" --mode phong --spp 3 --crop 5,7,40,30 -o "$tmp/phong_crop.exr"
+# The other sampler (the default is Sobol, docs/path-tracing.md): its tiles too.
+"$G" render $S "${common[@]}" --spp 5 --sampler independent -o "$tmp/whole_ind.exr"
+queue ind_crop render $S "${common[@]}" --spp 5 --sampler independent --crop 5,7,40,30 -o "$tmp/ind_crop.exr"
 # Tiles x seeds: 2 tiles x 2 seeds merged = 2 whole renders of those seeds merged.
 for s in 1 2; do
     queue "w$s" render $S "${common[@]}" --spp 4 --seed $s --aov variance -o "$tmp/w$s.exr"
@@ -51,6 +54,8 @@ exrheader "$tmp/frac.exr" >"$tmp/hf"
 has "$tmp/hf" "dataWindow (type box2i): (33 12) - (65 47)"
 same "$tmp/whole.exr" "$tmp/frac.exr" "a fractional crop's pixels are the whole render's"
 same "$tmp/phong.exr" "$tmp/phong_crop.exr" "a phong crop's pixels are the whole render's"
+same "$tmp/whole_ind.exr" "$tmp/ind_crop.exr" "--sampler independent: a crop's pixels are the whole render's"
+check_fails "the samplers' images differ" 1 "$G" diff "$tmp/whole.exr" "$tmp/whole_ind.exr" --max-error 0
 "$G" merge "$tmp/w1.exr" "$tmp/w2.exr" -o "$tmp/wm.exr"
 check "tiles x seeds merge" "$G" merge "$tmp/a1.exr" "$tmp/b2.exr" "$tmp/b1.exr" "$tmp/a2.exr" -o "$tmp/tm.exr"
 same "$tmp/wm.exr" "$tmp/tm.exr" "tiles x seeds merged equal the seeds' whole renders merged"
@@ -77,6 +82,11 @@ queue r64_128 render $S "${r[@]}" --spp 128 --resume "$tmp/r64.exr" -o "$tmp/r64
 # A crop resumes too, and in an odd split (13 + 27), even with --half for the means.
 queue c13 render $S "${r[@]}" --spp 13 --crop 8,4,31,25 --resumable --half -o "$tmp/c13.exr"
 queue c13_40 render $S "${r[@]}" --spp 40 --crop 8,4,31,25 --resume "$tmp/c13.exr" -o "$tmp/c13_40.exr"
+# ... and with the other sampler; a file of one sampler does not resume with the other.
+queue i64 render $S "${r[@]}" --spp 64 --sampler independent --resumable -o "$tmp/i64.exr"
+queue i64_128 render $S "${r[@]}" --spp 128 --sampler independent --resume "$tmp/i64.exr" -o "$tmp/i64_128.exr"
+queue i128 render $S "${r[@]}" --spp 128 --sampler independent -o "$tmp/i128.exr"
+queue sampler render $S "${r[@]}" --spp 128 --resume "$tmp/i64.exr" -o "$tmp/x.exr"
 queue seed render $S "${r[@]/7/8}" --spp 128 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
 queue depth render $S "${r[@]}" --max-depth 3 --spp 128 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
 queue camera render $S "${r[@]}" --fov 30 --spp 128 --resume "$tmp/r64.exr" -o "$tmp/x.exr"
@@ -95,6 +105,11 @@ has "$tmp/hr" "gonio:spp (type int): 128"
 check_queued "a crop, resumable" 0 c13
 check_queued "a crop resumed" 0 c13_40
 same "$tmp/c40.exr" "$tmp/c13_40.exr" "a crop's 13 + 27 resumed equals its 40 in one run"
+check_queued "--sampler independent: resumed to 128" 0 i64_128
+same "$tmp/i128.exr" "$tmp/i64_128.exr" "--sampler independent: 64 + 64 resumed equals 128 in one run"
+has "$tmp/h64" 'gonio:sampler (type string): "sobol"'
+check_queued "resume: another sampler is refused" 1 sampler
+has "$tmp/last" "independent sampler's, this render's the sobol one's"
 check_queued "resume: another seed is refused" 1 seed
 has "$tmp/last" "seed"
 check_queued "resume: another max depth is refused" 1 depth
