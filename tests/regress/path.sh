@@ -78,26 +78,28 @@ same_pixels() {
 # estimator, the AOVs, both kinds of environment, and sample models with textures, normal
 # maps, glass, punctual lights and vertex colours.
 same_as_unspecialised() { same_pixels "specialised = unspecialised" GONIO_ALL_FEATURES=1 "$@"; }
-# Fast: glTF's layers, the lobe with the most code; slow: every model of the table and the
-# other glTF settings, and each estimator alone. (The unit test brdf.specialised_same checks
-# the same rule on every BSDF case's queries in the fast tier.)
+# Fast: the Cornell box and its AOVs; slow: glTF's layers (the lobe with the most code),
+# every model of the table and the other glTF settings, sample models with textures, normal
+# maps and punctual lights, and each estimator alone. (The unit test brdf.specialised_same
+# checks the same rule on every BSDF case's queries in the fast tier; each unspecialised
+# kernel is the costliest compile of the suite.)
 models=$("$G" brdf --list | cut -d' ' -f1) # every model of the table, at its defaults
-fast_models="gltf:roughness=0.4:clearcoat=1:clearcoat-roughness=0.2:sheen-color=0.6,0.4,0.2:sheen-roughness=0.5"
+layers_models="gltf:roughness=0.4:clearcoat=1:clearcoat-roughness=0.2:sheen-color=0.6,0.4,0.2:sheen-roughness=0.5"
 A=${GONIO_ASSETS:-}/gltf
 if in_tier fast; then
     same_as_unspecialised "Cornell box" $C
     check "brdf --list names models" test -n "$models"
-    for model in $fast_models; do
+    same_as_unspecialised "AOVs" $C --aov albedo,normal,depth,variance
+fi
+if in_tier slow; then
+    for model in $layers_models; do
         same_as_unspecialised "--brdf $model" $C --brdf "$model" --env 0.2
     done
-    same_as_unspecialised "AOVs" $C --aov albedo,normal,depth,variance
     # textures and normal maps; punctual lights
     for m in DamagedHelmet LightsPunctualLamp; do
         f=$A/$m/glTF/$m.gltf
         [ -f "$f" ] && same_as_unspecialised "$m" "$f" --env 0.5
     done
-fi
-if in_tier slow; then
     same_as_unspecialised "an environment map" scenes/teapot.gltf --env "$tmp/d.exr"
     f=${GONIO_ASSETS:-}/asset-generator/Material_MetallicRoughness/Material_MetallicRoughness_01.gltf
     [ -f "$f" ] && same_as_unspecialised "vertex colours (Asset Generator)" "$f" --env 0.5
@@ -107,7 +109,7 @@ if in_tier slow; then
         gltf:metallic=0.5:roughness=0.02 gltf:transmission=1:roughness=0.4 \
         gltf:roughness=0.4:clearcoat=1:clearcoat-roughness=0.2:sheen-color=0.6,0.4,0.2:sheen-roughness=0.5 \
         gltf:roughness=0:metallic=1:clearcoat=0.7; do
-        case " $(echo $fast_models) " in *" $model "*) continue ;; esac
+        case " $(echo $layers_models) " in *" $model "*) continue ;; esac
         same_as_unspecialised "--brdf $model" $C --brdf "$model" --env 0.2
     done
     for m in TransmissionRoughnessTest NormalTangentTest; do
@@ -160,10 +162,10 @@ if in_tier fast; then
     same_interrupted "Cornell box, AOVs" $C --aov albedo,normal,depth,variance
     GONIO_WALK_ARRAY=1 same_interrupted "Cornell box, GONIO_WALK_ARRAY=1" $C
     same_interrupted "teapot, glass" scenes/teapot.gltf --camera 0 --brdf dielectric
-    f=$A/DamagedHelmet/glTF/DamagedHelmet.gltf
-    [ -f "$f" ] && same_interrupted "DamagedHelmet" "$f" --env 0.5
 fi
 if in_tier slow; then
+    f=$A/DamagedHelmet/glTF/DamagedHelmet.gltf
+    [ -f "$f" ] && same_interrupted "DamagedHelmet" "$f" --env 0.5
     same_interrupted "Cornell box, environment, --max-depth 6" $C --env 0.3 --max-depth 6 --seed 5
     same_interrupted "teapot, an environment map" scenes/teapot.gltf --env "$tmp/d.exr"
     for m in LightsPunctualLamp TransmissionTest; do
