@@ -21,8 +21,9 @@ CXX := g++
 endif
 
 PKGS := vulkan glfw3 OpenEXR tinygltf nlohmann_json libpng zlib stb draco libwebp libzstd
-# meshoptimizer ships no pkg-config file (Debian 12): linked by name.
-LIBS_EXTRA := -lmeshoptimizer
+# meshoptimizer ships no pkg-config file (Debian 12), SPIRV-Tools only static libraries
+# (src/core/spirv_specialise.cpp): linked by name.
+LIBS_EXTRA := -lmeshoptimizer -lSPIRV-Tools-opt -lSPIRV-Tools
 WARN := -Wall -Wextra -Wshadow -Werror
 # The folders of the architecture (docs/architecture.md) are layers, lowest first: core
 # (errors, images, Vulkan, plots), scene (glTF, meshes, camera, environment) and accel (the

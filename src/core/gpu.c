@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "spirv_specialise.h"
 #include "util.h"
 
 #if defined(__SANITIZE_ADDRESS__)
@@ -714,9 +715,16 @@ static gpu_kernel *kernel_get(gpu *g, const gpu_pipeline_desc *desc)
     plci.pushConstantRangeCount = desc->push_size ? 1 : 0;
     plci.pPushConstantRanges = &push;
     GPU_CHECK(vkCreatePipelineLayout(g->device, &plci, NULL, &k->layout));
-    smci.codeSize = desc->code_size;
-    smci.pCode = desc->code;
+    /* The module with its constants folded in where that can be done (spirv_specialise.h);
+     * the specialisation info goes along either way (an id the module no longer has is
+     * ignored). */
+    uint32_t *folded = NULL;
+    size_t folded_size = 0;
+    const bool on_host = spirv_specialise(desc->code, desc->code_size, desc->specialization, &folded, &folded_size);
+    smci.codeSize = on_host ? folded_size : desc->code_size;
+    smci.pCode = on_host ? folded : desc->code;
     GPU_CHECK(vkCreateShaderModule(g->device, &smci, NULL, &module));
+    free(folded);
     cpci.stage = (VkPipelineShaderStageCreateInfo){VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
                                                    NULL, 0, VK_SHADER_STAGE_COMPUTE_BIT, module,
                                                    "main", desc->specialization};

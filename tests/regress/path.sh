@@ -135,6 +135,23 @@ fi
 # The walk keeps its stack in registers for trees of up to GN_WALK_REGS_MAX levels
 # (glsl/lib/bvh.glsl): every pixel must be what the stack in memory gives (GONIO_WALK_ARRAY=1),
 # in the path kernel and the local modes.
+# The kernels reach the driver with their specialisation constants folded in by the host
+# (src/core/spirv_specialise.h); the driver specialising the module as built
+# (GONIO_DRIVER_SPECIALISE) must give the same pixels.
+same_as_driver_specialised() { same_pixels "specialised on the host = by the driver" GONIO_DRIVER_SPECIALISE=1 "$@"; }
+if in_tier fast; then
+    same_as_driver_specialised "Cornell box" $C
+    same_as_driver_specialised "Cornell box, --mode phong" $C --mode phong
+    f=$A/DamagedHelmet/glTF/DamagedHelmet.gltf
+    [ -f "$f" ] && same_as_driver_specialised "DamagedHelmet" "$f" --env 0.5
+fi
+if in_tier slow; then
+    same_as_driver_specialised "teapot, glass" scenes/teapot.gltf --camera 0 --brdf dielectric
+    same_as_driver_specialised "Cornell box, AOVs, light sampling only" $C --aov albedo,normal,depth,variance --estimator light
+    f=$A/LightsPunctualLamp/glTF/LightsPunctualLamp.gltf
+    [ -f "$f" ] && same_as_driver_specialised "LightsPunctualLamp" "$f" --env 0.5
+fi
+
 same_as_stack_array() { same_pixels "stack in registers = in memory" GONIO_WALK_ARRAY=1 "$@"; }
 if in_tier fast; then
     d=$("$G" info $C | awk '$1 == "bvh" && $2 == "depth" {print $3}')
