@@ -373,7 +373,7 @@ int cmd_bench(int argc, char **argv)
          FLT_MIN, 1e6, "a number > 0", NULL, NULL},
         {"--paths", NULL, "measure the path tracer", CLI_FLAG, CLI_AS(bool, &paths), 0, 0, NULL, NULL, NULL},
         CLI_OPT_ENV(&env, "--paths: the environment, as gonio render's (default 0: black)"),
-        CLI_OPT_SAMPLER(&sampler),
+        CLI_OPT_SAMPLER(&sampler), /* (--paths: its help is the render's) */
         {"--reference", "WxH:SPP", "--paths: the RMSE reference (default 128x128:512)", CLI_CALL, &ref,
          0, 0, "WxH:SPP", take_reference, NULL},
         CLI_OPT_DENOISE(&denoise, "--paths: also the time to each RMSE of the denoised image (render\n"

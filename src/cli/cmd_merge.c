@@ -375,13 +375,14 @@ static void merge_pixels(image *out, const int box[4], const merge_inputs *in, i
 }
 
 /* Writes out with the identity of the first input (all are equal), then the merge's own:
- * gonio:spp total, every seed (when the inputs said them all), the seconds summed. */
+ * gonio:spp total, every seed (when the inputs said them all), the sampler (when all said
+ * the same one), the seconds summed. */
 static bool write_merge(const image *out, const char *out_path, const merge_inputs *in, int64_t total,
                         const image_exr_options *exr)
 {
     enum { MAX_ID = 16 };
-    image_attr attrs[MAX_ID + 5];
-    char values[MAX_ID][512], *seed_text = NULL;
+    image_attr attrs[MAX_ID + 6];
+    char values[MAX_ID][512], *seed_text = NULL, sampler[64] = "";
     int na = 0;
     for (int k = 0; render_identity_names[k] && k < MAX_ID; k++)
         if (image_exr_attr_string(in->path[0], render_identity_names[k], values[na], sizeof values[0])) {
@@ -397,6 +398,13 @@ static bool write_merge(const image *out, const char *out_path, const merge_inpu
             len += (size_t)sprintf(seed_text + len, "%s%u", k ? "," : "", in->seeds.seed[k]);
         attrs[na++] = (image_attr){"gonio:seeds", IMAGE_ATTR_STRING, seed_text, 0, 0, NULL};
     }
+    bool same_sampler = image_exr_attr_string(in->path[0], "gonio:sampler", sampler, sizeof sampler);
+    for (int i = 1; i < in->n && same_sampler; i++) {
+        char other[64];
+        same_sampler = image_exr_attr_string(in->path[i], "gonio:sampler", other, sizeof other) && !strcmp(other, sampler);
+    }
+    if (same_sampler)
+        attrs[na++] = (image_attr){"gonio:sampler", IMAGE_ATTR_STRING, sampler, 0, 0, NULL};
     attrs[na++] = (image_attr){"gonio:seconds", IMAGE_ATTR_DOUBLE, NULL, 0, in->seconds, NULL};
     attrs[na++] = (image_attr){"gonio:command", IMAGE_ATTR_STRING, cli_command_line(), 0, 0, NULL};
     attrs[na++] = (image_attr){"gonio:version", IMAGE_ATTR_STRING, GONIO_VERSION, 0, 0, NULL};

@@ -225,9 +225,14 @@ static bool check_resume(const char *path, const renderer *r, render_settings *s
         util_error("%s: cannot resume: its seed is not this render's %u (--seed)", path, s->seed);
         return false;
     }
-    if (s->mode == GN_MODE_PATH) { /* (renders before the samplers: independent numbers) */
-        char file[64] = "independent";
-        image_exr_attr_string(path, "gonio:sampler", file, sizeof file);
+    if (s->mode == GN_MODE_PATH) {
+        char file[64];
+        if (!image_exr_attr_string(path, "gonio:sampler", file, sizeof file)) {
+            /* (a render from before the samplers: its numbers are none of today's) */
+            util_error("%s: cannot resume: no gonio:sampler in the header (a render older than the samplers: "
+                       "render it again)", path);
+            return false;
+        }
         if (strcmp(file, render_sampler_name(s->sampler))) {
             util_error("%s: cannot resume: its samples are the %s sampler's, this render's the %s one's (--sampler)",
                        path, file, render_sampler_name(s->sampler));
@@ -742,7 +747,7 @@ static int write_outputs(render_state *rs)
     if (job->denoise) {
         ok = denoise_render(&rs->img, job->s.aov, out_path, &dn);
         if (ok) {
-            assert(h.count + 2 <= RENDER_HEADER_MAX); /* a path render's header has 22 at most */
+            assert(h.count + 2 <= RENDER_HEADER_MAX); /* a path render's header has 25 at most */
             h.attrs[h.count++] = (image_attr){"gonio:denoiser", IMAGE_ATTR_STRING, dn.description, 0, 0, NULL};
             h.attrs[h.count++] = (image_attr){"gonio:denoise-seconds", IMAGE_ATTR_DOUBLE, NULL, 0, dn.seconds, NULL};
         }

@@ -599,6 +599,7 @@ void gpu_buffer_create_storage(gpu *g, gpu_buffer *b, const void *data, VkDevice
 struct gpu_kernel {
     const uint32_t *code;
     size_t code_size;
+    bool on_host; /* its constants folded in by the host (spirv_specialise), not the driver */
     uint32_t push_size, num_bindings;
     VkDescriptorSetLayoutBinding bindings[32];
     uint32_t num_entries, spec_size;
@@ -644,6 +645,10 @@ static void kernel_key(gpu_kernel *k, const gpu_pipeline_desc *desc)
     memset(k, 0, sizeof *k);
     k->code = desc->code;
     k->code_size = desc->code_size;
+    /* GONIO_DRIVER_SPECIALISE: the driver specialises the module as built, for checking that
+     * folding on the host changes nothing (tests/regress/path.sh) and for ruling it out when
+     * chasing a bug; another kernel, so a batch line that sets it gets its own. */
+    k->on_host = !getenv("GONIO_DRIVER_SPECIALISE");
     k->push_size = desc->push_size;
     k->num_bindings = desc->num_bindings;
     for (uint32_t i = 0; i < desc->num_bindings; i++)
@@ -660,7 +665,8 @@ static void kernel_key(gpu_kernel *k, const gpu_pipeline_desc *desc)
 
 static bool kernel_same(const gpu_kernel *a, const gpu_kernel *b)
 {
-    return a->code == b->code && a->code_size == b->code_size && a->push_size == b->push_size &&
+    return a->code == b->code && a->code_size == b->code_size && a->on_host == b->on_host &&
+           a->push_size == b->push_size &&
            a->num_bindings == b->num_bindings && a->num_entries == b->num_entries && a->spec_size == b->spec_size &&
            !memcmp(a->bindings, b->bindings, sizeof *a->bindings * a->num_bindings) &&
            !memcmp(a->entries, b->entries, sizeof *a->entries * a->num_entries) &&
@@ -720,7 +726,15 @@ static gpu_kernel *kernel_get(gpu *g, const gpu_pipeline_desc *desc)
      * ignored). */
     uint32_t *folded = NULL;
     size_t folded_size = 0;
-    const bool on_host = spirv_specialise(desc->code, desc->code_size, desc->specialization, &folded, &folded_size);
+    char why[256] = "";
+    static bool warned;
+    const bool on_host =
+        k->on_host && spirv_specialise(desc->code, desc->code_size, desc->specialization, &folded, &folded_size, why,
+                                       sizeof why);
+    if (k->on_host && why[0] && !warned) { /* (slower, the same pixels: said once) */
+        util_warn("kernel %s: its specialisation constants are left to the driver: %s", desc->name, why);
+        warned = true;
+    }
     smci.codeSize = on_host ? folded_size : desc->code_size;
     smci.pCode = on_host ? folded : desc->code;
     GPU_CHECK(vkCreateShaderModule(g->device, &smci, NULL, &module));

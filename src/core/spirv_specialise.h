@@ -7,7 +7,7 @@
  * costs it as much as the kernel with all of them. Handing it the module already folded
  * takes about 40 % off a small render's CPU time (docs/performance.md, "Specialisation on
  * the host"), with the same pixels: the constants are those the driver would have applied,
- * and nothing else of the module changes. */
+ * and the passes only remove code no value of the constants can reach. */
 #ifndef GONIO_SPIRV_SPECIALISE_H
 #define GONIO_SPIRV_SPECIALISE_H
 
@@ -21,14 +21,13 @@
 extern "C" {
 #endif
 
-/* The module code (bytes, a multiple of 4) with spec's constants folded in, into a new
- * buffer (free()) and its size in bytes; false, with nothing allocated, when spec is NULL
- * or holds a constant that is not 4 bytes, when GONIO_DRIVER_SPECIALISE is set (the driver
- * specialises the module as given: for checking that folding changes nothing, and for
- * ruling it out when chasing a bug), or when the optimizer fails. The caller then gives the
- * driver the module as it is, with spec, which is always correct. */
+/* The module code (code_size bytes) with spec's constants folded in, into a new buffer
+ * (free()) and its size in bytes. False, with nothing allocated, when spec is NULL or has
+ * no constants (why ""), or when it cannot be done (why says why: a constant that is not 4
+ * bytes, the optimizer's error). The caller then gives the driver the module as it is, with
+ * spec, which is always correct. */
 bool spirv_specialise(const uint32_t *code, size_t code_size, const VkSpecializationInfo *spec, uint32_t **out,
-                      size_t *out_size);
+                      size_t *out_size, char *why, size_t why_size);
 
 #ifdef __cplusplus
 }

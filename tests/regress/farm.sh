@@ -62,6 +62,7 @@ same "$tmp/wm.exr" "$tmp/tm.exr" "tiles x seeds merged equal the seeds' whole re
 exrheader "$tmp/tm.exr" >"$tmp/htm"
 has "$tmp/htm" 'gonio:seeds (type string): "1,2"'
 has "$tmp/htm" "gonio:spp (type int): 8"
+has "$tmp/htm" 'gonio:sampler (type string): "sobol"'
 check_fails "a hole between tiles is refused" 1 "$G" merge "$tmp/tile_00.exr" "$tmp/tile_20.exr" -o "$tmp/x.exr"
 has "$tmp/last" "leave a hole"
 check_fails "overlapping tiles of one seed are refused" 1 "$G" merge "$tmp/tile_00.exr" "$tmp/whole.exr" -o "$tmp/x.exr"

@@ -78,11 +78,12 @@ same_pixels() {
 # estimator, the AOVs, both kinds of environment, and sample models with textures, normal
 # maps, glass, punctual lights and vertex colours.
 same_as_unspecialised() { same_pixels "specialised = unspecialised" GONIO_ALL_FEATURES=1 "$@"; }
-# Fast: the Cornell box and its AOVs; slow: glTF's layers (the lobe with the most code),
-# every model of the table and the other glTF settings, sample models with textures, normal
-# maps and punctual lights, and each estimator alone. (The unit test brdf.specialised_same
-# checks the same rule on every BSDF case's queries in the fast tier; each unspecialised
-# kernel is the costliest compile of the suite.)
+# Fast: the Cornell box and its AOVs, and sample models with textures, normal maps and
+# punctual lights (scene features no unit test specialises); slow: glTF's layers (the lobe
+# with the most code), every model of the table and the other glTF settings, and each
+# estimator alone. (The unit test brdf.specialised_same checks the same rule on every BSDF
+# case's queries in the fast tier; each unspecialised kernel is the costliest compile of the
+# suite.)
 models=$("$G" brdf --list | cut -d' ' -f1) # every model of the table, at its defaults
 layers_models="gltf:roughness=0.4:clearcoat=1:clearcoat-roughness=0.2:sheen-color=0.6,0.4,0.2:sheen-roughness=0.5"
 A=${GONIO_ASSETS:-}/gltf
@@ -90,15 +91,15 @@ if in_tier fast; then
     same_as_unspecialised "Cornell box" $C
     check "brdf --list names models" test -n "$models"
     same_as_unspecialised "AOVs" $C --aov albedo,normal,depth,variance
-fi
-if in_tier slow; then
-    for model in $layers_models; do
-        same_as_unspecialised "--brdf $model" $C --brdf "$model" --env 0.2
-    done
     # textures and normal maps; punctual lights
     for m in DamagedHelmet LightsPunctualLamp; do
         f=$A/$m/glTF/$m.gltf
         [ -f "$f" ] && same_as_unspecialised "$m" "$f" --env 0.5
+    done
+fi
+if in_tier slow; then
+    for model in $layers_models; do
+        same_as_unspecialised "--brdf $model" $C --brdf "$model" --env 0.2
     done
     same_as_unspecialised "an environment map" scenes/teapot.gltf --env "$tmp/d.exr"
     f=${GONIO_ASSETS:-}/asset-generator/Material_MetallicRoughness/Material_MetallicRoughness_01.gltf
@@ -132,9 +133,6 @@ if in_tier slow; then
     done
 fi
 
-# The walk keeps its stack in registers for trees of up to GN_WALK_REGS_MAX levels
-# (glsl/lib/bvh.glsl): every pixel must be what the stack in memory gives (GONIO_WALK_ARRAY=1),
-# in the path kernel and the local modes.
 # The kernels reach the driver with their specialisation constants folded in by the host
 # (src/core/spirv_specialise.h); the driver specialising the module as built
 # (GONIO_DRIVER_SPECIALISE) must give the same pixels.
@@ -152,6 +150,9 @@ if in_tier slow; then
     [ -f "$f" ] && same_as_driver_specialised "LightsPunctualLamp" "$f" --env 0.5
 fi
 
+# The walk keeps its stack in registers for trees of up to GN_WALK_REGS_MAX levels
+# (glsl/lib/bvh.glsl): every pixel must be what the stack in memory gives (GONIO_WALK_ARRAY=1),
+# in the path kernel and the local modes.
 same_as_stack_array() { same_pixels "stack in registers = in memory" GONIO_WALK_ARRAY=1 "$@"; }
 if in_tier fast; then
     d=$("$G" info $C | awk '$1 == "bvh" && $2 == "depth" {print $3}')

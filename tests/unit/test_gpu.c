@@ -17,6 +17,8 @@
 #include "test.h"
 #include "trace_test.h" /* spv_trace_test: tests/kernels/trace_test.comp compiled by the build */
 #include "wrap_test.h"  /* spv_wrap_test: tests/kernels/wrap_test.comp */
+#include "render_kernels.h"
+#include "spirv_specialise.h"
 
 typedef struct ray {
     float o[3], tmin, d[3], tmax;
@@ -712,4 +714,41 @@ TEST(gpu, kernels_shared)
         gpu_buffer_destroy(&g, &q[b]);
     CHECK(gpu_validation_message_count() == 0);
     gpu_destroy(&g);
+}
+
+/* The SpecId decorations a SPIR-V module has (OpDecorate id SpecId n: opcode 71, decoration 1). */
+static int spec_ids(const uint32_t *w, size_t words)
+{
+    int n = 0;
+    for (size_t i = 5; i < words && (w[i] >> 16); i += w[i] >> 16)
+        n += (w[i] & 0xffff) == 71 && (w[i] >> 16) >= 3 && i + 2 < words && w[i + 2] == 1;
+    return n;
+}
+
+/* The kernels reach the driver with their constants folded in by the host (gpu.c:
+ * kernel_get, src/core/spirv_specialise.h): the path kernel specialised as for the Cornell
+ * box folds, has no specialisation constant left and is smaller; tests/regress/path.sh
+ * checks that its pixels are the driver-specialised kernel's. */
+TEST(gpu, specialise_folds)
+{
+    render_kernel_key key = {.mode = GN_MODE_PATH, .scene_features = 0, .walk_regs = 3, .loop_cap = 0};
+    render_spec spec;
+    const render_kernel *kernel = render_mode_kernel(GN_MODE_PATH);
+    const size_t words = kernel->code_size / 4;
+    uint32_t *out = NULL;
+    size_t size = 0;
+    char why[256];
+    const VkSpecializationInfo *info = render_kernel_specialize(&key, &spec);
+    CHECKF(spec_ids(kernel->code, words) >= RENDER_SPEC_COUNT - 1, "the path kernel as built has %d SpecIds",
+           spec_ids(kernel->code, words));
+    bool ok = spirv_specialise(kernel->code, kernel->code_size, info, &out, &size, why, sizeof why);
+    CHECKF(ok, "not folded: %s", why);
+    if (ok) {
+        CHECKF(spec_ids(out, size / 4) == 0, "%d SpecIds left", spec_ids(out, size / 4));
+        CHECKF(size < kernel->code_size, "folded %zu bytes, as built %zu", size, kernel->code_size);
+        printf("    the path kernel for the Cornell box's features: %zu bytes as built, %zu folded\n",
+               kernel->code_size, size);
+    }
+    free(out);
+    CHECK(!spirv_specialise(kernel->code, kernel->code_size, NULL, &out, &size, why, sizeof why) && !why[0]);
 }
