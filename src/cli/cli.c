@@ -14,6 +14,9 @@
 #include "scene.h"
 #include "util.h"
 
+/* The usage errors said so far (cli_usage_error). */
+static int usage_errors;
+
 static char command_line[4096];
 
 void cli_set_command_line(int argc, char **argv)
@@ -117,10 +120,13 @@ static int take_value(const cli_command *c, const cli_option *o, const char *opt
         else
             *(double *)o->dest = f;
         return -1;
-    case CLI_CALL:
+    case CLI_CALL: {
+        /* (a parser that said what is wrong itself is not followed by a second message) */
+        const int said = usage_errors;
         if (o->call(c->name, opt, val, o->dest))
             return -1;
-        return expect ? bad_value(c, opt, val, expect) : 2;
+        return expect && usage_errors == said ? bad_value(c, opt, val, expect) : 2;
+    }
     default:
         return -1;
     }
@@ -280,6 +286,7 @@ void cli_help_item(FILE *f, const char *name, const char *help)
 int cli_usage_error(const char *cmd, const char *fmt, ...)
 {
     va_list ap;
+    usage_errors++;
     fprintf(stderr, "gonio %s: ", cmd);
     va_start(ap, fmt);
     vfprintf(stderr, fmt, ap);

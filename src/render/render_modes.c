@@ -20,71 +20,57 @@ static const render_kernel kernels[] = {
 
 const render_kernel *render_mode_kernel(uint32_t mode) { return &kernels[render_modes[mode].kernel]; }
 
-int render_mode_from_name(const char *name)
+/* A list of names (the modes', the samplers'), with their help and the texts made of them. */
+typedef struct name_table {
+    const char *const *names, *const *help;
+    uint32_t count;
+    int width;        /* the names' column in the help */
+    char list[256];   /* "a, b, c" */
+    char text[2048];  /* lines "name  help" */
+} name_table;
+
+static int table_index(const name_table *t, const char *name)
 {
-    for (int i = 0; i < (int)GN_MODE_COUNT; i++)
-        if (strcmp(name, render_modes[i].name) == 0)
-            return i;
+    for (uint32_t i = 0; i < t->count; i++)
+        if (strcmp(name, t->names[i]) == 0)
+            return (int)i;
     return -1;
 }
 
-const char *render_mode_name(uint32_t mode) { return mode < GN_MODE_COUNT ? render_modes[mode].name : "?"; }
-
-/* "a, b, c" of n names, or lines "name  help" with the names `width` wide (help non-NULL),
- * into buf. */
-static const char *names_text(char *buf, size_t size, const char *const *names, const char *const *help, uint32_t n,
-                              int width)
+static const char *table_list(name_table *t)
 {
-    if (!buf[0])
-        for (uint32_t i = 0; i < n; i++) {
-            size_t at = strlen(buf);
-            if (help)
-                snprintf(buf + at, size - at, "%s%-*s %s", i ? "\n" : "", width, names[i], help[i]);
-            else
-                snprintf(buf + at, size - at, "%s%s", i ? ", " : "", names[i]);
-        }
-    return buf;
+    if (!t->list[0])
+        for (uint32_t i = 0; i < t->count; i++)
+            snprintf(t->list + strlen(t->list), sizeof t->list - strlen(t->list), "%s%s", i ? ", " : "", t->names[i]);
+    return t->list;
+}
+
+static const char *table_help(name_table *t)
+{
+    if (!t->text[0])
+        for (uint32_t i = 0; i < t->count; i++)
+            snprintf(t->text + strlen(t->text), sizeof t->text - strlen(t->text), "%s%-*s %s", i ? "\n" : "",
+                     t->width, t->names[i], t->help[i]);
+    return t->text;
 }
 
 #define MODE_NAME(id, value, kernel, flags, name, help) [value] = name,
 #define MODE_HELP(id, value, kernel, flags, name, help) [value] = help,
 static const char *const mode_names[] = {GN_MODES(MODE_NAME)}, *const mode_help[] = {GN_MODES(MODE_HELP)};
-
-const char *render_mode_list(void)
-{
-    static char list[256];
-    return names_text(list, sizeof list, mode_names, NULL, GN_MODE_COUNT, 0);
-}
-
-const char *render_mode_help(void)
-{
-    static char help[2048];
-    return names_text(help, sizeof help, mode_names, mode_help, GN_MODE_COUNT, 8);
-}
+static name_table modes = {mode_names, mode_help, GN_MODE_COUNT, 8, "", ""};
 
 #define SAMPLER_NAME(id, value, name, help) [value] = name,
 #define SAMPLER_HELP(id, value, name, help) [value] = help,
 static const char *const sampler_names[] = {GN_SAMPLERS(SAMPLER_NAME)},
                          *const sampler_help[] = {GN_SAMPLERS(SAMPLER_HELP)};
+static name_table samplers = {sampler_names, sampler_help, GN_SAMPLER_COUNT, 11, "", ""};
 
-int render_sampler_from_name(const char *name)
-{
-    for (int i = 0; i < (int)GN_SAMPLER_COUNT; i++)
-        if (strcmp(name, sampler_names[i]) == 0)
-            return i;
-    return -1;
-}
+int render_mode_from_name(const char *name) { return table_index(&modes, name); }
+const char *render_mode_name(uint32_t mode) { return mode < GN_MODE_COUNT ? render_modes[mode].name : "?"; }
+const char *render_mode_list(void) { return table_list(&modes); }
+const char *render_mode_help(void) { return table_help(&modes); }
 
+int render_sampler_from_name(const char *name) { return table_index(&samplers, name); }
 const char *render_sampler_name(uint32_t sampler) { return sampler < GN_SAMPLER_COUNT ? sampler_names[sampler] : "?"; }
-
-const char *render_sampler_list(void)
-{
-    static char list[256];
-    return names_text(list, sizeof list, sampler_names, NULL, GN_SAMPLER_COUNT, 0);
-}
-
-const char *render_sampler_help(void)
-{
-    static char help[1024];
-    return names_text(help, sizeof help, sampler_names, sampler_help, GN_SAMPLER_COUNT, 11);
-}
+const char *render_sampler_list(void) { return table_list(&samplers); }
+const char *render_sampler_help(void) { return table_help(&samplers); }

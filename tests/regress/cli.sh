@@ -98,6 +98,11 @@ for c in "render $C -o $tmp/x.exr --spp" "preview $C --frames" "bench --seconds"
     check "${c%% *} ${c##* }=bogus: the option's own message" \
         sh -c "grep -q bogus '$tmp/last' && ! grep -q 'unknown option' '$tmp/last'"
 done
+# ... and says it once, whether the option's parser or the list it completes from words it.
+for o in "--mode bogus" "--sampler bogus" "--aov bogus" "--tonemap bogus"; do
+    check_fails "render $o: a usage error" 2 "$G" render $C -o "$tmp/x.exr" $o
+    check "render $o: one message" test "$(grep -c bogus "$tmp/last")" = 1
+done
 # Options several commands take are defined once: the same range and message everywhere.
 for c in "render $C -o $tmp/x.exr" "preview $C"; do
     check_fails "${c%% *} --max-depth 65537" 2 "$G" $c --max-depth 65537
