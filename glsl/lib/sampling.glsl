@@ -106,9 +106,9 @@ uint sampler_sobol1_reversed(uint i)
 
 // Sample i of Sobol's first two dimensions with the index shuffled and each coordinate
 // Owen-scrambled by the three words of h (Burley 2020): the first 2^m shuffled indices are
-// one aligned block of 2^m Sobol points, so every power-of-two prefix of a pixel's samples
-// is a (0, m, 2)-net of the square and every prefix is a (0, 2)-sequence's: stratified in
-// every elementary interval.
+// one aligned block of 2^m Sobol points, so every aligned power-of-two block of a pixel's
+// samples is a (0, m, 2)-net of the square (one point in every elementary box): the pixel's
+// samples are a (0, 2)-sequence.
 vec2 sampler_sobol2(uint i, uvec3 h)
 {
     uint j = bitfieldReverse(sampler_lk_permute(bitfieldReverse(i), h.x));
@@ -118,9 +118,9 @@ vec2 sampler_sobol2(uint i, uvec3 h)
 }
 
 // Four numbers for (pixel, sample index, dimension, seed) from the sampler `kind`
-// (GN_SAMPLER_*). The
-// path kernel's layout (docs/path-tracing.md): .yz a 2D decision (film position, a point on
-// a light, a direction), .x and .w two 1D ones (light or lobe choice, roulette or medium).
+// (GN_SAMPLER_*). The path kernel's layout (docs/path-tracing.md): .yz a 2D decision (film
+// position, a point on a light, a direction), .x and .w two 1D ones (light or lobe choice,
+// roulette or medium).
 // With GN_SAMPLER_SOBOL .yz is one scrambled Sobol pair and (.x, .w) another, each pair's
 // index shuffled by its own hash of (pixel, dimension, seed), so pairs, dimensions and
 // pixels are decorrelated while each pair is stratified over a pixel's samples.
