@@ -38,6 +38,7 @@ _Static_assert(GN_WALK_STACK - 2 >= BVH_MAX_DEPTH - 1, "glsl/lib/bvh.glsl's stac
 #define BVH_SUBTREES 16
 #define BVH_PARALLEL_MIN 50000
 #define BVH_SETUP_CHUNK 16384 /* triangles */
+#define BVH_EDGE_FAN 8        /* pair_by_edges: candidates looked at per edge of a triangle */
 /* builder.rec: the record holds triangles (index) and (index + 1) */
 #define BVH_REC_PAIR 0x80000000u
 
@@ -509,13 +510,20 @@ static void pair_by_edges(builder *bd)
     single_tri *order = util_malloc(n * sizeof *order);
     for (uint32_t t = 0, i = 0; t < bd->num_tris; t++)
         slot[t] = bd->mate[t] == GN_INVALID ? i++ : GN_INVALID;
+    /* An edge of a manifold mesh has two triangles; one that many share (copies of one
+     * triangle stacked, a fan of sheets on one edge, a mesh collapsed to a point) offers
+     * each of them only the first BVH_EDGE_FAN others (in index order), so that pairing stays
+     * linear in the triangles however many meet at one edge. */
     for (size_t lo = 0, hi; lo < m; lo = hi) {
         for (hi = lo + 1; hi < m && e[hi].key == e[lo].key; hi++)
             ;
         for (size_t i = lo; i < hi; i++)
-            for (size_t j = lo; j < hi; j++) {
+            for (size_t j = lo, seen = 0; j < hi && seen < BVH_EDGE_FAN; j++) {
                 uint32_t t = e[i].tri, u = e[j].tri, st = slot[t];
-                if (t != u && degree[st] < 3 && pairs_with(bd, t, u))
+                if (t == u)
+                    continue;
+                seen++;
+                if (degree[st] < 3 && pairs_with(bd, t, u))
                     cand[3 * (size_t)st + degree[st]++] = u;
             }
     }

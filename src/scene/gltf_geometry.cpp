@@ -392,6 +392,20 @@ void generate_tangents(Prim &p, const std::vector<float> &uv)
     free(tan);
 }
 
+/* Are all of p's triangles of zero area (their corners on one line or at one point)? */
+static bool all_degenerate(const Prim &p)
+{
+    for (size_t t = 0; t < p.idx.size(); t += 3) {
+        const float *a = &p.pos[3 * size_t(p.idx[t])], *b = &p.pos[3 * size_t(p.idx[t + 1])], *d = &p.pos[3 * size_t(p.idx[t + 2])];
+        double u[3], v[3];
+        for (int k = 0; k < 3; k++)
+            u[k] = double(b[k]) - a[k], v[k] = double(d[k]) - a[k];
+        if (u[1] * v[2] - u[2] * v[1] != 0 || u[2] * v[0] - u[0] * v[2] != 0 || u[0] * v[1] - u[1] * v[0] != 0)
+            return false;
+    }
+    return true;
+}
+
 const char *mode_name(int mode)
 {
     static const char *const names[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
@@ -460,6 +474,13 @@ bool load_primitive(Ctx &c, int mi, int pi, Prim &out)
         }
     }
     out.pos = to_float(read_accessor(c, pos));
+    /* Nothing can ever hit a primitive of zero-area triangles unless a morph target or a
+     * skin moves its corners apart: dropped here, before normals, tangents or a tree are made
+     * of it (a 4 M-vertex accessor of zeros is a few hundred bytes of JSON). */
+    if (p.targets.empty() && !p.attributes.count("JOINTS_0") && !out.idx.empty() && all_degenerate(out)) {
+        warn(c, "%s: all %zu triangles have zero area (skipped)", what.c_str(), out.idx.size() / 3);
+        return false;
+    }
     out.material = p.material >= 0 ? uint32_t(p.material) : GN_INVALID;
     if (nrm >= 0)
         read_normals(c, what, nrm, out);

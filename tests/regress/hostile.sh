@@ -124,6 +124,30 @@ g.write(sys.argv[1])
 PY
 check_fails "a 17 M-triangle amplification is refused" 1 "$G" info "$B/amplified.gltf"
 check "... with the numbers" grep -q "scene too large: .* the limit is 16777216" "$tmp/last"
+# Sharing is legitimate (one mesh drawn by many nodes is instancing), so the same accessor
+# drawn by 16 nodes is not refused by size: what keeps it cheap is that every step stays
+# O(n log n) on coincident triangles. A mesh all of whose 1.33 M triangles sit at one point is
+# dropped with one warning before anything is built of it; 150,000 copies of one triangle
+# (every edge shared by all of them, a 0.9 MB file) load. Either in seconds, not minutes.
+python3 - "$B" <<'PY'
+import sys
+import gltf_fixture as gf
+b = sys.argv[1]
+g = gf.Gltf()
+zeros = g.add("accessors", {"componentType": gf.FLOAT, "count": 3999999, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0]})
+point = g.mesh({"attributes": {"POSITION": zeros}})
+g.scene([g.node(mesh=point) for _ in range(16)])
+g.write(b + "/point.gltf")
+g = gf.Gltf()
+n = 150000
+tri = g.accessor([0, 0, 0, 1, 0, 0, 0, 1, 0], "VEC3", bounds=True)
+idx = g.accessor(gf.pack(gf.UNSIGNED_SHORT, [0, 1, 2] * n), "SCALAR", component=gf.UNSIGNED_SHORT, count=3 * n)
+g.scene([g.node(mesh=g.mesh({"attributes": {"POSITION": tri}, "indices": idx}))])
+g.write(b + "/stacked.gltf", bin="stacked.bin")
+PY
+check_fails "16 nodes drawing 1.33 M triangles at one point: no triangles left" 1 timeout 20 "$G" info "$B/point.gltf"
+check "... said once, naming the primitive" test "$(grep -c 'mesh 0 primitive 0: all 1333333 triangles have zero area (skipped)' "$tmp/last")" = 1
+check "150,000 copies of one triangle load" timeout 20 "$G" info "$B/stacked.gltf"
 # Images: the same bytes are decoded once and count once against SCENE_MAX_TEXELS (2^28).
 # A 16384 x 4096 grey PNG is 67 M texels: listed 8 times it loads, 5 different ones do not.
 python3 - "$B" <<'PY'
