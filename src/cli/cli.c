@@ -19,6 +19,23 @@ static int usage_errors;
 
 static char command_line[4096];
 
+bool cli_strict_all;
+
+int cli_strict_begin(bool strict)
+{
+    util_set_strict(strict || cli_strict_all);
+    return util_warning_count();
+}
+
+bool cli_strict_ok(int since, const char *what)
+{
+    int n = util_warning_count() - since;
+    if (!util_strict() || n <= 0)
+        return true;
+    util_error("%s: %d warning%s, which --strict makes errors: nothing written", what, n, n == 1 ? "" : "s");
+    return false;
+}
+
 void cli_set_command_line(int argc, char **argv)
 {
     size_t len = 0;

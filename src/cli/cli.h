@@ -170,6 +170,13 @@ void cli_complete_print(const char *list);
     {"--allow-outside-files", NULL,                                                               \
      "let the scene read files outside its folder (default: only\nregular files under it)",       \
      CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL, NULL}
+/* --strict (render, compare, info; batch: every line): every warning about the file or the
+ * command line, and a light gonio adds to a dark view, is an error, and nothing is written. */
+#define CLI_OPT_STRICT(dest)                                                                      \
+    {"--strict", NULL, "warnings are errors: a skipped primitive, an ignored extension or\n"      \
+                       "option, a clamped value, a light added to a dark view exits 1\n"         \
+                       "and writes nothing",                                                      \
+     CLI_FLAG, CLI_AS(bool, dest), 0, 0, NULL, NULL, NULL}
 /* EXR output (render, merge). */
 #define CLI_OPT_EXR_HALF(dest)                                                                    \
     {"--half", NULL, "EXR: 16-bit half channels (default 32-bit float)", CLI_FLAG, CLI_AS(bool, dest), \
@@ -251,6 +258,13 @@ bool cli_gpu_finish(gpu *g);
  * a device kept before is destroyed. off: the kept device is destroyed. False when that
  * destruction fails validation. */
 bool cli_gpu_share(bool on);
+/* --strict: cli_strict_begin(the command's --strict) turns it on (also when the batch running
+ * the command has it: cli_strict_all) and returns the warnings so far; cli_strict_ok(that,
+ * WHAT) is false, with an error naming WHAT, once more have come under --strict. A command
+ * asks it before it writes anything. */
+extern bool cli_strict_all;
+int cli_strict_begin(bool strict);
+bool cli_strict_ok(int since, const char *what);
 /* The command line, space-joined, for output headers. */
 void cli_set_command_line(int argc, char **argv);
 const char *cli_command_line(void);

@@ -158,15 +158,19 @@ static bool write_line_file(const char *dir, int number, const char *ext, const 
 int cmd_batch(int argc, char **argv)
 {
     const char *logs = NULL;
+    bool strict = false;
     const cli_option options[] = {
         {"--logs", "DIR", "each line's output (stdout and stderr) in DIR/N.log, its exit status in\n"
                           "DIR/N.status and its wall time in seconds in DIR/N.time, N its line\n"
                           "number; else the output goes to the batch's own",
          CLI_STRING, CLI_AS(const char *, &logs), 0, 0, NULL, NULL, "/"},
+        {"--strict", NULL, "every render, compare and info line as with --strict: its warnings\n"
+                           "are errors and it writes nothing (the batch goes on)",
+         CLI_FLAG, CLI_AS(bool, &strict), 0, 0, NULL, NULL, NULL},
     };
     const cli_command cmd = {
         .name = "batch",
-        .synopsis = "FILE|- [--logs DIR]",
+        .synopsis = "FILE|- [--logs DIR] [--strict]",
         .intro = "Runs the gonio command lines of FILE (- for standard input) one after the other in\n"
                  "this process, as `gonio LINE` would run each: one Vulkan device serves them all, so\n"
                  "each kernel is compiled once for the batch rather than once a command (most of a\n"
@@ -197,6 +201,7 @@ int cmd_batch(int argc, char **argv)
     size_t cap = 0;
     int number = 0, failed = 0, stopped = 0;
     cli_gpu_share(true);
+    cli_strict_all = strict;
     while (!stopped && getline(&line, &cap, f) >= 0) {
         number++;
         line[strcspn(line, "\r\n")] = 0;
@@ -220,6 +225,7 @@ int cmd_batch(int argc, char **argv)
             status = 2;
         } else {
             status = run_line(words, n);
+            util_set_strict(false); /* (a line's --strict is its own) */
         }
         if (logged)
             restore_output(saved);
@@ -238,6 +244,7 @@ int cmd_batch(int argc, char **argv)
             stopped = status;
     }
     free(line);
+    cli_strict_all = false;
     if (f != stdin)
         fclose(f);
     if (!cli_gpu_share(false))

@@ -584,7 +584,7 @@ int cmd_compare(int argc, char **argv)
     const char *input = NULL, *sweep = NULL;
     level_list sweep_levels = {.n = 0};
     int rc = 1, scene_index = -1;
-    bool outside = false;
+    bool outside = false, strict = false;
     gpu g = {0};
     const cli_option options[] = {
         {"-o, --output", "DIR", "output directory (created if missing)", CLI_STRING, CLI_AS(const char *, &o.dir), 0, 0, NULL, NULL,
@@ -605,6 +605,7 @@ int cmd_compare(int argc, char **argv)
         CLI_OPT_DEVICE(&o.device),
         CLI_OPT_VALIDATE(&o.validate),
         CLI_OPT_QUIET(&o.quiet, "no progress and no table"),
+        CLI_OPT_STRICT(&strict),
     };
     const cli_command command = {
         .name = "compare", .synopsis = "SCENE.gltf -o DIR [options]\n"
@@ -634,6 +635,7 @@ int cmd_compare(int argc, char **argv)
     if (strlen(o.dir) > COMPARE_MAX_DIR)
         return cli_usage_error("compare", "-o: a directory name of at most %d characters", COMPARE_MAX_DIR);
     util_set_quiet(o.quiet);
+    int since = cli_strict_begin(strict);
     if (!make_dir(o.dir))
         return 1;
 
@@ -645,10 +647,13 @@ int cmd_compare(int argc, char **argv)
         image imgs[COMPARE_MAX_MODES] = {{0}};
         if (!scene_load_scene(&sc, input, scene_index))
             return 1;
-        if (!choose_view(&sc, &o)) {
+        if (!cli_strict_ok(since, input)) {
+            /* said */
+        } else if (!choose_view(&sc, &o)) {
             /* camera_resolve said why */
         } else if (cli_gpu_create(&g, o.device, o.validate)) {
-            rc = render_every_mode(&g, &sc, input, scene_index, &o, imgs) && run_compare(imgs, &o) ? 0 : 1;
+            rc = render_every_mode(&g, &sc, input, scene_index, &o, imgs) && cli_strict_ok(since, input) &&
+                         run_compare(imgs, &o) ? 0 : 1;
         }
         for (int i = 0; i < COMPARE_MAX_MODES; i++)
             image_destroy(&imgs[i]);

@@ -139,10 +139,10 @@ static const char *info_intro(void)
 
 int cmd_info(int argc, char **argv)
 {
-    bool outside = false;
-    const cli_option options[] = {CLI_OPT_ALLOW_OUTSIDE_FILES(&outside)};
+    bool outside = false, strict = false;
+    const cli_option options[] = {CLI_OPT_ALLOW_OUTSIDE_FILES(&outside), CLI_OPT_STRICT(&strict)};
     const cli_command cmd = {
-        .name = "info", .synopsis = "SCENE.gltf|.glb [--allow-outside-files]",
+        .name = "info", .synopsis = "SCENE.gltf|.glb [--allow-outside-files] [--strict]",
         .intro = info_intro(),
         CLI_OPTIONS(options), .min_args = 1, .max_args = 1, .missing = "no scene given",
         .complete_args = "*.gltf *.glb"};
@@ -154,10 +154,15 @@ int cmd_info(int argc, char **argv)
         return rc;
     const char *path = args.arg[0];
     scene_allow_outside_files(outside);
+    int since = cli_strict_begin(strict);
     double t0 = util_now();
     if (!scene_load(&sc, path))
         return 1;
     double load_seconds = util_now() - t0;
+    if (!cli_strict_ok(since, path)) {
+        scene_destroy(&sc);
+        return 1;
+    }
     if (!render_geometry_build(&geo, &sc)) {
         scene_destroy(&sc);
         return 1;

@@ -354,7 +354,8 @@ typedef struct render_job {
     env_option env;
     crop_option crop;
     int size[2];  /* --size */
-    bool size_given, quiet, validate, resumable, outside, denoise;
+    bool size_given, quiet, validate, resumable, outside, denoise, strict;
+    int strict_since; /* the warnings before the command's own (cli_strict_begin) */
     int frame;   /* --frame, -1 none */
     float fps;
     float at;    /* --at, -1 none */
@@ -563,6 +564,7 @@ int cmd_render(int argc, char **argv)
         CLI_OPT_DEVICE(&j.device),
         CLI_OPT_VALIDATE(&j.validate),
         CLI_OPT_QUIET(&j.quiet, "no progress and no summary line"),
+        CLI_OPT_STRICT(&j.strict),
     };
     const cli_command command = {.name = "render", .synopsis = "SCENE.gltf|.glb -o OUT.exr|OUT.png [options]",
                                  CLI_OPTIONS(options), .epilog = RENDER_EPILOG, .min_args = 1, .max_args = 1,
@@ -578,6 +580,7 @@ int cmd_render(int argc, char **argv)
     }
     j.s.no_shadows = no_shadows;
     const char *out_path = j.out_path, *png_path = j.png_path, *exr_path = NULL;
+    j.strict_since = cli_strict_begin(j.strict);
     warn_inapplicable(&command, &args, &j.s, png_path, out_path);
     /* The name says the format: -o OUT.png is the tonemapped PNG, as --png is. */
     if ((rc = cli_image_outputs("render", out_path, png_path, &exr_path)) >= 0)
@@ -805,8 +808,11 @@ static int render_run(const render_job *job)
     }
     if ((rc = load_view(&rs)) == 0) {
         rc = 1;
-        if (start_renderer(&rs) && (!job->resume_path || check_resume(job->resume_path, rs.r, &rs.s, job->brdf, &rs.prev)) &&
-            renderer_render(rs.r, &rs.s, &rs.img, &rs.st))
+        /* --strict: what loading said stops it before the device is made, what the light
+         * rule said before the render, what the render said before its outputs */
+        if (cli_strict_ok(job->strict_since, job->scene_path) && start_renderer(&rs) && (!job->resume_path || check_resume(job->resume_path, rs.r, &rs.s, job->brdf, &rs.prev)) &&
+            cli_strict_ok(job->strict_since, job->scene_path) && renderer_render(rs.r, &rs.s, &rs.img, &rs.st) &&
+            cli_strict_ok(job->strict_since, job->scene_path))
             rc = write_outputs(&rs);
     }
     image_destroy(&rs.img);

@@ -19,7 +19,7 @@
 #include <time.h>
 #include <unistd.h>
 
-static bool quiet_flag, silent_flag;
+static bool quiet_flag, silent_flag, strict_flag;
 static int warnings;
 
 /* One character of s at *p, escaped when it is a control character, into out (room for 7
@@ -100,7 +100,18 @@ void util_warn(const char *fmt, ...)
     va_list ap;
     warnings++;
     va_start(ap, fmt);
-    vreport("warning: ", fmt, ap);
+    vreport(strict_flag ? "error: " : "warning: ", fmt, ap);
+    va_end(ap);
+}
+
+void util_fallback(const char *fmt, ...)
+{
+    va_list ap;
+    if (quiet_flag && !strict_flag)
+        return;
+    warnings += strict_flag;
+    va_start(ap, fmt);
+    vreport(strict_flag ? "error: " : "", fmt, ap);
     va_end(ap);
 }
 
@@ -117,6 +128,8 @@ void util_info(const char *fmt, ...)
 void util_set_quiet(bool quiet) { quiet_flag = quiet; }
 void util_set_silent(bool silent) { silent_flag = silent; }
 bool util_quiet(void) { return quiet_flag; }
+void util_set_strict(bool strict) { strict_flag = strict; }
+bool util_strict(void) { return strict_flag; }
 int util_warning_count(void) { return warnings; }
 
 double util_now(void)

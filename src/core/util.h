@@ -40,6 +40,13 @@ void util_set_silent(bool silent);
 bool util_quiet(void);
 /* Number of warnings printed so far (tests and the CLI summary use it). */
 int util_warning_count(void);
+/* --strict: a warning (and a util_fallback) is printed as an error, and still counted, so
+ * that the command refuses to write anything once it sees the count grow (cli_strict_ok). */
+void util_set_strict(bool strict);
+bool util_strict(void);
+/* A fallback the program chose for the file (a light added where its own leaves the view
+ * dark): an informational line (util_info), which --strict makes an error as it does warnings. */
+void util_fallback(const char *fmt, ...) UTIL_PRINTF(1, 2);
 
 /* Monotonic seconds. */
 double util_now(void);

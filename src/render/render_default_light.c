@@ -156,10 +156,10 @@ static void env_add_studio(const render_light_request *e, scene *sc, bool quiet,
                            render_settings *s)
 {
     float scale = e->intensity > 0 ? e->intensity : 1, mean[3];
-    if (!quiet)
-        util_info("%s: its own light leaves the view dark (%.0f %% of the model brighter than %g, under %.0f %%): "
-                  "added gonio's studio environment (--env 0 for the file's light alone)",
-                  sc->path, 100 * lit, ENV_PROBE_LEVEL, 100 * ENV_PROBE_LIT);
+    if (!quiet || util_strict())
+        util_fallback("%s: its own light leaves the view dark (%.0f %% of the model brighter than %g, under %.0f %%): "
+                      "added gonio's studio environment (--env 0 for the file's light alone)",
+                      sc->path, 100 * lit, ENV_PROBE_LEVEL, 100 * ENV_PROBE_LIT);
     image_destroy(&l->map);
     studio_setup(e, sc, s->mode != GN_MODE_PATH, &l->map);
     env_use_map(&l->map, scale, mean, s);
@@ -258,10 +258,10 @@ static bool env_add_headlight(renderer *r, scene *sc, render_settings *s, bool q
     sc->lights[sc->num_lights++] = head;
     s->env_map = NULL; /* (the local modes keep the studio's ambient term) */
     s->env[0] = s->env[1] = s->env[2] = 0;
-    if (!quiet)
-        util_info("%s: the camera is inside a closed model (%.0f %% of the rays from it meet the scene) that keeps "
-                  "the studio out (%.0f %% of the model lit): a headlight, a point light at the camera, replaces "
-                  "the studio (any --env decides instead)", sc->path, 100 * enclosed, 100 * fmaxf(lit, 0));
+    if (!quiet || util_strict())
+        util_fallback("%s: the camera is inside a closed model (%.0f %% of the rays from it meet the scene) that "
+                      "keeps the studio out (%.0f %% of the model lit): a headlight, a point light at the camera, "
+                      "replaces the studio (any --env decides instead)", sc->path, 100 * enclosed, 100 * fmaxf(lit, 0));
     return true;
 }
 

@@ -118,6 +118,7 @@ Q lit-0 "$tmp/lit.gltf" -o "$tmp/lit-0.exr" --size 48x48 --env 0
 Q dim "$tmp/dim.gltf" -o "$tmp/dim.exr" --size 48x48
 Q dim-0 "$tmp/dim.gltf" -o "$tmp/dim-0.exr" --size 48x48 --env 0
 Q dim-s "$tmp/dim.gltf" -o "$tmp/dim-s.exr" --size 48x48 --env studio
+Q dim-strict "$tmp/dim.gltf" -o "$tmp/dim-strict.exr" --size 48x48 --strict --quiet
 for m in sky open black dimlamp lamp; do Q "$m" "$tmp/$m.gltf" -o "$tmp/$m.exr" --size 48x32; done
 Q sky-s "$tmp/sky.gltf" -o "$tmp/sky-s.exr" --size 48x32 --env studio
 Q lamp-0 "$tmp/lamp.gltf" -o "$tmp/lamp-0.exr" --size 48x32 --env 0
@@ -151,6 +152,9 @@ got=$(lit "$tmp/dim-0.exr")
 check "--env 0 keeps the dark file dark (lit fraction $got < 0.6)" python3 -c "assert $got < 0.6"
 check_queued "--env studio given: no message of the rule" 0 "dim-s"
 grep -q "$ADDED" "$tmp/last" && fail "an explicit --env studio printed the rule's message" || pass
+check_queued "--strict (and --quiet): the studio added to a dark view is an error" 1 "dim-strict"
+check "... said as one" grep -qF "gonio: error: $tmp/dim.gltf: its own light leaves the view dark" "$tmp/last"
+check "... and nothing written" test ! -e "$tmp/dim-strict.exr"
 
 
 HEAD="a headlight, a point light at the camera, replaces the studio"
