@@ -203,8 +203,11 @@ const Extension EXTENSIONS[] = {
      false, nullptr},
     {"EXT_mesh_gpu_instancing", SCENE_SUPPORTED,
      "TRANSLATION, ROTATION and SCALE: the node's mesh kept once and placed by each instance", false, nullptr},
-    {"KHR_xmp_json_ld", SCENE_UNSUPPORTED, "metadata: nothing in it is rendered", false, nullptr},
-    {"KHR_xmp", SCENE_UNSUPPORTED, "metadata (KHR_xmp_json_ld's draft): nothing in it is rendered", false, nullptr},
+    /* metadata only: a file renders as meant with them ignored, so they are no warning */
+    {"KHR_xmp_json_ld", SCENE_SUPPORTED, "metadata (title, author, licence): nothing in it changes the image", false,
+     nullptr},
+    {"KHR_xmp", SCENE_SUPPORTED, "metadata (KHR_xmp_json_ld's draft): nothing in it changes the image", false,
+     nullptr},
 };
 
 const Extension *find_extension(const std::string &name)
