@@ -95,6 +95,12 @@ check "brdf --sphere -o x.exr writes an EXR" is_exr "$tmp/ball.exr"
 check "brdf lobe -o x.png" "$G" brdf lambert -o "$tmp/lobe.png"
 check "brdf lobe writes a PNG" is_png "$tmp/lobe.png"
 check_fails "teapot -o x.obj" 2 "$G" teapot -o "$tmp/bad.obj"
+# The teapot is an open mesh (the spout and the lid's gap show its inside): double-sided.
+check "teapot --level 2 -o x.gltf" "$G" teapot --level 2 -o "$tmp/teapot-2.gltf"
+for f in "$tmp/teapot.gltf" "$tmp/teapot-2.gltf"; do
+    check "$(basename "$f"): its material is double-sided" python3 -c \
+        'import json, sys; assert json.load(open(sys.argv[1]))["materials"][0]["doubleSided"] is True' "$f"
+done
 # .glb is binary glTF (magic, version 2, total length = file size) that info and render read,
 # and the same scene as the .gltf: identical pixels and the same gonio:scene hash.
 # (the files are written and rendered above, in the batch)
