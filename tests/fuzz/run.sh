@@ -3,8 +3,8 @@
 # each (default 60), seeded in place from scenes/, tests/fuzz/seeds (what the sample models
 # lack: a skinned and morphed scene, sparse targets, animated weights), $GONIO_ASSETS (sample
 # models, glTF-Validator's invalid files), from EXRs that $GONIO writes here, every
-# compression, scanline and tiled, and from WebP and KTX2 textures written here ($TESTTOOL
-# ktx2, cwebp). New inputs and crash files go to a temporary folder, kept and named on a crash:
+# compression, scanline and tiled, from WebP and KTX2 textures written here ($TESTTOOL
+# ktx2, cwebp), and from image-based lights written here. New inputs and crash files go to a temporary folder, kept and named on a crash:
 # minimise one (TARGET -minimize_crash=1 FILE), fix the bug, and add the small file to
 # tests/fuzz/regress (tests/regress/fuzz.sh replays them in make test).
 set -u
@@ -34,6 +34,21 @@ fi
 if python3 tests/tool/instances.py "$tmp/instances" >/dev/null 2>&1; then
     for f in "$tmp"/instances/*.gltf; do link "$tmp/seed-scene" "$f"; done
 fi
+# image-based lights (EXT_lights_image_based): a cube map of six embedded 4x4 PNG faces over
+# two levels, rotated and scaled, and one whose faces disagree in size
+PYTHONPATH=tests/tool python3 - "$tmp/seed-scene" <<'PY' || echo "note: no image-based-light seeds"
+import sys
+import gltf_fixture as gf
+for name, sizes in (("ibl", [4] * 6), ("ibl-mismatched", [4, 4, 2, 4, 8, 4])):
+    g = gf.Gltf()
+    faces = [g.image(gf.png(n, n, lambda x, y, f=f: (40 * f, 255 - 40 * f, 16 * x + 8 * y), 3)) for f, n in enumerate(sizes)]
+    small = [g.image(gf.png(2, 2, lambda x, y, f=f: (40 * f, 90, 30), 3)) for f in range(6)]
+    g.extend(g.doc, "EXT_lights_image_based", lights=[{"rotation": [0, 0.7071068, 0, 0.7071068], "intensity": 1.5,
+             "irradianceCoefficients": [[0.1, 0.2, 0.3]] * 9, "specularImageSize": 4,
+             "specularImages": [faces, small]}])
+    g.scene([g.node(mesh=g.mesh(g.primitive([0, 0, 0, 1, 0, 0, 0, 1, 0])))], extensions={"EXT_lights_image_based": {"light": 0}})
+    g.write(f"{sys.argv[1]}/{name}.gltf")
+PY
 # Textures: a WebP by cwebp and a KTX2 of each Basis Universal mode by testtool ktx2, as GLBs
 # that use them (tests/tool/gltf_fixture.py textured-glb) for the scene fuzzer, and bare for
 # fuzz_image in its layout: a format byte (1 KTX2, 0 WebP), then the file past its 12-byte
