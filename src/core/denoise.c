@@ -67,6 +67,7 @@ static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
 static struct {
     void *lib;
     char lib_path[PATH_MAX];
+    char lib_env[PATH_MAX]; /* DENOISE_LIB_ENV when it was loaded ("": unset) */
     oidn_api api;
     OIDNDevice device;
     int version;
@@ -108,8 +109,18 @@ static bool load_locked(void)
     char tried[4 * PATH_MAX + 512] = "", exe[PATH_MAX], path[PATH_MAX + 64];
     const char *env = getenv(DENOISE_LIB_ENV);
     ssize_t n;
+    /* The library stays loaded for the process (unloading OIDN under its thread pool is not
+     * safe): a later command (a batch line) that names another one is refused, not served
+     * by the first. */
+    if (st.lib && strcmp(env ? env : "", st.lib_env)) {
+        util_error("the denoiser: %s=%s, but this process has Open Image Denoise loaded from %s already (a "
+                   "batch loads one library for all its lines): run this command in a process of its own",
+                   DENOISE_LIB_ENV, env ? env : "(unset)", st.lib_path);
+        return false;
+    }
     if (st.lib)
         return true;
+    snprintf(st.lib_env, sizeof st.lib_env, "%s", env ? env : "");
     if (env && *env) {
         if (try_open(env, tried, sizeof tried))
             return true;

@@ -38,6 +38,7 @@ need_denoiser "the checks that denoise did not run"
 # the usage errors and gonio denoise stay processes of their own.)
 V="--look-at 0,0.15,0.8,0,0.12,0 --fov 30 --size 64x64 --quiet"
 queue d render $C -o "$tmp/d.exr" --png "$tmp/d.png" --spp 16 --denoise $R
+queue other-lib GONIO_OIDN_LIB="$tmp/none.so" render $C -o "$tmp/other-lib.exr" --spp 1 --denoise $R
 queue n render $C -o "$tmp/n.exr" --png "$tmp/n.png" --spp 16 $R
 queue da render $C -o "$tmp/da.exr" --spp 16 --denoise --aov albedo,normal,depth $R
 queue dt render $C -o "$tmp/dt.exr" --time 0.5 --denoise $R
@@ -59,6 +60,9 @@ check "... channels R, G, B, A and the noisy layer, nothing else (no --aov)" \
 check "... the header names the denoiser, its version and what it did" \
     sh -c "exrheader '$tmp/d.exr' | grep -Eq 'gonio:denoiser .*OpenImageDenoise 2\.[0-9]+\.[0-9]+ RT \(hdr, albedo\+normal prefiltered, cleanAux'"
 check "... and its time" sh -c "exrheader '$tmp/d.exr' | grep -q 'gonio:denoise-seconds (type double)'"
+check_queued "a later batch line naming another library: exit 1, as in a process of its own" 1 other-lib
+check "... saying which one the batch has loaded" grep -q "GONIO_OIDN_LIB=$tmp/none.so, but this process has Open Image Denoise loaded from .* already" "$tmp/last"
+check "... and no output" test ! -e "$tmp/other-lib.exr"
 check_queued "render the same without --denoise" 0 n
 check "the noisy layer as R, G, B" "$T" rename "$tmp/d.exr" "$tmp/d-noisy.exr" R=,G=,B=,noisy.R=R,noisy.G=G,noisy.B=B
 check "... is the render without --denoise, bit for bit" "$T" same "$tmp/n.exr" "$tmp/d-noisy.exr"
