@@ -371,6 +371,7 @@ bool pose_primitive(Ctx &c, const Instance &in, const Prim &p, Prim &out)
     out.material = p.material;
     const size_t nv = p.pos.size() / 3;
     std::vector<double> pos(p.pos.begin(), p.pos.end()), nrm(p.nrm.begin(), p.nrm.end()), tan(p.tan.begin(), p.tan.end());
+    std::vector<int8_t> mirrored(skinned ? nv : 0); /* the vertex's skin matrix has det < 0 */
     /* glTF 2.0, "Morph Targets": the base plus the weighted sum of the targets' displacements */
     for (size_t t = 0; morphed && t < p.targets.size() && t < w.size(); t++) {
         const Prim::Target &d = p.targets[t];
@@ -411,6 +412,7 @@ bool pose_primitive(Ctx &c, const Instance &in, const Prim &p, Prim &out)
                     a[r][k] = s[size_t(k * 4 + r)];
             const double det = vec_cofactors3(a, cof);
             const double sgn = det < 0 ? -1 : 1;
+            mirrored[v] = det < 0;
             if (!nrm.empty() && !p.flat) {
                 double *n = &nrm[v * 3];
                 for (int r = 0; r < 3; r++)
@@ -426,6 +428,16 @@ bool pose_primitive(Ctx &c, const Instance &in, const Prim &p, Prim &out)
             }
         }
     }
+    /* A triangle the skin mirrors (most of its corners' matrices have det < 0) is listed the
+     * other way round, as bake_mesh lists a mirrored node's: its front stays its front. Flat
+     * normals, made from the corners in the vertices' order below, turn with it. */
+    std::vector<int8_t> turned(mirrored.empty() ? 0 : out.idx.size() / 3);
+    for (size_t t = 0; t < turned.size(); t++) {
+        uint32_t *q = &out.idx[t * 3];
+        turned[t] = mirrored[q[0]] + mirrored[q[1]] + mirrored[q[2]] >= 2;
+        if (turned[t])
+            std::swap(q[1], q[2]);
+    }
     out.pos.assign(pos.begin(), pos.end());
     out.nrm.resize(nv * 3);
     for (size_t v = 0; v < nv; v++) {
@@ -433,9 +445,10 @@ bool pose_primitive(Ctx &c, const Instance &in, const Prim &p, Prim &out)
         if (p.flat && v % 3 == 0 && v + 2 < nv) { /* flat: a triangle per three vertices, in order */
             const double *a = &pos[v * 3], *b = a + 3, *cc = a + 6;
             const double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {cc[0] - a[0], cc[1] - a[1], cc[2] - a[2]};
-            n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-            n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-            n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            const double turn = !turned.empty() && turned[v / 3] ? -1 : 1; /* (flat: triangle v / 3 is vertices v..v+2) */
+            n[0] = turn * (e1[1] * e2[2] - e1[2] * e2[1]);
+            n[1] = turn * (e1[2] * e2[0] - e1[0] * e2[2]);
+            n[2] = turn * (e1[0] * e2[1] - e1[1] * e2[0]);
         } else if (p.flat) {
             std::copy(&out.nrm[(v - v % 3) * 3], &out.nrm[(v - v % 3) * 3] + 3, n);
         } else {

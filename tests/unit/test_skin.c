@@ -518,3 +518,48 @@ TEST(skin, morph_flat_normals_and_tangents)
     }
     scene_destroy(&s);
 }
+
+/* A joint that mirrors (scale -1 on x) turns the skinned quad's triangles around: their
+ * corner order must be reversed, as a node's mirroring transform reverses it, so that the
+ * winding's normal and the shading normal agree and face +z, as the quad did (a mirror in x
+ * keeps a plane facing +z; a one-sided material stays seen from the side it faces). With
+ * NORMAL (mesh 0) and without (mesh 1: flat normals, made after posing); node 1 mirrors a
+ * plain quad by its own transform, the reference. */
+TEST(skin, mirroring_joint_keeps_the_winding)
+{
+    gltf_file f = {0};
+    const uint8_t joints[16] = {0};
+    const float weights[16] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    quad_accessors(&f);                                             /* 0-2 */
+    accessor(&f, joints, sizeof joints, 5121, 4, "VEC4", "");       /* 3 */
+    accessor(&f, weights, sizeof weights, 5126, 4, "VEC4", "");     /* 4 */
+    const char *rest =
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"JOINTS_0\":3,\"WEIGHTS_0\":4},"
+        "\"indices\":2}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":3,\"WEIGHTS_0\":4},\"indices\":2}]},"
+        "{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1},\"indices\":2}]}],"
+        "\"nodes\":[{\"mesh\":0,\"skin\":0},{\"mesh\":2,\"scale\":[-1,1,1],\"translation\":[0,3,0]},"
+        "{\"scale\":[-1,1,1]},{\"mesh\":1,\"skin\":1},{\"scale\":[-1,1,1],\"translation\":[0,-3,0]}],"
+        "\"skins\":[{\"joints\":[2]},{\"joints\":[4]}],\"scenes\":[{\"nodes\":[0,1,2,3,4]}]";
+    scene s;
+    bool ok = write_and_load(&s, &f, rest, -1);
+    CHECKF(ok, "%s", load_log);
+    if (!ok)
+        return;
+    CHECKF(s.num_triangles == 6, "%u triangles", s.num_triangles);
+    for (uint32_t t = 0; t < s.num_triangles; t++) {
+        const GnVertex *v[3];
+        for (int k = 0; k < 3; k++)
+            v[k] = &s.vertices[s.indices[3 * t + k]];
+        double e1[3] = {v[1]->position.x - v[0]->position.x, v[1]->position.y - v[0]->position.y,
+                        v[1]->position.z - v[0]->position.z};
+        double e2[3] = {v[2]->position.x - v[0]->position.x, v[2]->position.y - v[0]->position.y,
+                        v[2]->position.z - v[0]->position.z};
+        double gz = e1[0] * e2[1] - e1[1] * e2[0]; /* the winding's normal: along z only */
+        for (int k = 0; k < 3; k++)
+            CHECKF(gz > 0 && v[k]->normal.z > 0 && v[k]->position.x >= -1 && v[k]->position.x <= 0,
+                   "triangle %u (at y %g) corner %d: winding's normal z %g, shading normal z %g, x %g", t,
+                   v[0]->position.y, k, gz, v[k]->normal.z, v[k]->position.x);
+    }
+    scene_destroy(&s);
+}
