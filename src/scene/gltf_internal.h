@@ -63,6 +63,8 @@ struct Prim {                  /* one triangle primitive of a glTF mesh, in the 
     std::vector<float> weights;    /* influences per vertex */
     struct Target {                /* a morph target: displacements, 3 per vertex, empty if absent */
         std::vector<float> pos, nrm, tan;
+        std::vector<float> uv, uv1;    /* TEXCOORD_0, _1: 2 per vertex */
+        std::vector<float> col;        /* COLOR_0: 4 per vertex (RGB for a VEC3 one, A 0) */
     };
     std::vector<Target> targets;
     int max_joint = -1;            /* the largest joint index with a weight > 0 ... */

@@ -124,11 +124,26 @@ bool check_skins_and_targets(Ctx &c)
                 for (const auto &attr : pr.targets[ti]) {
                     const std::string tp = pp + ".targets[" + std::to_string(ti) + "]." + attr.first;
                     const bool position = attr.first == "POSITION";
-                    if (!position && attr.first != "NORMAL" && attr.first != "TANGENT")
-                        continue; /* TEXCOORD_n and COLOR_n displacements: a warning when read */
+                    const bool uv = attr.first == "TEXCOORD_0" || attr.first == "TEXCOORD_1", col = attr.first == "COLOR_0";
+                    if (!position && attr.first != "NORMAL" && attr.first != "TANGENT" && !uv && !col)
+                        continue; /* the other sets are not read, nor are their bases: nothing to morph */
                     if (!in_range(attr.second, m.accessors.size()))
                         return fail(c, "%s: accessor %d does not exist", tp.c_str(), attr.second);
                     const auto &a = m.accessors[size_t(attr.second)];
+                    if (uv || col) { /* glTF 2.0, "Morph Targets": float or normalized integers */
+                        const unsigned ok = F_F | F_I8N | F_U8N | F_I16N | F_U16N;
+                        const bool type = uv ? a.type == TINYGLTF_TYPE_VEC2 : a.type == TINYGLTF_TYPE_VEC3 || a.type == TINYGLTF_TYPE_VEC4;
+                        if (!type || !(format_bit(a) & ok))
+                            return fail(c, "%s: accessor %d (%s, component type %d%s) is not allowed for a morph "
+                                        "target's %s (%s of floats or normalized integers)", tp.c_str(), attr.second,
+                                        type_name(a.type), a.componentType, a.normalized ? " normalized" : "",
+                                        uv ? "texture coordinates" : "colour", uv ? "VEC2" : "VEC3 or VEC4");
+                        if (a.count != nv)
+                            return fail(c, "%s: accessor %d has %zu elements, but the primitive has %zu vertices",
+                                        tp.c_str(), attr.second, a.count, nv);
+                        per_vertex += uv ? 2 : 4;
+                        continue;
+                    }
                     /* glTF 2.0 and KHR_mesh_quantization: float VEC3, or with the extension
                      * (normalized) byte and short, non-normalized ones only for POSITION */
                     const unsigned allowed = !quant ? F_F : position ? F_F | F_I8 | F_I8N | F_I16 | F_I16N
@@ -251,20 +266,34 @@ bool read_skin_and_targets(Ctx &c, int mi, int pi, Prim &out)
     for (size_t ti = 0; ti < pr.targets.size(); ti++)
         for (const auto &attr : pr.targets[ti]) {
             const std::string tp = pp + ".targets[" + std::to_string(ti) + "]." + attr.first;
-            std::vector<float> *dst = attr.first == "POSITION" ? &out.targets[ti].pos
-                                      : attr.first == "NORMAL" ? &out.targets[ti].nrm
-                                      : attr.first == "TANGENT" ? &out.targets[ti].tan : nullptr;
+            Prim::Target &t = out.targets[ti];
+            const std::string &n = attr.first;
+            /* a displacement of an attribute the primitive has (a TEXCOORD or COLOR one without
+             * its base changes nothing gonio draws) */
+            std::vector<float> *dst = n == "POSITION" ? &t.pos : n == "NORMAL" ? &t.nrm : n == "TANGENT" ? &t.tan
+                                      : n == "TEXCOORD_0" ? (out.uv.empty() ? nullptr : &t.uv)
+                                      : n == "TEXCOORD_1" ? (out.uv1.empty() ? nullptr : &t.uv1)
+                                      : n == "COLOR_0" ? (out.col.empty() ? nullptr : &t.col) : nullptr;
             if (!dst) {
-                if (!warned)
-                    warn(c, "%s: morph target attribute %s is not read (ignored)", tp.c_str(), attr.first.c_str());
-                warned = true;
+                const bool a_set = set_number(n, "TEXCOORD_") >= 0 || set_number(n, "COLOR_") >= 0;
+                if (!a_set && !warned)
+                    warn(c, "%s: morph target attribute %s is not read (ignored)", tp.c_str(), n.c_str());
+                warned = warned || !a_set;
                 continue;
             }
             std::vector<double> d = read_accessor(c, attr.second);
-            for (size_t k = 0; k < d.size(); k++)
-                if (!std::isfinite(d[k]))
-                    return fail(c, "%s: element %zu is not finite", tp.c_str(), k / 3);
-            dst->assign(d.begin(), d.end());
+            const size_t k = d.size() / std::max<size_t>(nv, 1); /* components */
+            for (size_t e = 0; e < d.size(); e++)
+                if (!std::isfinite(d[e]))
+                    return fail(c, "%s: element %zu is not finite", tp.c_str(), e / std::max<size_t>(k, 1));
+            if (dst == &t.col) { /* RGBA, alpha displaced by nothing where the target is RGB */
+                dst->assign(nv * 4, 0.0f);
+                for (size_t v = 0; v < nv && k >= 3; v++)
+                    for (size_t j = 0; j < k && j < 4; j++)
+                        (*dst)[v * 4 + j] = float(d[v * k + j]);
+            } else {
+                dst->assign(d.begin(), d.end());
+            }
         }
     return true;
 }
@@ -285,6 +314,9 @@ void remap_skin_and_targets(Prim &p, const uint32_t *src, size_t n)
         remap(t.pos, 3);
         remap(t.nrm, 3);
         remap(t.tan, 3);
+        remap(t.uv, 2);
+        remap(t.uv1, 2);
+        remap(t.col, 4);
     }
 }
 
@@ -384,7 +416,15 @@ bool pose_primitive(Ctx &c, const Instance &in, const Prim &p, Prim &out)
         for (size_t v = 0; !tan.empty() && v < d.tan.size() / 3; v++)
             for (size_t k = 0; k < 3; k++)
                 tan[v * 4 + k] += w[t] * d.tan[v * 3 + k];
+        for (size_t i = 0; i < d.uv.size() && i < out.uv.size(); i++)
+            out.uv[i] += float(w[t] * d.uv[i]);
+        for (size_t i = 0; i < d.uv1.size() && i < out.uv1.size(); i++)
+            out.uv1[i] += float(w[t] * d.uv1[i]);
+        for (size_t i = 0; i < d.col.size() && i < out.col.size(); i++)
+            out.col[i] += float(w[t] * d.col[i]);
     }
+    for (float &x : out.col) /* a colour stays in [0, 1], as COLOR_0 is read */
+        x = std::min(1.0f, std::max(0.0f, x));
     if (skinned) {
         for (size_t v = 0; v < nv; v++) {
             /* the skin matrix: the weighted sum of the joint matrices (weights sum to one) */

@@ -563,3 +563,58 @@ TEST(skin, mirroring_joint_keeps_the_winding)
     }
     scene_destroy(&s);
 }
+
+/* Morph targets displace TEXCOORD_0, TEXCOORD_1 and COLOR_0 too (glTF 2.0, "Morph Targets"):
+ * the base plus the weighted displacements, as for positions; a VEC3 colour displacement
+ * leaves alpha, a normalized unsigned byte one reads as k / 255, and the colour is clamped
+ * to [0, 1]. Two targets at weights 0.5 and 0.25; a target's TEXCOORD_3 (a set gonio does
+ * not read) changes nothing and is no warning. */
+TEST(skin, morph_texcoords_and_colors)
+{
+    gltf_file f = {0};
+    const float uv[8] = {0, 0, 1, 0, 1, 1, 0, 1}, uv1[8] = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
+    const float col[16] = {0.2f, 0.4f, 0.6f, 1, 0.2f, 0.4f, 0.6f, 1, 0.2f, 0.4f, 0.6f, 1, 0.2f, 0.4f, 0.6f, 0.5f};
+    const float duv[8] = {0.2f, 0, 0.2f, 0, 0.2f, 0, 0.2f, -0.4f}, duv1[8] = {0, 0.4f, 0, 0.4f, 0, 0.4f, 0, 0.4f};
+    const float dcol[12] = {0.4f, 0, 0, 0.4f, 0, 0, 0.4f, 0, 0, 2, -2, 0}; /* vertex 3: clamped */
+    const uint8_t dcol2[16] = {0, 0, 255, 0, 0, 0, 255, 0, 0, 0, 255, 0, 0, 0, 255, 204};
+    quad_accessors(&f);                                                   /* 0-2 */
+    accessor(&f, uv, sizeof uv, 5126, 4, "VEC2", "");                     /* 3 */
+    accessor(&f, uv1, sizeof uv1, 5126, 4, "VEC2", "");                   /* 4 */
+    accessor(&f, col, sizeof col, 5126, 4, "VEC4", "");                   /* 5 */
+    accessor(&f, duv, sizeof duv, 5126, 4, "VEC2", "");                   /* 6 */
+    accessor(&f, duv1, sizeof duv1, 5126, 4, "VEC2", "");                 /* 7 */
+    accessor(&f, dcol, sizeof dcol, 5126, 4, "VEC3", "");                 /* 8 */
+    accessor(&f, dcol2, sizeof dcol2, 5121, 4, "VEC4", ",\"normalized\":true"); /* 9 */
+    const char *rest =
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"TEXCOORD_0\":3,\"TEXCOORD_1\":4,"
+        "\"COLOR_0\":5},\"indices\":2,\"targets\":[{\"TEXCOORD_0\":6,\"TEXCOORD_1\":7,\"COLOR_0\":8},"
+        "{\"COLOR_0\":9,\"TEXCOORD_3\":6}]}],\"weights\":[0.5,0.25]}],"
+        "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]";
+    scene s;
+    int w0 = util_warning_count();
+    bool ok = write_and_load(&s, &f, rest, -1);
+    CHECKF(ok, "%s", load_log);
+    if (!ok)
+        return;
+    CHECKF(util_warning_count() == w0, "%s", load_log);
+    CHECKF(s.num_vertices == 4, "%u vertices", s.num_vertices);
+    for (int v = 0; v < 4 && s.num_vertices == 4; v++) {
+        const GnVertex *g = &s.vertices[v];
+        double want_uv[2] = {uv[2 * v] + 0.5 * duv[2 * v], uv[2 * v + 1] + 0.5 * duv[2 * v + 1]};
+        double want_uv1[2] = {0.5, 0.5 + 0.5 * 0.4};
+        double want[4];
+        for (int k = 0; k < 4; k++) {
+            double x = col[4 * v + k] + (k < 3 ? 0.5 * dcol[3 * v + k] : 0) + 0.25 * dcol2[4 * v + k] / 255.0;
+            want[k] = x < 0 ? 0 : x > 1 ? 1 : x;
+        }
+        CHECKF(fabs(g->u - want_uv[0]) < 1e-6 && fabs(g->v - want_uv[1]) < 1e-6 && fabs(g->u1 - want_uv1[0]) < 1e-6 &&
+                   fabs(g->v1 - want_uv1[1]) < 1e-6,
+               "vertex %d: uv (%g, %g) uv1 (%g, %g), expected (%g, %g) (%g, %g)", v, g->u, g->v, g->u1, g->v1,
+               want_uv[0], want_uv[1], want_uv1[0], want_uv1[1]);
+        CHECKF(fabs(g->color.x - want[0]) < 1e-6 && fabs(g->color.y - want[1]) < 1e-6 &&
+                   fabs(g->color.z - want[2]) < 1e-6 && fabs(g->color.w - want[3]) < 1e-6,
+               "vertex %d: colour (%g, %g, %g, %g), expected (%g, %g, %g, %g)", v, g->color.x, g->color.y, g->color.z,
+               g->color.w, want[0], want[1], want[2], want[3]);
+    }
+    scene_destroy(&s);
+}
