@@ -796,6 +796,14 @@ void material_read(Doc &d, const Json &m, const std::string &p, size_t i)
         if (e.read)
             if (const Json *base = row_base(m, ex, e.name, p, bp))
                 e.read(d, *base, bp, out);
+    /* The specular-glossiness model has its own specular colour and no index: the PBR
+     * extensions made for metallic-roughness do not combine with it, and read_spec_gloss
+     * replaced what they set. */
+    if (ex && ex->is_object() && ex->count("KHR_materials_pbrSpecularGlossiness"))
+        for (const char *other : {"KHR_materials_specular", "KHR_materials_ior"})
+            if (ex->count(other))
+                warn(d.c, "%s: %s does not combine with KHR_materials_pbrSpecularGlossiness (ignored)",
+                     out.what.c_str(), other);
     /* the core's own flags */
     d.boolean(m, "doubleSided", p);
     d.enum_str(m, "alphaMode", p, {"OPAQUE", "MASK", "BLEND"});

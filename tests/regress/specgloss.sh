@@ -9,6 +9,8 @@
 # half, as two untextured twins. Then the Khronos sample SpecGlossVsMetalRough (a bottle in
 # each model, made to look alike) seen straight on from afar: its halves' mean luminances
 # agree; `gonio info` names the extension as supported. Dyadic factors keep both paths exact.
+# KHR_materials_specular and _ior beside it are ignored with a warning each (they do not
+# combine with it).
 . "$(dirname "$0")/../lib.sh"
 G=$GONIO
 A=${GONIO_ASSETS:-}
@@ -51,6 +53,10 @@ gen sg-tex '{"extensions": {"KHR_materials_pbrSpecularGlossiness": {"diffuseFact
 gen mr-white "$(mr "$D" "$S" 0.75)" "$MR_EXT"  # the left texel: specular x 1, glossiness x 1
 gen mr-black "$(mr "$D" '[0, 0, 0]' 0)" "$MR_EXT" # the right one: specular x 0, glossiness x 0
 
+# the PBR extensions of metallic-roughness beside it: ignored, saying so (checked below)
+gen sg-mixed '{"extensions": {"KHR_materials_pbrSpecularGlossiness": {"diffuseFactor": [0.75, 0.5, 0.25, 1],
+    "specularFactor": '"$S"', "glossinessFactor": 0.75}, "KHR_materials_specular": {"specularFactor": 0.5},
+    "KHR_materials_ior": {"ior": 2}}}' '["KHR_materials_pbrSpecularGlossiness","KHR_materials_specular","KHR_materials_ior"]'
 # a bad value (checked below)
 gen bad '{"extensions": {"KHR_materials_pbrSpecularGlossiness": {"specularFactor": [0.5, "x", 0.5]}}}' "$SG_EXT"
 f=$A/gltf/SpecGlossVsMetalRough/glTF/SpecGlossVsMetalRough.gltf
@@ -58,7 +64,7 @@ assets=0
 [ -n "$A" ] && [ -f "$f" ] && assets=1
 
 # ---- the renders, queued (lib.sh: queue), run in one batch --------------------------------
-for s in sg-factors mr-factors sg-tex mr-white mr-black; do
+for s in sg-factors mr-factors sg-tex mr-white mr-black sg-mixed; do
     queue $s render "$tmp/$s.gltf" --spp 4 --size ${W}x$H --env 1 --compression none --quiet -o "$tmp/$s.exr"
 done
 queue bad render "$tmp/bad.gltf" --spp 1 --size 8x8 -o "$tmp/bad.exr"
@@ -77,6 +83,13 @@ check "factors: the spec-gloss quad renders as its metallic-roughness twin" \
     same_halves "$tmp/sg-factors.exr" "$tmp/mr-factors.exr" "$tmp/mr-factors.exr" $W
 check "specularGlossinessTexture: RGB scales the specular colour, A the glossiness, texel by texel" \
     same_halves "$tmp/sg-tex.exr" "$tmp/mr-white.exr" "$tmp/mr-black.exr" $W
+
+check_queued "spec-gloss beside KHR_materials_specular and _ior renders" 0 sg-mixed
+for x in specular ior; do
+    check "... warning that KHR_materials_$x does not combine with it" \
+        grep -qF "material 0: KHR_materials_$x does not combine with KHR_materials_pbrSpecularGlossiness (ignored)" "$tmp/last"
+done
+check "... and renders as the spec-gloss material alone" "$TESTTOOL" same "$tmp/sg-factors.exr" "$tmp/sg-mixed.exr"
 
 # a bad value: an error naming the JSON path, exit 1
 check_queued "a specularFactor of the wrong type is refused" 1 bad
