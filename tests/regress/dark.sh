@@ -121,6 +121,7 @@ Q dim-s "$tmp/dim.gltf" -o "$tmp/dim-s.exr" --size 48x48 --env studio
 Q dim-strict "$tmp/dim.gltf" -o "$tmp/dim-strict.exr" --size 48x48 --strict --quiet
 for m in sky open black dimlamp lamp; do Q "$m" "$tmp/$m.gltf" -o "$tmp/$m.exr" --size 48x32; done
 Q sky-s "$tmp/sky.gltf" -o "$tmp/sky-s.exr" --size 48x32 --env studio
+Q sky-frames "$tmp/sky.gltf" --frames 0-1 -o "$tmp/sky-f%d.exr" --size 48x32
 Q lamp-0 "$tmp/lamp.gltf" -o "$tmp/lamp-0.exr" --size 48x32 --env 0
 for m in tiny huge; do Q "$m" "$tmp/$m.gltf" -o "$tmp/$m.exr" --size 64x64 --env 1; done
 run_queue
@@ -158,6 +159,10 @@ check "... and nothing written" test ! -e "$tmp/dim-strict.exr"
 
 
 HEAD="a headlight, a point light at the camera, replaces the studio"
+check_queued "--frames with the headlight" 0 "sky-frames"
+check "... keeps the renderer from frame to frame (the light is the rule's, not the geometry)" \
+    grep -qF "frame 1: the same geometry, moved" "$tmp/last"
+check "... and each frame is the render of the frame alone, bit for bit" "$TESTTOOL" same "$tmp/sky-f1.exr" "$tmp/sky.exr"
 check_queued "a camera inside a closed sky, no light: renders" 0 "sky"
 cp "$tmp/last" "$tmp/msg"
 check "... a headlight added, saying why" grep -qF "the camera is inside a closed model (100 % of the rays from it meet the scene)" "$tmp/msg"
