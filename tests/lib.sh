@@ -223,6 +223,10 @@ same_image() {
         exit !(e != "" && e <= 1.5 / 255 && n + 0 <= d[1] * d[2] / 100) }'
 }
 differs() { ! same_image "$@"; }
+# wait_for FILE PATTERN: until FILE has a line matching PATTERN (grep; at most 60 s). A test
+# that signals a render waits so for its first progress line (a log's: "gonio:   0% ...", a
+# second into the passes, once the handlers are in place), never for a fixed time.
+wait_for() { for _ in $(seq 600); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
 # preview_open OUT ARGS...: starts `gonio preview ARGS` in the background (its stdout in
 # OUT.out, stderr in OUT.err; stopped after 120 s) and finds its window: $pid, $wid (empty
 # when no window opened within 30 s). preview_close OUT: Esc; the preview exits 0 (2 checks).

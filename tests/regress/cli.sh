@@ -4,8 +4,6 @@
 . "$(dirname "$0")/../lib.sh"
 G=$GONIO
 C=$PWD/scenes/cornell.gltf
-# wait_for FILE PATTERN: until FILE has a line matching PATTERN (at most 60 s).
-wait_for() { for _ in $(seq 600); do grep -q "$2" "$1" 2>/dev/null && return 0; sleep 0.1; done; return 1; }
 
 # ---- the slow tier (lib.sh: in_tier) ---------------------------------------------------------
 if in_tier slow; then

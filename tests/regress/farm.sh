@@ -128,9 +128,9 @@ has "$tmp/last" "none.exr"
 
 # SIGTERM (a scheduler's pre-emption) writes a resumable file; resuming it gives the render
 # of the total. The render is long enough to be running when the signal comes.
-"$G" render $S --size 40x30 --seed 3 --spp 4000 --quiet -o "$tmp/term.exr" &
+"$G" render $S --size 40x30 --seed 3 --spp 4000 -o "$tmp/term.exr" 2>"$tmp/term.err" &
 pid=$!
-sleep 2
+check "the render to pre-empt is in its passes" wait_for "$tmp/term.err" '^gonio: *[0-9]*%'
 kill -TERM $pid
 wait $pid
 st=$?

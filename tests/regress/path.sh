@@ -200,9 +200,9 @@ run_queue # every pair above, in one batch
 in_tier fast || { finish; exit; }
 
 # Ctrl-C: the render stops after the current pass, writes what it has and exits 130.
-"$G" render $C -o "$tmp/int.exr" --time 60 --size 32x32 --quiet &
+"$G" render $C -o "$tmp/int.exr" --time 60 --size 32x32 2>"$tmp/int.err" &
 pid=$!
-sleep 3
+check "the render to interrupt is in its passes" wait_for "$tmp/int.err" '^gonio: *[0-9]*%'
 kill -INT $pid
 wait $pid
 check "an interrupted render exits 130" test $? = 130
