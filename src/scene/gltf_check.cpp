@@ -111,30 +111,36 @@ bool check_accessor(Ctx &c, int i)
 }
 
 /* Data-level problems the validator reports as errors but that cannot make reading unsafe:
- * warn, and let the geometry code deal with what it uses. */
-void check_accessor_data(Ctx &c, int i)
+ * warn, and let the geometry code deal with what it uses. False (and no warning) for an
+ * accessor decompress decoded (its view is one of those added after the file's) whose data
+ * lies outside its declared bounds: those are the file's stale ones, said once by the caller. */
+bool check_accessor_data(Ctx &c, int i)
 {
     const auto &a = c.m.accessors[size_t(i)];
     size_t nc = num_comps(a);
     if (nc > 4 || (a.bufferView < 0 && !a.sparse.isSparse))
-        return;
+        return true;
+    const bool decoded = a.bufferView >= 0 && size_t(a.bufferView) >= c.file_views;
     std::vector<double> d = read_accessor(c, i);
     std::string what = label("accessor", i, a.name);
     for (size_t j = 0; j < d.size(); j++) {
         double v = d[j];
         if (!std::isfinite(v)) {
             warn(c, "%s: element %zu is not finite", what.c_str(), j / nc);
-            return;
+            return true;
         }
         /* Declared bounds are decimal JSON numbers, the data float: allow the rounding. */
         double lo = a.minValues.empty() ? v : a.minValues[j % nc];
         double hi = a.maxValues.empty() ? v : a.maxValues[j % nc];
         double tol = 1e-6 * std::fmax(1.0, std::fmax(std::fabs(lo), std::fabs(hi)));
         if (v < lo - tol || v > hi + tol) {
+            if (decoded)
+                return false;
             warn(c, "%s: element %zu (%g) lies outside its declared min/max [%g, %g]", what.c_str(), j / nc, v, lo, hi);
-            return;
+            return true;
         }
     }
+    return true;
 }
 
 struct Format {

@@ -141,6 +141,7 @@ struct Ctx {
     std::vector<MaterialDraft> materials;    /* per glTF material, read with the document */
     std::map<int, int> image_channels;       /* decoded image -> its channels in the file */
     std::vector<Ibl> ibls;                   /* EXT_lights_image_based lights, read with the document */
+    size_t file_views = 0;                   /* the file's buffer views; decompress adds its after them */
     std::vector<int> scene_ibl;              /* per glTF scene: the index of its light, or -1 */
 };
 
@@ -173,7 +174,7 @@ bool uses_extension(const tinygltf::Model &m, const char *name);
 bool check_asset(Ctx &c);
 bool check_buffers_and_views(Ctx &c);
 bool check_accessor(Ctx &c, int i);
-void check_accessor_data(Ctx &c, int i);
+bool check_accessor_data(Ctx &c, int i); /* false: a decoded accessor out of its (stale) bounds */
 bool check_primitive(Ctx &c, int mi, int pi);
 bool check_number_array(Ctx &c, const std::vector<double> &v, size_t n, const std::string &what, const char *name);
 bool check_nodes_and_scenes(Ctx &c);
