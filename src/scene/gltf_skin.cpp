@@ -358,10 +358,22 @@ bool joint_matrices(Ctx &c)
         std::vector<double> ibm;
         if (s.inverseBindMatrices >= 0)
             ibm = read_accessor(c, s.inverseBindMatrices);
+        bool singular_said = false;
         for (size_t j = 0; j < s.joints.size(); j++) {
             Mat b = identity();
             if (!ibm.empty())
                 std::copy(&ibm[j * 16], &ibm[j * 16] + 16, b.begin());
+            /* an inverse bind matrix is the inverse of one: a singular one is no such thing, and
+             * flattens what the joint weighs (drawn as the file says, said once a skin) */
+            double a3[3][3], cof[3][3];
+            for (int r = 0; r < 3; r++)
+                for (int k = 0; k < 3; k++)
+                    a3[r][k] = b[size_t(k * 4 + r)];
+            if (!singular_said && !(std::fabs(vec_cofactors3(a3, cof)) > 0)) {
+                warn(c, "skins[%zu].inverseBindMatrices: joint %zu's matrix is singular (what it weighs is "
+                     "flattened)", si, j);
+                singular_said = true;
+            }
             Mat jm = mat_mul(c.world[size_t(s.joints[j])], b);
             if (!mat_finite(jm))
                 return fail(c, "skins[%zu].joints[%zu]: the joint's matrix (node %d's world transform x its inverse "

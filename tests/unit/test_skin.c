@@ -618,3 +618,30 @@ TEST(skin, morph_texcoords_and_colors)
     }
     scene_destroy(&s);
 }
+
+/* An inverse bind matrix that is singular (all zeros) is no inverse of a bind matrix: the
+ * mesh is drawn as the file says (flattened) with one warning naming the skin and joint. */
+TEST(skin, singular_inverse_bind_matrix)
+{
+    gltf_file f = {0};
+    const uint8_t joints[16] = {0};
+    const float weights[16] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}, zero[32] = {0};
+    quad_accessors(&f);                                         /* 0-2 */
+    accessor(&f, joints, sizeof joints, 5121, 4, "VEC4", "");   /* 3 */
+    accessor(&f, weights, sizeof weights, 5126, 4, "VEC4", ""); /* 4 */
+    accessor(&f, zero, sizeof zero, 5126, 2, "MAT4", "");       /* 5 */
+    const char *rest =
+        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"JOINTS_0\":3,\"WEIGHTS_0\":4},"
+        "\"indices\":2}]},{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2}]}],"
+        "\"nodes\":[{\"mesh\":0,\"skin\":0},{},{},{\"mesh\":1,\"translation\":[3,0,0]}],"
+        "\"skins\":[{\"joints\":[1,2],\"inverseBindMatrices\":5}],\"scenes\":[{\"nodes\":[0,1,2,3]}]";
+    scene s;
+    int w0 = util_warning_count();
+    bool ok = write_and_load(&s, &f, rest, -1);
+    CHECKF(ok, "%s", load_log);
+    if (!ok)
+        return;
+    CHECKF(util_warning_count() - w0 == 1 && strstr(load_log, "skins[0].inverseBindMatrices: joint 0's matrix is singular"),
+           "%s", load_log);
+    scene_destroy(&s);
+}
