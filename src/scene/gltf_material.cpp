@@ -312,6 +312,13 @@ std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned c
         char why_bad[512];
         image_decode_status st = image_decode(bytes, size, img->mimeType.c_str(), SCENE_MAX_TEXELS - c.texels, &rgba,
                                               &w, &h, why_bad, sizeof why_bad);
+        /* One image larger than all the images may be is unusable (its header may lie; a
+         * texture's fallback is then used); one that overflows what the others left, the
+         * scene's limit. */
+        if (st == IMAGE_TOO_LARGE && uint64_t(w) * h > SCENE_MAX_TEXELS)
+            return std::string(format == TEXTURE_FORMAT_KTX2 ? "KTX2" : "WebP") + ": it declares " +
+                   std::to_string(w) + "x" + std::to_string(h) + ", " + std::to_string(uint64_t(w) * h) +
+                   " texels, more than the " + std::to_string(uint64_t(SCENE_MAX_TEXELS)) + " a scene's images may have";
         if (st == IMAGE_TOO_LARGE)
             return too_large(c, idx, w, h);
         c.texels += uint64_t(w) * h; /* the declared size, decoded or not, as stb's images count */

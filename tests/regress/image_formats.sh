@@ -268,11 +268,15 @@ PY
         check "... '$want' named, with the file and image" grep -q "error: .*bad_$k.gltf: material 0: baseColorTexture: texture 0: image 0 $k.ktx2: KTX2: .*$want.*" "$tmp/last"
     done
     # A huge declared size is refused by the texel limit before anything is allocated (a
-    # 65536x65536 RGBA8 buffer would be 16 GiB).
+    # 65536x65536 RGBA8 buffer would be 16 GiB): an image larger than all a scene's images may
+    # be is unusable, and so a texture's fallback is used where it has one.
     scene huge "{\"images\": [\"huge.ktx2\"], \"texture\": {\"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU, \"required\": $BASISU}"
     check_fails "KTX2 declaring 65536x65536: refused" 1 "$G" render "$tmp/huge.gltf" --mode albedo --spp 1 --size 8x8 --quiet -o "$tmp/huge.exr"
-    check "... by the texel limit, with the numbers" grep -q "huge.gltf: images too large: 4294967296 texels with image 0 (65536x65536), the limit is 268435456" "$tmp/last"
+    check "... by the texel limit, with the numbers" grep -q "huge.gltf: .*image 0 huge.ktx2: KTX2: it declares 65536x65536, 4294967296 texels, more than the 268435456 a scene's images may have" "$tmp/last"
     check "... and no output" test ! -e "$tmp/huge.exr"
+    scene huge_fb "{\"images\": [\"huge.ktx2\", \"fallback.png\"], \"texture\": {\"source\": 1, \"extensions\": {\"KHR_texture_basisu\": {\"source\": 0}}}, \"used\": $BASISU}"
+    check "with a PNG fallback it loads" sh -c '"$0" info "$1" >/dev/null 2>"$2"' "$G" "$tmp/huge_fb.gltf" "$tmp/huge_fb.err"
+    check "... saying the fallback is used" grep -q "its KHR_texture_basisu image 0 is unusable; its fallback, image 1, is used instead" "$tmp/huge_fb.err"
 fi
 # WebP sizes stop at 16383: two declared at the most pass the limit together. The lossless
 # header's 14-bit width and height fields are set, the data left as it is.
