@@ -34,6 +34,10 @@ fi
 if python3 tests/tool/instances.py "$tmp/instances" >/dev/null 2>&1; then
     for f in "$tmp"/instances/*.gltf; do link "$tmp/seed-scene" "$f"; done
 fi
+# skins, morph targets and instancing under attack (tests/tool/attacks.py)
+if python3 tests/tool/attacks.py "$tmp/attacks" >/dev/null 2>&1; then
+    for f in "$tmp"/attacks/*.gltf; do link "$tmp/seed-scene" "$f"; done
+fi
 # image-based lights (EXT_lights_image_based): a cube map of six embedded 4x4 PNG faces over
 # two levels, rotated and scaled, and one whose faces disagree in size
 PYTHONPATH=tests/tool python3 - "$tmp/seed-scene" <<'PY' || echo "note: no image-based-light seeds"

@@ -148,6 +148,22 @@ PY
 check_fails "16 nodes drawing 1.33 M triangles at one point: no triangles left" 1 timeout 20 "$G" info "$B/point.gltf"
 check "... said once, naming the primitive" test "$(grep -c 'mesh 0 primitive 0: all 1333333 triangles have zero area (skipped)' "$tmp/last")" = 1
 check "150,000 copies of one triangle load" timeout 20 "$G" info "$B/stacked.gltf"
+# The loaders of skins, morph targets and instancing under attack (tests/tool/attacks.py:
+# singular, non-finite and huge inverse bind matrices, weights that do not sum to one, joints
+# outside the tree, in a loop or missing, 70,000 joints, 5,000 targets, weights that carry
+# positions to infinity, 10^9 instances asked directly or by sharing, counts that disagree):
+# each gives its exit status and its message, in seconds, and no other warning.
+python3 tests/tool/attacks.py "$tmp/attacks" || fail "attacks.py"
+while read -r attack status message; do
+    timeout 20 "$G" info "$tmp/attacks/$attack.gltf" >/dev/null 2>"$tmp/attack.err"
+    got=$?
+    check "attack $attack: exit $status (got $got)" test "$got" = "$status"
+    if [ "$message" = - ]; then
+        check "... and no warning" sh -c "! grep -q 'warning\|error' '$tmp/attack.err'"
+    else
+        check "... saying '$message'" grep -qF -- "$message" "$tmp/attack.err"
+    fi
+done <"$tmp/attacks/expect.txt"
 # Images: the same bytes are decoded once and count once against SCENE_MAX_TEXELS (2^28).
 # A 16384 x 4096 grey PNG is 67 M texels: listed 8 times it loads, 5 different ones do not.
 python3 - "$B" <<'PY'
