@@ -79,20 +79,21 @@ static struct {
     float *color, *albedo, *normal, *output;
 } st;
 
-/* Tries one file; on failure appends "  PATH: why\n" to `tried`. */
+/* Tries one file; on failure appends "PATH: why" to `tried` ("; " between them: a message
+ * is one line, util_error escapes a newline). */
 static bool try_open(const char *path, char *tried, size_t cap)
 {
     size_t len = strlen(tried);
     void *lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!lib) {
         const char *why = dlerror();
-        snprintf(tried + len, cap - len, "  %s: %s\n", path, why ? why : "cannot be loaded");
+        snprintf(tried + len, cap - len, "%s%s: %s", len ? "; " : "", path, why ? why : "cannot be loaded");
         return false;
     }
     for (size_t k = 0; k < sizeof oidn_symbols / sizeof *oidn_symbols; k++) {
         void *f = dlsym(lib, oidn_symbols[k].name);
         if (!f) {
-            snprintf(tried + len, cap - len, "  %s: has no %s (not OpenImageDenoise 2.x)\n", path,
+            snprintf(tried + len, cap - len, "%s%s: has no %s (not OpenImageDenoise 2.x)", len ? "; " : "", path,
                      oidn_symbols[k].name);
             dlclose(lib);
             return false;
@@ -124,8 +125,8 @@ static bool load_locked(void)
     if (env && *env) {
         if (try_open(env, tried, sizeof tried))
             return true;
-        util_error("the denoiser cannot load Intel Open Image Denoise from %s=%s:\n%s"
-                   "(unset it to use the library `make denoiser` fetches into build/oidn/lib)",
+        util_error("the denoiser cannot load Intel Open Image Denoise from %s=%s (%s); unset it to use the "
+                   "library `make denoiser` fetches into build/oidn/lib",
                    DENOISE_LIB_ENV, env, tried);
         return false;
     }
@@ -139,12 +140,12 @@ static bool load_locked(void)
                 return true;
         } else {
             size_t len = strlen(tried);
-            snprintf(tried + len, sizeof tried - len, "  %s: absent\n", path);
+            snprintf(tried + len, sizeof tried - len, "%s%s: absent", len ? "; " : "", path);
         }
     }
     if (try_open(DENOISE_LIB_NAME, tried, sizeof tried))
         return true;
-    util_error("the denoiser needs Intel Open Image Denoise 2 (%s), which is not installed:\n%s"
+    util_error("the denoiser needs Intel Open Image Denoise 2 (%s), which is not installed (tried %s). "
                "Run `make denoiser` in gonio's source tree (it fetches the pyoidn wheel's libraries "
                "into build/oidn/lib), or set %s to the path of a %s.",
                DENOISE_LIB_NAME, tried, DENOISE_LIB_ENV, DENOISE_LIB_NAME);

@@ -31,6 +31,19 @@ check "... with the loader's reason" grep -q "fake.so" "$tmp/last"
 check_fails "--denoise with --mode phong is bad usage" 2 "$G" render $C -o "$tmp/x.exr" --mode phong --denoise $R
 check "... saying it is for path" grep -q "denoise is for --mode path" "$tmp/last"
 
+# The library is never taken from the scene's folder or the current directory: a gonio with
+# no build/oidn beside it, run where a file of the library's name lies beside the scene, does
+# not try that file (a system-wide OIDN 2 may serve it; nothing else may).
+mkdir -p "$tmp/bin" "$tmp/here"
+cp "$G" "$tmp/bin/gonio"
+cp "$C" "$tmp/here/scene.gltf"
+head -c 4096 /dev/zero | tr '\0' x >"$tmp/here/libOpenImageDenoise.so.2" # not an ELF file
+(cd "$tmp/here" && env -u GONIO_OIDN_LIB -u LD_LIBRARY_PATH "$tmp/bin/gonio" render scene.gltf -o x.exr --denoise $R) \
+    >"$tmp/here.log" 2>&1
+check "a library beside the scene and in the current directory is not tried" \
+    sh -c "! grep -q -e '$tmp/here' -e 'invalid ELF' -e '\./libOpenImageDenoise' '$tmp/here.log'"
+check "... and the error is one line, naming what was tried" sh -c "[ \$(wc -l <'$tmp/here.log') -le 1 ] && ! grep -q 'x0a' '$tmp/here.log'"
+
 need_denoiser "the checks that denoise did not run"
 
 # The renders and the bench below run in one batch (lib.sh: queue), the checks after it; the
