@@ -331,24 +331,46 @@ static struct {
     bool on, kept;
     gpu g;
     int device_index;
+    char driver_env[4096]; /* driver_environment() when it was made */
 } shared;
 static int messages_before; /* validation messages when the command's device was made or lent */
+
+/* The environment the Vulkan loader and the drivers read when a device is made (VK_ICD_FILENAMES,
+ * VK_LOADER_*, Mesa's MESA_* and lavapipe's LP_*, ...), as one string: a batch line that sets
+ * any of them gets a device of its own, as `gonio LINE` would, not the one kept. */
+static void driver_environment(char *out, size_t cap)
+{
+    extern char **environ;
+    static const char *const prefixes[] = {"VK_", "MESA_", "LP_", "GALLIUM_", "RADV_", "ANV_", "NV_", "__GL"};
+    size_t len = 0;
+    out[0] = 0;
+    for (char **e = environ; e && *e; e++)
+        for (size_t k = 0; k < sizeof prefixes / sizeof *prefixes; k++)
+            if (!strncmp(*e, prefixes[k], strlen(prefixes[k])) && len + strlen(*e) + 2 < cap) {
+                len += (size_t)snprintf(out + len, cap - len, "%s\n", *e);
+                break;
+            }
+}
 
 bool cli_gpu_create(gpu *g, int device_index, bool validate)
 {
     const char *env = getenv("GONIO_VALIDATE");
     gpu_desc d = {.device_index = device_index};
+    char driver_env[sizeof shared.driver_env];
     d.validate = validate || (env && strcmp(env, "1") == 0);
-    if (shared.kept && shared.device_index == device_index && shared.g.validate == d.validate) {
+    driver_environment(driver_env, sizeof driver_env);
+    if (shared.kept && shared.device_index == device_index && shared.g.validate == d.validate &&
+        !strcmp(shared.driver_env, driver_env)) {
         *g = shared.g;
         shared.kept = false;
         messages_before = gpu_validation_message_count();
         return true;
     }
-    if (shared.kept && !cli_gpu_share(true)) /* another device or validation setting: made anew */
+    if (shared.kept && !cli_gpu_share(true)) /* another device, validation or driver setting: made anew */
         return false;
     messages_before = gpu_validation_message_count();
     shared.device_index = device_index;
+    memcpy(shared.driver_env, driver_env, sizeof driver_env);
     return gpu_create(g, &d);
 }
 

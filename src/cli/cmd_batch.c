@@ -99,6 +99,16 @@ static int run_line(char **words, int n)
     int first = 0;
     while (first < n && is_assignment(words[first]))
         first++;
+    /* What the dynamic loader reads when a program starts cannot take effect in this one: such
+     * a line is refused rather than run without it. (The Vulkan loader's and the drivers'
+     * variables do take effect: such a line gets a device of its own, cli_gpu_create.) */
+    for (int k = 0; k < first; k++)
+        if (!strncmp(words[k], "LD_", 3)) {
+            util_error("batch: %.*s is read by the dynamic loader when a program starts, so it cannot take effect "
+                       "on a batch line: run that line as a gonio of its own", (int)(strchr(words[k], '=') - words[k]),
+                       words[k]);
+            return 2;
+        }
     char *old[BATCH_MAX_WORDS] = {0};
     bool had[BATCH_MAX_WORDS] = {0};
     for (int k = 0; k < first; k++) {
@@ -176,8 +186,9 @@ int cmd_batch(int argc, char **argv)
                  "each kernel is compiled once for the batch rather than once a command (most of a\n"
                  "small render's time on a CPU). A line is words split at blanks, '...' and \"...\"\n"
                  "quoting; a # starts a comment; NAME=value words before the command set that\n"
-                 "environment variable for that line only. Every line runs, whatever the ones\n"
-                 "before it gave; preview and batch cannot be lines.",
+                 "environment variable for that line only (VK_*, MESA_*, LP_*: the line gets a\n"
+                 "device of its own; LD_*, read when a program starts, refuse the line). Every\n"
+                 "line runs, whatever the ones before it gave; preview and batch cannot be lines.",
         CLI_OPTIONS(options),
         .epilog = "Exit status: 0 when every line gave 0; else 1, after a line on stderr for each\n"
                   "line that did not (2 for a usage error of the batch itself). A line stopped by\n"

@@ -63,6 +63,21 @@ check "a batch of two lines" "$G" batch "$tmp/env.txt" --logs "$tmp/envlogs"
 check "... the first with its variables" grep -q "gonio: debug: .*dispatch" "$tmp/envlogs/1.log"
 check "... the second without them" sh -c "test -s '$tmp/envlogs/2.log' -o -e '$tmp/envlogs/2.status' && ! grep -q 'debug' '$tmp/envlogs/2.log'"
 check "... both the pixels of one process" sh -c "'$TESTTOOL' same '$tmp/ref-1.exr' '$tmp/e-1.exr' && '$TESTTOOL' same '$tmp/ref-1.exr' '$tmp/e-2.exr'"
+# A line that sets what the Vulkan loader or a driver reads gets a device of its own, as
+# `gonio LINE` would (an ICD file that is not there: no device, exit 1, as alone), not the
+# one the line before left; a line that sets what the dynamic loader reads at a program's
+# start (LD_PRELOAD) cannot be honoured in a running process and is refused (exit 2).
+cat >"$tmp/drv.txt" <<EOF
+render $C -o $tmp/d-1.exr $R --seed 1
+VK_ICD_FILENAMES=$tmp/none.json render $C -o $tmp/d-2.exr $R --seed 1
+LD_PRELOAD=$tmp/none.so render $C -o $tmp/d-3.exr $R --seed 1
+render $C -o $tmp/d-4.exr $R --seed 1
+EOF
+mkdir -p "$tmp/drvlogs"
+check_fails "a batch whose lines change the driver" 1 "$G" batch "$tmp/drv.txt" --logs "$tmp/drvlogs"
+check "... the VK_ICD_FILENAMES line fails as alone: no Vulkan device" sh -c "test \$(cat '$tmp/drvlogs/2.status') = 1 && grep -q 'cannot create a Vulkan instance' '$tmp/drvlogs/2.log'"
+check "... the LD_PRELOAD line is refused, saying why" sh -c "test \$(cat '$tmp/drvlogs/3.status') = 2 && grep -q 'LD_PRELOAD is read by the dynamic loader' '$tmp/drvlogs/3.log'"
+check "... the lines around them render, the pixels of one process" sh -c "'$TESTTOOL' same '$tmp/ref-1.exr' '$tmp/d-1.exr' && '$TESTTOOL' same '$tmp/ref-1.exr' '$tmp/d-4.exr'"
 check "a batch from standard input" sh -c "echo 'render $C -o $tmp/s-1.exr $R --seed 1' | '$G' batch -"
 check "... renders" "$TESTTOOL" same "$tmp/ref-1.exr" "$tmp/s-1.exr"
 # A line's --variant, --at and --allow-outside-files do not reach the lines after it.
