@@ -341,12 +341,17 @@ static int messages_before; /* validation messages when the command's device was
 static void driver_environment(char *out, size_t cap)
 {
     extern char **environ;
-    static const char *const prefixes[] = {"VK_", "MESA_", "LP_", "GALLIUM_", "RADV_", "ANV_", "NV_", "__GL"};
+    static const char *const prefixes[] = {"VK_", "MESA_", "LP_", "GALLIUM_", "RADV_", "ANV_", "NV_", "__GL", "DRI_PRIME"};
+    static unsigned long overflows;
     size_t len = 0;
     out[0] = 0;
     for (char **e = environ; e && *e; e++)
         for (size_t k = 0; k < sizeof prefixes / sizeof *prefixes; k++)
-            if (!strncmp(*e, prefixes[k], strlen(prefixes[k])) && len + strlen(*e) + 2 < cap) {
+            if (!strncmp(*e, prefixes[k], strlen(prefixes[k]))) {
+                if (len + strlen(*e) + 2 >= cap) { /* too long to compare: never the same as another */
+                    snprintf(out, cap, "(%lu: too long)", ++overflows);
+                    return;
+                }
                 len += (size_t)snprintf(out + len, cap - len, "%s\n", *e);
                 break;
             }

@@ -744,9 +744,9 @@ static int write_outputs(render_state *rs)
     int region[4];
     bool ok = true;
     build_header(rs, &h);
-    if (stop_requested && !job->quiet)
-        util_warn("interrupted: writing the %d spp rendered so far%s", rs->st.spp,
-                  stop_requested == SIGTERM && rs->exr_path ? " (resumable: --resume)" : "");
+    if (stop_requested && !job->quiet) /* (said, not a warning about the file: --strict writes it too) */
+        (util_strict() ? util_info : util_warn)("interrupted: writing the %d spp rendered so far%s", rs->st.spp,
+                                                stop_requested == SIGTERM && rs->exr_path ? " (resumable: --resume)" : "");
     if (job->denoise) {
         ok = denoise_render(&rs->img, job->s.aov, out_path, &dn);
         if (ok) {

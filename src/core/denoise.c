@@ -105,6 +105,16 @@ static bool try_open(const char *path, char *tried, size_t cap)
     return true;
 }
 
+/* Is the library that DENOISE_LIB_ENV (env, or NULL) asks for the one loaded? The same
+ * setting, or a path to the same file. */
+static bool same_library(const char *env)
+{
+    char a[PATH_MAX], b[PATH_MAX];
+    if (!strcmp(env ? env : "", st.lib_env))
+        return true;
+    return env && *env && realpath(env, a) && realpath(st.lib_path, b) && !strcmp(a, b);
+}
+
 static bool load_locked(void)
 {
     char tried[4 * PATH_MAX + 512] = "", exe[PATH_MAX], path[PATH_MAX + 64];
@@ -113,7 +123,7 @@ static bool load_locked(void)
     /* The library stays loaded for the process (unloading OIDN under its thread pool is not
      * safe): a later command (a batch line) that names another one is refused, not served
      * by the first. */
-    if (st.lib && strcmp(env ? env : "", st.lib_env)) {
+    if (st.lib && !same_library(env)) {
         util_error("the denoiser: %s=%s, but this process has Open Image Denoise loaded from %s already (a "
                    "batch loads one library for all its lines): run this command in a process of its own",
                    DENOISE_LIB_ENV, env ? env : "(unset)", st.lib_path);

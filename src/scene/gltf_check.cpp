@@ -112,15 +112,17 @@ bool check_accessor(Ctx &c, int i)
 
 /* Data-level problems the validator reports as errors but that cannot make reading unsafe:
  * warn, and let the geometry code deal with what it uses. False (and no warning) for an
- * accessor decompress decoded (its view is one of those added after the file's) whose data
- * lies outside its declared bounds: those are the file's stale ones, said once by the caller. */
+ * accessor decompress decoded (its view's bytes in a buffer added after the file's: Draco's
+ * new views, meshopt's views decoded in place) whose data lies outside its declared bounds:
+ * those are the file's stale ones, said once by the caller. */
 bool check_accessor_data(Ctx &c, int i)
 {
     const auto &a = c.m.accessors[size_t(i)];
     size_t nc = num_comps(a);
     if (nc > 4 || (a.bufferView < 0 && !a.sparse.isSparse))
         return true;
-    const bool decoded = a.bufferView >= 0 && size_t(a.bufferView) >= c.file_views;
+    const bool decoded = a.bufferView >= 0 && size_t(a.bufferView) < c.m.bufferViews.size() &&
+                         size_t(c.m.bufferViews[size_t(a.bufferView)].buffer) >= c.file_buffers;
     std::vector<double> d = read_accessor(c, i);
     std::string what = label("accessor", i, a.name);
     for (size_t j = 0; j < d.size(); j++) {

@@ -141,7 +141,7 @@ struct Ctx {
     std::vector<MaterialDraft> materials;    /* per glTF material, read with the document */
     std::map<int, int> image_channels;       /* decoded image -> its channels in the file */
     std::vector<Ibl> ibls;                   /* EXT_lights_image_based lights, read with the document */
-    size_t file_views = 0;                   /* the file's buffer views; decompress adds its after them */
+    size_t file_buffers = 0;                 /* the file's buffers; decompress puts what it decodes after them */
     std::vector<int> scene_ibl;              /* per glTF scene: the index of its light, or -1 */
 };
 

@@ -337,6 +337,10 @@ std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned c
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(bytes, int(size), &w, &h, &comp))
         return "cannot decode";
+    if (uint64_t(w) * uint64_t(h) > SCENE_MAX_TEXELS) /* as a WebP or KTX2 image's, above */
+        return std::string("it declares ") + std::to_string(w) + "x" + std::to_string(h) + ", " +
+               std::to_string(uint64_t(w) * uint64_t(h)) + " texels, more than the " +
+               std::to_string(uint64_t(SCENE_MAX_TEXELS)) + " a scene's images may have";
     if (c.texels + uint64_t(w) * uint64_t(h) > SCENE_MAX_TEXELS)
         return too_large(c, idx, uint64_t(w), uint64_t(h));
     c.texels += uint64_t(w) * uint64_t(h);

@@ -369,7 +369,7 @@ bool joint_matrices(Ctx &c)
             for (int r = 0; r < 3; r++)
                 for (int k = 0; k < 3; k++)
                     a3[r][k] = b[size_t(k * 4 + r)];
-            if (!singular_said && !(std::fabs(vec_cofactors3(a3, cof)) > 0)) {
+            if (!singular_said && vec_cofactors3(a3, cof) == 0) { /* (NaN: the finite check below) */
                 warn(c, "skins[%zu].inverseBindMatrices: joint %zu's matrix is singular (what it weighs is "
                      "flattened)", si, j);
                 singular_said = true;

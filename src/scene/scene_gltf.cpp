@@ -165,7 +165,7 @@ bool check_json_text(Ctx &c, const uint8_t *s, size_t n)
 bool decompress(Ctx &c)
 {
     std::vector<std::string> errors;
-    c.file_views = c.m.bufferViews.size();
+    c.file_buffers = c.m.buffers.size();
     if (gltf_decompress(c.m, MAX_ELEMENTS, &errors))
         return true;
     for (const auto &e : errors)

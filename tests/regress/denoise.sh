@@ -40,6 +40,8 @@ cp "$C" "$tmp/here/scene.gltf"
 head -c 4096 /dev/zero | tr '\0' x >"$tmp/here/libOpenImageDenoise.so.2" # not an ELF file
 (cd "$tmp/here" && env -u GONIO_OIDN_LIB -u LD_LIBRARY_PATH "$tmp/bin/gonio" render scene.gltf -o x.exr --denoise $R) \
     >"$tmp/here.log" 2>&1
+check "a gonio without build/oidn asks for the library: not installed, it says, or a system one denoised" \
+    sh -c "grep -q 'the denoiser needs Intel Open Image Denoise 2' '$tmp/here.log' || test -e '$tmp/here/x.exr'"
 check "a library beside the scene and in the current directory is not tried" \
     sh -c "! grep -q -e '$tmp/here' -e 'invalid ELF' -e '\./libOpenImageDenoise' '$tmp/here.log'"
 check "... and the error is one line, naming what was tried" sh -c "[ \$(wc -l <'$tmp/here.log') -le 1 ] && ! grep -q 'x0a' '$tmp/here.log'"

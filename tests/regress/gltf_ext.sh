@@ -42,22 +42,25 @@ g.write(sys.argv[2])
 PY
 done
 
-# Stale bounds: the Draco teapot with every float accessor's min/max shrunk to half (as a
-# file whose bounds were kept from before its encoding has them) warns once, naming them as
-# stale, not once an accessor; the plain teapot so edited warns of its accessor's data.
-python3 - "$tmp/teapot-draco.gltf" "$tmp/stale-draco.gltf" "${src[teapot]}" "$tmp/stale-plain.gltf" <<'PY'
+# Stale bounds: the Draco and meshopt teapots with every float accessor's min/max shrunk to
+# half (as a file whose bounds were kept from before its encoding has them) warn once,
+# naming them as stale, not once an accessor; the plain teapot so edited warns of its data.
+python3 - "$tmp/teapot-draco.gltf" "$tmp/stale-draco.gltf" "${src[teapot]}" "$tmp/stale-plain.gltf" \
+    "$tmp/teapot-meshopt.gltf" "$tmp/stale-meshopt.gltf" <<'PY'
 import sys
 import gltf_fixture as gf
-for src, out in ((sys.argv[1], sys.argv[2]), (sys.argv[3], sys.argv[4])):
+for src, out in ((sys.argv[1], sys.argv[2]), (sys.argv[3], sys.argv[4]), (sys.argv[5], sys.argv[6])):
     g = gf.Gltf.load(src)
     for a in g.doc["accessors"]:
         if a.get("componentType") == gf.FLOAT and "max" in a:
             a["min"], a["max"] = [0.5 * v for v in a["min"]], [0.5 * v for v in a["max"]]
     g.write(out)
 PY
-check "stale bounds of decoded data: the file loads" sh -c '"$0" info "$1" 2>"$2" >/dev/null' "$G" "$tmp/stale-draco.gltf" "$tmp/stale.err"
-check "... with one line saying they are stale" test "$(grep -c 'decoded from compressed data (the first: accessor [0-9]*) lie outside the min/max the file declares for them: its bounds are stale' "$tmp/stale.err")" = 1
-check "... and no other warning" test "$(grep -c warning "$tmp/stale.err")" = 1
+for k in draco meshopt; do
+    check "stale bounds of $k-decoded data: the file loads" sh -c '"$0" info "$1" 2>"$2" >/dev/null' "$G" "$tmp/stale-$k.gltf" "$tmp/stale.err"
+    check "... with one line saying they are stale" test "$(grep -c 'decoded from compressed data (the first: accessor [0-9]*) lie outside the min/max the file declares for them: its bounds are stale' "$tmp/stale.err")" = 1
+    check "... and no other warning" test "$(grep -c warning "$tmp/stale.err")" = 1
+done
 check "the same bounds of plain data: the file loads" sh -c '"$0" info "$1" 2>"$2" >/dev/null' "$G" "$tmp/stale-plain.gltf" "$tmp/stale.err"
 check "... warning of the accessor's element outside them" grep -q "lies outside its declared min/max" "$tmp/stale.err"
 

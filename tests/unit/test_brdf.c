@@ -284,8 +284,8 @@ static double sidak(int tests) { return 1 - pow(1 - 0.01, 1.0 / tests); }
  * with 2 x 2 Gauss-Legendre nodes per cell (exact for cubics). Half-vector lobes seen at
  * grazing angles are slivers about 2 alpha cos(theta_o) wide in phi, as narrow as a cell at
  * 75 degrees for alpha 0.04: where the pdf's second differences over the nodes say a cell's
- * quadrature may be off by more than REFINE_ERR expected samples, that cell and its eight
- * neighbours are integrated again on a REFINE x REFINE grid of their own (measure_case).
+ * quadrature may be off by more than REFINE_ERR expected samples, that cell and its four
+ * edge neighbours are integrated again on a REFINE x REFINE grid of their own (measure_case).
  * The quadrature checks stop at 75 degrees; sampled albedos cover the rest. */
 #define BT 10
 #define BP 20
@@ -379,8 +379,10 @@ static uint8_t cell_refine[NTC * NPC];
 
 /* Cells whose quadrature may be off by REFINE_ERR expected samples or more: a node's second
  * difference of the pdf (in theta or phi, whichever is larger) times the cell's solid angle
- * bounds the error of a rule exact for cubics where the pdf is smooth at the nodes' scale,
- * and is large where it is not (a lobe between nodes). Marked with their neighbours. */
+ * estimates the error of a rule exact for cubics where the pdf is smooth at the nodes'
+ * scale, and is large where it is not (a lobe between nodes); the theta nodes' uneven
+ * spacing makes it count a slope too, which only refines more. Marked with their edge
+ * neighbours. */
 static int mark_cells(double pdf_scale)
 {
     static uint8_t rough[NTC * NPC];
