@@ -170,6 +170,14 @@ bool mat_finite(const Mat &m)
     return true;
 }
 
+double mat_cofactors3(const Mat &m, double a[3][3], double cof[3][3])
+{
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++)
+            a[r][k] = m[size_t(k * 4 + r)];
+    return vec_cofactors3(a, cof);
+}
+
 /* T R S as a matrix: translation t, rotation by the unit quaternion q (x, y, z, w), scale s. */
 Mat trs_matrix(const double t[3], const double q[4], const double s[3])
 {
@@ -673,12 +681,8 @@ bool bake_mesh(Ctx &c, const Instance &in, const Mat &w, GnVertex *vertices, uin
 {
     /* Normals go through the cofactor matrix, det * inverse transpose: defined even for a
      * singular matrix; multiplied by sign(det) so mirroring keeps them pointing out. */
-    double a[3][3];
-    for (int r = 0; r < 3; r++)
-        for (int k = 0; k < 3; k++)
-            a[r][k] = w[size_t(k * 4 + r)];
-    double cof[3][3];
-    double det = vec_cofactors3(a, cof);
+    double a[3][3], cof[3][3];
+    double det = mat_cofactors3(w, a, cof);
     double sgn = det < 0 ? -1 : 1;
     uint32_t default_material = uint32_t(c.m.materials.size());
     for (const Prim &base : c.meshes[size_t(in.mesh)]) {

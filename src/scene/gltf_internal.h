@@ -197,6 +197,8 @@ double read_comp(const uint8_t *p, int ct, bool norm);
 std::vector<double> read_accessor(const Ctx &c, int i);
 Mat mat_mul(const Mat &a, const Mat &b);
 bool mat_finite(const Mat &m);
+/* m's linear part (its upper 3x3, row-major) and its cofactor matrix: returns det. */
+double mat_cofactors3(const Mat &m, double a[3][3], double cof[3][3]);
 bool node_local(Ctx &c, int i, Mat &out, const Pose *pose = nullptr);
 int node_light(const tinygltf::Node &n);
 bool load_meshes(Ctx &c);

@@ -285,6 +285,14 @@ std::string too_large(Ctx &c, int idx, uint64_t w, uint64_t h)
     return msg;
 }
 
+/* An image that alone declares more texels than all a scene's images may have: unusable (its
+ * header may lie; a texture's fallback then takes its place), not the scene's limit. */
+std::string too_many_texels(uint64_t w, uint64_t h)
+{
+    return "it declares " + std::to_string(w) + "x" + std::to_string(h) + ", " + std::to_string(w * h) +
+           " texels, more than the " + std::to_string(uint64_t(SCENE_MAX_TEXELS)) + " a scene's images may have";
+}
+
 /* Decodes PNG or JPEG, the formats glTF 2.0 allows, through tinygltf's stb, and WebP and KTX2
  * (EXT_texture_webp, KHR_texture_basisu) through image_decode.h. Anything else is refused
  * before stb_image sees it: its other decoders are not needed, and the 16-bit PNM path of the
@@ -312,13 +320,10 @@ std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned c
         char why_bad[512];
         image_decode_status st = image_decode(bytes, size, img->mimeType.c_str(), SCENE_MAX_TEXELS - c.texels, &rgba,
                                               &w, &h, why_bad, sizeof why_bad);
-        /* One image larger than all the images may be is unusable (its header may lie; a
-         * texture's fallback is then used); one that overflows what the others left, the
-         * scene's limit. */
+        /* one image over the limit alone: unusable; one that overflows what the others left:
+         * the scene's limit */
         if (st == IMAGE_TOO_LARGE && uint64_t(w) * h > SCENE_MAX_TEXELS)
-            return std::string(format == TEXTURE_FORMAT_KTX2 ? "KTX2" : "WebP") + ": it declares " +
-                   std::to_string(w) + "x" + std::to_string(h) + ", " + std::to_string(uint64_t(w) * h) +
-                   " texels, more than the " + std::to_string(uint64_t(SCENE_MAX_TEXELS)) + " a scene's images may have";
+            return std::string(format == TEXTURE_FORMAT_KTX2 ? "KTX2: " : "WebP: ") + too_many_texels(w, h);
         if (st == IMAGE_TOO_LARGE)
             return too_large(c, idx, w, h);
         c.texels += uint64_t(w) * h; /* the declared size, decoded or not, as stb's images count */
@@ -337,10 +342,8 @@ std::string decode_image(Ctx &c, tinygltf::Image *img, int idx, const unsigned c
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(bytes, int(size), &w, &h, &comp))
         return "cannot decode";
-    if (uint64_t(w) * uint64_t(h) > SCENE_MAX_TEXELS) /* as a WebP or KTX2 image's, above */
-        return std::string("it declares ") + std::to_string(w) + "x" + std::to_string(h) + ", " +
-               std::to_string(uint64_t(w) * uint64_t(h)) + " texels, more than the " +
-               std::to_string(uint64_t(SCENE_MAX_TEXELS)) + " a scene's images may have";
+    if (uint64_t(w) * uint64_t(h) > SCENE_MAX_TEXELS)
+        return too_many_texels(uint64_t(w), uint64_t(h));
     if (c.texels + uint64_t(w) * uint64_t(h) > SCENE_MAX_TEXELS)
         return too_large(c, idx, uint64_t(w), uint64_t(h));
     c.texels += uint64_t(w) * uint64_t(h);

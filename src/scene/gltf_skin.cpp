@@ -366,10 +366,7 @@ bool joint_matrices(Ctx &c)
             /* an inverse bind matrix is the inverse of one: a singular one is no such thing, and
              * flattens what the joint weighs (drawn as the file says, said once a skin) */
             double a3[3][3], cof[3][3];
-            for (int r = 0; r < 3; r++)
-                for (int k = 0; k < 3; k++)
-                    a3[r][k] = b[size_t(k * 4 + r)];
-            if (!singular_said && vec_cofactors3(a3, cof) == 0) { /* (NaN: the finite check below) */
+            if (!singular_said && mat_cofactors3(b, a3, cof) == 0) { /* (NaN: the finite check below) */
                 warn(c, "skins[%zu].inverseBindMatrices: joint %zu's matrix is singular (what it weighs is "
                      "flattened)", si, j);
                 singular_said = true;
@@ -428,12 +425,9 @@ bool pose_primitive(Ctx &c, const Instance &in, const Prim &p, Prim &out)
         for (size_t v = 0; !tan.empty() && v < d.tan.size() / 3; v++)
             for (size_t k = 0; k < 3; k++)
                 tan[v * 4 + k] += w[t] * d.tan[v * 3 + k];
-        for (size_t i = 0; i < d.uv.size() && i < out.uv.size(); i++)
-            out.uv[i] += float(w[t] * d.uv[i]);
-        for (size_t i = 0; i < d.uv1.size() && i < out.uv1.size(); i++)
-            out.uv1[i] += float(w[t] * d.uv1[i]);
-        for (size_t i = 0; i < d.col.size() && i < out.col.size(); i++)
-            out.col[i] += float(w[t] * d.col[i]);
+        for (auto a : {std::make_pair(&out.uv, &d.uv), std::make_pair(&out.uv1, &d.uv1), std::make_pair(&out.col, &d.col)})
+            for (size_t i = 0; i < a.second->size() && i < a.first->size(); i++)
+                (*a.first)[i] += float(w[t] * (*a.second)[i]);
     }
     for (float &x : out.col) /* a colour stays in [0, 1], as COLOR_0 is read */
         x = std::min(1.0f, std::max(0.0f, x));
@@ -459,10 +453,7 @@ bool pose_primitive(Ctx &c, const Instance &in, const Prim &p, Prim &out)
             std::copy(y, y + 3, x);
             /* normals by the cofactor matrix (det x inverse transpose), times sign(det) */
             double a[3][3], cof[3][3];
-            for (int r = 0; r < 3; r++)
-                for (int k = 0; k < 3; k++)
-                    a[r][k] = s[size_t(k * 4 + r)];
-            const double det = vec_cofactors3(a, cof);
+            const double det = mat_cofactors3(s, a, cof);
             const double sgn = det < 0 ? -1 : 1;
             mirrored[v] = det < 0;
             if (!nrm.empty() && !p.flat) {

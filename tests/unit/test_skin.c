@@ -85,6 +85,17 @@ static void quad_accessors(gltf_file *f)
     accessor(f, idx, sizeof idx, 5123, 6, "SCALAR", "");
 }
 
+/* The quad's accessors and, after them, 3 JOINTS_0 (every vertex joint 0) and 4 WEIGHTS_0
+ * (weight 1): the scenes below skin it with one joint. */
+static void skinned_quad_accessors(gltf_file *f)
+{
+    static const uint8_t joints[16] = {0};
+    static const float weights[16] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    quad_accessors(f);
+    accessor(f, joints, sizeof joints, 5121, 4, "VEC4", "");
+    accessor(f, weights, sizeof weights, 5126, 4, "VEC4", "");
+}
+
 /* Writes the file (`rest`: meshes, nodes, skins, animations, scenes) and loads it at time t
  * (< 0: the nodes' own transforms), its messages in load_log. */
 static bool write_and_load(scene *s, const gltf_file *f, const char *rest, double t)
@@ -99,6 +110,14 @@ static bool write_and_load(scene *s, const gltf_file *f, const char *rest, doubl
     scene_animation_time(t);
     bool ok = load(s, path);
     scene_animation_time(-1);
+    return ok;
+}
+
+/* write_and_load at no animation time, a failure checked (its log printed): whether it loaded. */
+static bool loads(scene *s, const gltf_file *f, const char *rest)
+{
+    bool ok = write_and_load(s, f, rest, -1);
+    CHECKF(ok, "%s", load_log);
     return ok;
 }
 
@@ -479,9 +498,7 @@ TEST(skin, morph_flat_normals_and_tangents)
         "\"targets\":[{\"NORMAL\":5,\"TANGENT\":6}]}],\"weights\":[0.5]}],"
         "\"nodes\":[{\"mesh\":0},{\"mesh\":1,\"translation\":[5,0,0]}],\"scenes\":[{\"nodes\":[0,1]}]";
     scene s;
-    bool ok = write_and_load(&s, &f, rest, -1);
-    CHECKF(ok, "%s", load_log);
-    if (!ok)
+    if (!loads(&s, &f, rest))
         return;
     CHECKF(s.num_vertices == 10, "%u vertices", s.num_vertices);
     const int tris[2][3] = {{0, 1, 2}, {0, 2, 3}};
@@ -528,11 +545,7 @@ TEST(skin, morph_flat_normals_and_tangents)
 TEST(skin, mirroring_joint_keeps_the_winding)
 {
     gltf_file f = {0};
-    const uint8_t joints[16] = {0};
-    const float weights[16] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
-    quad_accessors(&f);                                             /* 0-2 */
-    accessor(&f, joints, sizeof joints, 5121, 4, "VEC4", "");       /* 3 */
-    accessor(&f, weights, sizeof weights, 5126, 4, "VEC4", "");     /* 4 */
+    skinned_quad_accessors(&f); /* 0-4 */
     const char *rest =
         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"JOINTS_0\":3,\"WEIGHTS_0\":4},"
         "\"indices\":2}]},"
@@ -542,9 +555,7 @@ TEST(skin, mirroring_joint_keeps_the_winding)
         "{\"scale\":[-1,1,1]},{\"mesh\":1,\"skin\":1},{\"scale\":[-1,1,1],\"translation\":[0,-3,0]}],"
         "\"skins\":[{\"joints\":[2]},{\"joints\":[4]}],\"scenes\":[{\"nodes\":[0,1,2,3,4]}]";
     scene s;
-    bool ok = write_and_load(&s, &f, rest, -1);
-    CHECKF(ok, "%s", load_log);
-    if (!ok)
+    if (!loads(&s, &f, rest))
         return;
     CHECKF(s.num_triangles == 6, "%u triangles", s.num_triangles);
     for (uint32_t t = 0; t < s.num_triangles; t++) {
@@ -592,9 +603,7 @@ TEST(skin, morph_texcoords_and_colors)
         "\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}]";
     scene s;
     int w0 = util_warning_count();
-    bool ok = write_and_load(&s, &f, rest, -1);
-    CHECKF(ok, "%s", load_log);
-    if (!ok)
+    if (!loads(&s, &f, rest))
         return;
     CHECKF(util_warning_count() == w0, "%s", load_log);
     CHECKF(s.num_vertices == 4, "%u vertices", s.num_vertices);
@@ -624,12 +633,9 @@ TEST(skin, morph_texcoords_and_colors)
 TEST(skin, singular_inverse_bind_matrix)
 {
     gltf_file f = {0};
-    const uint8_t joints[16] = {0};
-    const float weights[16] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}, zero[32] = {0};
-    quad_accessors(&f);                                         /* 0-2 */
-    accessor(&f, joints, sizeof joints, 5121, 4, "VEC4", "");   /* 3 */
-    accessor(&f, weights, sizeof weights, 5126, 4, "VEC4", ""); /* 4 */
-    accessor(&f, zero, sizeof zero, 5126, 2, "MAT4", "");       /* 5 */
+    const float zero[32] = {0};
+    skinned_quad_accessors(&f);                           /* 0-4 */
+    accessor(&f, zero, sizeof zero, 5126, 2, "MAT4", ""); /* 5 */
     const char *rest =
         "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"JOINTS_0\":3,\"WEIGHTS_0\":4},"
         "\"indices\":2}]},{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":2}]}],"
@@ -637,9 +643,7 @@ TEST(skin, singular_inverse_bind_matrix)
         "\"skins\":[{\"joints\":[1,2],\"inverseBindMatrices\":5}],\"scenes\":[{\"nodes\":[0,1,2,3]}]";
     scene s;
     int w0 = util_warning_count();
-    bool ok = write_and_load(&s, &f, rest, -1);
-    CHECKF(ok, "%s", load_log);
-    if (!ok)
+    if (!loads(&s, &f, rest))
         return;
     CHECKF(util_warning_count() - w0 == 1 && strstr(load_log, "skins[0].inverseBindMatrices: joint 0's matrix is singular"),
            "%s", load_log);
